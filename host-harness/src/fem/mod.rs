@@ -1,0 +1,1 @@
+//! Linear P1 finite elements: element stiffness and global assembly.

@@ -1,0 +1,1 @@
+//! Tetrahedral mesh input, validation and boundary surface.

@@ -1,0 +1,1 @@
+//! Offline tables: compliance computation and the table file writer.

@@ -1,0 +1,2 @@
+//! Palpate kernel.
+#![no_std]
