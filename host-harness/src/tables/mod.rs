@@ -1,1 +1,2 @@
 //! Offline tables: compliance computation and the table file writer.
+pub mod file;

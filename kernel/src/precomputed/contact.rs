@@ -1,0 +1,249 @@
+//! Contact points, their validation against a table, and contact errors.
+
+use core::fmt;
+
+use nalgebra::Vector3;
+
+use crate::Real;
+use crate::table::PrecomputedTable;
+
+/// Where a contact acts on the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContactPoint<T> {
+    /// A touchable (free, boundary-surface) vertex, by mesh vertex index.
+    Vertex(u32),
+    /// A point on a surface triangle: its three mesh vertices and barycentric
+    /// weights (each in `[0, 1]`, summing to 1, within
+    /// [`Real::WEIGHT_TOLERANCE`]). A fixed vertex of the triangle contributes
+    /// zero compliance (its displacement is zero), which is the exact
+    /// constraint `Σ_a β_a u_a = d`. The kernel does not check that the three
+    /// vertices form a triangle of the table: any convex combination of
+    /// touchable vertices is a valid point constraint.
+    Triangle {
+        /// Mesh vertex indices.
+        vertices: [u32; 3],
+        /// Barycentric weights `β_a`.
+        weights: [T; 3],
+    },
+}
+
+/// One contact: a point and the displacement the tool imposes on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact<T: Real> {
+    /// Where the tool touches.
+    pub point: ContactPoint<T>,
+    /// Imposed displacement `d_p` of the point from rest, m.
+    pub displacement_m: Vector3<T>,
+}
+
+impl<T: Real> Contact<T> {
+    /// A contact at a touchable vertex.
+    pub fn at_vertex(vertex: u32, displacement_m: Vector3<T>) -> Self {
+        Self {
+            point: ContactPoint::Vertex(vertex),
+            displacement_m,
+        }
+    }
+
+    /// A contact at a point of a surface triangle.
+    pub fn on_triangle(vertices: [u32; 3], weights: [T; 3], displacement_m: Vector3<T>) -> Self {
+        Self {
+            point: ContactPoint::Triangle { vertices, weights },
+            displacement_m,
+        }
+    }
+}
+
+/// Why a contact set was refused. `contact` is the index in the caller's slice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactError {
+    /// More contacts than the compile-time capacity `M`.
+    TooManyContacts {
+        /// Contacts given.
+        given: usize,
+        /// Capacity `M`.
+        capacity: usize,
+    },
+    /// A vertex index beyond the mesh.
+    VertexOutOfRange {
+        /// Contact index.
+        contact: usize,
+        /// The vertex.
+        vertex: u32,
+    },
+    /// A vertex contact on a fixed vertex: it cannot move, no force can be
+    /// defined.
+    FixedVertex {
+        /// Contact index.
+        contact: usize,
+        /// The vertex.
+        vertex: u32,
+    },
+    /// A free vertex that is not on the boundary surface (not touchable).
+    NotOnSurface {
+        /// Contact index.
+        contact: usize,
+        /// The vertex.
+        vertex: u32,
+    },
+    /// Barycentric weights outside `[0, 1]` or not summing to one.
+    BadWeights {
+        /// Contact index.
+        contact: usize,
+    },
+    /// A NaN or infinite displacement or weight.
+    NonFiniteInput {
+        /// Contact index.
+        contact: usize,
+    },
+    /// Two vertex contacts on the same vertex: the system would be singular.
+    DuplicateContact {
+        /// First contact index.
+        first: usize,
+        /// Second contact index.
+        second: usize,
+    },
+    /// The contact system is singular or too ill-conditioned for the scalar
+    /// (a Cholesky pivot below [`Real::MIN_PIVOT_RATIO`] of the largest
+    /// diagonal compliance), e.g. two contacts at the same point, or a point
+    /// whose weight is all on fixed vertices.
+    IllConditioned {
+        /// Contact index at which factorization failed.
+        contact: usize,
+    },
+    /// The solve produced a non-finite force (not reachable with a valid table
+    /// and finite input; kept so no wrong force can leave).
+    NonFiniteResult,
+}
+
+impl fmt::Display for ContactError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            ContactError::TooManyContacts { given, capacity } => {
+                write!(f, "{given} contacts exceed the capacity of {capacity}")
+            }
+            ContactError::VertexOutOfRange { contact, vertex } => {
+                write!(f, "contact {contact}: vertex {vertex} out of range")
+            }
+            ContactError::FixedVertex { contact, vertex } => {
+                write!(f, "contact {contact}: vertex {vertex} is fixed")
+            }
+            ContactError::NotOnSurface { contact, vertex } => write!(
+                f,
+                "contact {contact}: vertex {vertex} is not on the boundary surface"
+            ),
+            ContactError::BadWeights { contact } => write!(
+                f,
+                "contact {contact}: barycentric weights must lie in [0, 1] and sum to 1"
+            ),
+            ContactError::NonFiniteInput { contact } => {
+                write!(f, "contact {contact}: non-finite displacement or weight")
+            }
+            ContactError::DuplicateContact { first, second } => {
+                write!(f, "contacts {first} and {second} are on the same vertex")
+            }
+            ContactError::IllConditioned { contact } => write!(
+                f,
+                "contact system singular or ill-conditioned at contact {contact}"
+            ),
+            ContactError::NonFiniteResult => {
+                f.write_str("contact solve produced a non-finite force")
+            }
+        }
+    }
+}
+
+impl core::error::Error for ContactError {}
+
+/// A contact point resolved against a table: up to three touchable free
+/// indices with weights. Fixed vertices (zero compliance) are dropped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ResolvedPoint<T> {
+    pub(crate) touchable: [u32; 3],
+    pub(crate) weights: [T; 3],
+    pub(crate) len: usize,
+}
+
+impl<T: Real> ResolvedPoint<T> {
+    /// The `(touchable index, weight)` pairs, at most three.
+    pub(crate) fn terms(&self) -> impl Iterator<Item = (u32, T)> + '_ {
+        self.touchable
+            .iter()
+            .copied()
+            .zip(self.weights.iter().copied())
+            .take(self.len)
+    }
+}
+
+/// Validates contact `index` against `table` (see [`ContactError`]).
+pub(crate) fn resolve<T: Real>(
+    table: &PrecomputedTable<'_, T>,
+    index: usize,
+    contact: &Contact<T>,
+) -> Result<ResolvedPoint<T>, ContactError> {
+    let contact_index = index;
+    if !contact.displacement_m.iter().all(|x| x.finite()) {
+        return Err(ContactError::NonFiniteInput {
+            contact: contact_index,
+        });
+    }
+    let touchable = table.touchable_count() as u32;
+    let lookup = |vertex: u32| -> Result<Option<u32>, ContactError> {
+        match table.free_index(vertex) {
+            None => Err(ContactError::VertexOutOfRange {
+                contact: contact_index,
+                vertex,
+            }),
+            Some(None) => Ok(None),
+            Some(Some(i)) if i < touchable => Ok(Some(i)),
+            Some(Some(_)) => Err(ContactError::NotOnSurface {
+                contact: contact_index,
+                vertex,
+            }),
+        }
+    };
+    let mut point = ResolvedPoint {
+        touchable: [0; 3],
+        weights: [T::zero(); 3],
+        len: 0,
+    };
+    match contact.point {
+        ContactPoint::Vertex(vertex) => {
+            let slot = lookup(vertex)?.ok_or(ContactError::FixedVertex {
+                contact: contact_index,
+                vertex,
+            })?;
+            point.touchable[0] = slot;
+            point.weights[0] = T::one();
+            point.len = 1;
+        }
+        ContactPoint::Triangle { vertices, weights } => {
+            if !weights.iter().all(|w| w.finite()) {
+                return Err(ContactError::NonFiniteInput {
+                    contact: contact_index,
+                });
+            }
+            let tol = T::WEIGHT_TOLERANCE;
+            let sum = weights.iter().fold(T::zero(), |a, &w| a + w);
+            let in_range = weights.iter().all(|&w| w >= -tol && w <= T::one() + tol);
+            if !in_range || (sum - T::one()).abs() > tol {
+                return Err(ContactError::BadWeights {
+                    contact: contact_index,
+                });
+            }
+            for (&vertex, &w) in vertices.iter().zip(weights.iter()) {
+                if let Some(slot) = lookup(vertex)? {
+                    if let (Some(t), Some(b)) = (
+                        point.touchable.get_mut(point.len),
+                        point.weights.get_mut(point.len),
+                    ) {
+                        *t = slot;
+                        *b = w;
+                        point.len += 1;
+                    }
+                }
+            }
+        }
+    }
+    Ok(point)
+}

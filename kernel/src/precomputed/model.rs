@@ -1,0 +1,282 @@
+//! The multi-contact solve and the displacement update.
+
+use core::fmt;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::cholesky::solve_blocks;
+use super::contact::{Contact, ContactError, ResolvedPoint, resolve};
+use crate::Real;
+use crate::table::PrecomputedTable;
+use crate::table::format::surface_block_index;
+
+/// The pre-computed model over a validated table (RR-3510 §4, MODELS.md §2).
+/// Holds no mutable state: every query is a pure function of the table and
+/// the contact set, so it is trivially deterministic and re-entrant.
+#[derive(Clone, Copy, Debug)]
+pub struct PrecomputedModel<'a, T: Real> {
+    table: PrecomputedTable<'a, T>,
+}
+
+/// Contact forces for one contact set: the output of the haptic path, and the
+/// input of [`PrecomputedModel::displacements`]. Size on the stack:
+/// `M · (3·4 + 3·size_of::<T>() + 3·size_of::<T>()) + …` bytes, see
+/// `size_of::<ContactSolution<f32, 4>>()` in the README.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactSolution<T: Real, const M: usize> {
+    points: [ResolvedPoint<T>; M],
+    forces_n: [Vector3<T>; M],
+    len: usize,
+}
+
+impl<T: Real, const M: usize> ContactSolution<T, M> {
+    /// Number of contacts solved.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// `true` for an empty contact set (zero force).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// `g_p`: the force the tool applies to the tissue at each contact, N, in
+    /// the order the contacts were given.
+    pub fn contact_forces_n(&self) -> &[Vector3<T>] {
+        self.forces_n.get(..self.len).unwrap_or(&[])
+    }
+
+    /// `-Σ g_p`: the force the tissue applies to the tool, what the haptic
+    /// device renders, N.
+    pub fn device_force_n(&self) -> Vector3<T> {
+        -self
+            .contact_forces_n()
+            .iter()
+            .fold(Vector3::zeros(), |acc, g| acc + g)
+    }
+
+    fn resolved(&self) -> impl Iterator<Item = (&ResolvedPoint<T>, &Vector3<T>)> {
+        self.points.iter().zip(self.forces_n.iter()).take(self.len)
+    }
+}
+
+/// The output buffer of [`PrecomputedModel::displacements`] has the wrong length.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DisplacementError {
+    /// Vertices of the table.
+    pub expected: usize,
+    /// Length of the buffer given.
+    pub found: usize,
+}
+
+impl fmt::Display for DisplacementError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "displacement buffer holds {} vertices, the table has {}",
+            self.found, self.expected
+        )
+    }
+}
+
+impl core::error::Error for DisplacementError {}
+
+impl<'a, T: Real> PrecomputedModel<'a, T> {
+    /// A model over a table validated by [`PrecomputedTable::load`].
+    pub fn new(table: PrecomputedTable<'a, T>) -> Self {
+        Self { table }
+    }
+
+    /// The table this model reads.
+    pub fn table(&self) -> &PrecomputedTable<'a, T> {
+        &self.table
+    }
+
+    /// Contact forces for `contacts` (MODELS.md §2): builds the point
+    /// compliances `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` and solves
+    /// `Σ_q C_pq g_q = d_p` by block Cholesky on the stack. The haptic path.
+    ///
+    /// Bounded: at most `M` contacts × 3 vertices each, `O(M³)` 3×3 products.
+    /// An empty set gives zero force. Errors: see [`ContactError`]; no force
+    /// is returned unless every check passed and every force is finite.
+    pub fn contact_forces<const M: usize>(
+        &self,
+        contacts: &[Contact<T>],
+    ) -> Result<ContactSolution<T, M>, ContactError> {
+        const { assert!(M >= 1 && M <= 16, "contact capacity M must be in 1..=16") };
+        let m = contacts.len();
+        if m > M {
+            return Err(ContactError::TooManyContacts {
+                given: m,
+                capacity: M,
+            });
+        }
+        let empty = ResolvedPoint {
+            touchable: [0; 3],
+            weights: [T::zero(); 3],
+            len: 0,
+        };
+        let mut solution = ContactSolution {
+            points: [empty; M],
+            forces_n: [Vector3::zeros(); M],
+            len: m,
+        };
+        for (p, ((contact, point), d)) in contacts
+            .iter()
+            .zip(solution.points.iter_mut())
+            .zip(solution.forces_n.iter_mut())
+            .enumerate()
+        {
+            *point = resolve(&self.table, p, contact)?;
+            *d = contact.displacement_m;
+        }
+        check_duplicates(contacts)?;
+
+        // Lower blocks of the point-compliance matrix, and its scale.
+        let mut blocks = [[Matrix3::<T>::zeros(); M]; M];
+        let mut scale = T::zero();
+        for (q, (row, pq)) in blocks.iter_mut().zip(solution.points.iter()).enumerate() {
+            for (p, (block, pp)) in row
+                .iter_mut()
+                .zip(solution.points.iter())
+                .enumerate()
+                .take(q + 1)
+            {
+                *block = self.point_compliance(pq, pp);
+                if p == q {
+                    scale = block.diagonal().iter().fold(scale, |s, &c| s.max(c));
+                }
+            }
+        }
+        let min_pivot = T::MIN_PIVOT_RATIO * scale;
+        if scale <= T::zero() || !scale.finite() {
+            return Err(ContactError::IllConditioned { contact: 0 });
+        }
+        solve_blocks(&mut blocks, &mut solution.forces_n, m, min_pivot)
+            .map_err(|contact| ContactError::IllConditioned { contact })?;
+        if !solution
+            .contact_forces_n()
+            .iter()
+            .all(|g| g.iter().all(|x| x.finite()))
+        {
+            return Err(ContactError::NonFiniteResult);
+        }
+        Ok(solution)
+    }
+
+    /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N).
+    fn point_compliance(&self, p: &ResolvedPoint<T>, q: &ResolvedPoint<T>) -> Matrix3<T> {
+        let mut c = Matrix3::zeros();
+        for (a, beta_a) in p.terms() {
+            for (b, beta_b) in q.terms() {
+                if let Some(block) = self.table.touchable_block(a, b) {
+                    c += block * (beta_a * beta_b);
+                }
+            }
+        }
+        c
+    }
+
+    /// The displacement of every vertex for a solved contact set, m, in mesh
+    /// vertex order (MODELS.md §2: `u_n = Σ_q Σ_b β^q_b C_{n v^q_b} g_q`; fixed
+    /// vertices get zero). Overwrites all of `out`, which must hold
+    /// [`PrecomputedTable::vertex_count`] entries.
+    ///
+    /// Bounded: one pass over the compliance column of each contact vertex
+    /// (≤ 3·M columns of `F` blocks). Not needed by the haptic path.
+    pub fn displacements<const M: usize>(
+        &self,
+        solution: &ContactSolution<T, M>,
+        out: &mut [[T; 3]],
+    ) -> Result<(), DisplacementError> {
+        let expected = self.table.vertex_count();
+        if out.len() != expected {
+            return Err(DisplacementError {
+                expected,
+                found: out.len(),
+            });
+        }
+        out.fill([T::zero(); 3]);
+        for (point, g) in solution.resolved() {
+            for (k, beta) in point.terms() {
+                self.add_column(k as usize, &(g * beta), out);
+            }
+        }
+        Ok(())
+    }
+
+    /// `out[free_vertex[n]] += C_nk w` for every free `n`.
+    fn add_column(&self, k: usize, w: &Vector3<T>, out: &mut [[T; 3]]) {
+        let free = self.table.free_vertices();
+        let s = self.table.touchable_count();
+        let surface = self.table.surface_blocks();
+        let add = |out: &mut [[T; 3]], v: u32, u: [T; 3]| {
+            if let Some(o) = out.get_mut(v as usize) {
+                o[0] += u[0];
+                o[1] += u[1];
+                o[2] += u[2];
+            }
+        };
+        // Rows n ≤ k: column k of the packed upper part, contiguous.
+        let start = surface_block_index(0, k);
+        if let Some(column) = surface.get(start..=start + k) {
+            for (c, &v) in column.iter().zip(free) {
+                add(out, v, mul(c, w));
+            }
+        }
+        // Rows k < n < S: stored as C_kn in column n; C_nk = C_knᵀ.
+        let mut index = surface_block_index(k, k + 1);
+        for (n, &v) in free.iter().enumerate().take(s).skip(k + 1) {
+            if let Some(c) = surface.get(index) {
+                add(out, v, mul_transposed(c, w));
+            }
+            index += n + 1;
+        }
+        // Interior rows: column k of the interior part, contiguous.
+        let interior_count = free.len() - s;
+        let start = k * interior_count;
+        let interior = self.table.interior_blocks();
+        if let (Some(column), Some(rows)) =
+            (interior.get(start..start + interior_count), free.get(s..))
+        {
+            for (c, &v) in column.iter().zip(rows) {
+                add(out, v, mul(c, w));
+            }
+        }
+    }
+}
+
+/// Two vertex contacts on one vertex make the system exactly singular; name them.
+fn check_duplicates<T: Real>(contacts: &[Contact<T>]) -> Result<(), ContactError> {
+    use super::contact::ContactPoint::Vertex;
+    for (second, b) in contacts.iter().enumerate() {
+        for (first, a) in contacts.iter().enumerate().take(second) {
+            if let (Vertex(va), Vertex(vb)) = (a.point, b.point) {
+                if va == vb {
+                    return Err(ContactError::DuplicateContact { first, second });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Row-major 3×3 block times a vector.
+#[inline(always)]
+fn mul<T: Real>(c: &[T; 9], w: &Vector3<T>) -> [T; 3] {
+    [
+        c[0] * w.x + c[1] * w.y + c[2] * w.z,
+        c[3] * w.x + c[4] * w.y + c[5] * w.z,
+        c[6] * w.x + c[7] * w.y + c[8] * w.z,
+    ]
+}
+
+/// Transpose of a row-major 3×3 block times a vector.
+#[inline(always)]
+fn mul_transposed<T: Real>(c: &[T; 9], w: &Vector3<T>) -> [T; 3] {
+    [
+        c[0] * w.x + c[3] * w.y + c[6] * w.z,
+        c[1] * w.x + c[4] * w.y + c[7] * w.z,
+        c[2] * w.x + c[5] * w.y + c[8] * w.z,
+    ]
+}

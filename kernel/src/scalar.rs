@@ -1,0 +1,57 @@
+//! The scalar the kernel computes in: `f32` on firmware, `f64` for verification.
+
+use nalgebra::RealField;
+
+/// A floating-point scalar usable both as table storage and for computation.
+///
+/// Implemented for `f32` (firmware, the default table precision) and `f64`
+/// (verification against reference FEM data).
+pub trait Real: RealField + Copy + bytemuck::Pod + Default + PartialOrd {
+    /// Bytes per stored value; written in the table header so an `f32` table is
+    /// never read as `f64`.
+    const BYTES: u32;
+    /// A Cholesky pivot of the contact system below this fraction of the
+    /// largest diagonal compliance means the contact set is (numerically)
+    /// singular: `sqrt(machine epsilon)`, so that forces keep at least half the
+    /// available digits (f32: 3.5e-4, f64: 1.5e-8).
+    const MIN_PIVOT_RATIO: Self;
+    /// Tolerance on barycentric weights: each in `[-tol, 1 + tol]`, sum within
+    /// `tol` of one (f32: 1e-5, f64: 1e-12).
+    const WEIGHT_TOLERANCE: Self;
+    /// Converts from `f64` (rounding to nearest for `f32`).
+    fn of_f64(x: f64) -> Self;
+    /// Converts to `f64` (exact).
+    fn as_f64(self) -> f64;
+    /// `true` if neither NaN nor infinite.
+    fn finite(self) -> bool;
+}
+
+impl Real for f32 {
+    const BYTES: u32 = 4;
+    const MIN_PIVOT_RATIO: Self = 3.5e-4;
+    const WEIGHT_TOLERANCE: Self = 1e-5;
+    fn of_f64(x: f64) -> Self {
+        x as f32
+    }
+    fn as_f64(self) -> f64 {
+        f64::from(self)
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Real for f64 {
+    const BYTES: u32 = 8;
+    const MIN_PIVOT_RATIO: Self = 1.5e-8;
+    const WEIGHT_TOLERANCE: Self = 1e-12;
+    fn of_f64(x: f64) -> Self {
+        x
+    }
+    fn as_f64(self) -> f64 {
+        self
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}

@@ -1,0 +1,167 @@
+//! Why a table was refused at load.
+
+use core::fmt;
+
+use super::format::SectionKind;
+
+/// A table failed validation in [`super::PrecomputedTable::load`]. The host
+/// wraps it with the file name; every variant says what is wrong and where.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadError {
+    /// Fewer bytes than a header and a checksum.
+    TooShort {
+        /// Bytes given.
+        len: usize,
+    },
+    /// The first 8 bytes are not [`super::format::MAGIC`].
+    BadMagic,
+    /// A format version this kernel does not read.
+    UnsupportedVersion {
+        /// Version in the header.
+        found: u32,
+    },
+    /// The header's file length differs from the bytes given (truncated or padded).
+    LengthMismatch {
+        /// Length the header declares.
+        declared: u64,
+        /// Bytes given.
+        actual: usize,
+    },
+    /// The CRC-32 trailer does not match the contents (corruption).
+    ChecksumMismatch {
+        /// CRC stored in the trailer.
+        stored: u32,
+        /// CRC computed over the contents.
+        computed: u32,
+    },
+    /// The table stores floats of another width than the caller asked for.
+    ScalarMismatch {
+        /// Bytes per float in the table.
+        table: u32,
+        /// Bytes per float of the requested scalar.
+        requested: u32,
+    },
+    /// Header counts contradict each other (free > vertices, touchable > free,
+    /// directory length, a reserved field not zero).
+    InconsistentHeader,
+    /// Material out of range (E ≤ 0, ν outside [0, 0.5), non-finite).
+    BadMaterial,
+    /// A section kind this version does not know.
+    UnknownSection {
+        /// The kind value found.
+        kind: u32,
+    },
+    /// A section kind occurs twice.
+    DuplicateSection {
+        /// The repeated kind.
+        kind: SectionKind,
+    },
+    /// A required section is absent.
+    MissingSection {
+        /// The missing kind.
+        kind: SectionKind,
+    },
+    /// A section's element size or count differs from what the header implies.
+    SectionSize {
+        /// The section.
+        kind: SectionKind,
+    },
+    /// A section lies (partly) outside the payload.
+    SectionBounds {
+        /// The section.
+        kind: SectionKind,
+    },
+    /// A section is not aligned for its element type in memory (the buffer
+    /// must be aligned to 16 bytes, e.g. with `palpate_kernel::include_table!`).
+    Misaligned {
+        /// The section.
+        kind: SectionKind,
+    },
+    /// `vertex-slot` and `free-vertex` are not inverse maps, or the touchable
+    /// ordering is broken, at this vertex.
+    BadVertexMap {
+        /// Vertex index.
+        vertex: u32,
+    },
+    /// A surface triangle references a vertex out of range.
+    BadTriangle {
+        /// Triangle index.
+        triangle: u32,
+    },
+    /// A non-finite float.
+    NonFinite {
+        /// The section.
+        kind: SectionKind,
+        /// Element index within it.
+        index: u64,
+    },
+    /// A diagonal compliance block `C_kk` is not symmetric positive definite.
+    NotPositiveDefinite {
+        /// Touchable index `k` (free index; the vertex is `free-vertex[k]`).
+        touchable: u32,
+    },
+}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            LoadError::TooShort { len } => write!(f, "table too short ({len} bytes)"),
+            LoadError::BadMagic => f.write_str("not a Palpate table (bad magic)"),
+            LoadError::UnsupportedVersion { found } => {
+                write!(f, "unsupported table format version {found}")
+            }
+            LoadError::LengthMismatch { declared, actual } => write!(
+                f,
+                "table length {actual} bytes differs from the header's {declared} (truncated?)"
+            ),
+            LoadError::ChecksumMismatch { stored, computed } => write!(
+                f,
+                "checksum mismatch: stored CRC-32 {stored:#010x}, computed {computed:#010x} (corrupt table)"
+            ),
+            LoadError::ScalarMismatch { table, requested } => write!(
+                f,
+                "table stores {table}-byte floats, caller requested {requested}-byte floats"
+            ),
+            LoadError::InconsistentHeader => f.write_str("inconsistent header counts"),
+            LoadError::BadMaterial => f.write_str("material out of range in header"),
+            LoadError::UnknownSection { kind } => write!(f, "unknown section kind {kind}"),
+            LoadError::DuplicateSection { kind } => {
+                write!(f, "section {} occurs twice", kind.name())
+            }
+            LoadError::MissingSection { kind } => write!(f, "section {} missing", kind.name()),
+            LoadError::SectionSize { kind } => {
+                write!(f, "section {} has the wrong size", kind.name())
+            }
+            LoadError::SectionBounds { kind } => {
+                write!(f, "section {} lies outside the table", kind.name())
+            }
+            LoadError::Misaligned { kind } => write!(
+                f,
+                "section {} is misaligned in memory (align the table buffer to 16 bytes)",
+                kind.name()
+            ),
+            LoadError::BadVertexMap { vertex } => {
+                write!(f, "vertex {vertex}: free-vertex/vertex-slot maps disagree")
+            }
+            LoadError::BadTriangle { triangle } => {
+                write!(
+                    f,
+                    "surface triangle {triangle} references a vertex out of range"
+                )
+            }
+            LoadError::NonFinite { kind, index } => {
+                write!(
+                    f,
+                    "section {} element {index}: non-finite value",
+                    kind.name()
+                )
+            }
+            LoadError::NotPositiveDefinite { touchable } => write!(
+                f,
+                "compliance block C_kk of touchable index {touchable} is not symmetric positive definite"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for LoadError {}

@@ -1,0 +1,173 @@
+//! The table file format, version 1: one definition shared by the host writer
+//! and the kernel reader.
+//!
+//! ```text
+//! offset 0            RawHeader (80 bytes)
+//! offset 80           SectionEntry × section_count (24 bytes each)
+//! …                   sections, each starting at a multiple of SECTION_ALIGN
+//! file_len - 4        CRC-32/ISO-HDLC of bytes [0, file_len - 4), little-endian
+//! ```
+//!
+//! All integers and floats are little-endian. Floats in the sections are the
+//! table scalar (`scalar_bytes` = 4 for `f32`, 8 for `f64`).
+//!
+//! Vertex numbering is the source mesh's input order. The free vertices (not
+//! fixed) are renumbered by a *free index*: first the `touchable_count` free
+//! surface vertices (the ones a tool can touch) in ascending vertex order,
+//! then the interior free vertices in ascending order.
+//!
+//! Compliance blocks `C_nk` (RR-3510 §4, MODELS.md §2; `C = A⁻¹`, `A` the
+//! stiffness restricted to free DOFs; unit m/N) are stored for every free `n`
+//! and every touchable `k`, row-major 3×3: element `3a + b` is
+//! `C[(n, a), (k, b)]`. Blocks that occur twice by symmetry (`C_kn = C_nkᵀ`,
+//! both touchable) are stored once:
+//! - [`SectionKind::ComplianceSurface`]: `S(S+1)/2` blocks, packed upper by
+//!   columns: column `k` holds rows `n = 0..=k` at index `k(k+1)/2 + n`;
+//! - [`SectionKind::ComplianceInterior`]: `I·S` blocks (`I = F − S`): column `k`
+//!   holds interior rows `i = 0..I` (free index `S + i`) at index `k·I + i`.
+
+use bytemuck::{Pod, Zeroable};
+
+/// First 8 bytes of every table.
+pub const MAGIC: [u8; 8] = *b"PALPTBL\0";
+/// The format version this kernel reads and the host writes.
+pub const FORMAT_VERSION: u32 = 1;
+/// Every section starts at a multiple of this many bytes from the file start.
+pub const SECTION_ALIGN: usize = 16;
+/// Size of the CRC-32 trailer.
+pub const CRC_LEN: usize = 4;
+/// Marks a fixed vertex in [`SectionKind::VertexSlot`].
+pub const FIXED_SLOT: u32 = u32::MAX;
+/// The checksum algorithm over the file (all bytes but the trailer).
+pub const CRC32: crc::Algorithm<u32> = crc::CRC_32_ISO_HDLC;
+
+/// The fixed-size file header.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct RawHeader {
+    /// [`MAGIC`].
+    pub magic: [u8; 8],
+    /// [`FORMAT_VERSION`].
+    pub format_version: u32,
+    /// Bytes of header plus section directory.
+    pub header_len: u32,
+    /// Bytes per stored float: 4 (`f32`) or 8 (`f64`).
+    pub scalar_bytes: u32,
+    /// Number of [`SectionEntry`] after the header.
+    pub section_count: u32,
+    /// Vertices of the source mesh (`N`).
+    pub vertex_count: u32,
+    /// Tetrahedra of the source mesh (informative).
+    pub tet_count: u32,
+    /// Free (not fixed) vertices (`F`).
+    pub free_count: u32,
+    /// Free surface vertices, the touchable ones (`S`).
+    pub touchable_count: u32,
+    /// Boundary surface triangles.
+    pub triangle_count: u32,
+    /// Zero.
+    pub reserved: u32,
+    /// Young's modulus the table was built with, Pa.
+    pub young_pa: f64,
+    /// Poisson ratio the table was built with, dimensionless.
+    pub poisson: f64,
+    /// CRC-64/XZ of the source mesh (positions as f64 LE, then tets as u32 LE).
+    pub mesh_hash: u64,
+    /// Total file length in bytes, trailer included.
+    pub file_len: u64,
+}
+
+/// Size of [`RawHeader`] in bytes.
+pub const HEADER_LEN: usize = core::mem::size_of::<RawHeader>();
+const _: () = assert!(HEADER_LEN == 80);
+
+/// One entry of the section directory.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
+pub struct SectionEntry {
+    /// A [`SectionKind`] value.
+    pub kind: u32,
+    /// Bytes per element (e.g. 36 for an `f32` 3×3 block).
+    pub elem_bytes: u32,
+    /// Byte offset from the file start; a multiple of [`SECTION_ALIGN`].
+    pub offset: u64,
+    /// Number of elements.
+    pub count: u64,
+}
+
+/// Size of [`SectionEntry`] in bytes.
+pub const SECTION_ENTRY_LEN: usize = core::mem::size_of::<SectionEntry>();
+const _: () = assert!(SECTION_ENTRY_LEN == 24);
+
+/// What a section holds. Each kind occurs at most once; all are required in
+/// version 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum SectionKind {
+    /// `u32` × N: free index of each vertex, or [`FIXED_SLOT`].
+    VertexSlot = 1,
+    /// `u32` × F: vertex of each free index (inverse of `VertexSlot`).
+    FreeVertex = 2,
+    /// `[scalar; 3]` × N: rest positions, mesh units (m).
+    RestPositions = 3,
+    /// `[u32; 3]` × triangle_count: boundary triangles, outward normals.
+    SurfaceTriangles = 4,
+    /// `[scalar; 9]` × S(S+1)/2: compliance among touchable vertices, m/N.
+    ComplianceSurface = 5,
+    /// `[scalar; 9]` × (F−S)·S: compliance of interior rows, m/N.
+    ComplianceInterior = 6,
+}
+
+impl SectionKind {
+    /// All kinds of format version 1, in file order.
+    pub const ALL: [SectionKind; 6] = [
+        SectionKind::VertexSlot,
+        SectionKind::FreeVertex,
+        SectionKind::RestPositions,
+        SectionKind::SurfaceTriangles,
+        SectionKind::ComplianceSurface,
+        SectionKind::ComplianceInterior,
+    ];
+
+    /// Bytes per element for a table whose floats have `scalar_bytes` bytes.
+    pub const fn elem_bytes(self, scalar_bytes: u32) -> u32 {
+        match self {
+            SectionKind::VertexSlot | SectionKind::FreeVertex => 4,
+            SectionKind::RestPositions => 3 * scalar_bytes,
+            SectionKind::SurfaceTriangles => 12,
+            SectionKind::ComplianceSurface | SectionKind::ComplianceInterior => 9 * scalar_bytes,
+        }
+    }
+
+    /// Number of elements the header's counts require, `None` on overflow.
+    pub fn expected_count(self, h: &RawHeader) -> Option<u64> {
+        let n = u64::from(h.vertex_count);
+        let f = u64::from(h.free_count);
+        let s = u64::from(h.touchable_count);
+        match self {
+            SectionKind::VertexSlot | SectionKind::RestPositions => Some(n),
+            SectionKind::FreeVertex => Some(f),
+            SectionKind::SurfaceTriangles => Some(u64::from(h.triangle_count)),
+            SectionKind::ComplianceSurface => s.checked_mul(s.checked_add(1)?).map(|x| x / 2),
+            SectionKind::ComplianceInterior => f.checked_sub(s)?.checked_mul(s),
+        }
+    }
+
+    /// Human-readable name, for errors and `tables info`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            SectionKind::VertexSlot => "vertex-slot",
+            SectionKind::FreeVertex => "free-vertex",
+            SectionKind::RestPositions => "rest-positions",
+            SectionKind::SurfaceTriangles => "surface-triangles",
+            SectionKind::ComplianceSurface => "compliance-surface",
+            SectionKind::ComplianceInterior => "compliance-interior",
+        }
+    }
+}
+
+/// Index of the packed surface block `C_nk`, `n ≤ k` (see module docs).
+#[inline]
+pub const fn surface_block_index(n: usize, k: usize) -> usize {
+    k * (k + 1) / 2 + n
+}

@@ -1,0 +1,34 @@
+//! Offline tables: the byte format ([`format`]), load errors ([`LoadError`]) and
+//! the validated, zero-copy view the step path uses ([`PrecomputedTable`]).
+//!
+//! A table is bytes until [`PrecomputedTable::load`] has checked it once
+//! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
+//! diagonal blocks); afterwards the step path trusts it.
+
+mod error;
+pub mod format;
+mod view;
+
+pub use error::LoadError;
+pub use view::PrecomputedTable;
+
+/// A byte buffer aligned to 16 bytes ([`format::SECTION_ALIGN`]), so that table
+/// sections can be viewed in place. Use [`crate::include_table!`] for tables
+/// linked into flash.
+#[repr(C, align(16))]
+pub struct Aligned<B: ?Sized>(pub B);
+
+/// Includes a table file as a 16-byte-aligned `&'static [u8]`
+/// (`include_bytes!` alone gives no alignment guarantee).
+///
+/// ```ignore
+/// static TABLE: &[u8] = palpate_kernel::include_table!("table.bin");
+/// ```
+#[macro_export]
+macro_rules! include_table {
+    ($path:expr) => {{
+        static ALIGNED: &$crate::table::Aligned<[u8]> =
+            &$crate::table::Aligned(*include_bytes!($path));
+        &ALIGNED.0
+    }};
+}
