@@ -1,0 +1,277 @@
+//! VTK legacy `UNSTRUCTURED_GRID` reader (ASCII and big-endian binary; classic `CELLS n size`
+//! layout and the 5.1 `OFFSETS`/`CONNECTIVITY` layout).
+
+use super::MeshError;
+use super::cursor::{Cursor, cap, show};
+use super::validate::{Numbering, RawMesh};
+
+/// VTK cell type of the linear tet.
+const VTK_TETRA: i64 = 10;
+/// VTK cell type of the quadratic tet (first 4 points are the corners).
+const VTK_QUADRATIC_TETRA: i64 = 24;
+
+struct Reader<'a> {
+    cur: Cursor<'a>,
+    binary: bool,
+}
+
+impl Reader<'_> {
+    /// After a keyword line: binary data starts on the next line.
+    fn start_data(&mut self) {
+        if self.binary {
+            self.cur.skip_line();
+        }
+    }
+
+    fn float(&mut self, double: bool, what: &dyn core::fmt::Display) -> Result<f64, MeshError> {
+        match (self.binary, double) {
+            (false, _) => self.cur.parse::<f64>(what),
+            (true, true) => self.cur.f64(true, what),
+            (true, false) => self.cur.f32(true, what),
+        }
+    }
+
+    /// Integer of `size` bytes in binary (4 or 8), any integer in ASCII.
+    fn int(&mut self, size: usize, what: &dyn core::fmt::Display) -> Result<i64, MeshError> {
+        match (self.binary, size) {
+            (false, _) => self.cur.parse::<i64>(what),
+            (true, 8) => self.cur.i64(true, what),
+            (true, _) => Ok(i64::from(self.cur.i32(true, what)?)),
+        }
+    }
+
+    fn count(&mut self, what: &str) -> Result<usize, MeshError> {
+        self.cur.parse::<usize>(&what)
+    }
+}
+
+/// Bytes of an integer data type name in binary files.
+fn int_size(ty: &[u8]) -> Option<usize> {
+    match ty.to_ascii_lowercase().as_slice() {
+        b"int" | b"unsigned_int" | b"vtktypeint32" | b"vtktypeuint32" => Some(4),
+        b"long" | b"unsigned_long" | b"vtktypeint64" | b"vtktypeuint64" | b"vtkidtype" => Some(8),
+        _ => None,
+    }
+}
+
+/// Parse a VTK legacy file into unvalidated arrays.
+pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
+    let mut cur = Cursor::new(bytes, file);
+    let l1 = cur
+        .line()
+        .ok_or_else(|| cur.eof("`# vtk DataFile Version`"))?;
+    if !l1.trim_ascii().starts_with(b"# vtk DataFile") {
+        return Err(cur.err(format_args!(
+            "not a VTK legacy file: first line {:?}",
+            show(l1)
+        )));
+    }
+    cur.line().ok_or_else(|| cur.eof("title line"))?;
+    let enc = cur
+        .nonempty_line()
+        .ok_or_else(|| cur.eof("ASCII or BINARY"))?;
+    let binary = match enc.to_ascii_uppercase().as_slice() {
+        b"ASCII" => false,
+        b"BINARY" => true,
+        _ => {
+            return Err(cur.err(format_args!(
+                "expected ASCII or BINARY, found {:?}",
+                show(enc)
+            )));
+        }
+    };
+    let mut r = Reader { cur, binary };
+    let mut positions: Option<Vec<[f64; 3]>> = None;
+    // Per cell: (npts, first 4 point ids).
+    let mut cells: Option<Vec<(usize, [i64; 4])>> = None;
+    let mut types: Option<Vec<i64>> = None;
+    let mut have_dataset = false;
+    while let Some(tok) = r.cur.token() {
+        match tok.to_ascii_uppercase().as_slice() {
+            b"DATASET" => {
+                r.cur.section = "DATASET";
+                let ty = r.cur.expect_token(&"dataset type")?;
+                if !ty.eq_ignore_ascii_case(b"UNSTRUCTURED_GRID") {
+                    return Err(MeshError::Unsupported {
+                        file: file.to_string(),
+                        msg: format!("VTK DATASET {} (expected UNSTRUCTURED_GRID)", show(ty)),
+                    });
+                }
+                have_dataset = true;
+            }
+            b"POINTS" => {
+                r.cur.section = "POINTS";
+                let n = r.count("number of points")?;
+                let ty = r.cur.expect_token(&"point data type")?;
+                let double = match ty.to_ascii_lowercase().as_slice() {
+                    b"double" => true,
+                    b"float" => false,
+                    _ if !binary => true,
+                    _ => {
+                        return Err(r.cur.err(format_args!(
+                            "point type {:?} (expected float or double)",
+                            show(ty)
+                        )));
+                    }
+                };
+                r.start_data();
+                let mut pts = Vec::with_capacity(cap(n, r.cur.len()));
+                for i in 0..n {
+                    let what = format_args!("point {i}");
+                    let mut p = [0.0; 3];
+                    for x in &mut p {
+                        *x = r.float(double, &what)?;
+                    }
+                    pts.push(p);
+                }
+                positions = Some(pts);
+            }
+            b"CELLS" => {
+                r.cur.section = "CELLS";
+                let n = r.count("number of cells")?;
+                let size = r.count("cell list size")?;
+                r.start_data();
+                cells = Some(read_cells(&mut r, n, size)?);
+            }
+            b"CELL_TYPES" => {
+                r.cur.section = "CELL_TYPES";
+                let n = r.count("number of cell types")?;
+                r.start_data();
+                let mut ts = Vec::with_capacity(cap(n, r.cur.len()));
+                for i in 0..n {
+                    ts.push(r.int(4, &format_args!("cell type {i}"))?);
+                }
+                types = Some(ts);
+            }
+            b"POINT_DATA" | b"CELL_DATA" => break,
+            b"METADATA" | b"FIELD" => {
+                return Err(r.cur.err(format_args!(
+                    "{} blocks are not supported before the cells",
+                    show(tok)
+                )));
+            }
+            _ => {
+                return Err(r
+                    .cur
+                    .err(format_args!("unexpected keyword {:?}", show(tok))));
+            }
+        }
+        if positions.is_some() && cells.is_some() && types.is_some() {
+            break;
+        }
+    }
+    r.cur.section = "file";
+    if !have_dataset {
+        return Err(r.cur.err("missing DATASET UNSTRUCTURED_GRID"));
+    }
+    let positions = positions.ok_or_else(|| r.cur.err("missing POINTS"))?;
+    let cells = cells.ok_or_else(|| r.cur.err("missing CELLS"))?;
+    let types = types.ok_or_else(|| r.cur.err("missing CELL_TYPES"))?;
+    if cells.len() != types.len() {
+        return Err(r.cur.err(format_args!(
+            "{} cells but {} cell types",
+            cells.len(),
+            types.len()
+        )));
+    }
+    let mut tets = Vec::new();
+    let mut skipped = 0;
+    for (i, (&(npts, ids), &ty)) in cells.iter().zip(&types).enumerate() {
+        let want = match ty {
+            VTK_TETRA => 4,
+            VTK_QUADRATIC_TETRA => 10,
+            _ => {
+                skipped += 1;
+                continue;
+            }
+        };
+        if npts != want {
+            return Err(MeshError::Parse {
+                file: file.to_string(),
+                msg: format!(
+                    "cell {i} (tet {}): type {ty} needs {want} points, has {npts}",
+                    tets.len()
+                ),
+            });
+        }
+        tets.push(ids);
+    }
+    Ok(RawMesh {
+        positions,
+        node_ids: None,
+        tets,
+        elem_ids: None,
+        numbering: Numbering::Base(0),
+        skipped,
+    })
+}
+
+fn read_cells(
+    r: &mut Reader<'_>,
+    n: usize,
+    size: usize,
+) -> Result<Vec<(usize, [i64; 4])>, MeshError> {
+    // VTK 5.1: `CELLS nOffsets nConn` then `OFFSETS type` and `CONNECTIVITY type`.
+    let mut cells = Vec::with_capacity(cap(n, r.cur.len()));
+    let is_51 = matches!(r.cur.peek_token(), Some(t) if t.eq_ignore_ascii_case(b"OFFSETS"));
+    if is_51 {
+        r.cur.token();
+        let ty = r.cur.expect_token(&"offsets type")?;
+        let osz = int_size(ty).unwrap_or(8);
+        r.start_data();
+        let mut offsets = Vec::with_capacity(cap(n, r.cur.len()));
+        for i in 0..n {
+            offsets.push(r.int(osz, &format_args!("offset {i}"))?);
+        }
+        match r.cur.token() {
+            Some(t) if t.eq_ignore_ascii_case(b"CONNECTIVITY") => {}
+            _ => return Err(r.cur.err("expected CONNECTIVITY after OFFSETS")),
+        }
+        let ty = r.cur.expect_token(&"connectivity type")?;
+        let csz = int_size(ty).unwrap_or(8);
+        r.start_data();
+        let mut conn = Vec::with_capacity(cap(size, r.cur.len()));
+        for i in 0..size {
+            conn.push(r.int(csz, &format_args!("connectivity entry {i}"))?);
+        }
+        for (i, w) in offsets.windows(2).enumerate() {
+            let (a, b) = (w[0], w[1]);
+            let range = usize::try_from(a)
+                .ok()
+                .zip(usize::try_from(b).ok())
+                .filter(|(a, b)| a <= b && *b <= conn.len())
+                .ok_or_else(|| r.cur.err(format_args!("cell {i}: bad offsets {a}..{b}")))?;
+            let ids = conn.get(range.0..range.1).unwrap_or(&[]);
+            let mut t = [0i64; 4];
+            for (s, v) in t.iter_mut().zip(ids) {
+                *s = *v;
+            }
+            cells.push((ids.len(), t));
+        }
+        return Ok(cells);
+    }
+    let mut used = 0usize;
+    for i in 0..n {
+        let what = format_args!("cell {i}");
+        let npts = r.int(4, &what)?;
+        let npts = usize::try_from(npts)
+            .ok()
+            .filter(|&k| k <= size.saturating_sub(used + 1))
+            .ok_or_else(|| r.cur.err(format_args!("cell {i}: bad point count {npts}")))?;
+        let mut t = [0i64; 4];
+        for k in 0..npts {
+            let v = r.int(4, &what)?;
+            if let Some(s) = t.get_mut(k) {
+                *s = v;
+            }
+        }
+        used += 1 + npts;
+        cells.push((npts, t));
+    }
+    if used != size {
+        return Err(r.cur.err(format_args!(
+            "cell list holds {used} integers, header declares {size}"
+        )));
+    }
+    Ok(cells)
+}
