@@ -1,1 +1,243 @@
-fn main() {}
+//! The `palpate` command line (contract in README.md): tables, solves, demo.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
+use palpate::fem::material::Material;
+use palpate::fix::FixPredicate;
+use palpate::mesh::read_mesh;
+use palpate::tables::build::{BuildOptions, build_table};
+use palpate::tables::compliance::Solver;
+use palpate::tables::file::Precision;
+use palpate::tables::load::{AnyModel, TableFile};
+use palpate_kernel::{Contact, Real};
+
+#[derive(Parser)]
+#[command(name = "palpate", version, about = "Real-time soft-tissue kernel: host harness")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Offline tables of the pre-computed model.
+    #[command(subcommand)]
+    Tables(TablesCommand),
+    /// Queries of the pre-computed model, through the kernel code path.
+    #[command(subcommand)]
+    Precomputed(PrecomputedCommand),
+    /// Built-in scene: two-probe press and release, forces, timings, VTK series.
+    Demo {
+        /// Folder for the VTK series (created if absent).
+        #[arg(long, default_value = "demo-out")]
+        out: PathBuf,
+    },
+}
+
+#[derive(Subcommand)]
+enum TablesCommand {
+    /// Build the compliance table of a tetrahedral mesh (.msh, .node/.ele, .vtk).
+    Build {
+        /// Input mesh.
+        mesh: PathBuf,
+        /// Young's modulus, Pa.
+        #[arg(long)]
+        young: f64,
+        /// Poisson ratio, in [0, 0.5).
+        #[arg(long)]
+        poisson: f64,
+        /// Fixed vertices: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
+        #[arg(long = "fix", required = true, value_parser = parse_fix, allow_hyphen_values = true)]
+        fix: Vec<FixPredicate>,
+        /// Sparse Cholesky (default) or the paper's conjugate-gradient baseline.
+        #[arg(long, value_enum, default_value = "cholesky")]
+        solver: SolverArg,
+        /// Stored float width: f32 (firmware) or f64 (verification).
+        #[arg(long, value_enum, default_value = "f32")]
+        precision: Precision,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Output table file.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+    },
+    /// Print a table's counts, sizes, material and checksum status.
+    Info {
+        /// Table file.
+        table: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum SolverArg {
+    Cholesky,
+    Cg,
+}
+
+#[derive(Subcommand)]
+enum PrecomputedCommand {
+    /// Contact forces and every vertex displacement for one contact set.
+    Solve {
+        /// Table file.
+        table: PathBuf,
+        /// Vertex contact <V>:<dx>,<dy>,<dz> (m).
+        #[arg(long = "contact", allow_hyphen_values = true)]
+        contact: Vec<String>,
+        /// Barycentric contact <A>,<B>,<C>@<ba>,<bb>,<bc>:<dx>,<dy>,<dz> (m).
+        #[arg(long = "contact-bary", allow_hyphen_values = true)]
+        contact_bary: Vec<String>,
+        /// Print one JSON object (the only output format).
+        #[arg(long)]
+        json: bool,
+    },
+    /// Run a contact sequence file (one step per line) and print each step's
+    /// forces as f32 bit patterns, exactly as the firmware example does.
+    Replay {
+        /// Table file (f32).
+        table: PathBuf,
+        /// Sequence file.
+        sequence: PathBuf,
+    },
+}
+
+fn parse_fix(s: &str) -> Result<FixPredicate, String> {
+    s.parse()
+}
+
+fn main() -> ExitCode {
+    let matches = Cli::command().get_matches();
+    let result = Cli::from_arg_matches(&matches)
+        .map_err(anyhow::Error::from)
+        .and_then(|cli| run(cli, &matches));
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Tables(TablesCommand::Build {
+            mesh,
+            young,
+            poisson,
+            fix,
+            solver,
+            precision,
+            quiet,
+            output,
+        }) => {
+            let (mesh_data, report) = read_mesh(&mesh)?;
+            for w in &report.warnings {
+                eprintln!("warning: {w}");
+            }
+            let options = BuildOptions {
+                material: Material::new(young, poisson)?,
+                fix,
+                solver: match solver {
+                    SolverArg::Cholesky => Solver::Cholesky,
+                    SolverArg::Cg => Solver::Cg,
+                },
+                precision,
+                progress: !quiet,
+            };
+            let built = build_table(&mesh_data, &report, &options)?;
+            std::fs::write(&output, &built.bytes)
+                .with_context(|| format!("{}: cannot write", output.display()))?;
+            eprintln!(
+                "{}: {} vertices ({} fixed by --fix, {} unreferenced kept fixed), {} tets, \
+                 {} free, {} touchable; {} non-tet elements skipped, {} tets reoriented; \
+                 compliance in {:.3} s; wrote {} bytes to {}",
+                report.source,
+                mesh_data.positions.len(),
+                built.fixed_by_predicate,
+                built.fixed_unreferenced,
+                mesh_data.tets.len(),
+                built.free_count,
+                built.touchable_count,
+                report.skipped_elements,
+                report.reoriented_tets,
+                built.solve_time.as_secs_f64(),
+                built.bytes.len(),
+                output.display()
+            );
+            Ok(())
+        }
+        Command::Tables(TablesCommand::Info { table }) => {
+            let file = TableFile::read(&table)?;
+            match file.info(&table.display().to_string()) {
+                Ok(report) => {
+                    print!("{report}");
+                    Ok(())
+                }
+                Err(report) => {
+                    print!("{report}");
+                    bail!("{}: table failed validation", table.display())
+                }
+            }
+        }
+        Command::Precomputed(PrecomputedCommand::Solve { table, json, .. }) => {
+            if !json {
+                bail!("precomputed solve prints JSON only: pass --json");
+            }
+            let solve = matches
+                .subcommand_matches("precomputed")
+                .and_then(|m| m.subcommand_matches("solve"))
+                .context("internal: solve arguments")?;
+            let file = TableFile::read(&table)?;
+            let model = file
+                .model()
+                .with_context(|| format!("{}: invalid table", table.display()))?;
+            let text = match model {
+                AnyModel::F32(m) => {
+                    serde_json::to_string(&palpate::precomputed::solve(&m, &contacts(solve)?)?)?
+                }
+                AnyModel::F64(m) => {
+                    serde_json::to_string(&palpate::precomputed::solve(&m, &contacts(solve)?)?)?
+                }
+            };
+            println!("{text}");
+            Ok(())
+        }
+        Command::Precomputed(PrecomputedCommand::Replay { table, sequence }) => {
+            let file = TableFile::read(&table)?;
+            let text = std::fs::read_to_string(&sequence)
+                .with_context(|| format!("{}: cannot read", sequence.display()))?;
+            print!("{}", palpate::replay::replay(file.bytes(), &text)?);
+            Ok(())
+        }
+        Command::Demo { out } => palpate::demo::run(&out),
+    }
+}
+
+/// The `--contact` and `--contact-bary` values in command-line order.
+fn contacts<T: Real>(solve: &ArgMatches) -> anyhow::Result<Vec<Contact<T>>> {
+    let mut all: Vec<(usize, bool, &String)> = Vec::new();
+    for (id, bary) in [("contact", false), ("contact_bary", true)] {
+        if let (Some(indices), Some(values)) =
+            (solve.indices_of(id), solve.get_many::<String>(id))
+        {
+            all.extend(indices.zip(values).map(|(i, v)| (i, bary, v)));
+        }
+    }
+    all.sort_by_key(|(i, _, _)| *i);
+    all.into_iter()
+        .map(|(_, bary, text)| {
+            let flag = if bary { "--contact-bary" } else { "--contact" };
+            let contact = palpate_script::parse_contact::<T>(text)
+                .map_err(|e| anyhow::anyhow!("{flag} '{text}': {e}"))?;
+            let is_bary = matches!(contact.point, palpate_kernel::ContactPoint::Triangle { .. });
+            if is_bary != bary {
+                bail!("{flag} '{text}': wrong form for {flag}");
+            }
+            Ok(contact)
+        })
+        .collect()
+}

@@ -1,0 +1,3 @@
+//! Files the harness writes for people and other tools: VTK series for ParaView.
+
+pub mod vtk;
