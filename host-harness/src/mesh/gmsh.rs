@@ -270,6 +270,10 @@ fn elements_v2(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), Me
             let line = cur
                 .nonempty_line()
                 .ok_or_else(|| cur.eof(format_args!("element {i}")))?;
+            if cur.at_end() {
+                // `$EndElements` must follow: this line was cut.
+                return Err(cur.eof(format_args!("element {i}")));
+            }
             let mut nums = Vec::with_capacity(16);
             for tok in line
                 .split(|c| c.is_ascii_whitespace())
@@ -463,7 +467,10 @@ fn elements_v41(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), M
                 }
                 acc.element(ty, i64::try_from(id).unwrap_or(i64::MAX), &nodes);
             } else {
-                let line = cur.nonempty_line().ok_or_else(|| cur.eof(&what))?;
+                let line = cur.nonempty_line().ok_or_else(|| cur.eof(what))?;
+                if cur.at_end() {
+                    return Err(cur.eof(what));
+                }
                 nodes.clear();
                 for tok in line
                     .split(|c| c.is_ascii_whitespace())

@@ -70,12 +70,13 @@ pub fn read_tetgen(
     if dim != 3 {
         return Err(perr(&nf, hl, format_args!("dimension {dim}, expected 3")));
     }
-    let nattr: usize = if h.len() > 2 {
+    // Attributes and boundary markers are ignored, but the header must be numeric.
+    let _nattr: usize = if h.len() > 2 {
         num(&nf, hl, &h, 2, "attribute count")?
     } else {
         0
     };
-    let nbnd: usize = if h.len() > 3 {
+    let _nbnd: usize = if h.len() > 3 {
         num(&nf, hl, &h, 3, "boundary marker flag")?
     } else {
         0
@@ -87,7 +88,7 @@ pub fn read_tetgen(
             file: nf.clone(),
             msg: format!("unexpected end of file (truncated?) at vertex {i} of {n}"),
         })?;
-        let idx: i64 = num(&nf, l, &t, 0, "node index")?;
+        let idx: i64 = num(&nf, l, &t, 0, &format!("vertex {i}: node index"))?;
         if i == 0 {
             base = idx;
             if base != 0 && base != 1 {
@@ -109,9 +110,8 @@ pub fn read_tetgen(
         }
         let mut p = [0.0; 3];
         for (c, x) in p.iter_mut().enumerate() {
-            *x = num(&nf, l, &t, 1 + c, "coordinate")?;
+            *x = num(&nf, l, &t, 1 + c, &format!("vertex {i}: coordinate {c}"))?;
         }
-        let _ = (nattr, nbnd);
         positions.push(p);
     }
 
@@ -152,7 +152,7 @@ pub fn read_tetgen(
         }
         let mut tet = [0i64; 4];
         for (c, v) in tet.iter_mut().enumerate() {
-            *v = num(&ef, l, &t, 1 + c, "vertex index")?;
+            *v = num(&ef, l, &t, 1 + c, &format!("tet {i}: vertex index"))?;
         }
         tets.push(tet);
     }
