@@ -12,3 +12,152 @@ pub fn reference_dir() -> PathBuf {
 pub fn data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data")
 }
+
+/// Reads the TetGen pair `meshes/NAME.node` / `meshes/NAME.ele` of the
+/// reference data (0-based indices): vertex positions and tets.
+pub fn read_reference_tetgen(name: &str) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
+    let dir = reference_dir().join("meshes");
+    let node = std::fs::read_to_string(dir.join(format!("{name}.node"))).expect("read .node");
+    let ele = std::fs::read_to_string(dir.join(format!("{name}.ele"))).expect("read .ele");
+    let rows = |text: &str| -> Vec<Vec<String>> {
+        text.lines()
+            .map(|l| l.split('#').next().unwrap_or("").trim())
+            .filter(|l| !l.is_empty())
+            .map(|l| l.split_whitespace().map(str::to_owned).collect())
+            .collect()
+    };
+    let node_rows = rows(&node);
+    let n: usize = node_rows[0][0].parse().expect("vertex count");
+    let positions: Vec<[f64; 3]> = node_rows[1..=n]
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            assert_eq!(
+                r[0].parse::<usize>().expect("index"),
+                i,
+                "0-based, in order"
+            );
+            [1, 2, 3].map(|c| r[c].parse().expect("coordinate"))
+        })
+        .collect();
+    let ele_rows = rows(&ele);
+    let m: usize = ele_rows[0][0].parse().expect("tet count");
+    let tets: Vec<[u32; 4]> = ele_rows[1..=m]
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            assert_eq!(
+                r[0].parse::<usize>().expect("index"),
+                i,
+                "0-based, in order"
+            );
+            [1, 2, 3, 4].map(|c| r[c].parse().expect("vertex index"))
+        })
+        .collect();
+    (positions, tets)
+}
+
+/// Unit box `[0,1]³` split into `cells` hexahedral cells, 6 Kuhn tets each,
+/// exactly as the reference `cube` mesh (reference README): vertex
+/// `idx(i,j,k) = i + (nx+1)(j + (ny+1)k)` at `(i/nx, j/ny, k/nz)`; in cell
+/// `c0`, for the axis permutations (0,1,2),(0,2,1),(1,0,2),(1,2,0),(2,0,1),
+/// (2,1,0) the tet `[c0, c0+e_a, c0+e_a+e_b, c0+e_a+e_b+e_c]`, last two
+/// swapped when negative; cells in x-fastest order.
+pub fn kuhn_box(cells: [usize; 3]) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
+    let [nx, ny, nz] = cells;
+    let idx = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
+    let mut positions = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
+    for k in 0..=nz {
+        for j in 0..=ny {
+            for i in 0..=nx {
+                positions.push([
+                    i as f64 / nx as f64,
+                    j as f64 / ny as f64,
+                    k as f64 / nz as f64,
+                ]);
+            }
+        }
+    }
+    const PERMS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut tets = Vec::with_capacity(6 * nx * ny * nz);
+    for ck in 0..nz {
+        for cj in 0..ny {
+            for ci in 0..nx {
+                for perm in PERMS {
+                    let mut c = [ci, cj, ck];
+                    let mut t = [idx(c[0], c[1], c[2]); 4];
+                    for (s, &axis) in perm.iter().enumerate() {
+                        c[axis] += 1;
+                        t[s + 1] = idx(c[0], c[1], c[2]);
+                    }
+                    let p = t.map(|v| positions[v as usize]);
+                    let d = |a: usize| [0, 1, 2].map(|x| p[a][x] - p[0][x]);
+                    let (a, b, e) = (d(1), d(2), d(3));
+                    let det = a[0] * (b[1] * e[2] - b[2] * e[1])
+                        - a[1] * (b[0] * e[2] - b[2] * e[0])
+                        + a[2] * (b[0] * e[1] - b[1] * e[0]);
+                    if det < 0.0 {
+                        t.swap(2, 3);
+                    }
+                    tets.push(t);
+                }
+            }
+        }
+    }
+    (positions, tets)
+}
+
+/// Vertices on the boundary surface (faces used by exactly one tet),
+/// ascending.
+pub fn boundary_vertices(vertex_count: usize, tets: &[[u32; 4]]) -> Vec<u32> {
+    let mut faces: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
+    for t in tets {
+        for skip in 0..4 {
+            let mut f = [0u32; 3];
+            let mut n = 0;
+            for (i, &v) in t.iter().enumerate() {
+                if i != skip {
+                    f[n] = v;
+                    n += 1;
+                }
+            }
+            f.sort_unstable();
+            *faces.entry(f).or_insert(0) += 1;
+        }
+    }
+    let mut on = vec![false; vertex_count];
+    for (f, c) in faces {
+        if c == 1 {
+            for v in f {
+                on[v as usize] = true;
+            }
+        }
+    }
+    (0..vertex_count as u32)
+        .filter(|&v| on[v as usize])
+        .collect()
+}
+
+/// Parses a JSON file of the reference data (`reference_dir()/rel`).
+pub fn read_reference_json(rel: &str) -> serde_json::Value {
+    let text = std::fs::read_to_string(reference_dir().join(rel)).expect("read reference JSON");
+    serde_json::from_str(&text).expect("parse reference JSON")
+}
+
+/// `max_i |a_i - b_i| / max_i |b_i|` (0 when both are all zero).
+pub fn rel_max_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    if scale == 0.0 { diff } else { diff / scale }
+}

@@ -1,0 +1,186 @@
+//! Global assembly of the P1 stiffness matrix and the free-vertex ordering
+//! shared with the kernel's compliance table (`MODELS.md` §1–2).
+
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+
+use super::element::element_stiffness;
+use super::material::Material;
+
+/// Marker for "this vertex has no slot" in slot maps ([`FreeOrdering::vertex_slot`]).
+pub const NO_SLOT: u32 = u32::MAX;
+
+/// Full global stiffness `K` (N/m), `3N × 3N` for `N = positions.len()`, with
+/// DOF `3 * vertex + component` (component 0 = x, 1 = y, 2 = z).
+///
+/// `K = Σ_tets` of the element blocks of [`element_stiffness`]
+/// (`MODELS.md` §1), so `K u = f` gives the external nodal forces `f` (N)
+/// balancing displacements `u` (m). Every block `(i, j)` of an edge or vertex
+/// of the mesh is stored (both triangles, sorted row indices); vertices used
+/// by no tet get empty columns.
+///
+/// # Panics
+/// If a tet references a vertex `>= positions.len()`.
+pub fn assemble_stiffness(
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    m: &Material,
+) -> SparseColMat<usize, f64> {
+    let n = u32::try_from(positions.len()).expect("vertex count fits in u32");
+    let slot: Vec<u32> = (0..n).collect();
+    assemble_restricted(positions, tets, m, &slot, positions.len())
+}
+
+/// Stiffness restricted to a subset of vertices, renumbered (N/m).
+///
+/// `slot[v]` is the new index of mesh vertex `v` in `0..slot_count`, or
+/// [`NO_SLOT`] to drop the vertex (its rows and columns are removed, i.e. the
+/// vertex is fixed or handled elsewhere). The result is `3·slot_count`
+/// square with DOF `3 * slot + component`: with `slot = vertex_slot` of a
+/// [`FreeOrdering`] it is the matrix `A` of `MODELS.md` §2 (Cotin RR-3510 §4),
+/// the stiffness restricted to the free DOFs. Both triangles are stored.
+///
+/// # Panics
+/// If `slot.len() != positions.len()`, a slot is `>= slot_count` (and not
+/// [`NO_SLOT`]), or a tet references a vertex `>= positions.len()`.
+pub fn assemble_restricted(
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    m: &Material,
+    slot: &[u32],
+    slot_count: usize,
+) -> SparseColMat<usize, f64> {
+    assert_eq!(slot.len(), positions.len(), "one slot per vertex");
+    assert!(
+        slot.iter()
+            .all(|&s| s == NO_SLOT || (s as usize) < slot_count),
+        "slot out of range"
+    );
+    // Block pattern: sorted neighbour slots (self included) of every slot.
+    let mut nbr: Vec<Vec<u32>> = vec![Vec::new(); slot_count];
+    for t in tets {
+        let s = t.map(|v| slot[v as usize]);
+        for &sj in &s {
+            if sj == NO_SLOT {
+                continue;
+            }
+            for &sk in &s {
+                if sk != NO_SLOT {
+                    nbr[sj as usize].push(sk);
+                }
+            }
+        }
+    }
+    for l in &mut nbr {
+        l.sort_unstable();
+        l.dedup();
+    }
+    let dof = 3 * slot_count;
+    let mut col_ptr = Vec::with_capacity(dof + 1);
+    col_ptr.push(0usize);
+    let mut row_idx = Vec::new();
+    for l in &nbr {
+        for _ in 0..3 {
+            for &w in l {
+                let w = 3 * w as usize;
+                row_idx.extend_from_slice(&[w, w + 1, w + 2]);
+            }
+            col_ptr.push(row_idx.len());
+        }
+    }
+    let mut val = vec![0.0f64; row_idx.len()];
+    for t in tets {
+        let s = t.map(|v| slot[v as usize]);
+        if s.iter().all(|&x| x == NO_SLOT) {
+            continue;
+        }
+        let p = t.map(|v| positions[v as usize]);
+        let ke = element_stiffness(&p, m);
+        // Block (row j, column k) goes to column slot s[k], neighbour s[j].
+        for (k, &sk) in s.iter().enumerate() {
+            if sk == NO_SLOT {
+                continue;
+            }
+            let l = &nbr[sk as usize];
+            for (j, &sj) in s.iter().enumerate() {
+                if sj == NO_SLOT {
+                    continue;
+                }
+                let pos = l.binary_search(&sj).expect("pattern holds every block");
+                for b in 0..3 {
+                    let base = col_ptr[3 * sk as usize + b] + 3 * pos;
+                    for a in 0..3 {
+                        val[base + a] += ke[j][k][a][b];
+                    }
+                }
+            }
+        }
+    }
+    let symbolic = SymbolicSparseColMat::new_checked(dof, dof, col_ptr, None, row_idx);
+    SparseColMat::new(symbolic, val)
+}
+
+/// The free/touchable vertex ordering shared with the kernel table format
+/// (`MODELS.md` §2).
+///
+/// Free index `0..touchable_count` are the free surface (touchable) vertices
+/// in ascending mesh-vertex order; `touchable_count..free_count()` are the
+/// remaining (interior) free vertices in ascending order. Fixed vertices have
+/// no free index.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FreeOrdering {
+    /// Free index → mesh vertex.
+    pub free_vertex: Vec<u32>,
+    /// Mesh vertex → free index, `u32::MAX` ([`NO_SLOT`]) if fixed.
+    pub vertex_slot: Vec<u32>,
+    /// Number of touchable (free surface) vertices, the first entries of
+    /// `free_vertex`.
+    pub touchable_count: usize,
+}
+
+impl FreeOrdering {
+    /// Ordering for `vertex_count` vertices: `fixed[v]` marks fully fixed
+    /// (zero-displacement) vertices; `surface_vertices` lists the boundary
+    /// vertices (any order, duplicates allowed). Touchable = surface and not
+    /// fixed.
+    ///
+    /// # Panics
+    /// If `fixed.len() != vertex_count`, a surface vertex is
+    /// `>= vertex_count`, or `vertex_count` does not fit in `u32`.
+    pub fn new(vertex_count: usize, fixed: &[bool], surface_vertices: &[u32]) -> Self {
+        assert_eq!(fixed.len(), vertex_count, "one fixed flag per vertex");
+        assert!(
+            u32::try_from(vertex_count).is_ok(),
+            "vertex count fits in u32"
+        );
+        let mut on_surface = vec![false; vertex_count];
+        for &v in surface_vertices {
+            on_surface[v as usize] = true;
+        }
+        let mut free_vertex = Vec::with_capacity(vertex_count);
+        free_vertex.extend(
+            (0..vertex_count)
+                .filter(|&v| on_surface[v] && !fixed[v])
+                .map(|v| v as u32),
+        );
+        let touchable_count = free_vertex.len();
+        free_vertex.extend(
+            (0..vertex_count)
+                .filter(|&v| !on_surface[v] && !fixed[v])
+                .map(|v| v as u32),
+        );
+        let mut vertex_slot = vec![NO_SLOT; vertex_count];
+        for (i, &v) in free_vertex.iter().enumerate() {
+            vertex_slot[v as usize] = i as u32;
+        }
+        Self {
+            free_vertex,
+            vertex_slot,
+            touchable_count,
+        }
+    }
+
+    /// Number of free (not fixed) vertices `F`; the free DOF count is `3F`.
+    pub fn free_count(&self) -> usize {
+        self.free_vertex.len()
+    }
+}
