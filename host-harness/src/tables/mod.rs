@@ -1,10 +1,8 @@
-//! Offline tables: compliance computation and the table file writer.
-<<<<<<< HEAD
-pub mod build;
-pub mod file;
-pub mod load;
-=======
+//! Offline tables: compliance computation (Cotin RR-3510 §4), the table file
+//! writer and reader, and the `tables build` pipeline.
 
+pub mod build;
 pub mod cg;
 pub mod compliance;
->>>>>>> fem
+pub mod file;
+pub mod load;
