@@ -40,7 +40,11 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
     };
     let options = BuildOptions {
         material: Material::new(3000.0, 0.45)?,
-        fix: vec!["z<0.0001".parse::<FixPredicate>().map_err(anyhow::Error::msg)?],
+        fix: vec![
+            "z<0.0001"
+                .parse::<FixPredicate>()
+                .map_err(anyhow::Error::msg)?,
+        ],
         solver: Solver::Cholesky,
         precision: Precision::F32,
         progress: false,
@@ -102,7 +106,9 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
     let mut force_time = Vec::new();
     let mut update_time = Vec::new();
     let mut step = 0usize;
-    println!("phase    steps  device force at end (N)          |F| peak (N)  contact forces at end (N)");
+    println!(
+        "phase    steps  device force at end (N)          |F| peak (N)  contact forces at end (N)"
+    );
     for (phase, steps) in PHASES {
         let mut peak = 0.0f32;
         let mut last = None;
@@ -128,10 +134,7 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
             step += 1;
             if step % FRAME_EVERY == 0 {
                 let path = out_dir.join(format!("frame_{step:04}.vtk"));
-                let u: Vec<[f64; 3]> = displacement
-                    .iter()
-                    .map(|u| u.map(f64::from))
-                    .collect();
+                let u: Vec<[f64; 3]> = displacement.iter().map(|u| u.map(f64::from)).collect();
                 vtk::write_frame(&path, &mesh.positions, &mesh.tets, &u)?;
                 frames.push((step as f64 * STEP_S, path));
             }

@@ -39,7 +39,11 @@ impl FromStr for FixPredicate {
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let s = s.trim();
-        let bad = || format!("bad --fix predicate '{s}': expected x|y|z then <, <=, > or >= then a number, e.g. 'z<0.001'");
+        let bad = || {
+            format!(
+                "bad --fix predicate '{s}': expected x|y|z then <, <=, > or >= then a number, e.g. 'z<0.001'"
+            )
+        };
         let mut chars = s.chars();
         let axis = match chars.next() {
             Some('x') => 0,

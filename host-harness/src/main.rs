@@ -15,7 +15,11 @@ use palpate::tables::load::{AnyModel, TableFile};
 use palpate_kernel::{Contact, Real};
 
 #[derive(Parser)]
-#[command(name = "palpate", version, about = "Real-time soft-tissue kernel: host harness")]
+#[command(
+    name = "palpate",
+    version,
+    about = "Real-time soft-tissue kernel: host harness"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -221,8 +225,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
 fn contacts<T: Real>(solve: &ArgMatches) -> anyhow::Result<Vec<Contact<T>>> {
     let mut all: Vec<(usize, bool, &String)> = Vec::new();
     for (id, bary) in [("contact", false), ("contact_bary", true)] {
-        if let (Some(indices), Some(values)) =
-            (solve.indices_of(id), solve.get_many::<String>(id))
+        if let (Some(indices), Some(values)) = (solve.indices_of(id), solve.get_many::<String>(id))
         {
             all.extend(indices.zip(values).map(|(i, v)| (i, bary, v)));
         }

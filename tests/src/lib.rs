@@ -161,3 +161,35 @@ pub fn rel_max_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     if scale == 0.0 { diff } else { diff / scale }
 }
+
+/// The reference cube (`shared/reference/meshes/cube.msh`, E = 5000 Pa,
+/// ν = 0.45) with its base `z = 0` fixed, built into a table of `precision`
+/// through the same pipeline as `palpate tables build`.
+pub fn reference_cube_table(
+    precision: palpate::tables::file::Precision,
+) -> palpate::tables::load::TableFile {
+    use palpate::tables::build::{BuildOptions, build_table};
+    let (mesh, report) =
+        palpate::mesh::read_mesh(&reference_dir().join("meshes/cube.msh")).expect("cube.msh");
+    let options = BuildOptions {
+        material: palpate::fem::material::Material::new(5000.0, 0.45).expect("material"),
+        fix: vec!["z<0.001".parse().expect("predicate")],
+        solver: palpate::tables::compliance::Solver::Cholesky,
+        precision,
+        progress: false,
+    };
+    let built = build_table(&mesh, &report, &options).expect("build table");
+    palpate::tables::load::TableFile::from_bytes(&built.bytes)
+}
+
+/// A JSON array of `[x, y, z]` rows as `f64` triples.
+pub fn json_rows(v: &serde_json::Value) -> Vec<[f64; 3]> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|row| {
+            let r = row.as_array().expect("row");
+            [0, 1, 2].map(|i| r[i].as_f64().expect("number"))
+        })
+        .collect()
+}

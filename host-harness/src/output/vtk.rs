@@ -18,7 +18,10 @@ pub fn write_frame(
     displacement_m: &[[f64; 3]],
 ) -> anyhow::Result<()> {
     let mut s = String::new();
-    let _ = writeln!(s, "# vtk DataFile Version 3.0\npalpate frame\nASCII\nDATASET UNSTRUCTURED_GRID");
+    let _ = writeln!(
+        s,
+        "# vtk DataFile Version 3.0\npalpate frame\nASCII\nDATASET UNSTRUCTURED_GRID"
+    );
     let _ = writeln!(s, "POINTS {} double", rest.len());
     for (p, u) in rest.iter().zip(displacement_m) {
         let _ = writeln!(s, "{} {} {}", p[0] + u[0], p[1] + u[1], p[2] + u[2]);
@@ -44,7 +47,10 @@ pub fn write_collection(path: &Path, frames: &[(f64, PathBuf)]) -> anyhow::Resul
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n",
     );
     for (t, file) in frames {
-        let name = file.file_name().map(|n| n.to_string_lossy()).unwrap_or_default();
+        let name = file
+            .file_name()
+            .map(|n| n.to_string_lossy())
+            .unwrap_or_default();
         let _ = writeln!(s, "<DataSet timestep=\"{t}\" file=\"{name}\"/>");
     }
     s.push_str("</Collection>\n</VTKFile>\n");

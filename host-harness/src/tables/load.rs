@@ -25,7 +25,8 @@ pub enum AnyModel<'a> {
 impl TableFile {
     /// Reads a table file.
     pub fn read(path: &Path) -> anyhow::Result<Self> {
-        let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let bytes =
+            std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
         Ok(Self::from_bytes(&bytes))
     }
 
@@ -33,7 +34,10 @@ impl TableFile {
     pub fn from_bytes(bytes: &[u8]) -> Self {
         let mut words = vec![0u128; bytes.len().div_ceil(16)];
         bytemuck::cast_slice_mut::<u128, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
-        Self { words, len: bytes.len() }
+        Self {
+            words,
+            len: bytes.len(),
+        }
     }
 
     /// The file bytes, 16-byte aligned.
@@ -43,7 +47,9 @@ impl TableFile {
 
     /// The header as stored, if the file is long enough (not validated).
     pub fn raw_header(&self) -> Option<RawHeader> {
-        self.bytes().get(..HEADER_LEN).map(bytemuck::pod_read_unaligned)
+        self.bytes()
+            .get(..HEADER_LEN)
+            .map(bytemuck::pod_read_unaligned)
     }
 
     /// Validates the table with the kernel's loader, in the precision the
@@ -51,8 +57,10 @@ impl TableFile {
     pub fn model(&self) -> Result<AnyModel<'_>, palpate_kernel::LoadError> {
         let bytes = self.bytes();
         match self.raw_header().map(|h| h.scalar_bytes) {
-            Some(8) => PrecomputedTable::<f64>::load(bytes).map(|t| AnyModel::F64(PrecomputedModel::new(t))),
-            _ => PrecomputedTable::<f32>::load(bytes).map(|t| AnyModel::F32(PrecomputedModel::new(t))),
+            Some(8) => PrecomputedTable::<f64>::load(bytes)
+                .map(|t| AnyModel::F64(PrecomputedModel::new(t))),
+            _ => PrecomputedTable::<f32>::load(bytes)
+                .map(|t| AnyModel::F32(PrecomputedModel::new(t))),
         }
     }
 
@@ -82,7 +90,11 @@ impl TableFile {
             h.vertex_count.saturating_sub(h.free_count)
         );
         let _ = writeln!(out, "free vertices: {}", h.free_count);
-        let _ = writeln!(out, "touchable (free surface) vertices: {}", h.touchable_count);
+        let _ = writeln!(
+            out,
+            "touchable (free surface) vertices: {}",
+            h.touchable_count
+        );
         let _ = writeln!(out, "surface triangles: {}", h.triangle_count);
         let _ = writeln!(out, "young modulus: {} Pa", h.young_pa);
         let _ = writeln!(out, "poisson ratio: {}", h.poisson);
@@ -90,7 +102,12 @@ impl TableFile {
         for kind in SectionKind::ALL {
             if let Some(count) = kind.expected_count(&h) {
                 let size = count * u64::from(kind.elem_bytes(h.scalar_bytes));
-                let _ = writeln!(out, "section {}: {count} x {} bytes = {size} bytes", kind.name(), kind.elem_bytes(h.scalar_bytes));
+                let _ = writeln!(
+                    out,
+                    "section {}: {count} x {} bytes = {size} bytes",
+                    kind.name(),
+                    kind.elem_bytes(h.scalar_bytes)
+                );
             }
         }
         let checksum_ok = bytes.len() >= HEADER_LEN + CRC_LEN && {
@@ -98,7 +115,11 @@ impl TableFile {
             let stored = u32::from_le_bytes(trailer.try_into().unwrap_or_default());
             stored == crc::Crc::<u32>::new(&CRC32).checksum(body)
         };
-        let _ = writeln!(out, "checksum: {}", if checksum_ok { "ok" } else { "MISMATCH" });
+        let _ = writeln!(
+            out,
+            "checksum: {}",
+            if checksum_ok { "ok" } else { "MISMATCH" }
+        );
         match self.model() {
             Ok(_) => {
                 let _ = writeln!(out, "validation: ok");

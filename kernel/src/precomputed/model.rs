@@ -131,6 +131,9 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             *d = contact.displacement_m;
         }
         check_duplicates(contacts)?;
+        if m == 0 {
+            return Ok(solution);
+        }
 
         // Lower blocks of the point-compliance matrix, and its scale.
         let mut blocks = [[Matrix3::<T>::zeros(); M]; M];

@@ -1,0 +1,228 @@
+//! Table loading (`palpate_kernel::table`): round trip, corruption detection,
+//! and every structural error a well-formed checksum cannot hide.
+
+use palpate::tables::file::{Precision, TableContents, write_table};
+use palpate::tables::load::TableFile;
+use palpate_kernel::table::format::{HEADER_LEN, SECTION_ENTRY_LEN, SectionKind};
+use palpate_kernel::{LoadError, PrecomputedTable};
+use palpate_tests::reference_cube_table;
+
+fn load32(bytes: &[u8]) -> Result<(), LoadError> {
+    let file = TableFile::from_bytes(bytes);
+    PrecomputedTable::<f32>::load(file.bytes()).map(|_| ())
+}
+
+#[test]
+fn round_trip_counts() {
+    let file = reference_cube_table(Precision::F32);
+    let t = PrecomputedTable::<f32>::load(file.bytes()).unwrap();
+    assert_eq!(t.vertex_count(), 216);
+    assert_eq!(t.free_count(), 180);
+    assert_eq!(t.touchable_count(), 116);
+    assert_eq!(t.surface_triangles().len(), 300);
+    assert_eq!(t.young_pa(), 5000.0);
+    assert_eq!(t.poisson(), 0.45);
+    assert!(t.is_fixed(0) && !t.is_fixed(194));
+    // f64 table of the same mesh: same counts, twice the compliance bytes.
+    let file64 = reference_cube_table(Precision::F64);
+    assert!(PrecomputedTable::<f64>::load(file64.bytes()).is_ok());
+    assert_eq!(
+        PrecomputedTable::<f32>::load(file64.bytes()).unwrap_err(),
+        LoadError::ScalarMismatch {
+            table: 8,
+            requested: 4
+        }
+    );
+}
+
+/// CRC-32 detects every single-bit error; check that each one in the header
+/// and directory is refused, and a seeded sample of 4000 in the payload.
+#[test]
+fn every_header_bit_flip_and_sampled_payload_flips_are_detected() {
+    let file = reference_cube_table(Precision::F32);
+    let original = file.bytes().to_vec();
+    let header_bits = (HEADER_LEN + 6 * SECTION_ENTRY_LEN) * 8;
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut payload_bits = Vec::new();
+    for _ in 0..4000 {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        payload_bits.push(header_bits + (state as usize) % (original.len() * 8 - header_bits));
+    }
+    for bit in (0..header_bits).chain(payload_bits) {
+        let mut bytes = original.clone();
+        bytes[bit / 8] ^= 1 << (bit % 8);
+        assert!(load32(&bytes).is_err(), "bit flip {bit} not detected");
+    }
+}
+
+#[test]
+fn truncation_padding_and_garbage_are_refused() {
+    let file = reference_cube_table(Precision::F32);
+    let bytes = file.bytes();
+    assert_eq!(load32(&bytes[..10]), Err(LoadError::TooShort { len: 10 }));
+    assert!(matches!(
+        load32(&bytes[..bytes.len() - 1]),
+        Err(LoadError::LengthMismatch { .. })
+    ));
+    let mut padded = bytes.to_vec();
+    padded.push(0);
+    assert!(matches!(
+        load32(&padded),
+        Err(LoadError::LengthMismatch { .. })
+    ));
+    assert_eq!(load32(&[0u8; 200]), Err(LoadError::BadMagic));
+}
+
+#[test]
+fn misaligned_buffer_is_refused() {
+    let file = reference_cube_table(Precision::F32);
+    let mut shifted = vec![0u8; file.bytes().len() + 1];
+    shifted[1..].copy_from_slice(file.bytes());
+    // `TableFile` aligns to 16, so byte 1 of its buffer is odd-aligned.
+    let holder = TableFile::from_bytes(&shifted);
+    let err = PrecomputedTable::<f32>::load(&holder.bytes()[1..]).unwrap_err();
+    assert!(matches!(err, LoadError::Misaligned { .. }), "{err}");
+}
+
+/// A table built from the 2-tet mesh below, with hand-set contents, so each
+/// structural check can be hit with a valid checksum.
+struct Tiny {
+    vertex_slot: Vec<u32>,
+    free_vertex: Vec<u32>,
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    surface: Vec<[f64; 9]>,
+    interior: Vec<[f64; 9]>,
+    young_pa: f64,
+}
+
+impl Tiny {
+    /// 5 vertices, vertex 0 fixed; free 1..=4 all touchable (S = F = 4).
+    fn new() -> Self {
+        let spd = [2e-4, 1e-5, 0.0, 1e-5, 3e-4, 0.0, 0.0, 0.0, 1e-4];
+        Self {
+            vertex_slot: vec![u32::MAX, 0, 1, 2, 3],
+            free_vertex: vec![1, 2, 3, 4],
+            positions: vec![
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 1.0, 1.0],
+            ],
+            triangles: vec![[1, 2, 3]],
+            surface: vec![spd; 10],
+            interior: vec![],
+            young_pa: 1000.0,
+        }
+    }
+
+    fn bytes(&self) -> Vec<u8> {
+        write_table(
+            &TableContents {
+                tet_count: 2,
+                young_pa: self.young_pa,
+                poisson: 0.3,
+                mesh_hash: 7,
+                vertex_slot: &self.vertex_slot,
+                free_vertex: &self.free_vertex,
+                touchable_count: 4,
+                positions: &self.positions,
+                triangles: &self.triangles,
+                surface: &self.surface,
+                interior: &self.interior,
+            },
+            Precision::F32,
+        )
+    }
+}
+
+#[test]
+fn structural_errors_behind_a_valid_checksum() {
+    assert_eq!(load32(&Tiny::new().bytes()), Ok(()));
+
+    let mut t = Tiny::new();
+    t.surface[4][8] = f64::NAN;
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::NonFinite {
+            kind: SectionKind::ComplianceSurface,
+            index: 4
+        })
+    );
+
+    let mut t = Tiny::new();
+    t.surface[5][0] = -1e-4; // C_22 (index 2·3/2 + 2 = 5) not positive definite
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::NotPositiveDefinite { touchable: 2 })
+    );
+
+    let mut t = Tiny::new();
+    t.surface[0][1] = 5e-5; // C_00 not symmetric
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::NotPositiveDefinite { touchable: 0 })
+    );
+
+    let mut t = Tiny::new();
+    t.free_vertex.swap(0, 1);
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::BadVertexMap { vertex: 1 })
+    );
+
+    let mut t = Tiny::new();
+    t.triangles[0][2] = 5;
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::BadTriangle { triangle: 0 })
+    );
+
+    let mut t = Tiny::new();
+    t.positions[3][1] = f64::INFINITY;
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::NonFinite {
+            kind: SectionKind::RestPositions,
+            index: 3
+        })
+    );
+
+    let mut t = Tiny::new();
+    t.young_pa = -1.0;
+    assert_eq!(load32(&t.bytes()), Err(LoadError::BadMaterial));
+
+    let mut t = Tiny::new();
+    t.surface.pop();
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::SectionSize {
+            kind: SectionKind::ComplianceSurface
+        })
+    );
+}
+
+#[test]
+fn info_reports_counts_and_checksum() {
+    let file = reference_cube_table(Precision::F32);
+    let info = file.info("cube.tbl").unwrap();
+    for line in [
+        "vertices: 216",
+        "tets: 750",
+        "fixed vertices: 36",
+        "touchable (free surface) vertices: 116",
+        "young modulus: 5000 Pa",
+        "checksum: ok",
+        "validation: ok",
+    ] {
+        assert!(info.contains(line), "missing '{line}' in\n{info}");
+    }
+    let mut bytes = file.bytes().to_vec();
+    let last = bytes.len() - 10;
+    bytes[last] ^= 0x10;
+    let info = TableFile::from_bytes(&bytes).info("bad.tbl").unwrap_err();
+    assert!(info.contains("checksum: MISMATCH"), "{info}");
+}
