@@ -184,7 +184,10 @@ fn time_box(cells: usize, solver: Solver) -> f64 {
     secs
 }
 
-/// Timing: `cargo test --release -p palpate-tests --test host_compliance -- --ignored --nocapture`.
+/// Timing: `cargo test --release -p palpate-tests --test host_compliance -- --ignored --nocapture`
+/// (pin to one core with `taskset -c 0 <test binary> --ignored --nocapture`).
+/// Measured on the 2-core dev box, one core: 12³ box Cholesky 1.01 s
+/// (2028 free, 697 touchable vertices); 6³ box Cholesky 0.019 s vs CG 5.17 s.
 #[test]
 #[ignore = "timing, run in release"]
 fn timing_box_compliance() {
