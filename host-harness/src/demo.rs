@@ -6,8 +6,9 @@
 //! `tables build`, stored in `f32` as on firmware, loaded by the kernel, and
 //! every step runs the kernel's force path and displacement update.
 
+use core::time::Duration;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::Context;
 use nalgebra::Vector3;

@@ -36,14 +36,27 @@ fn build_cube_table(name: &str, extra: &[&str]) -> PathBuf {
     let table = temp(name);
     let mesh = reference("meshes/cube.msh");
     let mut args = vec![
-        "tables", "build", &mesh, "--young", "5000", "--poisson", "0.45", "--fix", "z<0.001",
-        "--quiet", "-o",
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "--quiet",
+        "-o",
     ];
     let table_str = table.display().to_string();
     args.push(&table_str);
     args.extend_from_slice(extra);
     let out = palpate(&args);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     table
 }
 
@@ -54,12 +67,24 @@ fn build_info_and_solve_match_the_reference() {
     let info = palpate(&["tables", "info", &table_str]);
     assert!(info.status.success());
     let text = String::from_utf8_lossy(&info.stdout);
-    assert!(text.contains("vertices: 216") && text.contains("checksum: ok"), "{text}");
+    assert!(
+        text.contains("vertices: 216") && text.contains("checksum: ok"),
+        "{text}"
+    );
 
     let out = palpate(&[
-        "precomputed", "solve", &table_str, "--contact", "194:0,0,-0.01", "--json",
+        "precomputed",
+        "solve",
+        &table_str,
+        "--contact",
+        "194:0,0,-0.01",
+        "--json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["displacements"].as_array().unwrap().len(), 216);
     let f = &json["contact_forces"][0];
@@ -75,12 +100,20 @@ fn contacts_come_out_in_argument_order() {
     let table = build_cube_table("cube32.tbl", &[]);
     let table_str = table.display().to_string();
     let out = palpate(&[
-        "precomputed", "solve", &table_str,
-        "--contact-bary", "194,195,200@0.2,0.5,0.3:0,0,-0.004",
-        "--contact", "205:0,0,-0.002",
+        "precomputed",
+        "solve",
+        &table_str,
+        "--contact-bary",
+        "194,195,200@0.2,0.5,0.3:0,0,-0.004",
+        "--contact",
+        "205:0,0,-0.002",
         "--json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let forces = json["contact_forces"].as_array().unwrap();
     assert_eq!(forces.len(), 2);
@@ -92,25 +125,98 @@ fn contacts_come_out_in_argument_order() {
 #[test]
 fn bad_arguments_and_files_exit_2_with_one_line() {
     let mesh = reference("meshes/cube.msh");
-    let out = palpate(&["tables", "build", &mesh, "--young", "5000", "--poisson", "0.45", "--fix", "q<1", "-o", "/dev/null"]);
+    let out = palpate(&[
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "q<1",
+        "-o",
+        "/dev/null",
+    ]);
     assert_one_line_error(&out, "bad --fix predicate");
-    let out = palpate(&["tables", "build", &mesh, "--young", "5000", "--poisson", "0.6", "--fix", "z<0.001", "-o", "/dev/null"]);
+    let out = palpate(&[
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.6",
+        "--fix",
+        "z<0.001",
+        "-o",
+        "/dev/null",
+    ]);
     assert_one_line_error(&out, "oisson");
-    let out = palpate(&["tables", "build", &mesh, "--young", "5000", "--poisson", "0.45", "--fix", "z<-1", "-o", "/dev/null"]);
+    let out = palpate(&[
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<-1",
+        "-o",
+        "/dev/null",
+    ]);
     assert_one_line_error(&out, "no vertex matches");
-    let out = palpate(&["tables", "build", "/nonexistent.msh", "--young", "5000", "--poisson", "0.45", "--fix", "z<0", "-o", "/dev/null"]);
+    let out = palpate(&[
+        "tables",
+        "build",
+        "/nonexistent.msh",
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0",
+        "-o",
+        "/dev/null",
+    ]);
     assert_one_line_error(&out, "nonexistent.msh");
     let garbage = temp("garbage.tbl");
-    std::fs::write(&garbage, b"not a table at all, just some bytes that are long enough to parse a header from them ok").unwrap();
+    std::fs::write(
+        &garbage,
+        b"not a table at all, just some bytes that are long enough to parse a header from them ok",
+    )
+    .unwrap();
     let out = palpate(&["tables", "info", &garbage.display().to_string()]);
     assert_one_line_error(&out, "failed validation");
     let table = build_cube_table("cube-err.tbl", &[]);
     let table_str = table.display().to_string();
-    let out = palpate(&["precomputed", "solve", &table_str, "--contact", "0:0,0,-0.01", "--json"]);
+    let out = palpate(&[
+        "precomputed",
+        "solve",
+        &table_str,
+        "--contact",
+        "0:0,0,-0.01",
+        "--json",
+    ]);
     assert_one_line_error(&out, "vertex 0 is fixed");
-    let out = palpate(&["precomputed", "solve", &table_str, "--contact", "194:0,0", "--json"]);
+    let out = palpate(&[
+        "precomputed",
+        "solve",
+        &table_str,
+        "--contact",
+        "194:0,0",
+        "--json",
+    ]);
     assert_one_line_error(&out, "--contact '194:0,0'");
-    let out = palpate(&["precomputed", "solve", &table_str, "--contact", "194,195,200@1,0,0:0,0,0", "--json"]);
+    let out = palpate(&[
+        "precomputed",
+        "solve",
+        &table_str,
+        "--contact",
+        "194,195,200@1,0,0:0,0,0",
+        "--json",
+    ]);
     assert_one_line_error(&out, "wrong form");
     let out = palpate(&["precomputed", "nonsense"]);
     assert_eq!(out.status.code(), Some(2));

@@ -11,6 +11,8 @@
 //! ≤ 7.9e-8, bound 1e-6 (a contact system with condition number up to ~10
 //! stays inside it).
 
+#![allow(clippy::needless_range_loop)] // component loops mirror MODELS.md notation
+
 use nalgebra::Vector3;
 use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
@@ -19,6 +21,9 @@ use palpate::tables::load::{AnyModel, TableFile};
 use palpate_kernel::{Contact, ContactError, MAX_CONTACTS, PrecomputedModel, Real};
 use palpate_tests::{json_rows, read_reference_json, reference_cube_table, rel_max_diff};
 use proptest::prelude::*;
+
+/// Per-vertex or per-contact 3-vectors, as f64.
+type Rows = Vec<[f64; 3]>;
 
 const F64_TOL: f64 = 1e-13;
 const F32_TOL: f64 = 1e-6;
@@ -38,7 +43,7 @@ fn with_model<R>(
 fn solve<T: Real>(
     model: &PrecomputedModel<'_, T>,
     contacts: &[(u32, [f64; 3])],
-) -> Result<(Vec<[f64; 3]>, Vec<[f64; 3]>), ContactError> {
+) -> Result<(Rows, Rows), ContactError> {
     let contacts: Vec<Contact<T>> = contacts
         .iter()
         .map(|(v, d)| Contact::at_vertex(*v, Vector3::from(d.map(T::of_f64))))

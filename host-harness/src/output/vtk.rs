@@ -4,7 +4,7 @@
 //! lines, and vtkio 0.6 pulls in `nom` 3, which the compiler already flags as
 //! rejected by future Rust versions.
 
-use std::fmt::Write as _;
+use core::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;

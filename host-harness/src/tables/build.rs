@@ -1,6 +1,7 @@
 //! `palpate tables build`: mesh + material + fixed predicates → table bytes.
 
-use std::time::{Duration, Instant};
+use core::time::Duration;
+use std::time::Instant;
 
 use anyhow::{Context, bail};
 

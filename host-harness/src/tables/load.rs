@@ -1,6 +1,6 @@
 //! Reading table files on the host: aligned buffers, scalar dispatch, `tables info`.
 
-use std::fmt::Write as _;
+use core::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Context;

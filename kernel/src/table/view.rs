@@ -62,6 +62,13 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         check_finite(SectionKind::ComplianceSurface, table.surface)?;
         check_finite(SectionKind::ComplianceInterior, table.interior)?;
         table.check_diagonal_blocks()?;
+        log::debug!(
+            "table loaded: {} vertices, {} free, {} touchable, {}-byte floats",
+            table.vertex_count(),
+            table.free_count(),
+            table.touchable_count(),
+            T::BYTES
+        );
         Ok(table)
     }
 
