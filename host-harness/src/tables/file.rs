@@ -1,8 +1,9 @@
 //! Writes the table file format defined in `palpate_kernel::table::format`.
 
+use bytemuck::Zeroable;
 use palpate_kernel::table::format::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
-    SectionEntry, SectionKind,
+    SectionEntry, SectionKind, TableKind,
 };
 
 /// Float width of the stored tables: `f32` for firmware (the default), `f64`
@@ -41,92 +42,106 @@ pub struct TableContents<'a> {
     pub interior: &'a [[f64; 9]],
 }
 
-/// Serializes `c` with floats of `precision`: header, directory, 16-byte
-/// aligned sections, CRC-32 trailer.
+/// Serializes a pre-computed table (`TableKind::Precomputed`) with floats
+/// of `precision`.
 pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
-    let scalar_bytes: u32 = match precision {
-        Precision::F32 => 4,
-        Precision::F64 => 8,
-    };
-    let floats = |values: &mut dyn Iterator<Item = f64>| -> Vec<u8> {
-        match precision {
-            Precision::F32 => values.flat_map(|x| (x as f32).to_le_bytes()).collect(),
-            Precision::F64 => values.flat_map(f64::to_le_bytes).collect(),
-        }
-    };
-    let ints = |values: &mut dyn Iterator<Item = u32>| -> Vec<u8> {
-        values.flat_map(u32::to_le_bytes).collect()
-    };
-    let payloads: Vec<(SectionKind, u64, Vec<u8>)> = vec![
-        (
-            SectionKind::VertexSlot,
-            c.vertex_slot.len() as u64,
-            ints(&mut c.vertex_slot.iter().copied()),
-        ),
-        (
-            SectionKind::FreeVertex,
-            c.free_vertex.len() as u64,
-            ints(&mut c.free_vertex.iter().copied()),
-        ),
-        (
-            SectionKind::RestPositions,
-            c.positions.len() as u64,
-            floats(&mut c.positions.iter().flatten().copied()),
-        ),
-        (
-            SectionKind::SurfaceTriangles,
-            c.triangles.len() as u64,
-            ints(&mut c.triangles.iter().flatten().copied()),
-        ),
-        (
-            SectionKind::ComplianceSurface,
-            c.surface.len() as u64,
-            floats(&mut c.surface.iter().flatten().copied()),
-        ),
-        (
-            SectionKind::ComplianceInterior,
-            c.interior.len() as u64,
-            floats(&mut c.interior.iter().flatten().copied()),
-        ),
-    ];
-    let header_len = HEADER_LEN + payloads.len() * SECTION_ENTRY_LEN;
-    let mut offset = header_len.next_multiple_of(SECTION_ALIGN);
-    let mut entries = Vec::with_capacity(payloads.len());
-    for (kind, count, bytes) in &payloads {
-        entries.push(SectionEntry {
-            kind: *kind as u32,
-            elem_bytes: kind.elem_bytes(scalar_bytes),
-            offset: offset as u64,
-            count: *count,
-        });
-        offset = (offset + bytes.len()).next_multiple_of(SECTION_ALIGN);
-    }
-    let file_len = offset + CRC_LEN;
     let header = RawHeader {
-        magic: MAGIC,
-        format_version: FORMAT_VERSION,
-        header_len: header_len as u32,
-        scalar_bytes,
-        section_count: payloads.len() as u32,
+        table_kind: TableKind::Precomputed as u32,
         vertex_count: c.vertex_slot.len() as u32,
         tet_count: c.tet_count as u32,
         free_count: c.free_vertex.len() as u32,
         touchable_count: c.touchable_count as u32,
         triangle_count: c.triangles.len() as u32,
-        reserved: 0,
         young_pa: c.young_pa,
         poisson: c.poisson,
         mesh_hash: c.mesh_hash,
-        file_len: file_len as u64,
+        ..RawHeader::zeroed()
     };
+    let sections = vec![
+        Section::ints(SectionKind::VertexSlot, c.vertex_slot),
+        Section::ints(SectionKind::FreeVertex, c.free_vertex),
+        Section::floats(SectionKind::RestPositions, c.positions, precision),
+        Section::ints(SectionKind::SurfaceTriangles, c.triangles),
+        Section::floats(SectionKind::ComplianceSurface, c.surface, precision),
+        Section::floats(SectionKind::ComplianceInterior, c.interior, precision),
+    ];
+    write_container(header, precision, &sections)
+}
+
+/// One section's payload, ready to be laid out.
+pub struct Section {
+    kind: SectionKind,
+    count: u64,
+    bytes: Vec<u8>,
+}
+
+impl Section {
+    /// A section of elements made of `u32`s (`u32`, `[u32; 3]`, …), little-endian.
+    pub fn ints<E: bytemuck::Pod>(kind: SectionKind, items: &[E]) -> Self {
+        let values: &[u32] = bytemuck::cast_slice(items);
+        Self {
+            kind,
+            count: items.len() as u64,
+            bytes: values.iter().flat_map(|x| x.to_le_bytes()).collect(),
+        }
+    }
+
+    /// A section of elements made of `f64`s (`[f64; 9]`, …), rounded to
+    /// `precision`, little-endian.
+    pub fn floats<E: bytemuck::Pod>(kind: SectionKind, items: &[E], precision: Precision) -> Self {
+        let values: &[f64] = bytemuck::cast_slice(items);
+        let values = values.iter();
+        let bytes = match precision {
+            Precision::F32 => values.flat_map(|&x| (x as f32).to_le_bytes()).collect(),
+            Precision::F64 => values.flat_map(|x| x.to_le_bytes()).collect(),
+        };
+        Self {
+            kind,
+            count: items.len() as u64,
+            bytes,
+        }
+    }
+}
+
+/// Lays out any table: `header` supplies the kind, counts and material; this
+/// fills in magic, version, lengths, scalar width and section count, aligns
+/// each section to 16 bytes and appends the CRC-32 trailer.
+pub fn write_container(
+    mut header: RawHeader,
+    precision: Precision,
+    sections: &[Section],
+) -> Vec<u8> {
+    let scalar_bytes: u32 = match precision {
+        Precision::F32 => 4,
+        Precision::F64 => 8,
+    };
+    let header_len = HEADER_LEN + sections.len() * SECTION_ENTRY_LEN;
+    let mut offset = header_len.next_multiple_of(SECTION_ALIGN);
+    let mut entries = Vec::with_capacity(sections.len());
+    for section in sections {
+        entries.push(SectionEntry {
+            kind: section.kind as u32,
+            elem_bytes: section.kind.elem_bytes(scalar_bytes),
+            offset: offset as u64,
+            count: section.count,
+        });
+        offset = (offset + section.bytes.len()).next_multiple_of(SECTION_ALIGN);
+    }
+    let file_len = offset + CRC_LEN;
+    header.magic = MAGIC;
+    header.format_version = FORMAT_VERSION;
+    header.header_len = header_len as u32;
+    header.scalar_bytes = scalar_bytes;
+    header.section_count = sections.len() as u32;
+    header.file_len = file_len as u64;
     let mut out = Vec::with_capacity(file_len);
     out.extend_from_slice(bytemuck::bytes_of(&header));
     for entry in &entries {
         out.extend_from_slice(bytemuck::bytes_of(entry));
     }
-    for (entry, (_, _, bytes)) in entries.iter().zip(&payloads) {
+    for (entry, section) in entries.iter().zip(sections) {
         out.resize(entry.offset as usize, 0);
-        out.extend_from_slice(bytes);
+        out.extend_from_slice(&section.bytes);
     }
     out.resize(offset, 0);
     let crc = crc::Crc::<u32>::new(&CRC32).checksum(&out);

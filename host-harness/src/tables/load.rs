@@ -4,7 +4,7 @@ use core::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Context;
-use palpate_kernel::table::format::{CRC_LEN, CRC32, HEADER_LEN, RawHeader, SectionKind};
+use palpate_kernel::table::format::{CRC_LEN, CRC32, HEADER_LEN, RawHeader, TableKind};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
 /// Table bytes in a 16-byte-aligned buffer, as the kernel's zero-copy view
@@ -76,6 +76,11 @@ impl TableFile {
             return Err(out);
         };
         let _ = writeln!(out, "format version: {}", h.format_version);
+        let kind = match h.table_kind {
+            k if k == TableKind::Precomputed as u32 => "pre-computed (compliance)",
+            _ => "unknown",
+        };
+        let _ = writeln!(out, "table kind: {kind}");
         let precision = match h.scalar_bytes {
             4 => "f32",
             8 => "f64",
@@ -99,7 +104,11 @@ impl TableFile {
         let _ = writeln!(out, "young modulus: {} Pa", h.young_pa);
         let _ = writeln!(out, "poisson ratio: {}", h.poisson);
         let _ = writeln!(out, "mesh hash: {:016x}", h.mesh_hash);
-        for kind in SectionKind::ALL {
+        let sections = match h.table_kind {
+            k if k == TableKind::Precomputed as u32 => TableKind::Precomputed.sections(),
+            _ => &[],
+        };
+        for &kind in sections {
             if let Some(count) = kind.expected_count(&h) {
                 let size = count * u64::from(kind.elem_bytes(h.scalar_bytes));
                 let _ = writeln!(

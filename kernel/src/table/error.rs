@@ -41,10 +41,16 @@ pub enum LoadError {
         /// Bytes per float of the requested scalar.
         requested: u32,
     },
+    /// The table is of another kind than the caller asked for.
+    WrongTableKind {
+        /// The kind value in the header.
+        found: u32,
+    },
     /// Header counts contradict each other (free > vertices, touchable > free,
-    /// directory length, a reserved field not zero).
+    /// directory length, reserved field not zero).
     InconsistentHeader,
-    /// Material out of range (E ≤ 0, ν outside [0, 0.5), non-finite).
+    /// Material out of range (E ≤ 0, ν outside [0, 0.5), density < 0,
+    /// non-finite).
     BadMaterial,
     /// A section kind this version does not know.
     UnknownSection {
@@ -122,6 +128,9 @@ impl fmt::Display for LoadError {
                 f,
                 "table stores {table}-byte floats, caller requested {requested}-byte floats"
             ),
+            LoadError::WrongTableKind { found } => {
+                write!(f, "table kind {found} is not the kind requested")
+            }
             LoadError::InconsistentHeader => f.write_str("inconsistent header counts"),
             LoadError::BadMaterial => f.write_str("material out of range in header"),
             LoadError::UnknownSection { kind } => write!(f, "unknown section kind {kind}"),

@@ -2,7 +2,7 @@
 //! and the kernel reader.
 //!
 //! ```text
-//! offset 0            RawHeader (80 bytes)
+//! offset 0            RawHeader (96 bytes)
 //! offset 80           SectionEntry × section_count (24 bytes each)
 //! …                   sections, each starting at a multiple of SECTION_ALIGN
 //! file_len - 4        CRC-32/ISO-HDLC of bytes [0, file_len - 4), little-endian
@@ -55,9 +55,11 @@ pub struct RawHeader {
     pub scalar_bytes: u32,
     /// Number of [`SectionEntry`] after the header.
     pub section_count: u32,
+    /// What the table is for: a [`TableKind`] value.
+    pub table_kind: u32,
     /// Vertices of the source mesh (`N`).
     pub vertex_count: u32,
-    /// Tetrahedra of the source mesh (informative).
+    /// Tetrahedra of the source mesh.
     pub tet_count: u32,
     /// Free (not fixed) vertices (`F`).
     pub free_count: u32,
@@ -65,12 +67,16 @@ pub struct RawHeader {
     pub touchable_count: u32,
     /// Boundary surface triangles.
     pub triangle_count: u32,
-    /// Zero.
+    /// Mesh edges (tensor-mass tables; zero otherwise).
+    pub edge_count: u32,
+    /// Zero (keeps the floats 8-byte aligned).
     pub reserved: u32,
     /// Young's modulus the table was built with, Pa.
     pub young_pa: f64,
     /// Poisson ratio the table was built with, dimensionless.
     pub poisson: f64,
+    /// Mass density, kg/m³ (tensor-mass tables; zero otherwise).
+    pub density_kg_m3: f64,
     /// CRC-64/XZ of the source mesh (positions as f64 LE, then tets as u32 LE).
     pub mesh_hash: u64,
     /// Total file length in bytes, trailer included.
@@ -79,7 +85,31 @@ pub struct RawHeader {
 
 /// Size of [`RawHeader`] in bytes.
 pub const HEADER_LEN: usize = core::mem::size_of::<RawHeader>();
-const _: () = assert!(HEADER_LEN == 80);
+const _: () = assert!(HEADER_LEN == 96);
+
+/// What a table is for; each kind has its own required sections.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum TableKind {
+    /// The pre-computed quasi-static model (RR-3510 §4).
+    Precomputed = 1,
+}
+
+impl TableKind {
+    /// The sections a table of this kind must hold, in file order.
+    pub const fn sections(self) -> &'static [SectionKind] {
+        match self {
+            TableKind::Precomputed => &[
+                SectionKind::VertexSlot,
+                SectionKind::FreeVertex,
+                SectionKind::RestPositions,
+                SectionKind::SurfaceTriangles,
+                SectionKind::ComplianceSurface,
+                SectionKind::ComplianceInterior,
+            ],
+        }
+    }
+}
 
 /// One entry of the section directory.
 #[repr(C)]
@@ -99,8 +129,8 @@ pub struct SectionEntry {
 pub const SECTION_ENTRY_LEN: usize = core::mem::size_of::<SectionEntry>();
 const _: () = assert!(SECTION_ENTRY_LEN == 24);
 
-/// What a section holds. Each kind occurs at most once; all are required in
-/// version 1.
+/// What a section holds. Each kind occurs at most once; which are required
+/// depends on the [`TableKind`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
 pub enum SectionKind {
@@ -119,7 +149,7 @@ pub enum SectionKind {
 }
 
 impl SectionKind {
-    /// All kinds of format version 1, in file order.
+    /// Every section kind this version knows.
     pub const ALL: [SectionKind; 6] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,

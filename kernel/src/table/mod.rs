@@ -5,12 +5,13 @@
 //! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
 //! diagonal blocks); afterwards the step path trusts it.
 
+mod container;
 mod error;
 pub mod format;
-mod view;
+mod precomputed;
 
 pub use error::LoadError;
-pub use view::PrecomputedTable;
+pub use precomputed::PrecomputedTable;
 
 /// A byte buffer aligned to 16 bytes ([`format::SECTION_ALIGN`]), so that table
 /// sections can be viewed in place. Use [`crate::include_table!`] for tables

@@ -3,10 +3,8 @@
 use nalgebra::Matrix3;
 
 use super::LoadError;
-use super::format::{
-    self, CRC_LEN, FIXED_SLOT, HEADER_LEN, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
-    SectionEntry, SectionKind,
-};
+use super::container::{Container, check_finite};
+use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TableKind};
 use crate::Real;
 
 /// A pre-computed table that passed every load-time check; the step path
@@ -30,31 +28,24 @@ pub struct PrecomputedTable<'a, T: Real> {
     interior: &'a [[T; 9]],
 }
 
-/// The sections of a table, located but not yet checked for content.
-struct Located<'a> {
-    by_kind: [Option<&'a [u8]>; SectionKind::ALL.len()],
-}
-
 impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// Validates `bytes` once and returns the view (format in
-    /// [`super::format`]). Checks, in order: length, magic, version, declared
-    /// length, CRC-32, scalar width, header counts, material, section
-    /// directory (kinds, sizes, bounds, alignment), vertex maps, triangle
-    /// indices, finite floats, SPD diagonal compliance blocks.
+    /// [`super::format`]): the container checks (length, magic, version,
+    /// declared length, CRC-32, table kind, scalar width, header counts,
+    /// material, section directory), then vertex maps, triangle indices,
+    /// finite floats and SPD diagonal compliance blocks.
     ///
     /// Cost: linear in the table size. Not for the step path.
     pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
-        let header = read_header(bytes)?;
-        check_header::<T>(&header, bytes)?;
-        let located = locate_sections::<T>(&header, bytes)?;
+        let c = Container::parse::<T>(bytes, TableKind::Precomputed)?;
         let table = Self {
-            header,
-            vertex_slot: cast(&located, SectionKind::VertexSlot)?,
-            free_vertex: cast(&located, SectionKind::FreeVertex)?,
-            rest_positions: cast(&located, SectionKind::RestPositions)?,
-            triangles: cast(&located, SectionKind::SurfaceTriangles)?,
-            surface: cast(&located, SectionKind::ComplianceSurface)?,
-            interior: cast(&located, SectionKind::ComplianceInterior)?,
+            header: c.header,
+            vertex_slot: c.section(SectionKind::VertexSlot)?,
+            free_vertex: c.section(SectionKind::FreeVertex)?,
+            rest_positions: c.section(SectionKind::RestPositions)?,
+            triangles: c.section(SectionKind::SurfaceTriangles)?,
+            surface: c.section(SectionKind::ComplianceSurface)?,
+            interior: c.section(SectionKind::ComplianceInterior)?,
         };
         table.check_vertex_maps()?;
         table.check_triangles()?;
@@ -211,136 +202,5 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             }
         }
         Ok(())
-    }
-}
-
-fn read_header(bytes: &[u8]) -> Result<RawHeader, LoadError> {
-    let too_short = LoadError::TooShort { len: bytes.len() };
-    if bytes.len() < HEADER_LEN + CRC_LEN {
-        return Err(too_short);
-    }
-    let raw = bytes.get(..HEADER_LEN).ok_or(too_short)?;
-    Ok(bytemuck::pod_read_unaligned(raw))
-}
-
-fn check_header<T: Real>(h: &RawHeader, bytes: &[u8]) -> Result<(), LoadError> {
-    if h.magic != format::MAGIC {
-        return Err(LoadError::BadMagic);
-    }
-    if h.format_version != format::FORMAT_VERSION {
-        return Err(LoadError::UnsupportedVersion {
-            found: h.format_version,
-        });
-    }
-    if h.file_len != bytes.len() as u64 {
-        return Err(LoadError::LengthMismatch {
-            declared: h.file_len,
-            actual: bytes.len(),
-        });
-    }
-    let body_len = bytes.len() - CRC_LEN;
-    let (body, trailer) = bytes.split_at(body_len);
-    let stored = u32::from_le_bytes(
-        trailer
-            .try_into()
-            .map_err(|_| LoadError::TooShort { len: bytes.len() })?,
-    );
-    let computed = crc::Crc::<u32>::new(&format::CRC32).checksum(body);
-    if stored != computed {
-        return Err(LoadError::ChecksumMismatch { stored, computed });
-    }
-    if h.scalar_bytes != T::BYTES {
-        return Err(LoadError::ScalarMismatch {
-            table: h.scalar_bytes,
-            requested: T::BYTES,
-        });
-    }
-    let directory_len = (h.section_count as usize).checked_mul(SECTION_ENTRY_LEN);
-    let header_len = directory_len.and_then(|d| d.checked_add(HEADER_LEN));
-    if header_len != Some(h.header_len as usize)
-        || h.header_len as usize > body_len
-        || h.free_count > h.vertex_count
-        || h.touchable_count > h.free_count
-        || h.reserved != 0
-    {
-        return Err(LoadError::InconsistentHeader);
-    }
-    let material_ok = h.young_pa.is_finite()
-        && h.young_pa > 0.0
-        && h.poisson.is_finite()
-        && (0.0..0.5).contains(&h.poisson);
-    if !material_ok {
-        return Err(LoadError::BadMaterial);
-    }
-    Ok(())
-}
-
-fn locate_sections<'a, T: Real>(h: &RawHeader, bytes: &'a [u8]) -> Result<Located<'a>, LoadError> {
-    let body_len = bytes.len() - CRC_LEN;
-    let directory = bytes
-        .get(HEADER_LEN..h.header_len as usize)
-        .ok_or(LoadError::InconsistentHeader)?;
-    let mut located = Located {
-        by_kind: [None; SectionKind::ALL.len()],
-    };
-    for raw in directory.chunks_exact(SECTION_ENTRY_LEN) {
-        let entry: SectionEntry = bytemuck::pod_read_unaligned(raw);
-        let (slot, kind) = SectionKind::ALL
-            .iter()
-            .enumerate()
-            .find(|(_, k)| **k as u32 == entry.kind)
-            .ok_or(LoadError::UnknownSection { kind: entry.kind })?;
-        let expected = kind.expected_count(h);
-        if entry.elem_bytes != kind.elem_bytes(T::BYTES) || expected != Some(entry.count) {
-            return Err(LoadError::SectionSize { kind: *kind });
-        }
-        let bounds = LoadError::SectionBounds { kind: *kind };
-        let len = entry
-            .count
-            .checked_mul(u64::from(entry.elem_bytes))
-            .ok_or(bounds)?;
-        let end = entry.offset.checked_add(len).ok_or(bounds)?;
-        if entry.offset < u64::from(h.header_len)
-            || end > body_len as u64
-            || entry.offset % SECTION_ALIGN as u64 != 0
-        {
-            return Err(bounds);
-        }
-        let section = bytes
-            .get(entry.offset as usize..end as usize)
-            .ok_or(bounds)?;
-        let target = located.by_kind.get_mut(slot).ok_or(bounds)?;
-        if target.is_some() {
-            return Err(LoadError::DuplicateSection { kind: *kind });
-        }
-        *target = Some(section);
-    }
-    Ok(located)
-}
-
-fn cast<'a, E: bytemuck::Pod>(
-    located: &Located<'a>,
-    kind: SectionKind,
-) -> Result<&'a [E], LoadError> {
-    let slot = SectionKind::ALL.iter().position(|k| *k == kind);
-    let bytes = slot
-        .and_then(|s| located.by_kind.get(s).copied().flatten())
-        .ok_or(LoadError::MissingSection { kind })?;
-    bytemuck::try_cast_slice(bytes).map_err(|_| LoadError::Misaligned { kind })
-}
-
-fn check_finite<T: Real, const L: usize>(
-    kind: SectionKind,
-    items: &[[T; L]],
-) -> Result<(), LoadError> {
-    match items
-        .iter()
-        .position(|item| !item.iter().all(|x| x.finite()))
-    {
-        Some(index) => Err(LoadError::NonFinite {
-            kind,
-            index: index as u64,
-        }),
-        None => Ok(()),
     }
 }
