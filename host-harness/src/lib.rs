@@ -10,4 +10,5 @@ pub mod fix;
 pub mod mesh;
 pub mod output;
 pub mod precomputed;
+pub mod replay;
 pub mod tables;

@@ -214,7 +214,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             let file = TableFile::read(&table)?;
             let text = std::fs::read_to_string(&sequence)
                 .with_context(|| format!("{}: cannot read", sequence.display()))?;
-            print!("{}", palpate::replay::replay(file.bytes(), &text)?);
+            print!("{}", palpate::replay::replay(&file, &text)?);
             Ok(())
         }
         Command::Demo { out } => palpate::demo::run(&out),

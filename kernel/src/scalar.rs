@@ -6,7 +6,12 @@ use nalgebra::RealField;
 ///
 /// Implemented for `f32` (firmware, the default table precision) and `f64`
 /// (verification against reference FEM data).
-pub trait Real: RealField + Copy + bytemuck::Pod + Default + PartialOrd {
+///
+/// `FromStr` lets scripts and command lines be parsed straight into the
+/// scalar, with the same rounding on host and firmware.
+pub trait Real:
+    RealField + Copy + bytemuck::Pod + Default + PartialOrd + core::str::FromStr
+{
     /// Bytes per stored value; written in the table header so an `f32` table is
     /// never read as `f64`.
     const BYTES: u32;

@@ -1,0 +1,22 @@
+//! `palpate precomputed replay`: the firmware's scripted sequence run on the
+//! host through the same code ([`palpate_script::replay`]), so the two
+//! outputs can be compared byte for byte (`tools/firmware-check.sh`).
+
+use anyhow::{Context, bail};
+
+use crate::tables::load::{AnyModel, TableFile};
+
+/// Replays `sequence` on an f32 table and returns the output lines (format:
+/// `palpate_script` crate docs).
+pub fn replay(file: &TableFile, sequence: &str) -> anyhow::Result<String> {
+    let model = match file.model().context("invalid table")? {
+        AnyModel::F32(model) => model,
+        AnyModel::F64(_) => {
+            bail!("replay runs the firmware precision: build the table with --precision f32")
+        }
+    };
+    let mut displacements = vec![[0.0f32; 3]; model.table().vertex_count()];
+    let mut out = String::new();
+    palpate_script::replay(&model, sequence, &mut displacements, &mut out)?;
+    Ok(out)
+}
