@@ -8,6 +8,7 @@ use palpate::fem::assembly::FreeOrdering;
 use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
 use palpate::tables::compliance::{Compliance, Solver, compute_compliance};
+use palpate_kernel::table::format::surface_block_index;
 use palpate_tests::{
     boundary_vertices, kuhn_box, read_reference_json, read_reference_tetgen, rel_max_diff,
 };
@@ -29,9 +30,9 @@ fn block(c: &Compliance, o: &FreeOrdering, n: usize, k: usize) -> [[f64; 3]; 3] 
     let i_count = o.free_count() - s;
     let (flat, transpose) = if n < s {
         if n <= k {
-            (c.surface[Compliance::surface_index(n, k)], false)
+            (c.surface[surface_block_index(n, k)], false)
         } else {
-            (c.surface[Compliance::surface_index(k, n)], true)
+            (c.surface[surface_block_index(k, n)], true)
         }
     } else {
         (c.interior[k * i_count + (n - s)], false)

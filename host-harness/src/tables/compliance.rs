@@ -4,6 +4,7 @@
 use anyhow::{Context, ensure};
 use faer::Mat;
 use indicatif::{ProgressBar, ProgressStyle};
+use palpate_kernel::table::format::surface_block_index;
 
 use super::cg::JacobiCg;
 use crate::fem::assembly::{FreeOrdering, NO_SLOT, assemble_restricted};
@@ -39,18 +40,11 @@ pub enum Solver {
 /// `C_{k,n} = C_{n,k}ᵀ` gives the lower surface blocks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Compliance {
-    /// Surface–surface blocks `C_{n,k}`, `n ≤ k < S`, packed upper by columns.
+    /// Surface–surface blocks `C_{n,k}`, `n ≤ k < S`, packed upper by columns
+    /// (index [`surface_block_index`]`(n, k)`, the kernel's own layout).
     pub surface: Vec<[f64; 9]>,
     /// Interior–surface blocks `C_{S+i,k}`, column-major (`k·I + i`).
     pub interior: Vec<[f64; 9]>,
-}
-
-impl Compliance {
-    /// Index of block `C_{n,k}` (`n ≤ k < S`) in [`Self::surface`].
-    pub fn surface_index(n: usize, k: usize) -> usize {
-        debug_assert!(n <= k);
-        k * (k + 1) / 2 + n
-    }
 }
 
 /// Touchable vertices per batch of right-hand sides (3 columns each).
@@ -146,7 +140,7 @@ pub fn compute_compliance(
                 blk
             };
             for n in 0..=k {
-                out.surface[Compliance::surface_index(n, k)] = block(n);
+                out.surface[surface_block_index(n, k)] = block(n);
             }
             for i in 0..interior_count {
                 out.interior[k * interior_count + i] = block(s + i);

@@ -47,12 +47,12 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
     }
 
     /// `-Σ g_p`: the force the tissue applies to the tool, what the haptic
-    /// device renders, N.
+    /// device renders, N. Without contact it is `+0` in every component
+    /// (subtracting from zero, not negating a sum, so no `-0` reaches the device).
     pub fn device_force_n(&self) -> Vector3<T> {
-        -self
-            .contact_forces_n()
+        self.contact_forces_n()
             .iter()
-            .fold(Vector3::zeros(), |acc, g| acc + g)
+            .fold(Vector3::zeros(), |acc, g| acc - g)
     }
 
     fn resolved(&self) -> impl Iterator<Item = (&ResolvedPoint<T>, &Vector3<T>)> {

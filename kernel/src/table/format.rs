@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! offset 0            RawHeader (96 bytes)
-//! offset 80           SectionEntry × section_count (24 bytes each)
+//! offset 96           SectionEntry × section_count (24 bytes each)
 //! …                   sections, each starting at a multiple of SECTION_ALIGN
 //! file_len - 4        CRC-32/ISO-HDLC of bytes [0, file_len - 4), little-endian
 //! ```
