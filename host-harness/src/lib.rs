@@ -5,6 +5,7 @@
 //! (`palpate_kernel`) → [`precomputed`] / [`demo`] / [`replay`] (runs and reports).
 
 pub mod demo;
+pub mod dynamic;
 pub mod fem;
 pub mod fix;
 pub mod mesh;

@@ -25,9 +25,11 @@
     clippy::indexing_slicing
 )]
 
+pub mod element;
 pub mod precomputed;
 pub mod scalar;
 pub mod table;
+pub mod tensor_mass;
 
 pub use precomputed::{Contact, ContactError, ContactPoint, ContactSolution, PrecomputedModel};
 pub use scalar::Real;

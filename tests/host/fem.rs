@@ -8,7 +8,9 @@ use palpate::fem::assembly::{FreeOrdering, assemble_stiffness};
 use palpate::fem::element::{element_stiffness, shape_gradients};
 use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
-use palpate_tests::{read_reference_json, read_reference_tetgen, reference_dir, rel_max_diff};
+use palpate_tests::{
+    read_reference_json, read_reference_stiffness, read_reference_tetgen, rel_max_diff,
+};
 
 type Ke = [[[[f64; 3]; 3]; 4]; 4];
 
@@ -198,20 +200,7 @@ fn cube_k() -> faer::sparse::SparseColMat<usize, f64> {
 #[test]
 fn global_k_matches_reference_csv() {
     let k = cube_k();
-    let text = std::fs::read_to_string(reference_dir().join("linear/cube_K.csv")).unwrap();
-    let mut reference = std::collections::HashMap::new();
-    for line in text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.starts_with("row"))
-    {
-        let f: Vec<&str> = line.split(',').collect();
-        let (r, c, v): (usize, usize, f64) = (
-            f[0].parse().unwrap(),
-            f[1].parse().unwrap(),
-            f[2].parse().unwrap(),
-        );
-        reference.insert((r, c), v);
-    }
+    let reference = read_reference_stiffness();
     assert_eq!(reference.len(), 18372);
     let scale = reference.values().fold(0.0f64, |m, x| m.max(x.abs()));
     assert_eq!(k.nrows(), 648);

@@ -193,3 +193,18 @@ pub fn json_rows(v: &serde_json::Value) -> Vec<[f64; 3]> {
         })
         .collect()
 }
+
+/// `shared/reference/linear/cube_K.csv`: the global stiffness of `cube`
+/// (E = 5000 Pa, ν = 0.45) as `(row, col) → value` (DOF `3·vertex + axis`, N/m).
+pub fn read_reference_stiffness() -> std::collections::HashMap<(usize, usize), f64> {
+    let text =
+        std::fs::read_to_string(reference_dir().join("linear/cube_K.csv")).expect("cube_K.csv");
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("row"))
+        .map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            let parse = |i: usize| f[i].trim().parse::<f64>().expect("number");
+            ((parse(0) as usize, parse(1) as usize), parse(2))
+        })
+        .collect()
+}

@@ -1,5 +1,8 @@
 //! The linear P1 tetrahedron (`MODELS.md` §1; Cotin RR-3510 §4).
 
+use nalgebra::Vector3;
+use palpate_kernel::element::stiffness_block;
+
 use super::material::Material;
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -52,29 +55,18 @@ pub fn shape_gradients(p: &[[f64; 3]; 4]) -> ([[f64; 3]; 4], f64) {
 /// blocks of 3×3 in N/m: `K[j][k][a][b] = ∂f_{j,a}/∂u_{k,b}` with the sign
 /// convention `f_j = -Σ_k K_jk u_k` (elastic force on vertex `j`).
 ///
-/// `K_jk = |V| (λ a_j a_kᵀ + μ a_k a_jᵀ + μ (a_j·a_k) I)` (`MODELS.md` §1,
-/// Cotin RR-3510 §4), i.e. the Hessian of the strain energy
-/// `W = |V| (λ/2 (tr ε)² + μ ε:ε)`. `K_kj = K_jkᵀ`. Using `|V|` makes the
-/// result independent of the vertex orientation.
+/// Each block is the kernel's [`stiffness_block`] (`MODELS.md` §1), the Hessian
+/// of the strain energy `W = |V| (λ/2 (tr ε)² + μ ε:ε)`, so host assembly and
+/// kernel tet removal use one formula. Using `|V|` makes the result
+/// independent of the vertex orientation.
 pub fn element_stiffness(p: &[[f64; 3]; 4], m: &Material) -> [[[[f64; 3]; 3]; 4]; 4] {
     let (a, v) = shape_gradients(p);
-    let v = v.abs();
+    let a = a.map(Vector3::from);
     let (lambda, mu) = m.lame();
-    let mut k = [[[[0.0; 3]; 3]; 4]; 4];
-    for j in 0..4 {
-        for kk in 0..4 {
-            let d = mu * dot(a[j], a[kk]);
-            let blk = &mut k[j][kk];
-            for r in 0..3 {
-                for c in 0..3 {
-                    let mut x = lambda * a[j][r] * a[kk][c] + mu * a[kk][r] * a[j][c];
-                    if r == c {
-                        x += d;
-                    }
-                    blk[r][c] = v * x;
-                }
-            }
-        }
-    }
-    k
+    core::array::from_fn(|j| {
+        core::array::from_fn(|k| {
+            let block = stiffness_block(&a[j], &a[k], v.abs(), lambda, mu);
+            core::array::from_fn(|r| core::array::from_fn(|c| block[(r, c)]))
+        })
+    })
 }

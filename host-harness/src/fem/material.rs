@@ -36,9 +36,6 @@ impl Material {
     /// Lamé coefficients `(lambda, mu)` in Pa (`MODELS.md` §1):
     /// `lambda = E nu / ((1 + nu)(1 - 2 nu))`, `mu = E / (2 (1 + nu))`.
     pub fn lame(&self) -> (f64, f64) {
-        let (e, nu) = (self.young_pa, self.poisson);
-        let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-        let mu = e / (2.0 * (1.0 + nu));
-        (lambda, mu)
+        palpate_kernel::element::lame(self.young_pa, self.poisson)
     }
 }

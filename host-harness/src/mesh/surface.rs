@@ -2,6 +2,10 @@
 
 use std::collections::HashMap;
 
+// The four faces of a positively oriented tet, each with an outward right-hand normal (the
+// kernel's convention, shared with the tensor-mass face neighbours).
+use palpate_kernel::table::format::tet_face_vertices as faces;
+
 use super::TetMesh;
 
 /// Boundary surface of a tet mesh: the faces that belong to exactly one tet.
@@ -14,12 +18,6 @@ pub struct Surface {
     pub triangles: Vec<[u32; 3]>,
     /// Vertices used by some boundary triangle: sorted ascending, unique.
     pub vertices: Vec<u32>,
-}
-
-/// The four faces of a positively oriented tet, each with an outward right-hand normal.
-fn faces(t: [u32; 4]) -> [[u32; 3]; 4] {
-    let [a, b, c, d] = t;
-    [[b, c, d], [a, d, c], [a, b, d], [a, c, b]]
 }
 
 fn sorted3(mut f: [u32; 3]) -> [u32; 3] {

@@ -101,6 +101,24 @@ pub enum LoadError {
         /// Element index within it.
         index: u64,
     },
+    /// The CSR edge list is broken at this vertex's row (row starts not
+    /// ascending from 0 to E, a column not in `i+1..N`, columns not ascending).
+    BadEdges {
+        /// Vertex (row) index.
+        vertex: u32,
+    },
+    /// A tet references a vertex, edge or neighbour that does not exist or does
+    /// not match, or has a non-positive rest volume.
+    BadTet {
+        /// Tet index.
+        tet: u32,
+    },
+    /// A lumped mass or vertex tensor is invalid (negative mass, asymmetric
+    /// `K_ii`).
+    BadVertexData {
+        /// Vertex index.
+        vertex: u32,
+    },
     /// A diagonal compliance block `C_kk` is not symmetric positive definite.
     NotPositiveDefinite {
         /// Touchable index `k` (free index; the vertex is `free-vertex[k]`).
@@ -165,6 +183,17 @@ impl fmt::Display for LoadError {
                     kind.name()
                 )
             }
+            LoadError::BadEdges { vertex } => {
+                write!(f, "edge list broken at the row of vertex {vertex}")
+            }
+            LoadError::BadTet { tet } => write!(
+                f,
+                "tet {tet}: bad vertex, edge or neighbour reference, or non-positive rest volume"
+            ),
+            LoadError::BadVertexData { vertex } => write!(
+                f,
+                "vertex {vertex}: negative lumped mass or asymmetric vertex tensor"
+            ),
             LoadError::NotPositiveDefinite { touchable } => write!(
                 f,
                 "compliance block C_kk of touchable index {touchable} is not symmetric positive definite"

@@ -93,6 +93,9 @@ const _: () = assert!(HEADER_LEN == 96);
 pub enum TableKind {
     /// The pre-computed quasi-static model (RR-3510 §4).
     Precomputed = 1,
+    /// The dynamic tensor-mass model (RR-3510 §5): stiffness on vertices and
+    /// edges, lumped masses, per-tet rest data for local removal.
+    TensorMass = 2,
 }
 
 impl TableKind {
@@ -106,6 +109,20 @@ impl TableKind {
                 SectionKind::SurfaceTriangles,
                 SectionKind::ComplianceSurface,
                 SectionKind::ComplianceInterior,
+            ],
+            TableKind::TensorMass => &[
+                SectionKind::VertexSlot,
+                SectionKind::RestPositions,
+                SectionKind::SurfaceTriangles,
+                SectionKind::LumpedMass,
+                SectionKind::VertexTensor,
+                SectionKind::EdgeRowStart,
+                SectionKind::EdgeColumn,
+                SectionKind::EdgeTensor,
+                SectionKind::Tet,
+                SectionKind::TetEdge,
+                SectionKind::TetShape,
+                SectionKind::TetNeighbour,
             ],
         }
     }
@@ -146,26 +163,91 @@ pub enum SectionKind {
     ComplianceSurface = 5,
     /// `[scalar; 9]` × (F−S)·S: compliance of interior rows, m/N.
     ComplianceInterior = 6,
+    /// `scalar` × N: lumped vertex masses `m_i = ρ Σ_{tets ∋ i} V/4`, kg.
+    LumpedMass = 16,
+    /// `[scalar; 9]` × N: vertex tensors `K_ii`, row-major, N/m.
+    VertexTensor = 17,
+    /// `u32` × (N+1): CSR row starts of the edge list; the edges `(i, j)`,
+    /// `i < j`, of vertex `i` are `row_start[i]..row_start[i+1]`.
+    EdgeRowStart = 18,
+    /// `u32` × E: the other end `j > i` of each edge, ascending within a row.
+    EdgeColumn = 19,
+    /// `[scalar; 9]` × E: edge tensors `K_ij` (`i < j`, row-major, N/m);
+    /// `K_ji = K_ijᵀ` is not stored.
+    EdgeTensor = 20,
+    /// `[u32; 4]` × tet_count: tet vertices, positively oriented.
+    Tet = 21,
+    /// `[u32; 6]` × tet_count: edge index of the tet's vertex pairs
+    /// [`tet_edge_vertices`].
+    TetEdge = 22,
+    /// `[scalar; 13]` × tet_count: rest shape-function gradients `a_0..a_3`
+    /// (1/m, 12 values) and rest volume (m³), to recompute and subtract the
+    /// tet's stiffness blocks when it is removed.
+    TetShape = 23,
+    /// `[u32; 4]` × tet_count: the tet across the face opposite each vertex,
+    /// or [`NO_NEIGHBOUR`] on the boundary.
+    TetNeighbour = 24,
 }
+
+/// The vertex pairs of a tet's six edges, in [`SectionKind::TetEdge`] order:
+/// local pairs (0,1), (0,2), (0,3), (1,2), (1,3), (2,3).
+pub const fn tet_edge_vertices(tet: [u32; 4]) -> [[u32; 2]; 6] {
+    let [a, b, c, d] = tet;
+    [[a, b], [a, c], [a, d], [b, c], [b, d], [c, d]]
+}
+
+/// The faces of a positively oriented tet, face `j` opposite local vertex `j`,
+/// each ordered so its right-hand normal points out of the tet.
+pub const fn tet_face_vertices(tet: [u32; 4]) -> [[u32; 3]; 4] {
+    let [a, b, c, d] = tet;
+    [[b, c, d], [a, d, c], [a, b, d], [a, c, b]]
+}
+
+/// The local vertex pairs `(j, k)` of [`tet_edge_vertices`], for code that
+/// needs local indices (stiffness blocks `K_jk`).
+pub const TET_EDGE_PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+/// Marks a boundary face in [`SectionKind::TetNeighbour`].
+pub const NO_NEIGHBOUR: u32 = u32::MAX;
+/// Scalars per [`SectionKind::TetShape`] element.
+pub const TET_SHAPE_LEN: usize = 13;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 6] = [
+    pub const ALL: [SectionKind; 15] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
         SectionKind::SurfaceTriangles,
         SectionKind::ComplianceSurface,
         SectionKind::ComplianceInterior,
+        SectionKind::LumpedMass,
+        SectionKind::VertexTensor,
+        SectionKind::EdgeRowStart,
+        SectionKind::EdgeColumn,
+        SectionKind::EdgeTensor,
+        SectionKind::Tet,
+        SectionKind::TetEdge,
+        SectionKind::TetShape,
+        SectionKind::TetNeighbour,
     ];
 
     /// Bytes per element for a table whose floats have `scalar_bytes` bytes.
     pub const fn elem_bytes(self, scalar_bytes: u32) -> u32 {
         match self {
-            SectionKind::VertexSlot | SectionKind::FreeVertex => 4,
+            SectionKind::VertexSlot
+            | SectionKind::FreeVertex
+            | SectionKind::EdgeRowStart
+            | SectionKind::EdgeColumn => 4,
             SectionKind::RestPositions => 3 * scalar_bytes,
             SectionKind::SurfaceTriangles => 12,
-            SectionKind::ComplianceSurface | SectionKind::ComplianceInterior => 9 * scalar_bytes,
+            SectionKind::ComplianceSurface
+            | SectionKind::ComplianceInterior
+            | SectionKind::VertexTensor
+            | SectionKind::EdgeTensor => 9 * scalar_bytes,
+            SectionKind::LumpedMass => scalar_bytes,
+            SectionKind::Tet | SectionKind::TetNeighbour => 16,
+            SectionKind::TetEdge => 24,
+            SectionKind::TetShape => TET_SHAPE_LEN as u32 * scalar_bytes,
         }
     }
 
@@ -174,8 +256,19 @@ impl SectionKind {
         let n = u64::from(h.vertex_count);
         let f = u64::from(h.free_count);
         let s = u64::from(h.touchable_count);
+        let tets = u64::from(h.tet_count);
+        let edges = u64::from(h.edge_count);
         match self {
-            SectionKind::VertexSlot | SectionKind::RestPositions => Some(n),
+            SectionKind::VertexSlot
+            | SectionKind::RestPositions
+            | SectionKind::LumpedMass
+            | SectionKind::VertexTensor => Some(n),
+            SectionKind::EdgeRowStart => n.checked_add(1),
+            SectionKind::EdgeColumn | SectionKind::EdgeTensor => Some(edges),
+            SectionKind::Tet
+            | SectionKind::TetEdge
+            | SectionKind::TetShape
+            | SectionKind::TetNeighbour => Some(tets),
             SectionKind::FreeVertex => Some(f),
             SectionKind::SurfaceTriangles => Some(u64::from(h.triangle_count)),
             SectionKind::ComplianceSurface => s.checked_mul(s.checked_add(1)?).map(|x| x / 2),
@@ -192,6 +285,15 @@ impl SectionKind {
             SectionKind::SurfaceTriangles => "surface-triangles",
             SectionKind::ComplianceSurface => "compliance-surface",
             SectionKind::ComplianceInterior => "compliance-interior",
+            SectionKind::LumpedMass => "lumped-mass",
+            SectionKind::VertexTensor => "vertex-tensor",
+            SectionKind::EdgeRowStart => "edge-row-start",
+            SectionKind::EdgeColumn => "edge-column",
+            SectionKind::EdgeTensor => "edge-tensor",
+            SectionKind::Tet => "tet",
+            SectionKind::TetEdge => "tet-edge",
+            SectionKind::TetShape => "tet-shape",
+            SectionKind::TetNeighbour => "tet-neighbour",
         }
     }
 }

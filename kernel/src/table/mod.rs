@@ -9,9 +9,11 @@ mod container;
 mod error;
 pub mod format;
 mod precomputed;
+mod tensor_mass;
 
 pub use error::LoadError;
 pub use precomputed::PrecomputedTable;
+pub use tensor_mass::TensorMassTable;
 
 /// A byte buffer aligned to 16 bytes ([`format::SECTION_ALIGN`]), so that table
 /// sections can be viewed in place. Use [`crate::include_table!`] for tables

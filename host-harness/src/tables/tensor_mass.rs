@@ -1,0 +1,232 @@
+//! Tensor-mass arrays (RR-3510 §5, MODELS.md §1 and §3) and their table file:
+//! vertex tensors `K_ii`, edge tensors `K_ij` on a CSR edge list (each edge
+//! once), lumped masses, and per tet its vertices, edge references, rest
+//! shape data and face neighbours.
+
+use std::collections::HashMap;
+
+use anyhow::bail;
+use bytemuck::Zeroable;
+use nalgebra::Vector3;
+use palpate_kernel::element::stiffness_block;
+use palpate_kernel::table::format::{
+    FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS, TET_SHAPE_LEN, TableKind,
+    tet_edge_vertices, tet_face_vertices,
+};
+
+use super::file::{Precision, Section, write_container};
+use crate::fem::element::shape_gradients;
+use crate::fem::material::Material;
+use crate::fix::FixPredicate;
+use crate::mesh::{MeshReport, TetMesh, boundary_surface};
+
+/// The arrays of a tensor-mass table, in f64 before rounding.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TensorMassArrays {
+    /// `true` for fixed vertices (N).
+    pub fixed: Vec<bool>,
+    /// Lumped masses `ρ Σ V/4`, kg (N).
+    pub masses_kg: Vec<f64>,
+    /// `K_ii`, row-major, N/m (N).
+    pub vertex_tensors: Vec<[f64; 9]>,
+    /// CSR row starts (N + 1).
+    pub row_start: Vec<u32>,
+    /// CSR columns `j > i` (E).
+    pub column: Vec<u32>,
+    /// `K_ij`, `i < j`, row-major, N/m (E).
+    pub edge_tensors: Vec<[f64; 9]>,
+    /// Edge index of each tet's vertex pairs, `tet_edge_vertices` order.
+    pub tet_edges: Vec<[u32; 6]>,
+    /// Rest gradients `a_0..a_3` (1/m) and volume (m³) per tet.
+    pub tet_shapes: Vec<[f64; TET_SHAPE_LEN]>,
+    /// Tet across the face opposite each vertex, or `NO_NEIGHBOUR`.
+    pub neighbours: Vec<[u32; 4]>,
+}
+
+impl TensorMassArrays {
+    /// Assembles the arrays of `mesh` (positions in m) for `material`,
+    /// density `density_kg_m3` and the `fixed` flags (one per vertex). Every
+    /// block comes from the kernel's `stiffness_block`, the formula the
+    /// kernel subtracts when it removes a tet.
+    pub fn new(mesh: &TetMesh, material: &Material, density_kg_m3: f64, fixed: Vec<bool>) -> Self {
+        let n = mesh.positions.len();
+        let (lambda, mu) = material.lame();
+        let (row_start, column) = edge_csr(n, &mesh.tets);
+        let edge_index = |a: u32, b: u32| -> u32 {
+            let (lo, hi) = (a.min(b), a.max(b));
+            let start = row_start[lo as usize];
+            let row = &column[start as usize..row_start[lo as usize + 1] as usize];
+            start + row.binary_search(&hi).expect("edge of a tet is in the CSR") as u32
+        };
+        let mut arrays = Self {
+            fixed,
+            masses_kg: vec![0.0; n],
+            vertex_tensors: vec![[0.0; 9]; n],
+            edge_tensors: vec![[0.0; 9]; column.len()],
+            tet_edges: Vec::with_capacity(mesh.tets.len()),
+            tet_shapes: Vec::with_capacity(mesh.tets.len()),
+            neighbours: face_neighbours(&mesh.tets),
+            row_start: row_start.clone(),
+            column: column.clone(),
+        };
+        for tet in &mesh.tets {
+            let p = tet.map(|v| mesh.positions[v as usize]);
+            let (a, volume) = shape_gradients(&p);
+            let a = a.map(Vector3::from);
+            let block = |j: usize, k: usize| -> [f64; 9] {
+                let b = stiffness_block(&a[j], &a[k], volume, lambda, mu);
+                core::array::from_fn(|e| b[(e / 3, e % 3)])
+            };
+            for (j, &v) in tet.iter().enumerate() {
+                add(&mut arrays.vertex_tensors[v as usize], &block(j, j));
+                arrays.masses_kg[v as usize] += density_kg_m3 * volume / 4.0;
+            }
+            let edges = tet_edge_vertices(*tet).map(|[a, b]| edge_index(a, b));
+            for (&[j, k], &e) in TET_EDGE_PAIRS.iter().zip(&edges) {
+                // The stored tensor couples the lower vertex (row) to the higher.
+                let (row, col) = if tet[j] < tet[k] { (j, k) } else { (k, j) };
+                add(&mut arrays.edge_tensors[e as usize], &block(row, col));
+            }
+            arrays.tet_edges.push(edges);
+            let mut shape = [0.0; TET_SHAPE_LEN];
+            for (j, aj) in a.iter().enumerate() {
+                shape[3 * j..3 * j + 3].copy_from_slice(aj.as_slice());
+            }
+            shape[12] = volume;
+            arrays.tet_shapes.push(shape);
+        }
+        arrays
+    }
+}
+
+fn add(target: &mut [f64; 9], block: &[f64; 9]) {
+    for (t, b) in target.iter_mut().zip(block) {
+        *t += b;
+    }
+}
+
+/// The edges `(i, j)`, `i < j`, of every tet as a CSR: row starts (N + 1)
+/// and ascending columns.
+fn edge_csr(n: usize, tets: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
+    let mut pairs: Vec<[u32; 2]> = tets
+        .iter()
+        .flat_map(|&t| tet_edge_vertices(t))
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut row_start = vec![0u32; n + 1];
+    for &[i, _] in &pairs {
+        row_start[i as usize + 1] += 1;
+    }
+    for i in 0..n {
+        row_start[i + 1] += row_start[i];
+    }
+    (row_start, pairs.iter().map(|&[_, j]| j).collect())
+}
+
+/// For each tet and local face (opposite vertex `j`), the tet sharing it.
+fn face_neighbours(tets: &[[u32; 4]]) -> Vec<[u32; 4]> {
+    let mut owner: HashMap<[u32; 3], (u32, usize)> = HashMap::with_capacity(tets.len() * 2);
+    let mut neighbours = vec![[NO_NEIGHBOUR; 4]; tets.len()];
+    for (t, &tet) in tets.iter().enumerate() {
+        for (j, mut face) in tet_face_vertices(tet).into_iter().enumerate() {
+            face.sort_unstable();
+            if let Some((other, k)) = owner.remove(&face) {
+                neighbours[t][j] = other;
+                neighbours[other as usize][k] = t as u32;
+            } else {
+                owner.insert(face, (t as u32, j));
+            }
+        }
+    }
+    neighbours
+}
+
+/// Everything `dynamic` commands need to build a tensor-mass table.
+#[derive(Clone, Debug)]
+pub struct TensorMassOptions {
+    /// Young's modulus and Poisson ratio.
+    pub material: Material,
+    /// Mass density, kg/m³.
+    pub density_kg_m3: f64,
+    /// A vertex matching any predicate is fixed (none is allowed: a free body).
+    pub fix: Vec<FixPredicate>,
+    /// Stored float width.
+    pub precision: Precision,
+}
+
+/// Builds the tensor-mass table file of `mesh`. Unreferenced vertices are
+/// kept (numbering is the file's) and fixed (they have no mass).
+pub fn build_tensor_mass_table(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &TensorMassOptions,
+) -> anyhow::Result<Vec<u8>> {
+    if !(options.density_kg_m3.is_finite() && options.density_kg_m3 > 0.0) {
+        bail!(
+            "density must be finite and > 0 kg/m3, got {}",
+            options.density_kg_m3
+        );
+    }
+    let mut fixed: Vec<bool> = mesh
+        .positions
+        .iter()
+        .map(|p| options.fix.iter().any(|f| f.matches(p)))
+        .collect();
+    for &v in &report.unreferenced_vertices {
+        fixed[v as usize] = true;
+    }
+    let arrays = TensorMassArrays::new(mesh, &options.material, options.density_kg_m3, fixed);
+    Ok(write_tensor_mass_table(mesh, options, &arrays))
+}
+
+/// Serializes `arrays` of `mesh` (`TableKind::TensorMass`).
+pub fn write_tensor_mass_table(
+    mesh: &TetMesh,
+    options: &TensorMassOptions,
+    arrays: &TensorMassArrays,
+) -> Vec<u8> {
+    let vertex_slot: Vec<u32> = arrays
+        .fixed
+        .iter()
+        .scan(0u32, |free, &fixed| {
+            Some(if fixed {
+                FIXED_SLOT
+            } else {
+                *free += 1;
+                *free - 1
+            })
+        })
+        .collect();
+    let surface = boundary_surface(mesh);
+    let header = RawHeader {
+        table_kind: TableKind::TensorMass as u32,
+        vertex_count: mesh.positions.len() as u32,
+        tet_count: mesh.tets.len() as u32,
+        free_count: arrays.fixed.iter().filter(|&&f| !f).count() as u32,
+        triangle_count: surface.triangles.len() as u32,
+        edge_count: arrays.column.len() as u32,
+        young_pa: options.material.young_pa,
+        poisson: options.material.poisson,
+        density_kg_m3: options.density_kg_m3,
+        mesh_hash: mesh.content_hash(),
+        ..RawHeader::zeroed()
+    };
+    let p = options.precision;
+    let sections = [
+        Section::ints(SectionKind::VertexSlot, &vertex_slot),
+        Section::floats(SectionKind::RestPositions, &mesh.positions, p),
+        Section::ints(SectionKind::SurfaceTriangles, &surface.triangles),
+        Section::floats(SectionKind::LumpedMass, &arrays.masses_kg, p),
+        Section::floats(SectionKind::VertexTensor, &arrays.vertex_tensors, p),
+        Section::ints(SectionKind::EdgeRowStart, &arrays.row_start),
+        Section::ints(SectionKind::EdgeColumn, &arrays.column),
+        Section::floats(SectionKind::EdgeTensor, &arrays.edge_tensors, p),
+        Section::ints(SectionKind::Tet, &mesh.tets),
+        Section::ints(SectionKind::TetEdge, &arrays.tet_edges),
+        Section::floats(SectionKind::TetShape, &arrays.tet_shapes, p),
+        Section::ints(SectionKind::TetNeighbour, &arrays.neighbours),
+    ];
+    write_container(header, p, &sections)
+}

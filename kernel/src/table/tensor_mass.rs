@@ -1,0 +1,267 @@
+//! The validated, zero-copy view of a tensor-mass table (RR-3510 §5).
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::LoadError;
+use super::container::{Container, check_finite};
+use super::format::{
+    FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_SHAPE_LEN, TableKind, tet_edge_vertices,
+};
+use crate::Real;
+
+/// A tensor-mass table that passed every load-time check.
+///
+/// Invariants established by [`TensorMassTable::load`]:
+/// - the edge list is a CSR of the pairs `i < j`: row starts ascend from 0 to
+///   `E`, columns lie in `i+1..N` and ascend strictly within a row;
+/// - every tet has 4 distinct vertices `< N`, its 6 edge references name
+///   exactly the edges of its vertex pairs ([`tet_edge_vertices`]), its
+///   neighbours are `< tet_count` or [`NO_NEIGHBOUR`], and its rest volume is
+///   positive;
+/// - masses are `≥ 0`, vertex tensors symmetric, every float finite;
+/// - fixed vertices are marked [`FIXED_SLOT`] in the vertex-slot section and
+///   their number matches the header's free count.
+#[derive(Clone, Copy, Debug)]
+pub struct TensorMassTable<'a, T: Real> {
+    header: RawHeader,
+    vertex_slot: &'a [u32],
+    rest_positions: &'a [[T; 3]],
+    triangles: &'a [[u32; 3]],
+    masses: &'a [T],
+    vertex_tensors: &'a [[T; 9]],
+    row_start: &'a [u32],
+    column: &'a [u32],
+    edge_tensors: &'a [[T; 9]],
+    tets: &'a [[u32; 4]],
+    tet_edges: &'a [[u32; 6]],
+    tet_shapes: &'a [[T; TET_SHAPE_LEN]],
+    neighbours: &'a [[u32; 4]],
+}
+
+impl<'a, T: Real> TensorMassTable<'a, T> {
+    /// Validates `bytes` once and returns the view (format in
+    /// [`super::format`]). Cost: linear in the table size. Not for the step path.
+    pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
+        let c = Container::parse::<T>(bytes, TableKind::TensorMass)?;
+        let masses: &[T] = c.section(SectionKind::LumpedMass)?;
+        let table = Self {
+            header: c.header,
+            vertex_slot: c.section(SectionKind::VertexSlot)?,
+            rest_positions: c.section(SectionKind::RestPositions)?,
+            triangles: c.section(SectionKind::SurfaceTriangles)?,
+            masses,
+            vertex_tensors: c.section(SectionKind::VertexTensor)?,
+            row_start: c.section(SectionKind::EdgeRowStart)?,
+            column: c.section(SectionKind::EdgeColumn)?,
+            edge_tensors: c.section(SectionKind::EdgeTensor)?,
+            tets: c.section(SectionKind::Tet)?,
+            tet_edges: c.section(SectionKind::TetEdge)?,
+            tet_shapes: c.section(SectionKind::TetShape)?,
+            neighbours: c.section(SectionKind::TetNeighbour)?,
+        };
+        let fixed = table
+            .vertex_slot
+            .iter()
+            .filter(|&&s| s == FIXED_SLOT)
+            .count();
+        if table.vertex_count() - fixed != table.header.free_count as usize {
+            return Err(LoadError::InconsistentHeader);
+        }
+        check_finite(SectionKind::RestPositions, table.rest_positions)?;
+        check_finite(SectionKind::VertexTensor, table.vertex_tensors)?;
+        check_finite(SectionKind::EdgeTensor, table.edge_tensors)?;
+        check_finite(SectionKind::TetShape, table.tet_shapes)?;
+        table.check_vertices()?;
+        table.check_edges()?;
+        table.check_tets()?;
+        if let Some(t) = table
+            .triangles
+            .iter()
+            .position(|tri| tri.iter().any(|&v| v as usize >= table.vertex_count()))
+        {
+            return Err(LoadError::BadTriangle { triangle: t as u32 });
+        }
+        log::debug!(
+            "tensor-mass table loaded: {} vertices, {} edges, {} tets, {}-byte floats",
+            table.vertex_count(),
+            table.edge_count(),
+            table.tet_count(),
+            T::BYTES
+        );
+        Ok(table)
+    }
+
+    /// The header as stored.
+    pub fn header(&self) -> &RawHeader {
+        &self.header
+    }
+
+    /// Vertices (`N`).
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_slot.len()
+    }
+
+    /// Edges (`E`), each stored once.
+    pub fn edge_count(&self) -> usize {
+        self.column.len()
+    }
+
+    /// Tetrahedra.
+    pub fn tet_count(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// Lamé coefficients `(λ, μ)` of the table's material, Pa.
+    pub fn lame(&self) -> (T, T) {
+        let (lambda, mu) = crate::element::lame(self.header.young_pa, self.header.poisson);
+        (T::of_f64(lambda), T::of_f64(mu))
+    }
+
+    /// Mass density, kg/m³.
+    pub fn density_kg_m3(&self) -> f64 {
+        self.header.density_kg_m3
+    }
+
+    /// `true` if `vertex` is fixed by the table (out of range: `false`).
+    pub fn is_fixed(&self, vertex: u32) -> bool {
+        self.vertex_slot.get(vertex as usize) == Some(&FIXED_SLOT)
+    }
+
+    /// Rest positions, m.
+    pub fn rest_positions(&self) -> &'a [[T; 3]] {
+        self.rest_positions
+    }
+
+    /// Boundary surface triangles of the uncut mesh, outward normals.
+    pub fn surface_triangles(&self) -> &'a [[u32; 3]] {
+        self.triangles
+    }
+
+    /// Lumped masses of the uncut mesh, kg.
+    pub fn masses_kg(&self) -> &'a [T] {
+        self.masses
+    }
+
+    /// Vertex tensors `K_ii` of the uncut mesh, row-major, N/m.
+    pub fn vertex_tensors(&self) -> &'a [[T; 9]] {
+        self.vertex_tensors
+    }
+
+    /// Edge tensors `K_ij`, `i < j`, of the uncut mesh, row-major, N/m.
+    pub fn edge_tensors(&self) -> &'a [[T; 9]] {
+        self.edge_tensors
+    }
+
+    /// CSR row starts (`N + 1` entries).
+    pub fn edge_row_starts(&self) -> &'a [u32] {
+        self.row_start
+    }
+
+    /// CSR columns: the end `j > i` of each edge.
+    pub fn edge_columns(&self) -> &'a [u32] {
+        self.column
+    }
+
+    /// Tet vertices.
+    pub fn tets(&self) -> &'a [[u32; 4]] {
+        self.tets
+    }
+
+    /// Edge indices of each tet, in [`tet_edge_vertices`] order.
+    pub fn tet_edges(&self) -> &'a [[u32; 6]] {
+        self.tet_edges
+    }
+
+    /// Neighbour across the face opposite each local vertex, or [`NO_NEIGHBOUR`].
+    pub fn tet_neighbours(&self) -> &'a [[u32; 4]] {
+        self.neighbours
+    }
+
+    /// Rest shape-function gradients `a_0..a_3` (1/m) and rest volume (m³)
+    /// of `tet`; `None` out of range.
+    pub fn tet_shape(&self, tet: usize) -> Option<([Vector3<T>; 4], T)> {
+        let [x0, y0, z0, x1, y1, z1, x2, y2, z2, x3, y3, z3, volume] = *self.tet_shapes.get(tet)?;
+        let a = [
+            Vector3::new(x0, y0, z0),
+            Vector3::new(x1, y1, z1),
+            Vector3::new(x2, y2, z2),
+            Vector3::new(x3, y3, z3),
+        ];
+        Some((a, volume))
+    }
+
+    /// The edge `(i, j)` (either order) if it exists: its index. Bounded by
+    /// the row length of `min(i, j)`.
+    pub fn edge_index(&self, i: u32, j: u32) -> Option<u32> {
+        let (lo, hi) = if i < j { (i, j) } else { (j, i) };
+        let start = *self.row_start.get(lo as usize)?;
+        let end = *self.row_start.get(lo as usize + 1)?;
+        let row = self.column.get(start as usize..end as usize)?;
+        row.binary_search(&hi).ok().map(|k| start + k as u32)
+    }
+
+    fn check_vertices(&self) -> Result<(), LoadError> {
+        for (v, (m, k)) in self.masses.iter().zip(self.vertex_tensors).enumerate() {
+            let bad = LoadError::BadVertexData { vertex: v as u32 };
+            if !m.finite() {
+                return Err(LoadError::NonFinite {
+                    kind: SectionKind::LumpedMass,
+                    index: v as u64,
+                });
+            }
+            let k = Matrix3::from_row_slice(k);
+            let asym = (k - k.transpose()).abs().max();
+            if *m < T::zero() || asym > T::of_f64(1e-4) * k.abs().max() {
+                return Err(bad);
+            }
+        }
+        Ok(())
+    }
+
+    fn check_edges(&self) -> Result<(), LoadError> {
+        let n = self.vertex_count();
+        let edges = self.edge_count();
+        if self.row_start.first() != Some(&0) || self.row_start.last() != Some(&(edges as u32)) {
+            return Err(LoadError::BadEdges { vertex: 0 });
+        }
+        for (i, pair) in self.row_start.windows(2).enumerate() {
+            let bad = LoadError::BadEdges { vertex: i as u32 };
+            let [start, end] = *pair else {
+                return Err(bad);
+            };
+            let row = self.column.get(start as usize..end as usize).ok_or(bad)?;
+            let mut previous = i as u32;
+            for &j in row {
+                if j <= previous || j as usize >= n {
+                    return Err(bad);
+                }
+                previous = j;
+            }
+        }
+        Ok(())
+    }
+
+    fn check_tets(&self) -> Result<(), LoadError> {
+        let n = self.vertex_count() as u32;
+        let m = self.tet_count() as u32;
+        let rows = self.tets.iter().zip(self.tet_edges).zip(self.neighbours);
+        for (t, ((tet, edges), neighbours)) in rows.enumerate() {
+            let bad = LoadError::BadTet { tet: t as u32 };
+            if tet.iter().any(|&v| v >= n)
+                || neighbours.iter().any(|&o| o >= m && o != NO_NEIGHBOUR)
+            {
+                return Err(bad);
+            }
+            for ([a, b], &edge) in tet_edge_vertices(*tet).into_iter().zip(edges) {
+                if a == b || self.edge_index(a, b) != Some(edge) {
+                    return Err(bad);
+                }
+            }
+            let (_, volume) = self.tet_shape(t).ok_or(bad)?;
+            if volume <= T::zero() {
+                return Err(bad);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,159 @@
+//! Caller-provided mutable state, its validation, and the fault state.
+
+use core::fmt;
+
+use crate::Real;
+use crate::table::TensorMassTable;
+
+/// How a vertex moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VertexMode {
+    /// Integrated from the forces.
+    #[default]
+    Free,
+    /// Fixed by the table: zero displacement, never released.
+    Fixed,
+    /// Held at a displacement the caller imposes (tool contact, coupling).
+    Imposed,
+}
+
+/// Storage for the mutable state of a [`super::TensorMassModel`], provided by
+/// the caller (static arrays on firmware, vectors on the host). Lengths are
+/// checked once by [`super::TensorMassModel::new`]: `N` = vertices, `E` =
+/// edges, `M` = tets of the table.
+pub struct StateBuffers<'s, T> {
+    /// `N`: current vertex tensors `K_ii`, N/m (change when tets are removed).
+    pub vertex_tensors: &'s mut [[T; 9]],
+    /// `E`: current edge tensors `K_ij`, N/m.
+    pub edge_tensors: &'s mut [[T; 9]],
+    /// `N`: current lumped masses, kg.
+    pub masses_kg: &'s mut [T],
+    /// `M`: `false` once a tet is removed.
+    pub tet_alive: &'s mut [bool],
+    /// `N`: how each vertex moves.
+    pub modes: &'s mut [VertexMode],
+    /// `N`: displacement from rest `u = p − p_rest`, m.
+    pub displacement_m: &'s mut [[T; 3]],
+    /// `N`: velocity, m/s.
+    pub velocity_m_s: &'s mut [[T; 3]],
+    /// `N`: displacement one step earlier, m (central-difference scheme).
+    pub previous_displacement_m: &'s mut [[T; 3]],
+    /// `N`: external force per vertex, N.
+    pub external_force_n: &'s mut [[T; 3]],
+    /// `N`: force scratch, N.
+    pub force_n: &'s mut [[T; 3]],
+    /// `4N` for RK4 (stage displacement, stage velocity, and the two weighted
+    /// sums), or empty when RK4 is not needed (saves `48N` bytes in f32).
+    pub rk4_scratch: &'s mut [[T; 3]],
+}
+
+/// A [`StateBuffers`] field has the wrong length for the table, or a
+/// parameter is out of range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateError {
+    /// A buffer's length differs from what the table needs.
+    BufferLength {
+        /// The [`StateBuffers`] field.
+        buffer: &'static str,
+        /// Entries the table needs.
+        expected: usize,
+        /// Entries given.
+        found: usize,
+    },
+    /// A [`super::DynamicParams`] value is non-finite or negative.
+    BadParameter {
+        /// Which parameter.
+        name: &'static str,
+    },
+}
+
+impl fmt::Display for StateError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BufferLength {
+                buffer,
+                expected,
+                found,
+            } => write!(
+                f,
+                "state buffer {buffer} holds {found} entries, the table needs {expected}"
+            ),
+            Self::BadParameter { name } => write!(f, "parameter {name} must be finite and >= 0"),
+        }
+    }
+}
+
+impl core::error::Error for StateError {}
+
+impl<T: Real> StateBuffers<'_, T> {
+    /// Checks every length against `table`.
+    pub(crate) fn check(&self, table: &TensorMassTable<'_, T>) -> Result<(), StateError> {
+        let n = table.vertex_count();
+        let rk4 = if self.rk4_scratch.is_empty() {
+            0
+        } else {
+            4 * n
+        };
+        let lengths = [
+            ("vertex_tensors", self.vertex_tensors.len(), n),
+            ("edge_tensors", self.edge_tensors.len(), table.edge_count()),
+            ("masses_kg", self.masses_kg.len(), n),
+            ("tet_alive", self.tet_alive.len(), table.tet_count()),
+            ("modes", self.modes.len(), n),
+            ("displacement_m", self.displacement_m.len(), n),
+            ("velocity_m_s", self.velocity_m_s.len(), n),
+            (
+                "previous_displacement_m",
+                self.previous_displacement_m.len(),
+                n,
+            ),
+            ("external_force_n", self.external_force_n.len(), n),
+            ("force_n", self.force_n.len(), n),
+            ("rk4_scratch", self.rk4_scratch.len(), rk4),
+        ];
+        match lengths
+            .iter()
+            .find(|(_, found, expected)| found != expected)
+        {
+            Some(&(buffer, found, expected)) => Err(StateError::BufferLength {
+                buffer,
+                expected,
+                found,
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Why the model stopped producing numbers. Detected inside the step, before
+/// the new state can be read; cleared only by
+/// [`super::TensorMassModel::reset`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// A displacement or velocity became NaN or infinite at this vertex.
+    NonFinite {
+        /// Vertex index.
+        vertex: u32,
+    },
+    /// A displacement exceeded [`super::Limits::max_displacement_m`].
+    DisplacementBound {
+        /// Vertex index.
+        vertex: u32,
+    },
+    /// The kinetic energy exceeded [`super::Limits::max_kinetic_energy_j`].
+    KineticEnergyBound,
+}
+
+impl fmt::Display for Fault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NonFinite { vertex } => write!(f, "vertex {vertex}: non-finite state"),
+            Self::DisplacementBound { vertex } => {
+                write!(f, "vertex {vertex}: displacement beyond the bound")
+            }
+            Self::KineticEnergyBound => f.write_str("kinetic energy beyond the bound"),
+        }
+    }
+}
+
+impl core::error::Error for Fault {}

@@ -1,0 +1,424 @@
+//! The dynamic tensor-mass model (`palpate_kernel::tensor_mass`) against
+//! independent truth: scikit-fem's global stiffness and lumped masses
+//! (`shared/reference/linear/cube_K.csv`, `masses/cube_lumped_mass.csv`), the
+//! scikit-fem static contact solution (`linear/cube_contact.json`) as the
+//! damped steady state, integrator steps derived by hand for one tet, energy
+//! conservation of the symplectic schemes, and the fault state.
+
+use nalgebra::{Matrix2, Vector2, Vector3};
+use palpate::dynamic::OwnedState;
+use palpate::fem::material::Material;
+use palpate::mesh::{MeshReport, TetMesh, read_mesh};
+use palpate::tables::file::Precision;
+use palpate::tables::load::TableFile;
+use palpate::tables::tensor_mass::{
+    TensorMassArrays, TensorMassOptions, build_tensor_mass_table, write_tensor_mass_table,
+};
+use palpate_kernel::LoadError;
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::{
+    DynamicParams, Fault, Integrator, Limits, StepError, TensorMassModel,
+};
+use palpate_tests::{json_rows, read_reference_json, read_reference_stiffness, reference_dir};
+
+const DENSITY: f64 = 1000.0;
+
+fn cube() -> (TetMesh, MeshReport) {
+    read_mesh(&reference_dir().join("meshes/cube.msh")).expect("cube.msh")
+}
+
+fn options(fix: &[&str], young_pa: f64, poisson: f64) -> TensorMassOptions {
+    TensorMassOptions {
+        material: Material::new(young_pa, poisson).expect("material"),
+        density_kg_m3: DENSITY,
+        fix: fix.iter().map(|f| f.parse().expect("predicate")).collect(),
+        precision: Precision::F64,
+    }
+}
+
+fn cube_table(fix: &[&str]) -> TableFile {
+    let (mesh, report) = cube();
+    let bytes = build_tensor_mass_table(&mesh, &report, &options(fix, 5000.0, 0.45)).unwrap();
+    TableFile::from_bytes(&bytes)
+}
+
+fn params(damping_per_s: f64) -> DynamicParams<f64> {
+    DynamicParams {
+        damping_per_s,
+        gravity_m_s2: Vector3::zeros(),
+        limits: Limits {
+            max_displacement_m: f64::INFINITY,
+            max_kinetic_energy_j: f64::INFINITY,
+        },
+    }
+}
+
+/// `K u` assembled from the vertex and edge tensors equals scikit-fem's K
+/// entry by entry (the tensors are a re-indexing of the global K: MODELS.md
+/// §1). Measured 8e-16; bound 1e-12 (rounding of sums of ~24 blocks).
+#[test]
+fn tensors_and_masses_match_scikit_fem() {
+    let file = cube_table(&[]);
+    let table = TensorMassTable::<f64>::load(file.bytes()).expect("valid table");
+    let reference = read_reference_stiffness();
+    let scale = reference.values().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut ours = std::collections::HashMap::new();
+    let mut put = |i: usize, j: usize, k: &[f64; 9], transpose: bool| {
+        for (e, &x) in k.iter().enumerate() {
+            let (a, b) = if transpose {
+                (e % 3, e / 3)
+            } else {
+                (e / 3, e % 3)
+            };
+            ours.insert((3 * i + a, 3 * j + b), x);
+        }
+    };
+    for (i, k) in table.vertex_tensors().iter().enumerate() {
+        put(i, i, k, false);
+    }
+    let rows = table.edge_row_starts();
+    for i in 0..table.vertex_count() {
+        for e in rows[i] as usize..rows[i + 1] as usize {
+            let j = table.edge_columns()[e] as usize;
+            put(i, j, &table.edge_tensors()[e], false);
+            put(j, i, &table.edge_tensors()[e], true);
+        }
+    }
+    let mut worst = 0.0f64;
+    for (key, v) in &reference {
+        worst = worst.max((ours.get(key).copied().unwrap_or(0.0) - v).abs());
+    }
+    for (key, v) in &ours {
+        if !reference.contains_key(key) {
+            worst = worst.max(v.abs());
+        }
+    }
+    println!("tensors vs cube_K.csv: {:e}", worst / scale);
+    assert!(worst <= 1e-12 * scale, "relative {:e}", worst / scale);
+
+    let csv = std::fs::read_to_string(reference_dir().join("masses/cube_lumped_mass.csv")).unwrap();
+    let masses: Vec<f64> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("vertex"))
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(masses.len(), table.vertex_count());
+    for (ours, theirs) in table.masses_kg().iter().zip(&masses) {
+        assert!(
+            (ours - theirs).abs() <= 1e-12 * theirs,
+            "{ours} vs {theirs}"
+        );
+    }
+}
+
+/// Damped dynamics with vertex 194 held at `d` settle to the static solution
+/// scikit-fem computed (MODELS.md §3: the quasi-static limit of the dynamic
+/// model is the linear FEM). Stopping rule: `max |v| < 1e-13 m/s`; the
+/// remaining error is the transient, bound 1e-8 relative (measured 1e-10).
+#[test]
+fn damped_steady_state_is_the_static_solution() {
+    let reference = read_reference_json("linear/cube_contact.json");
+    let single = &reference["single_contact"];
+    let file = cube_table(&["z<0.001"]);
+    let table = TensorMassTable::<f64>::load(file.bytes()).expect("valid table");
+    let mut state = OwnedState::for_table(&table);
+    // c = 8/s: about critical for the slowest mode (ω ≈ 4 rad/s) of this cube.
+    let mut model = TensorMassModel::new(table, state.buffers(), params(8.0)).unwrap();
+    model.impose(194, Vector3::new(0.0, 0.0, -0.01)).unwrap();
+    let mut steps = 0;
+    loop {
+        model.step(Integrator::SymplecticEuler, 0.004).unwrap();
+        steps += 1;
+        let v = model.velocities_m_s().unwrap();
+        if v.iter().flatten().all(|x| x.abs() < 1e-13) || steps == 50_000 {
+            break;
+        }
+    }
+    let u = model.displacements_m().unwrap();
+    let want = json_rows(&single["displacements"]);
+    let scale = 0.01;
+    let worst = u
+        .iter()
+        .zip(&want)
+        .flat_map(|(a, b)| (0..3).map(move |i| (a[i] - b[i]).abs()))
+        .fold(0.0f64, f64::max);
+    let mut forces = vec![[0.0; 3]; u.len()];
+    model.elastic_forces_n(&mut forces);
+    let force_ref: Vec<f64> = single["force"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let force_err = (0..3)
+        .map(|i| (-forces[194][i] - force_ref[i]).abs())
+        .fold(0.0f64, f64::max);
+    println!(
+        "steady state after {steps} steps: displacement error {:e}, force error {:e}",
+        worst / scale,
+        force_err / 13.6227
+    );
+    assert!(worst <= 1e-8 * scale, "{:e}", worst / scale);
+    assert!(force_err <= 1e-8 * 13.6227, "{force_err:e}");
+}
+
+/// The unit right tet with vertices 0, 1, 2 fixed: vertex 3 moves under
+/// `K_33 = V diag(μ, μ, λ+2μ)` (its gradient is `a_3 = e_z`, `V = 1/6`), mass
+/// `ρV/4`. Each axis is an independent damped oscillator
+/// `ü = (F − k u)/m − c u̇`, stepped here by the textbook formula of each
+/// scheme; the kernel must agree to rounding (bound 1e-12 relative).
+#[test]
+fn one_tet_steps_match_hand_derivation() {
+    let mesh = TetMesh {
+        positions: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        tets: vec![[0, 1, 2, 3]],
+    };
+    let opts = options(&["z<0.5"], 1000.0, 0.25);
+    let bytes = build_tensor_mass_table(&mesh, &MeshReport::default(), &opts).unwrap();
+    let file = TableFile::from_bytes(&bytes);
+    let (lambda, mu) = (400.0, 400.0);
+    let volume = 1.0 / 6.0;
+    let k = [volume * mu, volume * mu, volume * (lambda + 2.0 * mu)];
+    let m = DENSITY * volume / 4.0;
+    let (c, dt) = (3.0, 0.01);
+    let force = [1.0, -2.0, 3.0];
+    let u0 = [0.01, 0.02, -0.03];
+    for integrator in Integrator::ALL {
+        let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+        let mut state = OwnedState::for_table(&table);
+        let mut model = TensorMassModel::new(table, state.buffers(), params(c)).unwrap();
+        model.impose(3, Vector3::from(u0)).unwrap();
+        model.release(3).unwrap();
+        model.set_external_force(3, Vector3::from(force)).unwrap();
+        for _ in 0..3 {
+            model.step(integrator, dt).unwrap();
+        }
+        let got = model.displacements_m().unwrap()[3];
+        let got_v = model.velocities_m_s().unwrap()[3];
+        for axis in 0..3 {
+            let (want_u, want_v) =
+                hand_steps(integrator, k[axis], m, c, force[axis], u0[axis], dt, 3);
+            let tol = 1e-12 * want_u.abs().max(1e-3);
+            assert!(
+                (got[axis] - want_u).abs() <= tol,
+                "{integrator:?} axis {axis}: {} vs {want_u}",
+                got[axis]
+            );
+            let tol_v = 1e-12 * want_v.abs().max(1e-2);
+            assert!(
+                (got_v[axis] - want_v).abs() <= tol_v,
+                "{integrator:?} v axis {axis}"
+            );
+        }
+    }
+}
+
+/// `steps` steps of `integrator` on `m ü = F − k u − c m u̇` from `(u0, 0)`.
+#[allow(clippy::too_many_arguments)]
+fn hand_steps(
+    integrator: Integrator,
+    k: f64,
+    m: f64,
+    c: f64,
+    f: f64,
+    u0: f64,
+    dt: f64,
+    steps: usize,
+) -> (f64, f64) {
+    let accel = |u: f64, v: f64| (f - k * u) / m - c * v;
+    let (mut u, mut v, mut u_prev) = (u0, 0.0, u0);
+    for _ in 0..steps {
+        match integrator {
+            Integrator::ExplicitEuler => (u, v) = (u + dt * v, v + dt * accel(u, v)),
+            Integrator::SymplecticEuler => {
+                v += dt * accel(u, v);
+                u += dt * v;
+            }
+            Integrator::Rk4 => {
+                // ẏ = A y + b, y = (u, v).
+                let a = Matrix2::new(0.0, 1.0, -k / m, -c);
+                let b = Vector2::new(0.0, f / m);
+                let rate = |y: Vector2<f64>| a * y + b;
+                let y = Vector2::new(u, v);
+                let k1 = rate(y);
+                let k2 = rate(y + k1 * (dt / 2.0));
+                let k3 = rate(y + k2 * (dt / 2.0));
+                let k4 = rate(y + k3 * dt);
+                let y = y + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
+                (u, v) = (y.x, y.y);
+            }
+            Integrator::CentralDifference => {
+                // Picinbono eq. (19) with γ = c m (damping sign of MODELS.md).
+                let lhs = m / (dt * dt) + c * m / (2.0 * dt);
+                let next = (f - k * u + 2.0 * m / (dt * dt) * u
+                    - (m / (dt * dt) - c * m / (2.0 * dt)) * u_prev)
+                    / lhs;
+                v = (next - u_prev) / (2.0 * dt);
+                u_prev = u;
+                u = next;
+            }
+        }
+    }
+    (u, v)
+}
+
+/// Total energy `½ Σ m v² + ½ uᵀ K u` (J), with `K u = −f_elastic`.
+fn total_energy(model: &TensorMassModel<'_, '_, f64>) -> f64 {
+    let u = model.displacements_m().unwrap();
+    let v = model.velocities_m_s().unwrap();
+    let mut f = vec![[0.0; 3]; u.len()];
+    model.elastic_forces_n(&mut f);
+    let kinetic: f64 = v
+        .iter()
+        .zip(model.masses_kg())
+        .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+        .sum();
+    let elastic: f64 = u
+        .iter()
+        .zip(&f)
+        .map(|(u, f)| -0.5 * (u[0] * f[0] + u[1] * f[1] + u[2] * f[2]))
+        .sum();
+    kinetic + elastic
+}
+
+/// Undamped, below the critical step: the symplectic and central schemes
+/// keep the energy (mean of the last 500 steps within 1 % of the first 500
+/// over 6000 steps, i.e. no drift), forward Euler gains energy (> 10 %), so
+/// the check can fail.
+#[test]
+fn symplectic_schemes_do_not_drift_euler_does() {
+    let file = cube_table(&["z<0.001"]);
+    let mean = |e: &[f64]| e.iter().sum::<f64>() / e.len() as f64;
+    for integrator in Integrator::ALL {
+        let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+        let mut state = OwnedState::for_table(&table);
+        let mut model = TensorMassModel::new(table, state.buffers(), params(0.0)).unwrap();
+        model.impose(194, Vector3::new(0.0, 0.0, -0.01)).unwrap();
+        model.release(194).unwrap();
+        let energies: Vec<f64> = (0..6000)
+            .map(|_| {
+                model.step(integrator, 0.002).unwrap();
+                total_energy(&model)
+            })
+            .collect();
+        let drift = mean(&energies[5500..]) / mean(&energies[..500]) - 1.0;
+        println!(
+            "{}: energy drift over 6000 steps {drift:+.3e}",
+            integrator.name()
+        );
+        match integrator {
+            Integrator::SymplecticEuler | Integrator::CentralDifference => {
+                assert!(drift.abs() < 0.01, "{integrator:?} drift {drift}")
+            }
+            Integrator::ExplicitEuler => assert!(drift > 0.1, "Euler drift {drift}"),
+            Integrator::Rk4 => assert!(drift.abs() < 0.01, "RK4 drift {drift}"),
+        }
+    }
+}
+
+/// A step far above the critical one diverges; the fault trips inside the
+/// step, and no displacement above the bound is ever readable.
+#[test]
+fn divergence_faults_before_output_exceeds_the_bound() {
+    let file = cube_table(&["z<0.001"]);
+    let bound = 0.05;
+    for integrator in Integrator::ALL {
+        let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+        let mut state = OwnedState::for_table(&table);
+        let mut p = params(0.0);
+        p.limits.max_displacement_m = bound;
+        let mut model = TensorMassModel::new(table, state.buffers(), p).unwrap();
+        model.impose(194, Vector3::new(0.0, 0.0, -0.01)).unwrap();
+        model.release(194).unwrap();
+        let mut faulted = None;
+        for step in 0..200 {
+            match model.step(integrator, 0.5) {
+                Ok(_) => {
+                    let u = model.displacements_m().unwrap();
+                    let max = u
+                        .iter()
+                        .map(|u| Vector3::from(*u).norm())
+                        .fold(0.0, f64::max);
+                    assert!(max <= bound, "{integrator:?} step {step}: {max} readable");
+                }
+                Err(StepError::Faulted(fault)) => {
+                    faulted = Some(fault);
+                    break;
+                }
+                Err(e) => panic!("{e}"),
+            }
+        }
+        let fault = faulted.unwrap_or_else(|| panic!("{integrator:?} never faulted"));
+        assert!(matches!(
+            fault,
+            Fault::DisplacementBound { .. } | Fault::NonFinite { .. }
+        ));
+        assert_eq!(model.displacements_m(), Err(fault));
+        assert_eq!(
+            model.step(integrator, 0.001),
+            Err(StepError::Faulted(fault))
+        );
+        model.reset();
+        assert!(model.displacements_m().is_ok());
+    }
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    let file = cube_table(&["z<0.001"]);
+    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+    let mut state = OwnedState::for_table(&table);
+    let mut model = TensorMassModel::new(table, state.buffers(), params(1.0)).unwrap();
+    use palpate_kernel::tensor_mass::InputError;
+    assert_eq!(
+        model.impose(0, Vector3::zeros()),
+        Err(InputError::FixedVertex { vertex: 0 })
+    );
+    assert_eq!(
+        model.impose(999, Vector3::zeros()),
+        Err(InputError::VertexOutOfRange { vertex: 999 })
+    );
+    assert_eq!(
+        model.set_external_force(194, Vector3::new(f64::NAN, 0.0, 0.0)),
+        Err(InputError::NonFinite { vertex: 194 })
+    );
+    assert_eq!(
+        model.step(Integrator::Rk4, -1.0),
+        Err(StepError::BadTimeStep)
+    );
+    assert_eq!(
+        model.step(Integrator::Rk4, f64::NAN),
+        Err(StepError::BadTimeStep)
+    );
+}
+
+/// Structural corruption behind a valid checksum is caught at load.
+#[test]
+fn broken_edge_and_tet_references_are_refused() {
+    let (mesh, _) = cube();
+    let opts = options(&["z<0.001"], 5000.0, 0.45);
+    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 0.001).collect();
+    let arrays = TensorMassArrays::new(&mesh, &opts.material, DENSITY, fixed);
+    let load = |arrays: &TensorMassArrays| {
+        let file = TableFile::from_bytes(&write_tensor_mass_table(&mesh, &opts, arrays));
+        TensorMassTable::<f64>::load(file.bytes()).map(|_| ())
+    };
+    assert_eq!(load(&arrays), Ok(()));
+    let mut bad = arrays.clone();
+    bad.tet_edges[5][2] = bad.tet_edges[5][3];
+    assert_eq!(load(&bad), Err(LoadError::BadTet { tet: 5 }));
+    let mut bad = arrays.clone();
+    bad.column.swap(0, 1);
+    assert_eq!(load(&bad), Err(LoadError::BadEdges { vertex: 0 }));
+    let mut bad = arrays.clone();
+    bad.neighbours[7][1] = 100_000;
+    assert_eq!(load(&bad), Err(LoadError::BadTet { tet: 7 }));
+    let mut bad = arrays.clone();
+    bad.masses_kg[3] = -1.0;
+    assert_eq!(load(&bad), Err(LoadError::BadVertexData { vertex: 3 }));
+}
