@@ -1,0 +1,21 @@
+//! Puts `memory.x` on the linker path and copies the table named by the
+//! `PALPATE_TABLE` environment variable to `$OUT_DIR/table.bin`, where
+//! `include_table!` links it into flash. `tools/firmware-check.sh` builds the
+//! table with `palpate tables build` and sets the variable.
+
+use std::path::PathBuf;
+
+fn main() {
+    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
+    std::fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x");
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=sequence.txt");
+    println!("cargo:rerun-if-env-changed=PALPATE_TABLE");
+    let Some(table) = std::env::var_os("PALPATE_TABLE") else {
+        panic!("set PALPATE_TABLE to a table built by `palpate tables build` (see tools/firmware-check.sh)");
+    };
+    println!("cargo:rerun-if-changed={}", table.to_string_lossy());
+    std::fs::copy(&table, out.join("table.bin"))
+        .unwrap_or_else(|e| panic!("PALPATE_TABLE={}: {e}", table.to_string_lossy()));
+}
