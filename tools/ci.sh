@@ -11,6 +11,9 @@ tools/setup.sh
 
 step "format"
 cargo fmt --all -- --check
+for crate in tools/firmware-m4f tools/nopanic-check; do
+    (cd "$crate" && cargo fmt -- --check)
+done
 
 step "clippy"
 cargo clippy --workspace --all-targets -- -D warnings

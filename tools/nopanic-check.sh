@@ -15,4 +15,4 @@ if ! PALPATE_TABLE="$table" cargo build --release 2>build.log; then
     exit 1
 fi
 rm -f build.log
-echo "no-panic check: linked, no panic reachable from load, contact_forces, displacements"
+echo "no-panic check: linked, no panic reachable from load, contact_forces, free_displacements, displacements"

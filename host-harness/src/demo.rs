@@ -133,7 +133,7 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
             update_time.push(t2 - t1);
             peak = peak.max(solution.device_force_n().norm());
             step += 1;
-            if step % FRAME_EVERY == 0 {
+            if step.is_multiple_of(FRAME_EVERY) {
                 let path = out_dir.join(format!("frame_{step:04}.vtk"));
                 let u: Vec<[f64; 3]> = displacement.iter().map(|u| u.map(f64::from)).collect();
                 vtk::write_frame(&path, &mesh.positions, &mesh.tets, &u)?;

@@ -1,6 +1,7 @@
 //! The linear P1 tetrahedron (MODELS.md §1; Cotin RR-3510 §4): the one
-//! stiffness-block formula shared by the host's assembly, the tensor-mass
-//! table builder and the kernel's local tet removal.
+//! stiffness-block formula shared by the host's assembly and the tensor-mass
+//! table builder, and the one a local tet removal must subtract (each tet's
+//! rest gradients and volume are in the table for that).
 
 use nalgebra::{Matrix3, Vector3};
 

@@ -256,6 +256,46 @@ fn barycentric_point_moves_by_the_imposed_displacement() {
     }
 }
 
+/// The fast free-index update and the vertex-order update are the same
+/// numbers (same arithmetic, so bit-identical), fixed vertices are zero, and
+/// a wrong buffer length is refused.
+#[test]
+fn free_displacements_are_the_vertex_displacements_by_free_index() {
+    let file = reference_cube_table(Precision::F32);
+    let AnyModel::F32(m) = file.model().unwrap() else {
+        unreachable!()
+    };
+    let s = m
+        .contact_forces::<4>(&[
+            Contact::on_triangle(
+                [194, 195, 200],
+                [0.2, 0.5, 0.3],
+                Vector3::new(0.0, 0.001, -0.004),
+            ),
+            Contact::at_vertex(205, Vector3::new(0.0, 0.0, -0.003)),
+            Contact::at_vertex(185, Vector3::new(0.002, 0.0, -0.001)),
+        ])
+        .unwrap();
+    let mut by_vertex = vec![[f32::NAN; 3]; m.table().vertex_count()];
+    m.displacements(&s, &mut by_vertex).unwrap();
+    let mut by_free = vec![[f32::NAN; 3]; m.table().free_count()];
+    m.free_displacements(&s, &mut by_free).unwrap();
+    for (u, &v) in by_free.iter().zip(m.table().free_vertices()) {
+        assert_eq!(
+            u.map(f32::to_bits),
+            by_vertex[v as usize].map(f32::to_bits),
+            "vertex {v}"
+        );
+    }
+    for v in 0..m.table().vertex_count() as u32 {
+        if m.table().is_fixed(v) {
+            assert_eq!(by_vertex[v as usize], [0.0; 3]);
+        }
+    }
+    assert!(m.free_displacements(&s, &mut by_free[1..]).is_err());
+    assert!(m.displacements(&s, &mut by_vertex[1..]).is_err());
+}
+
 #[test]
 fn contact_errors_are_typed() {
     let file = reference_cube_table(Precision::F32);

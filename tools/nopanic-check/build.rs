@@ -11,7 +11,9 @@ fn main() {
     println!("cargo:rerun-if-changed=../firmware-m4f/memory.x");
     println!("cargo:rerun-if-env-changed=PALPATE_TABLE");
     let Some(table) = std::env::var_os("PALPATE_TABLE") else {
-        panic!("set PALPATE_TABLE to a table built by `palpate tables build` (see tools/nopanic-check.sh)");
+        panic!(
+            "set PALPATE_TABLE to a table built by `palpate tables build` (see tools/nopanic-check.sh)"
+        );
     };
     println!("cargo:rerun-if-changed={}", table.to_string_lossy());
     std::fs::copy(&table, out.join("table.bin"))

@@ -232,15 +232,15 @@ pub(crate) fn resolve<T: Real>(
                 });
             }
             for (&vertex, &w) in vertices.iter().zip(weights.iter()) {
-                if let Some(slot) = lookup(vertex)? {
-                    if let (Some(t), Some(b)) = (
+                if let Some(slot) = lookup(vertex)?
+                    && let (Some(t), Some(b)) = (
                         point.touchable.get_mut(point.len),
                         point.weights.get_mut(point.len),
-                    ) {
-                        *t = slot;
-                        *b = w;
-                        point.len += 1;
-                    }
+                    )
+                {
+                    *t = slot;
+                    *b = w;
+                    point.len += 1;
                 }
             }
         }

@@ -180,18 +180,45 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         c
     }
 
-    /// The displacement of every vertex for a solved contact set, m, in mesh
-    /// vertex order (MODELS.md §2: `u_n = Σ_q Σ_b β^q_b C_{n v^q_b} g_q`; fixed
-    /// vertices get zero). Overwrites all of `out`, which must hold
-    /// [`PrecomputedTable::vertex_count`] entries.
+    /// The displacement of every free vertex for a solved contact set, m, by
+    /// free index: `out[i]` belongs to vertex
+    /// [`PrecomputedTable::free_vertices`]`()[i]` (fixed vertices do not
+    /// move and have no entry). MODELS.md §2:
+    /// `u_n = Σ_q Σ_b β^q_b C_{n v^q_b} g_q`. Overwrites all of `out`, which
+    /// must hold [`PrecomputedTable::free_count`] entries.
     ///
-    /// Bounded: one pass over the compliance column of each contact vertex
-    /// (≤ 3·M columns of `F` blocks). Not needed by the haptic path.
+    /// The fast path of the update (a renderer maps free indices to vertices
+    /// once): one pass per contact term over one compliance column, written
+    /// contiguously. Bounded: ≤ 3·M columns of `F` blocks.
+    pub fn free_displacements<const M: usize>(
+        &self,
+        solution: &ContactSolution<T, M>,
+        out: &mut [[T; 3]],
+    ) -> Result<(), DisplacementError> {
+        let expected = self.table.free_count();
+        if out.len() != expected {
+            return Err(DisplacementError {
+                expected,
+                found: out.len(),
+            });
+        }
+        out.fill([T::zero(); 3]);
+        self.add_rows(solution, 0, out);
+        Ok(())
+    }
+
+    /// The displacement of every vertex for a solved contact set, m, in mesh
+    /// vertex order (fixed vertices get zero): [`Self::free_displacements`]
+    /// scattered to vertex order, through a 64-vertex buffer on the stack.
+    /// Overwrites all of `out`, which must hold
+    /// [`PrecomputedTable::vertex_count`] entries. Not needed by the haptic
+    /// path.
     pub fn displacements<const M: usize>(
         &self,
         solution: &ContactSolution<T, M>,
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
+        const CHUNK: usize = 64;
         let expected = self.table.vertex_count();
         if out.len() != expected {
             return Err(DisplacementError {
@@ -200,52 +227,84 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             });
         }
         out.fill([T::zero(); 3]);
-        for (point, g) in solution.resolved() {
-            for (k, beta) in point.terms() {
-                self.add_column(k as usize, &(g * beta), out);
+        for (chunk, vertices) in self.table.free_vertices().chunks(CHUNK).enumerate() {
+            let mut buffer = [[T::zero(); 3]; CHUNK];
+            let rows = buffer.get_mut(..vertices.len()).unwrap_or(&mut []);
+            self.add_rows(solution, chunk * CHUNK, rows);
+            for (u, &v) in rows.iter().zip(vertices) {
+                if let Some(o) = out.get_mut(v as usize) {
+                    *o = *u;
+                }
             }
         }
         Ok(())
     }
 
-    /// `out[free_vertex[n]] += C_nk w` for every free `n`.
-    fn add_column(&self, k: usize, w: &Vector3<T>, out: &mut [[T; 3]]) {
-        let free = self.table.free_vertices();
+    /// `out[i] += Σ_terms C_{first+i, k} w` over the contact terms: free rows
+    /// `first .. first + out.len()`.
+    fn add_rows<const M: usize>(
+        &self,
+        solution: &ContactSolution<T, M>,
+        first: usize,
+        out: &mut [[T; 3]],
+    ) {
+        for (point, g) in solution.resolved() {
+            for (k, beta) in point.terms() {
+                self.add_column_rows(k as usize, &(g * beta), first, out);
+            }
+        }
+    }
+
+    /// `out[i] += C_{n,k} w` for the free rows `n = first + i` (format in
+    /// [`crate::table::format`]): rows `n ≤ k` from column `k` of the packed
+    /// surface part, rows `k < n < S` as `C_knᵀ` from column `n`, interior
+    /// rows from column `k` of the interior part. Rows outside `0..F` are
+    /// skipped.
+    fn add_column_rows(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
         let s = self.table.touchable_count();
+        let f = self.table.free_count();
+        let end = (first + out.len()).min(f);
         let surface = self.table.surface_blocks();
-        let add = |out: &mut [[T; 3]], v: u32, u: [T; 3]| {
-            if let Some(o) = out.get_mut(v as usize) {
-                o[0] += u[0];
-                o[1] += u[1];
-                o[2] += u[2];
-            }
+        // Which rows of `first..end` fall in `lo..hi`, and where they go in `out`.
+        let window = |lo: usize, hi: usize| {
+            let (a, b) = (first.max(lo), end.min(hi));
+            (a < b).then(|| (a, a - first..b - first))
         };
-        // Rows n ≤ k: column k of the packed upper part, contiguous.
-        let start = surface_block_index(0, k);
-        if let Some(column) = surface.get(start..=start + k) {
-            for (c, &v) in column.iter().zip(free) {
-                add(out, v, mul(c, w));
+        if let Some((a, rows)) = window(0, k + 1) {
+            let start = surface_block_index(a, k);
+            let blocks = surface.get(start..start + rows.len());
+            if let (Some(blocks), Some(out)) = (blocks, out.get_mut(rows)) {
+                add_products(blocks, w, out);
             }
         }
-        // Rows k < n < S: stored as C_kn in column n; C_nk = C_knᵀ.
-        let mut index = surface_block_index(k, k + 1);
-        for (n, &v) in free.iter().enumerate().take(s).skip(k + 1) {
-            if let Some(c) = surface.get(index) {
-                add(out, v, mul_transposed(c, w));
-            }
-            index += n + 1;
-        }
-        // Interior rows: column k of the interior part, contiguous.
-        let interior_count = free.len() - s;
-        let start = k * interior_count;
-        let interior = self.table.interior_blocks();
-        if let (Some(column), Some(rows)) =
-            (interior.get(start..start + interior_count), free.get(s..))
+        if let Some((a, rows)) = window(k + 1, s)
+            && let Some(out) = out.get_mut(rows)
         {
-            for (c, &v) in column.iter().zip(rows) {
-                add(out, v, mul(c, w));
+            for (n, u) in (a..).zip(out) {
+                if let Some(c) = surface.get(surface_block_index(k, n)) {
+                    let v = mul_transposed(c, w);
+                    *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
+                }
             }
         }
+        if let Some((a, rows)) = window(s, f) {
+            let start = k * (f - s) + (a - s);
+            let blocks = self.table.interior_blocks().get(start..start + rows.len());
+            if let (Some(blocks), Some(out)) = (blocks, out.get_mut(rows)) {
+                add_products(blocks, w, out);
+            }
+        }
+    }
+}
+
+/// `out[i] += C_i w` for row-major 3×3 blocks `C_i`, written as a product of
+/// the `3F × 3` matrix of their rows with `w` so that it vectorizes (one
+/// output float per row of 3).
+#[inline(always)]
+fn add_products<T: Real>(blocks: &[[T; 9]], w: &Vector3<T>, out: &mut [[T; 3]]) {
+    let (rows, _) = blocks.as_flattened().as_chunks::<3>();
+    for (r, u) in rows.iter().zip(out.as_flattened_mut()) {
+        *u += r[0] * w.x + r[1] * w.y + r[2] * w.z;
     }
 }
 
@@ -254,24 +313,14 @@ fn check_duplicates<T: Real>(contacts: &[Contact<T>]) -> Result<(), ContactError
     use super::contact::ContactPoint::Vertex;
     for (second, b) in contacts.iter().enumerate() {
         for (first, a) in contacts.iter().enumerate().take(second) {
-            if let (Vertex(va), Vertex(vb)) = (a.point, b.point) {
-                if va == vb {
-                    return Err(ContactError::DuplicateContact { first, second });
-                }
+            if let (Vertex(va), Vertex(vb)) = (a.point, b.point)
+                && va == vb
+            {
+                return Err(ContactError::DuplicateContact { first, second });
             }
         }
     }
     Ok(())
-}
-
-/// Row-major 3×3 block times a vector.
-#[inline(always)]
-fn mul<T: Real>(c: &[T; 9], w: &Vector3<T>) -> [T; 3] {
-    [
-        c[0] * w.x + c[1] * w.y + c[2] * w.z,
-        c[3] * w.x + c[4] * w.y + c[5] * w.z,
-        c[6] * w.x + c[7] * w.y + c[8] * w.z,
-    ]
 }
 
 /// Transpose of a row-major 3×3 block times a vector.

@@ -161,7 +161,7 @@ fn locate_sections<T: Real>(h: RawHeader, bytes: &[u8]) -> Result<Container<'_>,
         let end = entry.offset.checked_add(len).ok_or(bounds)?;
         if entry.offset < u64::from(h.header_len)
             || end > body_len as u64
-            || entry.offset % SECTION_ALIGN as u64 != 0
+            || !entry.offset.is_multiple_of(SECTION_ALIGN as u64)
         {
             return Err(bounds);
         }

@@ -164,10 +164,10 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         let touchable = self.free_vertex.get(..self.touchable_count());
         let touchable = touchable.ok_or(LoadError::InconsistentHeader)?;
         for pair in touchable.windows(2) {
-            if let [a, b] = *pair {
-                if a >= b {
-                    return Err(LoadError::BadVertexMap { vertex: b });
-                }
+            if let [a, b] = *pair
+                && a >= b
+            {
+                return Err(LoadError::BadVertexMap { vertex: b });
             }
         }
         Ok(())

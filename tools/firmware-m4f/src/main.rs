@@ -23,7 +23,11 @@ const VERTICES: usize = 64;
 #[entry]
 fn main() -> ! {
     let ok = run().is_ok();
-    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
     loop {
         cortex_m::asm::bkpt();
     }

@@ -6,8 +6,8 @@
 //! with "undefined symbol: palpate_step_path_can_panic". A successful link
 //! proves that no panic is reachable in what `main` calls: table validation
 //! (`PrecomputedTable::load`), the haptic force path
-//! (`PrecomputedModel::contact_forces`) and the displacement update
-//! (`PrecomputedModel::displacements`), on inputs the optimiser cannot see
+//! (`PrecomputedModel::contact_forces`) and the displacement updates
+//! (`PrecomputedModel::free_displacements`, `displacements`), on inputs the optimiser cannot see
 //! (`core::hint::black_box`).
 #![no_std]
 #![no_main]
@@ -52,6 +52,7 @@ fn main() -> ! {
             let len = black_box(VERTICES).min(displacements.len());
             if let Some(out) = displacements.get_mut(..len) {
                 black_box(model.displacements(&solution, out).is_ok());
+                black_box(model.free_displacements(&solution, out).is_ok());
             }
             black_box(&displacements);
         }
