@@ -4,13 +4,20 @@
 //! - `force_path`: `contact_forces::<4>` for m = 1..=4 vertex contacts and one
 //!   barycentric contact, on two mesh sizes (its cost depends on m only).
 //!   Target (issue 3): at most 1 µs for up to 4 contacts.
-//! - `displacement_update`: `free_displacements` (the update; the vertex-order
-//!   `displacements` adds a scatter and is shown too) for m = 1 and 4 on three
-//!   mesh sizes, next to a `copy_from_slice` of the bytes it reads and writes,
-//!   measured in the same run. It reads, per contact vertex, one compliance
-//!   column: `F` blocks of 9 f32 (36 bytes), and writes 12 bytes per free
-//!   vertex; the copy moves `m·F·36 + 12·F` bytes. Target: within 1.5× of the copy. The ratio
-//!   is printed after the group.
+//! - `displacement_update`: `free_displacements` (free-index order) and
+//!   `displacements` (vertex order, the call the issue names) for m = 1 and 4
+//!   vertex contacts on three mesh sizes, each next to a `copy_from_slice` of
+//!   the bytes it reads and writes, measured in the same run. Bytes, f32
+//!   tables (`add_column_rows` in `kernel/src/precomputed/model.rs`):
+//!   per contact vertex `k` one compliance column, `F` blocks of 9 f32
+//!   (36 bytes): rows `n ≤ k` contiguous in the packed surface part, rows
+//!   `k < n < S` one block each from column `n` (strided), interior rows
+//!   contiguous. `free_displacements` writes `F` outputs of 12 bytes, so its
+//!   copy moves `m·36·F + 12·F` bytes; `displacements` also reads the
+//!   free-vertex list (4 bytes per free vertex) and writes all `N` vertices
+//!   (12 bytes each), so its copy moves `m·36·F + 4·F + 12·N` bytes.
+//!   Target: within 1.5× of the copy. Both ratios are printed after the group
+//!   (medians of 31 `Instant` batches, criterion does not compute ratios).
 //!
 //! Run: `cargo bench -p palpate-benches --bench precomputed_contact`.
 
@@ -57,7 +64,8 @@ fn force_path(c: &mut Criterion) {
         }
         let [a, ..] = top_vertices(cells);
         let n = cells as u32 + 1;
-        let triangle = [a, a + 1, a + n];
+        // A top-face triangle of the Kuhn split: (i, j), (i+1, j), (i+1, j+1).
+        let triangle = [a, a + 1, a + n + 1];
         let set = [Contact::on_triangle(
             triangle,
             [0.2, 0.3, 0.5],
@@ -105,8 +113,9 @@ fn displacement_update(c: &mut Criterion) {
                 .contact_forces::<MAX_CONTACTS>(&contacts(cells, m))
                 .expect("solve");
             let bytes = m * free * 36 + 12 * free;
-            let source = vec![1u8; bytes];
-            let mut target = vec![0u8; bytes];
+            let bytes_vertex_order = m * free * 36 + 4 * free + 12 * vertices;
+            let source = vec![1u8; bytes_vertex_order.max(bytes)];
+            let mut target = vec![0u8; bytes_vertex_order.max(bytes)];
             let size = format!("{vertices}v");
             group.bench_function(BenchmarkId::new(format!("{m}_contacts"), &size), |b| {
                 b.iter(|| model.free_displacements(black_box(&solution), &mut out))
@@ -117,7 +126,20 @@ fn displacement_update(c: &mut Criterion) {
             );
             group.bench_function(
                 BenchmarkId::new(format!("memcpy_{m}_contacts"), &size),
-                |b| b.iter(|| target.copy_from_slice(black_box(&source))),
+                |b| {
+                    b.iter(|| {
+                        target[..bytes].copy_from_slice(black_box(&source[..bytes]));
+                    })
+                },
+            );
+            group.bench_function(
+                BenchmarkId::new(format!("memcpy_{m}_contacts_vertex_order"), &size),
+                |b| {
+                    b.iter(|| {
+                        target[..bytes_vertex_order]
+                            .copy_from_slice(black_box(&source[..bytes_vertex_order]));
+                    })
+                },
             );
             let reps = (2_000_000 / bytes).max(3);
             let update = median_time(31, reps, || {
@@ -125,17 +147,29 @@ fn displacement_update(c: &mut Criterion) {
                     .free_displacements(black_box(&solution), &mut out)
                     .expect("buffer");
             });
-            let copy = median_time(31, reps, || target.copy_from_slice(black_box(&source)));
-            ratios.push((vertices, m, bytes, update, copy));
+            let copy = median_time(31, reps, || {
+                target[..bytes].copy_from_slice(black_box(&source[..bytes]));
+            });
+            ratios.push(("free", vertices, m, bytes, update, copy));
+            let update = median_time(31, reps, || {
+                model
+                    .displacements(black_box(&solution), &mut by_vertex)
+                    .expect("buffer");
+            });
+            let copy = median_time(31, reps, || {
+                target[..bytes_vertex_order]
+                    .copy_from_slice(black_box(&source[..bytes_vertex_order]));
+            });
+            ratios.push(("vertex", vertices, m, bytes_vertex_order, update, copy));
         }
     }
     group.finish();
     let cold = cold_ratio(16);
     println!("\ndisplacement update vs memcpy of the bytes it reads and writes (median of 31):");
-    println!("vertices  m   bytes       update      memcpy      ratio");
-    for (vertices, m, bytes, update, copy) in ratios {
+    println!("order   vertices  m   bytes       update      memcpy      ratio");
+    for (order, vertices, m, bytes, update, copy) in ratios {
         println!(
-            "{vertices:8}  {m}  {bytes:9}  {:8.1} us  {:8.1} us  {:5.2}",
+            "{order:6}  {vertices:8}  {m}  {bytes:9}  {:8.2} us  {:8.2} us  {:5.2}",
             update * 1e6,
             copy * 1e6,
             update / copy

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
+use palpate::dynamic::run::RunOptions;
 use palpate::fem::material::Material;
 use palpate::fix::FixPredicate;
 use palpate::mesh::read_mesh;
@@ -12,6 +13,8 @@ use palpate::tables::build::{BuildOptions, build_table};
 use palpate::tables::compliance::Solver;
 use palpate::tables::file::Precision;
 use palpate::tables::load::{AnyModel, TableFile};
+use palpate::tables::tensor_mass::TensorMassOptions;
+use palpate_kernel::tensor_mass::Integrator;
 use palpate_kernel::{Contact, Real};
 
 #[derive(Parser)]
@@ -33,6 +36,9 @@ enum Command {
     /// Queries of the pre-computed model, through the kernel code path.
     #[command(subcommand)]
     Precomputed(PrecomputedCommand),
+    /// The dynamic tensor-mass model (RR-3510 §5), stepped through the kernel.
+    #[command(subcommand)]
+    Dynamic(DynamicCommand),
     /// Built-in scene: two-probe press and release, forces, timings, VTK series.
     Demo {
         /// Folder for the VTK series (created if absent).
@@ -108,8 +114,80 @@ enum PrecomputedCommand {
     },
 }
 
+#[derive(Subcommand)]
+enum DynamicCommand {
+    /// Step the model under constant loads and print the final state as JSON.
+    Run {
+        /// Input mesh (.msh, .node/.ele, .vtk), metres.
+        mesh: PathBuf,
+        /// Young's modulus, Pa.
+        #[arg(long)]
+        young: f64,
+        /// Poisson ratio, in [0, 0.5).
+        #[arg(long)]
+        poisson: f64,
+        /// Mass density, kg/m3.
+        #[arg(long)]
+        density: f64,
+        /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
+        #[arg(long)]
+        damping: f64,
+        /// Fixed vertices: x|y|z then <, <=, > or >= then a number (repeatable; none = free body).
+        #[arg(long = "fix", value_parser = parse_fix, allow_hyphen_values = true)]
+        fix: Vec<FixPredicate>,
+        /// Constant external force <V>:<fx>,<fy>,<fz> (N, repeatable).
+        #[arg(long = "load", value_parser = parse_load, allow_hyphen_values = true)]
+        load: Vec<(u32, [f64; 3])>,
+        /// Gravity <gx>,<gy>,<gz> (m/s2).
+        #[arg(long, value_parser = parse_gravity, allow_hyphen_values = true, default_value = "0,0,0")]
+        gravity: [f64; 3],
+        /// Time integrator.
+        #[arg(long, value_enum)]
+        integrator: IntegratorArg,
+        /// Time step, s.
+        #[arg(long)]
+        dt: f64,
+        /// Number of steps.
+        #[arg(long)]
+        steps: usize,
+        /// Tets to remove before the first step: <i>,<j>,...
+        #[arg(long = "cut-tets", value_delimiter = ',')]
+        cut_tets: Vec<u32>,
+        /// Print one JSON object (the only output format).
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum IntegratorArg {
+    Euler,
+    Symplectic,
+    Rk4,
+    Central,
+}
+
+impl From<IntegratorArg> for Integrator {
+    fn from(arg: IntegratorArg) -> Self {
+        match arg {
+            IntegratorArg::Euler => Integrator::ExplicitEuler,
+            IntegratorArg::Symplectic => Integrator::SymplecticEuler,
+            IntegratorArg::Rk4 => Integrator::Rk4,
+            IntegratorArg::Central => Integrator::CentralDifference,
+        }
+    }
+}
+
 fn parse_fix(s: &str) -> Result<FixPredicate, String> {
     s.parse()
+}
+
+fn parse_load(s: &str) -> Result<(u32, [f64; 3]), String> {
+    palpate_script::parse_vertex_vector(s).map_err(|e| e.to_string())
+}
+
+fn parse_gravity(s: &str) -> Result<[f64; 3], String> {
+    palpate_script::parse_vector(s).map_err(|e| e.to_string())
 }
 
 fn main() -> ExitCode {
@@ -215,6 +293,45 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             let text = std::fs::read_to_string(&sequence)
                 .with_context(|| format!("{}: cannot read", sequence.display()))?;
             print!("{}", palpate::replay::replay(&file, &text)?);
+            Ok(())
+        }
+        Command::Dynamic(DynamicCommand::Run {
+            mesh,
+            young,
+            poisson,
+            density,
+            damping,
+            fix,
+            load,
+            gravity,
+            integrator,
+            dt,
+            steps,
+            cut_tets,
+            json,
+        }) => {
+            if !json {
+                bail!("dynamic run prints JSON only: pass --json");
+            }
+            let (mesh_data, report) = read_mesh(&mesh)?;
+            let options = RunOptions {
+                table: TensorMassOptions {
+                    material: Material::new(young, poisson)?,
+                    density_kg_m3: density,
+                    fix,
+                    precision: Precision::F64,
+                },
+                damping_per_s: damping,
+                loads: load,
+                gravity_m_s2: gravity,
+                integrator: integrator.into(),
+                dt_s: dt,
+                steps,
+                cut_tets,
+            };
+            let output = palpate::dynamic::run::run(&mesh_data, &report, &options)
+                .with_context(|| mesh.display().to_string())?;
+            println!("{}", serde_json::to_string(&output)?);
             Ok(())
         }
         Command::Demo { out } => palpate::demo::run(&out),

@@ -221,3 +221,99 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
     let out = palpate(&["precomputed", "nonsense"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+fn dynamic_run(extra: &[&str]) -> Output {
+    let mesh = reference("meshes/cube.msh");
+    let mut args = vec![
+        "dynamic",
+        "run",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--density",
+        "1000",
+        "--fix",
+        "z<0.001",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    palpate(&args)
+}
+
+#[test]
+fn dynamic_run_prints_the_contract_json() {
+    let out = dynamic_run(&[
+        "--damping",
+        "8",
+        "--load",
+        "194:0,0,-1",
+        "--integrator",
+        "symplectic",
+        "--dt",
+        "0.004",
+        "--steps",
+        "200",
+        "--cut-tets",
+        "5,6",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["displacements"].as_array().unwrap().len(), 216);
+    // Pushed down at 194: it moves down; the base stays.
+    assert!(json["displacements"][194][2].as_f64().unwrap() < 0.0);
+    assert_eq!(json["displacements"][0][2].as_f64(), Some(0.0));
+    assert!(json["kinetic_energy"].as_f64().unwrap() >= 0.0);
+    assert!(json["volume_change"].as_f64().unwrap().is_finite());
+    assert!(json["fault"].is_null());
+    assert_eq!(json["removed_tets"], serde_json::json!([5, 6]));
+
+    let out = dynamic_run(&[
+        "--damping",
+        "0",
+        "--load",
+        "194:0,0,-1",
+        "--integrator",
+        "euler",
+        "--dt",
+        "0.5",
+        "--steps",
+        "100",
+    ]);
+    assert!(out.status.success());
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        json["fault"].as_str().unwrap().contains("beyond the bound"),
+        "{json}"
+    );
+
+    let out = dynamic_run(&[
+        "--damping",
+        "0",
+        "--integrator",
+        "rk4",
+        "--dt",
+        "0.01",
+        "--steps",
+        "1",
+        "--cut-tets",
+        "9999",
+    ]);
+    assert_one_line_error(&out, "tet 9999 does not exist");
+    let out = dynamic_run(&[
+        "--damping",
+        "0",
+        "--integrator",
+        "leapfrog",
+        "--dt",
+        "0.01",
+        "--steps",
+        "1",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}

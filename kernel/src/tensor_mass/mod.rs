@@ -12,11 +12,13 @@
 //! counts. Nothing allocates and nothing panics; divergence puts the model in
 //! a [`Fault`] state the caller sees instead of numbers.
 
+mod cut;
 mod force;
 mod integrator;
 mod model;
 mod state;
 
+pub use cut::RemoveError;
 pub use integrator::Integrator;
 pub use model::{DynamicParams, InputError, Limits, StepError, StepReport, TensorMassModel};
 pub use state::{Fault, StateBuffers, StateError, VertexMode};

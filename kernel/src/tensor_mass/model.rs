@@ -100,8 +100,8 @@ impl core::error::Error for InputError {}
 /// The dynamic tensor-mass model: a validated table, the caller's state
 /// buffers, and the parameters (RR-3510 §5, MODELS.md §3).
 pub struct TensorMassModel<'a, 's, T: Real> {
-    table: TensorMassTable<'a, T>,
-    state: StateBuffers<'s, T>,
+    pub(super) table: TensorMassTable<'a, T>,
+    pub(super) state: StateBuffers<'s, T>,
     params: DynamicParams<T>,
     previous_valid: bool,
     fault: Option<Fault>,
@@ -160,6 +160,14 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             .copy_from_slice_checked(self.table.edge_tensors());
         s.masses_kg.copy_from_slice_checked(self.table.masses_kg());
         s.tet_alive.fill(true);
+        s.live_tets.fill(0);
+        for tet in self.table.tets() {
+            for &v in tet {
+                if let Some(count) = s.live_tets.get_mut(v as usize) {
+                    *count += 1;
+                }
+            }
+        }
         for (v, mode) in s.modes.iter_mut().enumerate() {
             *mode = if self.table.is_fixed(v as u32) {
                 VertexMode::Fixed

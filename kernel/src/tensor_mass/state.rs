@@ -30,6 +30,9 @@ pub struct StateBuffers<'s, T> {
     pub masses_kg: &'s mut [T],
     /// `M`: `false` once a tet is removed.
     pub tet_alive: &'s mut [bool],
+    /// `N`: live tets around each vertex (a vertex left with none is
+    /// detached: zero mass and stiffness, it keeps still).
+    pub live_tets: &'s mut [u32],
     /// `N`: how each vertex moves.
     pub modes: &'s mut [VertexMode],
     /// `N`: displacement from rest `u = p − p_rest`, m.
@@ -99,6 +102,7 @@ impl<T: Real> StateBuffers<'_, T> {
             ("edge_tensors", self.edge_tensors.len(), table.edge_count()),
             ("masses_kg", self.masses_kg.len(), n),
             ("tet_alive", self.tet_alive.len(), table.tet_count()),
+            ("live_tets", self.live_tets.len(), n),
             ("modes", self.modes.len(), n),
             ("displacement_m", self.displacement_m.len(), n),
             ("velocity_m_s", self.velocity_m_s.len(), n),

@@ -32,5 +32,7 @@
 mod parse;
 mod replay;
 
-pub use parse::{ParseError, StepContacts, parse_contact, parse_step, steps};
+pub use parse::{
+    ParseError, StepContacts, parse_contact, parse_step, parse_vector, parse_vertex_vector, steps,
+};
 pub use replay::{ReplayError, replay};

@@ -59,23 +59,37 @@ fn three<E: core::str::FromStr + Copy + Default>(
     }
 }
 
+/// Parses a vector `x,y,z`.
+pub fn parse_vector<T: Real>(text: &str) -> Result<[T; 3], ParseError> {
+    three(text, "vector components", ParseError::BadNumber)
+}
+
+/// Parses a per-vertex vector `V:x,y,z` (a vertex contact's displacement,
+/// a vertex load).
+pub fn parse_vertex_vector<T: Real>(text: &str) -> Result<(u32, [T; 3]), ParseError> {
+    let (vertex, vector) = text.split_once(':').ok_or(ParseError::MissingColon)?;
+    let vertex = vertex.trim().parse().map_err(|_| ParseError::BadVertex)?;
+    Ok((
+        vertex,
+        three(vector, "displacement", ParseError::BadNumber)?,
+    ))
+}
+
 /// Parses one contact: `V:dx,dy,dz` or `A,B,C@ba,bb,bc:dx,dy,dz`.
 ///
 /// Only the syntax is checked here; whether the vertices are touchable and
 /// the weights valid is the kernel's check ([`palpate_kernel::ContactError`]).
 pub fn parse_contact<T: Real>(text: &str) -> Result<Contact<T>, ParseError> {
     let (point, displacement) = text.split_once(':').ok_or(ParseError::MissingColon)?;
-    let d: [T; 3] = three(displacement, "displacement", ParseError::BadNumber)?;
-    let d = Vector3::new(d[0], d[1], d[2]);
     match point.split_once('@') {
         None => {
-            let vertex = point.trim().parse().map_err(|_| ParseError::BadVertex)?;
-            Ok(Contact::at_vertex(vertex, d))
+            let (vertex, d) = parse_vertex_vector(text)?;
+            Ok(Contact::at_vertex(vertex, Vector3::from(d)))
         }
         Some((vertices, weights)) => Ok(Contact::on_triangle(
             three(vertices, "vertices", ParseError::BadVertex)?,
             three(weights, "weights", ParseError::BadNumber)?,
-            d,
+            Vector3::from(three(displacement, "displacement", ParseError::BadNumber)?),
         )),
     }
 }

@@ -1,0 +1,139 @@
+//! `palpate dynamic run`: a tensor-mass table built in memory (f64), a
+//! scripted load, `N` steps of one integrator through the kernel, a JSON
+//! report.
+
+use anyhow::{Context, bail};
+use nalgebra::Vector3;
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator, Limits, StepError, TensorMassModel};
+use serde::Serialize;
+
+use super::OwnedState;
+use crate::fem::element::shape_gradients;
+use crate::mesh::{MeshReport, TetMesh};
+use crate::tables::load::TableFile;
+use crate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+
+/// A scripted dynamic run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Material, density, fixed vertices (the precision is forced to f64).
+    pub table: TensorMassOptions,
+    /// Mass-proportional damping, 1/s.
+    pub damping_per_s: f64,
+    /// Constant external forces `(vertex, N)`.
+    pub loads: Vec<(u32, [f64; 3])>,
+    /// Gravity, m/s².
+    pub gravity_m_s2: [f64; 3],
+    /// The integrator.
+    pub integrator: Integrator,
+    /// Time step, s.
+    pub dt_s: f64,
+    /// Steps to run.
+    pub steps: usize,
+    /// Tets removed before the first step.
+    pub cut_tets: Vec<u32>,
+}
+
+/// The JSON object `dynamic run --json` prints (a CLI contract).
+#[derive(Serialize, Debug)]
+pub struct RunOutput {
+    /// Displacement of every vertex after the last good step, m.
+    pub displacements: Vec<[f64; 3]>,
+    /// Kinetic energy after the last good step, J.
+    pub kinetic_energy: f64,
+    /// `(V − V₀)/V₀` over the live tets after the last good step.
+    pub volume_change: f64,
+    /// `null`, or why the model faulted (it stops there).
+    pub fault: Option<String>,
+    /// Removed tets (cut and left hanging), ascending.
+    pub removed_tets: Vec<u32>,
+}
+
+/// Runs `options` on `mesh`. Divergence bound: a displacement larger than the
+/// mesh's bounding-box diagonal (a body that moves more than its own size
+/// has diverged); the kinetic energy is not bounded.
+pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow::Result<RunOutput> {
+    let mut table_options = options.table.clone();
+    table_options.precision = crate::tables::file::Precision::F64;
+    let file = TableFile::from_bytes(&build_tensor_mass_table(mesh, report, &table_options)?);
+    let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
+    let mut state = OwnedState::for_table(&table);
+    let params = DynamicParams {
+        damping_per_s: options.damping_per_s,
+        gravity_m_s2: Vector3::from(options.gravity_m_s2),
+        limits: Limits {
+            max_displacement_m: diagonal(&mesh.positions),
+            max_kinetic_energy_j: f64::INFINITY,
+        },
+    };
+    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    for &tet in &options.cut_tets {
+        model
+            .remove_tet(tet)
+            .with_context(|| format!("--cut-tets {tet}"))?;
+    }
+    for &(vertex, force) in &options.loads {
+        model
+            .set_external_force(vertex, Vector3::from(force))
+            .with_context(|| format!("--load {vertex}"))?;
+    }
+    if !(options.dt_s.is_finite() && options.dt_s > 0.0) {
+        bail!("--dt must be finite and > 0 s, got {}", options.dt_s);
+    }
+    let mut last = model.displacements_m()?.to_vec();
+    let mut kinetic_energy = 0.0;
+    let mut fault = None;
+    for _ in 0..options.steps {
+        match model.step(options.integrator, options.dt_s) {
+            Ok(report) => {
+                kinetic_energy = report.kinetic_energy_j;
+                last.copy_from_slice(model.displacements_m()?);
+            }
+            Err(StepError::Faulted(f)) => {
+                fault = Some(f.to_string());
+                break;
+            }
+            Err(e) => bail!("{e}"),
+        }
+    }
+    let alive = model.tet_alive();
+    Ok(RunOutput {
+        volume_change: volume_change(mesh, &last, alive),
+        displacements: last,
+        kinetic_energy,
+        fault,
+        removed_tets: (0..alive.len() as u32)
+            .filter(|&t| !alive[t as usize])
+            .collect(),
+    })
+}
+
+fn diagonal(positions: &[[f64; 3]]) -> f64 {
+    let (lo, hi) = positions.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                core::array::from_fn(|i| lo[i].min(p[i])),
+                core::array::from_fn(|i| hi[i].max(p[i])),
+            )
+        },
+    );
+    Vector3::from(hi).metric_distance(&Vector3::from(lo))
+}
+
+/// `(Σ V − Σ V₀) / Σ V₀` over the live tets, `V` at rest + `u` (MODELS.md §3:
+/// the linear model's volume is not conserved under large motion).
+pub fn volume_change(mesh: &TetMesh, u: &[[f64; 3]], alive: &[bool]) -> f64 {
+    let (mut rest, mut now) = (0.0, 0.0);
+    for (tet, _) in mesh.tets.iter().zip(alive).filter(|(_, a)| **a) {
+        let p0 = tet.map(|v| mesh.positions[v as usize]);
+        let p = tet.map(|v| {
+            let (x, d) = (mesh.positions[v as usize], u[v as usize]);
+            [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
+        });
+        rest += shape_gradients(&p0).1;
+        now += shape_gradients(&p).1;
+    }
+    (now - rest) / rest
+}
