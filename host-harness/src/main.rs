@@ -157,6 +157,32 @@ enum DynamicCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Largest stable time step of an integrator (bisection) next to 2/ω_max.
+    CriticalDt {
+        /// Input mesh (.msh, .node/.ele, .vtk), metres.
+        mesh: PathBuf,
+        /// Young's modulus, Pa.
+        #[arg(long)]
+        young: f64,
+        /// Poisson ratio, in [0, 0.5).
+        #[arg(long)]
+        poisson: f64,
+        /// Mass density, kg/m3.
+        #[arg(long)]
+        density: f64,
+        /// Mass-proportional damping c (1/s).
+        #[arg(long)]
+        damping: f64,
+        /// Fixed vertices (repeatable; none = free body).
+        #[arg(long = "fix", value_parser = parse_fix, allow_hyphen_values = true)]
+        fix: Vec<FixPredicate>,
+        /// Time integrator.
+        #[arg(long, value_enum)]
+        integrator: IntegratorArg,
+        /// Print one JSON object (the only output format).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -332,6 +358,39 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             let output = palpate::dynamic::run::run(&mesh_data, &report, &options)
                 .with_context(|| mesh.display().to_string())?;
             println!("{}", serde_json::to_string(&output)?);
+            Ok(())
+        }
+        Command::Dynamic(DynamicCommand::CriticalDt {
+            mesh,
+            young,
+            poisson,
+            density,
+            damping,
+            fix,
+            integrator,
+            json,
+        }) => {
+            if !json {
+                bail!("dynamic critical-dt prints JSON only: pass --json");
+            }
+            let (mesh_data, report) = read_mesh(&mesh)?;
+            let options = TensorMassOptions {
+                material: Material::new(young, poisson)?,
+                density_kg_m3: density,
+                fix,
+                precision: Precision::F64,
+            };
+            let file = palpate::dynamic::run::f64_table(&mesh_data, &report, &options)
+                .with_context(|| mesh.display().to_string())?;
+            let table = palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes())?;
+            let mut state = palpate::dynamic::OwnedState::for_table(&table);
+            let params = palpate::dynamic::run::host_params(&mesh_data.positions, damping);
+            let mut model =
+                palpate_kernel::tensor_mass::TensorMassModel::new(table, state.buffers(), params)?;
+            let amplitude = 1e-3 * palpate::dynamic::run::diagonal(&mesh_data.positions);
+            let result =
+                palpate::dynamic::stability::critical_dt(&mut model, integrator.into(), amplitude);
+            println!("{}", serde_json::to_string(&result)?);
             Ok(())
         }
         Command::Demo { out } => palpate::demo::run(&out),

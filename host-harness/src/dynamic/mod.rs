@@ -1,8 +1,9 @@
 //! The dynamic tensor-mass model on the host: heap-owned state buffers for
 //! the kernel's [`palpate_kernel::tensor_mass::TensorMassModel`] and the
-//! `dynamic run` command.
+//! `dynamic run` and `dynamic critical-dt` commands.
 
 mod owned;
 pub mod run;
+pub mod stability;
 
 pub use owned::OwnedState;

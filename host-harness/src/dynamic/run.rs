@@ -54,18 +54,12 @@ pub struct RunOutput {
 /// mesh's bounding-box diagonal (a body that moves more than its own size
 /// has diverged); the kinetic energy is not bounded.
 pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow::Result<RunOutput> {
-    let mut table_options = options.table.clone();
-    table_options.precision = crate::tables::file::Precision::F64;
-    let file = TableFile::from_bytes(&build_tensor_mass_table(mesh, report, &table_options)?);
+    let file = f64_table(mesh, report, &options.table)?;
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
     let params = DynamicParams {
-        damping_per_s: options.damping_per_s,
         gravity_m_s2: Vector3::from(options.gravity_m_s2),
-        limits: Limits {
-            max_displacement_m: diagonal(&mesh.positions),
-            max_kinetic_energy_j: f64::INFINITY,
-        },
+        ..host_params(&mesh.positions, options.damping_per_s)
     };
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     for &tet in &options.cut_tets {
@@ -109,7 +103,35 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     })
 }
 
-fn diagonal(positions: &[[f64; 3]]) -> f64 {
+/// The f64 tensor-mass table of `mesh` (host runs verify in f64).
+pub fn f64_table(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &TensorMassOptions,
+) -> anyhow::Result<TableFile> {
+    let mut options = options.clone();
+    options.precision = crate::tables::file::Precision::F64;
+    Ok(TableFile::from_bytes(&build_tensor_mass_table(
+        mesh, report, &options,
+    )?))
+}
+
+/// The host commands' parameters: damping `damping_per_s` (1/s), no gravity,
+/// divergence when a displacement exceeds the bounding-box diagonal of
+/// `positions` (m), kinetic energy unbounded.
+pub fn host_params(positions: &[[f64; 3]], damping_per_s: f64) -> DynamicParams<f64> {
+    DynamicParams {
+        damping_per_s,
+        gravity_m_s2: Vector3::zeros(),
+        limits: Limits {
+            max_displacement_m: diagonal(positions),
+            max_kinetic_energy_j: f64::INFINITY,
+        },
+    }
+}
+
+/// Bounding-box diagonal, m.
+pub fn diagonal(positions: &[[f64; 3]]) -> f64 {
     let (lo, hi) = positions.iter().fold(
         ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
         |(lo, hi), p| {

@@ -304,8 +304,13 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// vertex; a shorter `out` gets the first vertices only). The force an
     /// imposed vertex's holder applies is the negative of its entry.
     pub fn elastic_forces_n(&self, out: &mut [[T; 3]]) {
-        self.stiffness()
-            .elastic_forces(self.state.displacement_m, out);
+        self.elastic_forces_of(self.state.displacement_m, out);
+    }
+
+    /// The elastic forces `−K u` (N) of any displacement field `u` (m) with
+    /// the current stiffness (energy and eigenvalue estimates).
+    pub fn elastic_forces_of(&self, u: &[[T; 3]], out: &mut [[T; 3]]) {
+        self.stiffness().elastic_forces(u, out);
     }
 
     fn stiffness(&self) -> Stiffness<'_, T> {
