@@ -264,6 +264,22 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         Ok(())
     }
 
+    /// Sets the velocity of a free `vertex`, m/s (initial conditions).
+    pub fn set_velocity(
+        &mut self,
+        vertex: u32,
+        velocity_m_s: Vector3<T>,
+    ) -> Result<(), InputError> {
+        if !velocity_m_s.iter().all(|x| x.finite()) {
+            return Err(InputError::NonFinite { vertex });
+        }
+        let v = self.vertex_index(vertex)?;
+        if let Some(vel) = self.state.velocity_m_s.get_mut(v) {
+            *vel = velocity_m_s.into();
+        }
+        Ok(())
+    }
+
     /// Zeroes every external force.
     pub fn clear_external_forces(&mut self) {
         self.state.external_force_n.fill([T::zero(); 3]);
