@@ -2,7 +2,7 @@
 //! `f_i = −(K_ii u_i + Σ_j K_ij u_j)`, one pass over the vertices and one over
 //! the edges (each edge stored once, `K_ji = K_ijᵀ`).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 use crate::Real;
 
@@ -19,13 +19,34 @@ pub(crate) fn vec3<T: Real>(v: &[T; 3]) -> Vector3<T> {
     Vector3::new(v[0], v[1], v[2])
 }
 
+/// `K x` for a row-major 3×3 `K`.
+#[inline(always)]
+fn mul<T: Real>(k: &[T; 9], x: &[T; 3]) -> [T; 3] {
+    [
+        k[0] * x[0] + k[1] * x[1] + k[2] * x[2],
+        k[3] * x[0] + k[4] * x[1] + k[5] * x[2],
+        k[6] * x[0] + k[7] * x[1] + k[8] * x[2],
+    ]
+}
+
+/// `Kᵀ x` for a row-major 3×3 `K`.
+#[inline(always)]
+fn mul_transposed<T: Real>(k: &[T; 9], x: &[T; 3]) -> [T; 3] {
+    [
+        k[0] * x[0] + k[3] * x[1] + k[6] * x[2],
+        k[1] * x[0] + k[4] * x[1] + k[7] * x[2],
+        k[2] * x[0] + k[5] * x[1] + k[8] * x[2],
+    ]
+}
+
 impl<T: Real> Stiffness<'_, T> {
     /// Overwrites `f` with the elastic forces (N) of displacements `u` (m).
     /// Loops: `N` vertices, then `E` edges (lengths validated at load and at
     /// state construction; an out-of-range access is skipped, never a panic).
     pub(crate) fn elastic_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
         for ((fi, ui), k) in f.iter_mut().zip(u).zip(self.vertex_tensors) {
-            *fi = (-(Matrix3::from_row_slice(k) * vec3(ui))).into();
+            let ku = mul(k, ui);
+            *fi = [-ku[0], -ku[1], -ku[2]];
         }
         for (i, pair) in self.row_start.windows(2).enumerate() {
             let (Some(&[start, end]), Some(ui)) = (pair.first_chunk::<2>(), u.get(i)) else {
@@ -37,18 +58,18 @@ impl<T: Real> Stiffness<'_, T> {
             else {
                 continue;
             };
-            let ui = vec3(ui);
-            let mut fi = Vector3::zeros();
+            let mut fi = [T::zero(); 3];
             for (&j, k) in columns.iter().zip(tensors) {
                 let (Some(uj), Some(fj)) = (u.get(j as usize), f.get_mut(j as usize)) else {
                     continue;
                 };
-                let k = Matrix3::from_row_slice(k);
-                fi -= k * vec3(uj);
-                *fj = (vec3(fj) - k.tr_mul(&ui)).into();
+                let a = mul(k, uj);
+                let b = mul_transposed(k, ui);
+                fi = [fi[0] - a[0], fi[1] - a[1], fi[2] - a[2]];
+                *fj = [fj[0] - b[0], fj[1] - b[1], fj[2] - b[2]];
             }
             if let Some(f) = f.get_mut(i) {
-                *f = (vec3(f) + fi).into();
+                *f = [f[0] + fi[0], f[1] + fi[1], f[2] + fi[2]];
             }
         }
     }

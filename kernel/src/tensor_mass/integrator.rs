@@ -88,7 +88,10 @@ impl<T: Real> Loads<'_, T> {
             .zip(self.external_force_n);
         for ((((ai, vi), &m), &mode), fext) in per_vertex {
             *ai = if mode == VertexMode::Free && m > T::zero() {
-                ((vec3(ai) + vec3(fext)) / m + self.gravity_m_s2 - vec3(vi) * damping_per_s).into()
+                let inverse_mass = T::one() / m;
+                ((vec3(ai) + vec3(fext)) * inverse_mass + self.gravity_m_s2
+                    - vec3(vi) * damping_per_s)
+                    .into()
             } else {
                 [T::zero(); 3]
             };
