@@ -596,3 +596,134 @@ fn a_rotated_free_body_swells_by_theta_squared() {
         );
     }
 }
+
+/// Every live tet's face neighbours include a live one, and the model's
+/// surface is the host's boundary extraction of the live mesh.
+fn assert_conformal(model: &TensorMassModel<'_, '_, f64>, mesh: &TetMesh) {
+    let file = cube_table(&[]);
+    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+    let alive = model.tet_alive();
+    for (t, neighbours) in table.tet_neighbours().iter().enumerate() {
+        if alive[t] {
+            assert!(
+                neighbours
+                    .iter()
+                    .any(|&o| (o as usize) < alive.len() && alive[o as usize]),
+                "tet {t} hangs"
+            );
+        }
+    }
+    let live = TetMesh {
+        positions: mesh.positions.clone(),
+        tets: mesh
+            .tets
+            .iter()
+            .zip(alive)
+            .filter(|(_, a)| **a)
+            .map(|(t, _)| *t)
+            .collect(),
+    };
+    let canonical = |mut faces: Vec<[u32; 3]>| {
+        for f in &mut faces {
+            let min = (0..3).min_by_key(|&i| f[i]).unwrap();
+            f.rotate_left(min);
+        }
+        faces.sort_unstable();
+        faces
+    };
+    assert_eq!(
+        canonical(model.surface_triangles().collect()),
+        canonical(palpate::mesh::boundary_surface(&live).triangles)
+    );
+}
+
+/// A scalpel swept through the top of the cube removes every tet it touches,
+/// at most `capacity` per call, the rest on the next calls; the mesh stays
+/// conformal.
+#[test]
+fn tool_cut_is_bounded_per_call_and_complete() {
+    let (mesh, _) = cube();
+    let file = cube_table(&["z<0.001"]);
+    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+    let mut state = OwnedState::for_table(&table);
+    let mut model = TensorMassModel::new(table, state.buffers(), params(0.0)).unwrap();
+    let (a, b, radius) = (
+        Vector3::new(-0.1, 0.5, 0.9),
+        Vector3::new(1.1, 0.5, 0.9),
+        0.15,
+    );
+    let touched = |t: &[u32; 4]| {
+        t.iter().any(|&v| {
+            let p = mesh.positions[v as usize];
+            ((p[1] - 0.5).powi(2) + (p[2] - 0.9).powi(2)).sqrt() <= radius
+        })
+    };
+    let expected = mesh.tets.iter().filter(|t| touched(t)).count();
+    let mut calls = 0;
+    loop {
+        let report = model.cut_with_tool(a, b, radius, 10);
+        calls += 1;
+        assert!(report.removed <= 10 + 4, "{report:?}");
+        if !report.pending {
+            break;
+        }
+    }
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        if touched(tet) {
+            assert!(!model.tet_alive()[t], "tet {t} touched but alive");
+        }
+    }
+    assert!(
+        calls >= expected.div_ceil(14),
+        "{calls} calls for {expected} tets"
+    );
+    assert_conformal(&model, &mesh);
+}
+
+/// Stretching the top layer past a threshold tears exactly the tets whose
+/// edges elongate past it; with every criterion off nothing tears.
+#[test]
+fn tearing_removes_overstretched_tets_only() {
+    let (mesh, _) = cube();
+    let file = cube_table(&["z<0.001"]);
+    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+    let mut state = OwnedState::for_table(&table);
+    let mut model = TensorMassModel::new(table, state.buffers(), params(0.0)).unwrap();
+    // Lift the top face (z = 1) by 0.1: the top layer (height 0.2) stretches
+    // by 50 % vertically, everything else is at rest.
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if p[2] > 0.999 {
+            model.impose(v as u32, Vector3::new(0.0, 0.0, 0.1)).unwrap();
+        }
+    }
+    use palpate_kernel::tensor_mass::TearThresholds;
+    let off = TearThresholds {
+        volume_change: None,
+        mean_elongation: None,
+        max_elongation: None,
+    };
+    assert_eq!(model.tear(&off, 1000).removed, 0);
+    let tear = TearThresholds {
+        max_elongation: Some(0.3),
+        ..off
+    };
+    let mut removed = 0;
+    loop {
+        let report = model.tear(&tear, 50);
+        removed += report.removed;
+        if !report.pending {
+            break;
+        }
+    }
+    // Every top-layer tet has a vertical edge of the layer (+50 %).
+    let top_layer = mesh
+        .tets
+        .iter()
+        .filter(|t| t.iter().any(|&v| mesh.positions[v as usize][2] > 0.999))
+        .count();
+    assert_eq!(removed as usize, top_layer);
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        let in_top = tet.iter().any(|&v| mesh.positions[v as usize][2] > 0.999);
+        assert_eq!(model.tet_alive()[t], !in_top, "tet {t}");
+    }
+}

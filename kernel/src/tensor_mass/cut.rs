@@ -6,6 +6,8 @@
 
 use core::fmt;
 
+use nalgebra::Vector3;
+
 use super::model::TensorMassModel;
 use crate::Real;
 use crate::element::stiffness_block;
@@ -148,4 +150,154 @@ fn subtract_block<T: Real>(k: &mut [T; 9], block: &nalgebra::Matrix3<T>) {
             *x -= *b;
         }
     }
+}
+
+/// What one cutting or tearing call did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CutReport {
+    /// Tets removed by this call (hanging ones included).
+    pub removed: u32,
+    /// `true` if more tets qualified than the capacity allowed: call again
+    /// next step (the scan finds them again, so nothing is lost).
+    pub pending: bool,
+}
+
+/// Tearing thresholds (MODELS.md §3); `None` switches a criterion off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TearThresholds<T> {
+    /// Largest `|V − V₀| / V₀`.
+    pub volume_change: Option<T>,
+    /// Largest mean of the six `(l − l₀) / l₀`.
+    pub mean_elongation: Option<T>,
+    /// Largest single `(l − l₀) / l₀`.
+    pub max_elongation: Option<T>,
+}
+
+impl<T: Real> TensorMassModel<'_, '_, T> {
+    /// Current position of `vertex`, m (rest + displacement).
+    fn position(&self, vertex: u32) -> Option<Vector3<T>> {
+        let p = self.table.rest_positions().get(vertex as usize)?;
+        let u = self.state.displacement_m.get(vertex as usize)?;
+        Some(Vector3::new(p[0] + u[0], p[1] + u[1], p[2] + u[2]))
+    }
+
+    /// Removes every live tet with a vertex (current position) within
+    /// `radius_m` of the tool segment `a_m`–`b_m` (a point when equal), at
+    /// most `capacity` per call (Picinbono 2001 §3.1: the electric scalpel
+    /// removes the tets it touches). Bounded: one scan of the tets.
+    pub fn cut_with_tool(
+        &mut self,
+        a_m: Vector3<T>,
+        b_m: Vector3<T>,
+        radius_m: T,
+        capacity: u32,
+    ) -> CutReport {
+        let axis = b_m - a_m;
+        let length2 = axis.norm_squared();
+        let r2 = radius_m * radius_m;
+        let touches = |p: Vector3<T>| {
+            let t = if length2 > T::zero() {
+                ((p - a_m).dot(&axis) / length2)
+                    .max(T::zero())
+                    .min(T::one())
+            } else {
+                T::zero()
+            };
+            (p - (a_m + axis * t)).norm_squared() <= r2
+        };
+        self.remove_where(capacity, |model, tet| {
+            tet.iter().any(|&v| model.position(v).is_some_and(touches))
+        })
+    }
+
+    /// Removes every live tet past a [`TearThresholds`] criterion, at most
+    /// `capacity` per call. Bounded: one scan of the tets.
+    pub fn tear(&mut self, thresholds: &TearThresholds<T>, capacity: u32) -> CutReport {
+        let thresholds = *thresholds;
+        self.remove_where(capacity, move |model, tet| {
+            model
+                .corners(tet)
+                .is_some_and(|(now, rest)| exceeds(&now, &rest, &thresholds))
+        })
+    }
+
+    /// Current and rest corner positions of `tet`, m.
+    fn corners(&self, tet: [u32; 4]) -> Option<(Corners<T>, Corners<T>)> {
+        let mut now = [Vector3::zeros(); 4];
+        let mut rest = [Vector3::zeros(); 4];
+        for ((n, r), &v) in now.iter_mut().zip(rest.iter_mut()).zip(&tet) {
+            *n = self.position(v)?;
+            let p = self.table.rest_positions().get(v as usize)?;
+            *r = Vector3::new(p[0], p[1], p[2]);
+        }
+        Some((now, rest))
+    }
+
+    /// Scans the live tets in index order and removes those `qualifies`
+    /// picks, up to `capacity`.
+    fn remove_where(
+        &mut self,
+        capacity: u32,
+        qualifies: impl Fn(&Self, [u32; 4]) -> bool,
+    ) -> CutReport {
+        let mut report = CutReport::default();
+        for t in 0..self.table.tet_count() {
+            let Some(&tet) = self.table.tets().get(t) else {
+                break;
+            };
+            if !self.is_alive(t as u32) || !qualifies(self, tet) {
+                continue;
+            }
+            if report.removed >= capacity {
+                report.pending = true;
+                break;
+            }
+            report.removed += self.remove_tet(t as u32).unwrap_or(0);
+        }
+        report
+    }
+}
+
+/// The four corner positions of a tet, m.
+type Corners<T> = [Vector3<T>; 4];
+
+/// Signed volume of a tet, m³.
+fn volume<T: Real>(p: &[Vector3<T>; 4]) -> T {
+    let [p0, p1, p2, p3] = p;
+    (p1 - p0).dot(&(p2 - p0).cross(&(p3 - p0))) / T::of_f64(6.0)
+}
+
+/// `true` if the tet with corners `now` (rest `rest`) passes a threshold.
+fn exceeds<T: Real>(
+    now: &[Vector3<T>; 4],
+    rest: &[Vector3<T>; 4],
+    thresholds: &TearThresholds<T>,
+) -> bool {
+    let v0 = volume(rest);
+    let volume_change = ((volume(now) - v0) / v0).abs();
+    let (mut sum, mut max) = (T::zero(), T::zero());
+    for [j, k] in TET_EDGE_PAIRS {
+        let (Some(a), Some(b), Some(a0), Some(b0)) =
+            (now.get(j), now.get(k), rest.get(j), rest.get(k))
+        else {
+            continue;
+        };
+        let l0 = (b0 - a0).norm();
+        let elongation = ((b - a).norm() - l0) / l0;
+        sum += elongation;
+        max = max.max(elongation);
+    }
+    let mean = sum / T::of_f64(6.0);
+    // A NaN measure counts as past the limit.
+    let past = |value: T, limit: Option<T>| {
+        limit.is_some_and(|l| {
+            matches!(
+                value.partial_cmp(&l),
+                Some(core::cmp::Ordering::Greater) | None
+            )
+        })
+    };
+    past(volume_change, thresholds.volume_change)
+        || past(mean, thresholds.mean_elongation)
+        || past(max, thresholds.max_elongation)
 }

@@ -18,7 +18,7 @@ mod integrator;
 mod model;
 mod state;
 
-pub use cut::RemoveError;
+pub use cut::{CutReport, RemoveError, TearThresholds};
 pub use integrator::Integrator;
 pub use model::{DynamicParams, InputError, Limits, StepError, StepReport, TensorMassModel};
 pub use state::{Fault, StateBuffers, StateError, VertexMode};
