@@ -9,6 +9,11 @@
 //! one force pass touches (`40·(N+E)` bytes of tensors and CSR, `12·N` each
 //! for `u`, `v`, `f`, masses `4·N`), measured in the same run.
 //!
+//! `tet_removal`: the cost of one cut, `remove_tet` over 100 consecutive
+//! tets (indices 2700–2799, a band of cells mid-height) of the 6000-tet cube (10 blocks and 4 mass shares
+//! each, plus the hanging check), reset untimed between runs; the figure is
+//! tets removed per microsecond.
+//!
 //! Run: `RUSTFLAGS="-C target-cpu=native" cargo bench -p palpate-benches --bench tensor_mass_step`.
 
 use core::hint::black_box;
@@ -89,5 +94,30 @@ fn step(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, step);
+fn tet_removal(c: &mut Criterion) {
+    let file = table(10);
+    let table = TensorMassTable::<f32>::load(file.bytes()).expect("table");
+    let tets: Vec<u32> = (0..100).map(|i| 2700 + i).collect();
+    let mut state = OwnedState::for_table(&table);
+    let mut model = TensorMassModel::new(table, state.buffers(), params()).expect("model");
+    let mut group = c.benchmark_group("tet_removal");
+    group.throughput(criterion::Throughput::Elements(tets.len() as u64));
+    group.bench_function("100_tets_of_6000", |b| {
+        b.iter_custom(|iterations| {
+            let mut total = core::time::Duration::ZERO;
+            for _ in 0..iterations {
+                model.reset();
+                let start = std::time::Instant::now();
+                for &t in &tets {
+                    black_box(model.remove_tet(black_box(t)).ok());
+                }
+                total += start.elapsed();
+            }
+            total
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, step, tet_removal);
 criterion_main!(benches);
