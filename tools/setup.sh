@@ -1,7 +1,13 @@
 #!/usr/bin/env bash
 # Installs what the embedded checks need on a fresh machine that has only a
 # rustup toolchain (RUSTUP_AUTO_INSTALL=0: rust-toolchain files install
-# nothing, so this script does it). Idempotent; a no-op when all is present.
+# nothing, so this script does it):
+# - the thumbv7em-none-eabihf (Cortex-M4F firmware, no-panic check) and
+#   x86_64-unknown-none (kernel cross-build) targets;
+# - llvm-tools (llvm-size, llvm-nm, llvm-objdump for the size report and the
+#   no-panic diagnostics, under $(rustc --print sysroot)/lib/rustlib/*/bin);
+# - qemu-system-arm (runs the firmware), from apt-get, with sudo when not root.
+# Idempotent; a fast no-op when all is present.
 set -euo pipefail
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
@@ -9,8 +15,15 @@ rustup component add llvm-tools
 
 if ! command -v qemu-system-arm >/dev/null; then
     sudo=""
-    if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
+    if [ "$(id -u)" != 0 ]; then
+        if ! command -v sudo >/dev/null; then
+            echo "setup: qemu-system-arm is missing and installing it needs root (no sudo here)" >&2
+            exit 1
+        fi
+        sudo="sudo"
+    fi
     $sudo apt-get update -qq
-    $sudo apt-get install -y -qq --no-install-recommends qemu-system-arm
+    $sudo env DEBIAN_FRONTEND=noninteractive \
+        apt-get install -y -qq --no-install-recommends qemu-system-arm
 fi
 qemu-system-arm --version | head -1
