@@ -21,6 +21,28 @@ enum Comparison {
     GreaterEq,
 }
 
+/// The fixed flag of every vertex: matching any of `fix` at rest, or in
+/// `unreferenced` (kept so the numbering stays the file's, fixed because no
+/// tet gives them stiffness or mass). Also returns how many a predicate
+/// matched.
+pub fn fixed_vertices(
+    positions: &[[f64; 3]],
+    fix: &[FixPredicate],
+    unreferenced: &[u32],
+) -> (Vec<bool>, usize) {
+    let mut fixed: Vec<bool> = positions
+        .iter()
+        .map(|p| fix.iter().any(|f| f.matches(p)))
+        .collect();
+    let by_predicate = fixed.iter().filter(|&&f| f).count();
+    for &v in unreferenced {
+        if let Some(f) = fixed.get_mut(v as usize) {
+            *f = true;
+        }
+    }
+    (fixed, by_predicate)
+}
+
 impl FixPredicate {
     /// `true` if the rest position `p` (mesh units) satisfies the predicate.
     pub fn matches(&self, p: &[f64; 3]) -> bool {

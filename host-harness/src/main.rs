@@ -8,7 +8,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 use palpate::dynamic::run::RunOptions;
 use palpate::fem::material::Material;
 use palpate::fix::FixPredicate;
-use palpate::mesh::read_mesh;
+use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::tables::build::{BuildOptions, build_table};
 use palpate::tables::compliance::Solver;
 use palpate::tables::file::Precision;
@@ -114,36 +114,64 @@ enum PrecomputedCommand {
     },
 }
 
+/// What both `dynamic` commands take: the mesh, its material and supports,
+/// the damping and the integrator.
+#[derive(clap::Args)]
+struct DynamicModelArgs {
+    /// Input mesh (.msh, .node/.ele, .vtk), metres.
+    mesh: PathBuf,
+    /// Young's modulus, Pa.
+    #[arg(long)]
+    young: f64,
+    /// Poisson ratio, in [0, 0.5).
+    #[arg(long)]
+    poisson: f64,
+    /// Mass density, kg/m3.
+    #[arg(long)]
+    density: f64,
+    /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
+    #[arg(long)]
+    damping: f64,
+    /// Fixed vertices: x|y|z then <, <=, > or >= then a number (repeatable; none = free body).
+    #[arg(long = "fix", value_parser = parse_fix, allow_hyphen_values = true)]
+    fix: Vec<FixPredicate>,
+    /// Time integrator.
+    #[arg(long, value_enum)]
+    integrator: IntegratorArg,
+    /// Print one JSON object (the only output format).
+    #[arg(long)]
+    json: bool,
+}
+
+impl DynamicModelArgs {
+    /// Checks `--json`, reads the mesh and gathers the table options.
+    fn read(&self, command: &str) -> anyhow::Result<(TetMesh, MeshReport, TensorMassOptions)> {
+        if !self.json {
+            bail!("dynamic {command} prints JSON only: pass --json");
+        }
+        let (mesh, report) = read_mesh(&self.mesh)?;
+        let options = TensorMassOptions {
+            material: Material::new(self.young, self.poisson)?,
+            density_kg_m3: self.density,
+            fix: self.fix.clone(),
+            precision: Precision::F64,
+        };
+        Ok((mesh, report, options))
+    }
+}
+
 #[derive(Subcommand)]
 enum DynamicCommand {
     /// Step the model under constant loads and print the final state as JSON.
     Run {
-        /// Input mesh (.msh, .node/.ele, .vtk), metres.
-        mesh: PathBuf,
-        /// Young's modulus, Pa.
-        #[arg(long)]
-        young: f64,
-        /// Poisson ratio, in [0, 0.5).
-        #[arg(long)]
-        poisson: f64,
-        /// Mass density, kg/m3.
-        #[arg(long)]
-        density: f64,
-        /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
-        #[arg(long)]
-        damping: f64,
-        /// Fixed vertices: x|y|z then <, <=, > or >= then a number (repeatable; none = free body).
-        #[arg(long = "fix", value_parser = parse_fix, allow_hyphen_values = true)]
-        fix: Vec<FixPredicate>,
+        #[command(flatten)]
+        model: DynamicModelArgs,
         /// Constant external force <V>:<fx>,<fy>,<fz> (N, repeatable).
         #[arg(long = "load", value_parser = parse_load, allow_hyphen_values = true)]
         load: Vec<(u32, [f64; 3])>,
         /// Gravity <gx>,<gy>,<gz> (m/s2).
         #[arg(long, value_parser = parse_gravity, allow_hyphen_values = true, default_value = "0,0,0")]
         gravity: [f64; 3],
-        /// Time integrator.
-        #[arg(long, value_enum)]
-        integrator: IntegratorArg,
         /// Time step, s.
         #[arg(long)]
         dt: f64,
@@ -153,35 +181,11 @@ enum DynamicCommand {
         /// Tets to remove before the first step: <i>,<j>,...
         #[arg(long = "cut-tets", value_delimiter = ',')]
         cut_tets: Vec<u32>,
-        /// Print one JSON object (the only output format).
-        #[arg(long)]
-        json: bool,
     },
     /// Largest stable time step of an integrator (bisection) next to 2/ω_max.
     CriticalDt {
-        /// Input mesh (.msh, .node/.ele, .vtk), metres.
-        mesh: PathBuf,
-        /// Young's modulus, Pa.
-        #[arg(long)]
-        young: f64,
-        /// Poisson ratio, in [0, 0.5).
-        #[arg(long)]
-        poisson: f64,
-        /// Mass density, kg/m3.
-        #[arg(long)]
-        density: f64,
-        /// Mass-proportional damping c (1/s).
-        #[arg(long)]
-        damping: f64,
-        /// Fixed vertices (repeatable; none = free body).
-        #[arg(long = "fix", value_parser = parse_fix, allow_hyphen_values = true)]
-        fix: Vec<FixPredicate>,
-        /// Time integrator.
-        #[arg(long, value_enum)]
-        integrator: IntegratorArg,
-        /// Print one JSON object (the only output format).
-        #[arg(long)]
-        json: bool,
+        #[command(flatten)]
+        model: DynamicModelArgs,
     },
 }
 
@@ -322,74 +326,39 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Dynamic(DynamicCommand::Run {
-            mesh,
-            young,
-            poisson,
-            density,
-            damping,
-            fix,
+            model,
             load,
             gravity,
-            integrator,
             dt,
             steps,
             cut_tets,
-            json,
         }) => {
-            if !json {
-                bail!("dynamic run prints JSON only: pass --json");
-            }
-            let (mesh_data, report) = read_mesh(&mesh)?;
+            let (mesh, report, table) = model.read("run")?;
             let options = RunOptions {
-                table: TensorMassOptions {
-                    material: Material::new(young, poisson)?,
-                    density_kg_m3: density,
-                    fix,
-                    precision: Precision::F64,
-                },
-                damping_per_s: damping,
+                table,
+                damping_per_s: model.damping,
                 loads: load,
                 gravity_m_s2: gravity,
-                integrator: integrator.into(),
+                integrator: model.integrator.into(),
                 dt_s: dt,
                 steps,
                 cut_tets,
             };
-            let output = palpate::dynamic::run::run(&mesh_data, &report, &options)
-                .with_context(|| mesh.display().to_string())?;
+            let output = palpate::dynamic::run::run(&mesh, &report, &options)
+                .with_context(|| model.mesh.display().to_string())?;
             println!("{}", serde_json::to_string(&output)?);
             Ok(())
         }
-        Command::Dynamic(DynamicCommand::CriticalDt {
-            mesh,
-            young,
-            poisson,
-            density,
-            damping,
-            fix,
-            integrator,
-            json,
-        }) => {
-            if !json {
-                bail!("dynamic critical-dt prints JSON only: pass --json");
-            }
-            let (mesh_data, report) = read_mesh(&mesh)?;
-            let options = TensorMassOptions {
-                material: Material::new(young, poisson)?,
-                density_kg_m3: density,
-                fix,
-                precision: Precision::F64,
-            };
-            let file = palpate::dynamic::run::f64_table(&mesh_data, &report, &options)
-                .with_context(|| mesh.display().to_string())?;
-            let table = palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes())?;
-            let mut state = palpate::dynamic::OwnedState::for_table(&table);
-            let params = palpate::dynamic::run::host_params(&mesh_data.positions, damping);
-            let mut model =
-                palpate_kernel::tensor_mass::TensorMassModel::new(table, state.buffers(), params)?;
-            let amplitude = 1e-3 * palpate::dynamic::run::diagonal(&mesh_data.positions);
-            let result =
-                palpate::dynamic::stability::critical_dt(&mut model, integrator.into(), amplitude);
+        Command::Dynamic(DynamicCommand::CriticalDt { model }) => {
+            let (mesh, report, table) = model.read("critical-dt")?;
+            let result = palpate::dynamic::stability::critical_dt_of_mesh(
+                &mesh,
+                &report,
+                &table,
+                model.damping,
+                model.integrator.into(),
+            )
+            .with_context(|| model.mesh.display().to_string())?;
             println!("{}", serde_json::to_string(&result)?);
             Ok(())
         }

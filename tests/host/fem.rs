@@ -9,7 +9,8 @@ use palpate::fem::element::{element_stiffness, shape_gradients};
 use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
 use palpate_tests::{
-    read_reference_json, read_reference_stiffness, read_reference_tetgen, rel_max_diff,
+    max_entry_difference, read_reference_json, read_reference_stiffness, read_reference_tetgen,
+    rel_max_diff,
 };
 
 type Ke = [[[[f64; 3]; 3]; 4]; 4];
@@ -208,15 +209,7 @@ fn global_k_matches_reference_csv() {
     for t in k.triplet_iter() {
         ours.insert((t.row, t.col), *t.val);
     }
-    let mut worst = 0.0f64;
-    for (key, v) in &reference {
-        worst = worst.max((ours.get(key).copied().unwrap_or(0.0) - v).abs());
-    }
-    for (key, v) in &ours {
-        if !reference.contains_key(key) {
-            worst = worst.max(v.abs());
-        }
-    }
+    let worst = max_entry_difference(&ours, &reference);
     println!("max |K - K_ref| / max|K_ref| = {:e}", worst / scale);
     assert!(worst <= 1e-12 * scale, "relative {:e}", worst / scale);
 }

@@ -19,7 +19,9 @@ use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
     DynamicParams, Fault, Integrator, Limits, StepError, TensorMassModel,
 };
-use palpate_tests::{json_rows, read_reference_json, read_reference_stiffness, reference_dir};
+use palpate_tests::{
+    json_rows, max_entry_difference, read_reference_json, read_reference_stiffness, reference_dir,
+};
 
 const DENSITY: f64 = 1000.0;
 
@@ -84,15 +86,7 @@ fn tensors_and_masses_match_scikit_fem() {
             put(j, i, &table.edge_tensors()[e], true);
         }
     }
-    let mut worst = 0.0f64;
-    for (key, v) in &reference {
-        worst = worst.max((ours.get(key).copied().unwrap_or(0.0) - v).abs());
-    }
-    for (key, v) in &ours {
-        if !reference.contains_key(key) {
-            worst = worst.max(v.abs());
-        }
-    }
+    let worst = max_entry_difference(&ours, &reference);
     println!("tensors vs cube_K.csv: {:e}", worst / scale);
     assert!(worst <= 1e-12 * scale, "relative {:e}", worst / scale);
 
@@ -511,27 +505,7 @@ fn removal_equals_rebuild_and_keeps_the_mesh_conformal() {
         );
     }
 
-    let neighbours = table.tet_neighbours();
-    for (t, alive) in model.tet_alive().iter().enumerate() {
-        if *alive {
-            let live_neighbours = neighbours[t]
-                .iter()
-                .filter(|&&o| (o as usize) < 750 && model.tet_alive()[o as usize])
-                .count();
-            assert!(live_neighbours > 0, "tet {t} hangs");
-        }
-    }
-    let sorted = |mut faces: Vec<[u32; 3]>| {
-        for f in &mut faces {
-            let min = (0..3).min_by_key(|&i| f[i]).unwrap();
-            f.rotate_left(min);
-        }
-        faces.sort_unstable();
-        faces
-    };
-    let ours = sorted(model.surface_triangles().collect());
-    let theirs = sorted(palpate::mesh::boundary_surface(&live).triangles);
-    assert_eq!(ours, theirs);
+    assert_conformal(&model, &mesh);
 }
 
 /// A tet whose face neighbours are all removed hangs by edges and vertices:

@@ -208,3 +208,18 @@ pub fn read_reference_stiffness() -> std::collections::HashMap<(usize, usize), f
         })
         .collect()
 }
+
+/// Largest `|a − b|` over the entries of two sparse matrices given as
+/// `(row, col) → value` (an entry missing on one side counts as zero).
+pub fn max_entry_difference(
+    a: &std::collections::HashMap<(usize, usize), f64>,
+    b: &std::collections::HashMap<(usize, usize), f64>,
+) -> f64 {
+    let one_way = |x: &std::collections::HashMap<(usize, usize), f64>,
+                   y: &std::collections::HashMap<(usize, usize), f64>| {
+        x.iter().fold(0.0f64, |worst, (key, v)| {
+            worst.max((v - y.get(key).copied().unwrap_or(0.0)).abs())
+        })
+    };
+    one_way(a, b).max(one_way(b, a))
+}

@@ -5,6 +5,11 @@ use nalgebra::Vector3;
 use palpate_kernel::tensor_mass::{Integrator, TensorMassModel, VertexMode};
 use serde::Serialize;
 
+use super::OwnedState;
+use super::run::{diagonal, f64_table, host_params};
+use crate::mesh::{MeshReport, TetMesh};
+use crate::tables::tensor_mass::TensorMassOptions;
+
 /// Steps of the loading scenario per trial.
 pub const TRIAL_STEPS: usize = 2000;
 /// A trial is unstable when the total energy exceeds its start by this
@@ -181,4 +186,23 @@ pub fn critical_dt(
              below {ENERGY_GROWTH_LIMIT:e} times its start"
         ),
     }
+}
+
+/// `dynamic critical-dt`: builds the f64 model of `mesh` (damping
+/// `damping_per_s`, 1/s) and measures `integrator`'s critical step, with a
+/// perturbation of 1e-3 of the bounding-box diagonal.
+pub fn critical_dt_of_mesh(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &TensorMassOptions,
+    damping_per_s: f64,
+    integrator: Integrator,
+) -> anyhow::Result<CriticalDt> {
+    let file = f64_table(mesh, report, options)?;
+    let table = palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes())?;
+    let mut state = OwnedState::for_table(&table);
+    let params = host_params(&mesh.positions, damping_per_s);
+    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    let amplitude = 1e-3 * diagonal(&mesh.positions);
+    Ok(critical_dt(&mut model, integrator, amplitude))
 }

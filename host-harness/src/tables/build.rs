@@ -9,7 +9,7 @@ use super::compliance::{Solver, compute_compliance};
 use super::file::{Precision, TableContents, write_table};
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::material::Material;
-use crate::fix::FixPredicate;
+use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 
 /// Everything `tables build` needs besides the mesh.
@@ -53,23 +53,14 @@ pub fn build_table(
     options: &BuildOptions,
 ) -> anyhow::Result<BuiltTable> {
     let n = mesh.positions.len();
-    let mut fixed: Vec<bool> = mesh
-        .positions
-        .iter()
-        .map(|p| options.fix.iter().any(|f| f.matches(p)))
-        .collect();
-    let fixed_by_predicate = fixed.iter().filter(|&&f| f).count();
+    let (fixed, fixed_by_predicate) =
+        fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
     if fixed_by_predicate == 0 {
         bail!(
             "{}: no vertex matches the --fix predicates ({}); a free body has a singular stiffness",
             report.source,
             describe(&options.fix)
         );
-    }
-    for &v in &report.unreferenced_vertices {
-        if let Some(f) = fixed.get_mut(v as usize) {
-            *f = true;
-        }
     }
     let fixed_unreferenced = report.unreferenced_vertices.len();
     if fixed.iter().all(|&f| f) {

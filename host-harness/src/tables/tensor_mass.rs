@@ -17,7 +17,7 @@ use palpate_kernel::table::format::{
 use super::file::{Precision, Section, write_container};
 use crate::fem::element::shape_gradients;
 use crate::fem::material::Material;
-use crate::fix::FixPredicate;
+use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 
 /// The arrays of a tensor-mass table, in f64 before rounding.
@@ -169,14 +169,7 @@ pub fn build_tensor_mass_table(
             options.density_kg_m3
         );
     }
-    let mut fixed: Vec<bool> = mesh
-        .positions
-        .iter()
-        .map(|p| options.fix.iter().any(|f| f.matches(p)))
-        .collect();
-    for &v in &report.unreferenced_vertices {
-        fixed[v as usize] = true;
-    }
+    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
     let arrays = TensorMassArrays::new(mesh, &options.material, options.density_kg_m3, fixed);
     Ok(write_tensor_mass_table(mesh, options, &arrays))
 }

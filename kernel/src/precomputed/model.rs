@@ -195,13 +195,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         solution: &ContactSolution<T, M>,
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
-        let expected = self.table.free_count();
-        if out.len() != expected {
-            return Err(DisplacementError {
-                expected,
-                found: out.len(),
-            });
-        }
+        check_length(self.table.free_count(), out)?;
         out.fill([T::zero(); 3]);
         self.add_rows(solution, 0, out);
         Ok(())
@@ -219,14 +213,13 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
         const CHUNK: usize = 64;
-        let expected = self.table.vertex_count();
-        if out.len() != expected {
-            return Err(DisplacementError {
-                expected,
-                found: out.len(),
-            });
+        check_length(self.table.vertex_count(), out)?;
+        // Free vertices are written below, once each; fixed ones are zero.
+        for (v, o) in out.iter_mut().enumerate() {
+            if self.table.is_fixed(v as u32) {
+                *o = [T::zero(); 3];
+            }
         }
-        out.fill([T::zero(); 3]);
         for (chunk, vertices) in self.table.free_vertices().chunks(CHUNK).enumerate() {
             let mut buffer = [[T::zero(); 3]; CHUNK];
             let rows = buffer.get_mut(..vertices.len()).unwrap_or(&mut []);
@@ -294,6 +287,18 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 add_products(blocks, w, out);
             }
         }
+    }
+}
+
+/// `Err` unless `out` holds `expected` entries.
+fn check_length<E>(expected: usize, out: &[E]) -> Result<(), DisplacementError> {
+    if out.len() == expected {
+        Ok(())
+    } else {
+        Err(DisplacementError {
+            expected,
+            found: out.len(),
+        })
     }
 }
 

@@ -248,16 +248,21 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         Ok(v)
     }
 
+    /// The index of a free or imposed `vertex` taking the finite input `value`.
+    fn input_vertex(&self, vertex: u32, value: &Vector3<T>) -> Result<usize, InputError> {
+        if !value.iter().all(|x| x.finite()) {
+            return Err(InputError::NonFinite { vertex });
+        }
+        self.vertex_index(vertex)
+    }
+
     /// Sets the external force on `vertex`, N (replaces the previous one).
     pub fn set_external_force(
         &mut self,
         vertex: u32,
         force_n: Vector3<T>,
     ) -> Result<(), InputError> {
-        if !force_n.iter().all(|x| x.finite()) {
-            return Err(InputError::NonFinite { vertex });
-        }
-        let v = self.vertex_index(vertex)?;
+        let v = self.input_vertex(vertex, &force_n)?;
         if let Some(f) = self.state.external_force_n.get_mut(v) {
             *f = force_n.into();
         }
@@ -270,10 +275,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         vertex: u32,
         velocity_m_s: Vector3<T>,
     ) -> Result<(), InputError> {
-        if !velocity_m_s.iter().all(|x| x.finite()) {
-            return Err(InputError::NonFinite { vertex });
-        }
-        let v = self.vertex_index(vertex)?;
+        let v = self.input_vertex(vertex, &velocity_m_s)?;
         if let Some(vel) = self.state.velocity_m_s.get_mut(v) {
             *vel = velocity_m_s.into();
         }
@@ -288,10 +290,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// Holds `vertex` at displacement `displacement_m` (m) with zero velocity
     /// from now on (tool contact, coupling), until [`Self::release`].
     pub fn impose(&mut self, vertex: u32, displacement_m: Vector3<T>) -> Result<(), InputError> {
-        if !displacement_m.iter().all(|x| x.finite()) {
-            return Err(InputError::NonFinite { vertex });
-        }
-        let v = self.vertex_index(vertex)?;
+        let v = self.input_vertex(vertex, &displacement_m)?;
         let s = &mut self.state;
         if let (Some(mode), Some(u), Some(p), Some(vel)) = (
             s.modes.get_mut(v),
