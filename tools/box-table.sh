@@ -2,10 +2,22 @@
 # Builds the f32 table of the firmware example's mesh (tools/firmware-m4f/mesh/box.*)
 # with the host CLI (dev profile: `cargo test --workspace` has already built it
 # in CI) and prints its path. Used by firmware-check.sh and nopanic-check.sh.
+#
+#   tools/box-table.sh [OUT]                  pre-computed table (default OUT:
+#                                             target/firmware/box-table.bin)
+#   tools/box-table.sh --tensor-mass [OUT]    tensor-mass table, density 1000 kg/m3
+#                                             (default OUT: target/firmware/box-tensor-table.bin)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out="${1:-target/firmware/box-table.bin}"
+kind=(--kind precomputed)
+out_default=target/firmware/box-table.bin
+if [[ "${1:-}" == --tensor-mass ]]; then
+    shift
+    kind=(--kind tensor-mass --density 1000)
+    out_default=target/firmware/box-tensor-table.bin
+fi
+out="${1:-$out_default}"
 mkdir -p "$(dirname "$out")"
 cargo run -q -p palpate -- tables build tools/firmware-m4f/mesh/box.node \
-    --young 3000 --poisson 0.45 --fix 'z<0.001' --precision f32 --quiet -o "$out" >&2
+    --young 3000 --poisson 0.45 --fix 'z<0.001' --precision f32 "${kind[@]}" --quiet -o "$out" >&2
 echo "$PWD/$out"

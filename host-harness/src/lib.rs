@@ -6,6 +6,7 @@
 
 pub mod demo;
 pub mod dynamic;
+pub mod experiment;
 pub mod fem;
 pub mod fix;
 pub mod mesh;

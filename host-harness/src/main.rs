@@ -14,7 +14,7 @@ use palpate::tables::compliance::Solver;
 use palpate::tables::file::Precision;
 use palpate::tables::load::{AnyModel, TableFile};
 use palpate::tables::tensor_mass::TensorMassOptions;
-use palpate_kernel::tensor_mass::Integrator;
+use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use palpate_kernel::{Contact, Real};
 
 #[derive(Parser)]
@@ -39,6 +39,12 @@ enum Command {
     /// The dynamic tensor-mass model (RR-3510 §5), stepped through the kernel.
     #[command(subcommand)]
     Dynamic(DynamicCommand),
+    /// The St Venant-Kirchhoff force (Picinbono 2001, MODELS.md §4).
+    #[command(subcommand)]
+    Stvk(StvkCommand),
+    /// Experiments that reproduce the papers' figures.
+    #[command(subcommand)]
+    Experiment(ExperimentCommand),
     /// Built-in scene: two-probe press and release, forces, timings, VTK series.
     Demo {
         /// Folder for the VTK series (created if absent).
@@ -49,7 +55,8 @@ enum Command {
 
 #[derive(Subcommand)]
 enum TablesCommand {
-    /// Build the compliance table of a tetrahedral mesh (.msh, .node/.ele, .vtk).
+    /// Build the compliance table of a tetrahedral mesh (.msh, .node/.ele, .vtk),
+    /// or with `--kind tensor-mass` its tensor-mass table (RR-3510 §5).
     Build {
         /// Input mesh.
         mesh: PathBuf,
@@ -74,12 +81,26 @@ enum TablesCommand {
         /// Output table file.
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
+        /// Table kind: the pre-computed compliance table (RR-3510 §4) or the
+        /// dynamic tensor-mass table (§5).
+        #[arg(long, value_enum, default_value = "precomputed")]
+        kind: TableKindArg,
+        /// Mass density, kg/m3 (required with, and only with, --kind tensor-mass).
+        #[arg(long)]
+        density: Option<f64>,
     },
     /// Print a table's counts, sizes, material and checksum status.
     Info {
         /// Table file.
         table: PathBuf,
     },
+}
+
+/// `tables build --kind`: which model's table.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum TableKindArg {
+    Precomputed,
+    TensorMass,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -161,6 +182,42 @@ impl DynamicModelArgs {
 }
 
 #[derive(Subcommand)]
+enum ExperimentCommand {
+    /// Picinbono 2001 table 2: volume change of a bent cylinder (three stages)
+    /// and a lifted organ lobe, linear vs St Venant-Kirchhoff vs St
+    /// Venant-Kirchhoff + incompressibility, at static equilibrium.
+    VolumeBend {
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Subcommand)]
+enum StvkCommand {
+    /// Internal elastic forces (−∂W/∂x, free body) and energy of a deformed mesh.
+    Forces {
+        /// Input mesh (.msh, .node/.ele, .vtk), rest positions, metres.
+        mesh: PathBuf,
+        /// Young's modulus, Pa.
+        #[arg(long)]
+        young: f64,
+        /// Poisson ratio, in [0, 0.5).
+        #[arg(long)]
+        poisson: f64,
+        /// Deformed positions: one line x,y,z (m) per mesh vertex, input order, no header.
+        #[arg(long)]
+        deformed: PathBuf,
+        /// Which implementation evaluates the force.
+        #[arg(long, value_enum, default_value = "per-tet")]
+        form: FormArg,
+        /// Print one JSON object (the only output format).
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Subcommand)]
 enum DynamicCommand {
     /// Step the model under constant loads and print the final state as JSON.
     Run {
@@ -181,12 +238,76 @@ enum DynamicCommand {
         /// Tets to remove before the first step: <i>,<j>,...
         #[arg(long = "cut-tets", value_delimiter = ',')]
         cut_tets: Vec<u32>,
+        /// Elastic law: linear tensor-mass, St Venant-Kirchhoff, or St
+        /// Venant-Kirchhoff with the incompressibility penalty.
+        #[arg(long = "model", value_enum, default_value = "linear")]
+        law: ModelArg,
+        /// How the St Venant-Kirchhoff force is evaluated.
+        #[arg(long, value_enum, default_value = "per-tet")]
+        form: FormArg,
+        /// Incompressibility penalty γ, N (required by, and only for,
+        /// --model stvk-incompressible).
+        #[arg(long)]
+        incompressibility: Option<f64>,
     },
     /// Largest stable time step of an integrator (bisection) next to 2/ω_max.
     CriticalDt {
         #[command(flatten)]
         model: DynamicModelArgs,
     },
+}
+
+/// `--model` of `dynamic run`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ModelArg {
+    Linear,
+    Stvk,
+    StvkIncompressible,
+}
+
+/// `--form`: the two St Venant-Kirchhoff implementations.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FormArg {
+    /// Per tet from the deformation gradient.
+    PerTet,
+    /// Picinbono's split terms on vertices, edges, triangles and tets.
+    Tensors,
+}
+
+impl From<FormArg> for StvkForm {
+    fn from(form: FormArg) -> Self {
+        match form {
+            FormArg::PerTet => StvkForm::PerTet,
+            FormArg::Tensors => StvkForm::Tensors,
+        }
+    }
+}
+
+impl ModelArg {
+    /// The law and penalty of `--model`, `--form` and `--incompressibility`.
+    fn law(
+        self,
+        form: FormArg,
+        incompressibility: Option<f64>,
+    ) -> anyhow::Result<(ElasticLaw, Option<f64>)> {
+        let stvk = ElasticLaw::StVenantKirchhoff(form.into());
+        match (self, incompressibility) {
+            (ModelArg::Linear, None) => Ok((ElasticLaw::Linear, None)),
+            (ModelArg::Stvk, None) => Ok((stvk, None)),
+            (ModelArg::StvkIncompressible, Some(gamma)) if gamma.is_finite() && gamma >= 0.0 => {
+                Ok((stvk, Some(gamma)))
+            }
+            (ModelArg::StvkIncompressible, Some(gamma)) => {
+                bail!("--incompressibility must be finite and >= 0 N, got {gamma}")
+            }
+            (ModelArg::StvkIncompressible, None) => {
+                bail!("--model stvk-incompressible needs --incompressibility <gamma> (N)")
+            }
+            (_, Some(_)) => {
+                bail!("--incompressibility applies to --model stvk-incompressible only")
+            }
+        }
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -245,10 +366,68 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             precision,
             quiet,
             output,
+            kind,
+            density,
         }) => {
+            let tensor_mass = kind == TableKindArg::TensorMass;
+            let solver_given = matches
+                .subcommand_matches("tables")
+                .and_then(|m| m.subcommand_matches("build"))
+                .and_then(|m| m.value_source("solver"))
+                == Some(clap::parser::ValueSource::CommandLine);
+            match (tensor_mass, density) {
+                (true, None) => bail!("--kind tensor-mass needs --density <kg/m3>"),
+                (false, Some(_)) => {
+                    bail!(
+                        "--density applies to --kind tensor-mass only (the pre-computed model is quasi-static)"
+                    )
+                }
+                (true, Some(_)) if solver_given => {
+                    bail!("--solver applies to --kind precomputed only")
+                }
+                _ => {}
+            }
             let (mesh_data, report) = read_mesh(&mesh)?;
             for w in &report.warnings {
                 eprintln!("warning: {w}");
+            }
+            if let (true, Some(density_kg_m3)) = (tensor_mass, density) {
+                let (_, fixed_by_predicate) = palpate::fix::fixed_vertices(
+                    &mesh_data.positions,
+                    &fix,
+                    &report.unreferenced_vertices,
+                );
+                let options = TensorMassOptions {
+                    material: Material::new(young, poisson)?,
+                    density_kg_m3,
+                    fix,
+                    precision,
+                };
+                let bytes = palpate::tables::tensor_mass::build_tensor_mass_table(
+                    &mesh_data, &report, &options,
+                )?;
+                std::fs::write(&output, &bytes)
+                    .with_context(|| format!("{}: cannot write", output.display()))?;
+                let edges = TableFile::from_bytes(&bytes)
+                    .raw_header()
+                    .map_or(0, |h| h.edge_count);
+                eprintln!(
+                    "{}: tensor-mass table: {} vertices ({} fixed by --fix, {} unreferenced kept \
+                     fixed), {} tets, {} edges, {} kg/m3; {} non-tet elements skipped, {} tets \
+                     reoriented; wrote {} bytes to {}",
+                    report.source,
+                    mesh_data.positions.len(),
+                    fixed_by_predicate,
+                    report.unreferenced_vertices.len(),
+                    mesh_data.tets.len(),
+                    edges,
+                    density_kg_m3,
+                    report.skipped_elements,
+                    report.reoriented_tets,
+                    bytes.len(),
+                    output.display()
+                );
+                return Ok(());
             }
             let options = BuildOptions {
                 material: Material::new(young, poisson)?,
@@ -332,11 +511,17 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             dt,
             steps,
             cut_tets,
+            law,
+            form,
+            incompressibility,
         }) => {
             let (mesh, report, table) = model.read("run")?;
+            let (law, incompressibility_n) = law.law(form, incompressibility)?;
             let options = RunOptions {
                 table,
                 damping_per_s: model.damping,
+                law,
+                incompressibility_n,
                 loads: load,
                 gravity_m_s2: gravity,
                 integrator: model.integrator.into(),
@@ -360,6 +545,60 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             )
             .with_context(|| model.mesh.display().to_string())?;
             println!("{}", serde_json::to_string(&result)?);
+            Ok(())
+        }
+        Command::Stvk(StvkCommand::Forces {
+            mesh: path,
+            young,
+            poisson,
+            deformed,
+            form,
+            json,
+        }) => {
+            if !json {
+                bail!("stvk forces prints JSON only: pass --json");
+            }
+            let (mesh, report) = read_mesh(&path)?;
+            let deformed_m = palpate::dynamic::evaluate::read_positions_csv(&deformed)?;
+            let (forces, energy) = palpate::dynamic::evaluate::forces_and_energy(
+                &mesh,
+                &report,
+                Material::new(young, poisson)?,
+                ElasticLaw::StVenantKirchhoff(form.into()),
+                None,
+                &deformed_m,
+            )
+            .with_context(|| path.display().to_string())?;
+            let output = serde_json::json!({ "forces": forces, "energy": energy });
+            println!("{output}");
+            Ok(())
+        }
+        Command::Experiment(ExperimentCommand::VolumeBend { json }) => {
+            use palpate::experiment::{scenes, volume_bend};
+            let controls = volume_bend::Controls::default();
+            let mut results = Vec::new();
+            for scene in [scenes::default_cylinder(), scenes::organ()] {
+                results.push(volume_bend::run_scene(&scene, &controls, |line| {
+                    eprintln!("{line}")
+                })?);
+            }
+            if json {
+                let paper: serde_json::Map<String, serde_json::Value> = volume_bend::PAPER_TABLE_2
+                    .iter()
+                    .map(|(name, [linear, stvk, incompressible])| {
+                        let value = serde_json::json!({
+                            "linear": linear,
+                            "stvk": stvk,
+                            "stvk_incompressible": incompressible,
+                        });
+                        (name.to_string(), value)
+                    })
+                    .collect();
+                let output = serde_json::json!({ "scenes": results, "paper_percent": paper });
+                println!("{output}");
+            } else {
+                print!("{}", volume_bend::table(&results));
+            }
             Ok(())
         }
         Command::Demo { out } => palpate::demo::run(&out),

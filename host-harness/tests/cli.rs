@@ -123,6 +123,38 @@ fn contacts_come_out_in_argument_order() {
 }
 
 #[test]
+fn build_tensor_mass_table_needs_density() {
+    let table = build_cube_table(
+        "cube-tensor-mass.tbl",
+        &["--kind", "tensor-mass", "--density", "1000"],
+    );
+    let file = palpate::tables::load::TableFile::read(&table).unwrap();
+    let loaded = palpate_kernel::table::TensorMassTable::<f32>::load(file.bytes()).unwrap();
+    assert_eq!(loaded.vertex_count(), 216);
+    assert_eq!(loaded.density_kg_m3(), 1000.0);
+    assert!(loaded.is_fixed(0) && loaded.edge_count() > 0);
+
+    let mesh = reference("meshes/cube.msh");
+    let base = [
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "-o",
+        "/dev/null",
+    ];
+    let out = palpate(&[&base[..], &["--kind", "tensor-mass"]].concat());
+    assert_one_line_error(&out, "--kind tensor-mass needs --density");
+    let out = palpate(&[&base[..], &["--density", "1000"]].concat());
+    assert_one_line_error(&out, "--density applies to --kind tensor-mass only");
+}
+
+#[test]
 fn bad_arguments_and_files_exit_2_with_one_line() {
     let mesh = reference("meshes/cube.msh");
     let out = palpate(&[
@@ -316,4 +348,120 @@ fn dynamic_run_prints_the_contract_json() {
         "1",
     ]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// `dynamic run --model stvk|stvk-incompressible`: the same JSON contract;
+/// under the same load the St Venant-Kirchhoff cube moves (not the same as
+/// the linear one at this 10 % strain), and the penalty needs its γ.
+#[test]
+fn dynamic_run_takes_the_elastic_law() {
+    let common = [
+        "--damping",
+        "8",
+        "--load",
+        "194:0,0,-3",
+        "--integrator",
+        "symplectic",
+        "--dt",
+        "0.004",
+        "--steps",
+        "300",
+    ];
+    let mut tips = Vec::new();
+    for model in [
+        &["--model", "linear"][..],
+        &["--model", "stvk"],
+        &["--model", "stvk", "--form", "tensors"],
+        &["--model", "stvk-incompressible", "--incompressibility", "5"],
+    ] {
+        let out = dynamic_run(&[&common[..], model].concat());
+        assert!(
+            out.status.success(),
+            "{model:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(json["fault"].is_null(), "{model:?}: {json}");
+        tips.push(json["displacements"][194][2].as_f64().unwrap());
+    }
+    println!("vertex 194 z displacement, linear / StVK / StVK tensors / + penalty: {tips:?}");
+    assert!(tips.iter().all(|&z| z < 0.0));
+    assert_ne!(tips[0], tips[1]);
+    // The two St Venant-Kirchhoff forms agree to rounding (f64).
+    assert!((tips[1] - tips[2]).abs() <= 1e-12 * tips[1].abs());
+
+    let out = dynamic_run(&[&common[..], &["--model", "stvk-incompressible"]].concat());
+    assert_one_line_error(&out, "needs --incompressibility");
+    let out = dynamic_run(&[&common[..], &["--incompressibility", "5"]].concat());
+    assert_one_line_error(&out, "applies to --model stvk-incompressible only");
+}
+
+/// `stvk forces --json` on the JSON reference's first cube configuration:
+/// `{"forces": [...], "energy": J}` equal to the reference within 1e-10
+/// relative, both forms; a short CSV line is a one-line error naming it.
+#[test]
+fn stvk_forces_prints_forces_and_energy() {
+    let text = std::fs::read_to_string(reference("svk/svk_cube.json")).unwrap();
+    let reference_json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let config = &reference_json["configs"][0];
+    let csv = temp("deformed.csv");
+    let lines: String = config["x"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| format!("{},{},{}\n", p[0], p[1], p[2]))
+        .collect();
+    std::fs::write(&csv, lines).unwrap();
+    let mesh = reference("meshes/cube.msh");
+    for form in ["per-tet", "tensors"] {
+        let out = palpate(&[
+            "stvk",
+            "forces",
+            &mesh,
+            "--young",
+            "5000",
+            "--poisson",
+            "0.45",
+            "--deformed",
+            csv.to_str().unwrap(),
+            "--form",
+            form,
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let energy = json["energy"].as_f64().unwrap();
+        let expected = config["energy"].as_f64().unwrap();
+        assert!(
+            (energy - expected).abs() <= 1e-10 * expected,
+            "{form}: {energy} vs {expected}"
+        );
+        let forces = json["forces"].as_array().unwrap();
+        assert_eq!(forces.len(), 216);
+        let f = forces[7][1].as_f64().unwrap();
+        let r = config["forces"][7][1].as_f64().unwrap();
+        assert!(
+            (f - r).abs() <= 1e-10 * r.abs().max(1.0),
+            "{form}: {f} vs {r}"
+        );
+    }
+    let bad = temp("bad.csv");
+    std::fs::write(&bad, "0,0,0\n1,2\n").unwrap();
+    let out = palpate(&[
+        "stvk",
+        "forces",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--deformed",
+        bad.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_one_line_error(&out, "line 2");
 }

@@ -1,5 +1,6 @@
 //! Host mesh input: every reader against the reference meshes, small hand-written files, test-side
-//! binary writers, every validation error, the boundary surface, and a mutation fuzz test.
+//! binary writers, every validation error, the boundary surface, the procedural generators (box,
+//! cylinder, voxel carving, organ), and a mutation fuzz test.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -934,6 +935,340 @@ fn reference_cube_surface() {
         tets: vec![[0, 1, 2, 3]],
     };
     assert_eq!(check_surface(&single), 4);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Procedural meshes: cylinder, voxel carving, organ.
+
+/// Boundary-surface checks beyond [`check_surface`] for a mesh meant to be a solid: every tet
+/// positive, every vertex used, validation silent, every boundary edge in exactly two boundary
+/// triangles, the triangles around each boundary vertex forming a single fan (no vertex-only
+/// contacts), and the tets face-connected. Returns the boundary surface.
+fn assert_manifold_solid(mesh: &TetMesh) -> palpate::mesh::Surface {
+    assert!((0..mesh.tets.len()).all(|t| mesh.tet_volume(t) > 0.0));
+    assert!(mesh.referenced().iter().all(|&u| u));
+    let (m, r) = TetMesh::new_validated(mesh.positions.clone(), mesh.tets.clone(), "gen")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(&m, mesh);
+    assert_eq!(r.reoriented_tets, 0);
+    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    check_surface(mesh);
+    let s = boundary_surface(mesh);
+    let mut edges: HashMap<[u32; 2], u32> = HashMap::new();
+    let mut link: HashMap<u32, Vec<[u32; 2]>> = HashMap::new();
+    for tri in &s.triangles {
+        for k in 0..3 {
+            let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            *edges.entry([a.min(b), a.max(b)]).or_insert(0) += 1;
+            link.entry(a).or_default().push([b, c]);
+        }
+    }
+    for (e, n) in &edges {
+        assert_eq!(*n, 2, "boundary edge {e:?} in {n} boundary triangles");
+    }
+    // Around a vertex, each triangle links its two other vertices; one fan = one cycle.
+    for (v, segs) in &link {
+        let mut reached = vec![segs[0][0]];
+        let mut grew = true;
+        while grew {
+            grew = false;
+            for [a, b] in segs {
+                for (x, y) in [(a, b), (b, a)] {
+                    if reached.contains(x) && !reached.contains(y) {
+                        reached.push(*y);
+                        grew = true;
+                    }
+                }
+            }
+        }
+        assert_eq!(reached.len(), segs.len(), "vertex {v}: more than one fan");
+    }
+    // Face connectivity of the tets.
+    let mut by_face: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        for k in 0..4 {
+            let mut f = [0; 3];
+            for (slot, j) in f.iter_mut().zip((0..4).filter(|&j| j != k)) {
+                *slot = tet[j];
+            }
+            f.sort_unstable();
+            by_face.entry(f).or_default().push(t);
+        }
+    }
+    let mut seen = vec![false; mesh.tets.len()];
+    let mut stack = vec![0];
+    seen[0] = true;
+    while let Some(t) = stack.pop() {
+        for k in 0..4 {
+            let mut f = [0; 3];
+            for (slot, j) in f.iter_mut().zip((0..4).filter(|&j| j != k)) {
+                *slot = mesh.tets[t][j];
+            }
+            f.sort_unstable();
+            for &u in &by_face[&f] {
+                if !seen[u] {
+                    seen[u] = true;
+                    stack.push(u);
+                }
+            }
+        }
+    }
+    assert!(seen.iter().all(|&s| s), "tets not face-connected");
+    s
+}
+
+/// Tet shape quality `6√2·V / l_rms³`: 1 for a regular tet, 0.657 for a Kuhn tet of a cube.
+fn tet_quality(mesh: &TetMesh, t: usize) -> f64 {
+    let p = mesh.tets[t].map(|v| mesh.positions[v as usize]);
+    let mut sum = 0.0;
+    for (a, b) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+        let d = sub(p[a], p[b]);
+        sum += dot(d, d);
+    }
+    6.0 * 2f64.sqrt() * mesh.tet_volume(t) / (sum / 6.0).powf(1.5)
+}
+
+#[test]
+fn cylinder_mesh_default() {
+    use core::f64::consts::PI;
+    let (h, r) = (0.1, 0.02);
+    let (nr, nz) = (
+        generate::CYLINDER_RADIAL_CELLS,
+        generate::CYLINDER_HEIGHT_CELLS,
+    );
+    let m = generate::cylinder_mesh(h, nr, nz);
+    let side = 2 * nr + 1;
+    assert_eq!(m.positions.len(), side * side * (nz + 1));
+    assert_eq!((m.positions.len(), m.tets.len()), (784, 3240));
+    let s = assert_manifold_solid(&m);
+
+    // Not nearly degenerate: smallest tet 0.567 of the mean volume, worst shape 0.436 (an
+    // undistorted Kuhn tet: 0.657); the rim cells, squeezed by the mapping near the square's
+    // corners, are the worst. (Without the per-quadrant reflection the smallest tet is 0.29 of the
+    // mean: three rim vertices in one triangle.)
+    let vols: Vec<f64> = (0..m.tets.len()).map(|t| m.tet_volume(t)).collect();
+    let vol: f64 = vols.iter().sum();
+    let min_ratio = vols.iter().copied().fold(f64::INFINITY, f64::min) / (vol / vols.len() as f64);
+    let min_q = (0..m.tets.len())
+        .map(|t| tet_quality(&m, t))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (0.566..0.568).contains(&min_ratio),
+        "min V / mean V {min_ratio}"
+    );
+    assert!((0.436..0.437).contains(&min_q), "min quality {min_q}");
+
+    // The bottom and top faces: exactly z = 0 and z = H, (2·nr+1)² vertices each, nothing else
+    // within a tiny distance of them.
+    let near = |z0: f64| -> Vec<[f64; 3]> {
+        m.positions
+            .iter()
+            .copied()
+            .filter(|p| (p[2] - z0).abs() < 1e-9)
+            .collect()
+    };
+    let (bottom, top) = (near(0.0), near(h));
+    assert_eq!((bottom.len(), top.len()), (side * side, side * side));
+    assert!(bottom.iter().all(|p| p[2] == 0.0) && top.iter().all(|p| p[2] == h));
+
+    // Every other boundary vertex is on the circle of radius R.
+    let radius = |v: u32| m.positions[v as usize][0].hypot(m.positions[v as usize][1]);
+    let caps = |v: u32| m.positions[v as usize][2] == 0.0 || m.positions[v as usize][2] == h;
+    for &v in s.vertices.iter().filter(|&&v| !caps(v)) {
+        assert!(
+            (radius(v) - r).abs() < 1e-15,
+            "vertex {v} at radius {}",
+            radius(v)
+        );
+    }
+
+    // Volume: the cross-section is the polygon inscribed in the circle through the 8·nr rim
+    // vertices, of area Σ R²/2·sin Δθ_i; its deficit from πR² is (1/2π)·Σ (Δθ_i − sin Δθ_i) of
+    // πR², at most Δθ_max²/6 (Δθ − sin Δθ ≤ Δθ³/6 and Σ Δθ_i = 2π).
+    let mut angles: Vec<f64> = (0..side * side)
+        .filter(|&v| (radius(v as u32) - r).abs() < 1e-15)
+        .map(|v| m.positions[v][1].atan2(m.positions[v][0]))
+        .collect();
+    assert_eq!(angles.len(), 8 * nr);
+    angles.sort_by(f64::total_cmp);
+    let steps: Vec<f64> = (0..angles.len())
+        .map(|i| (angles[(i + 1) % angles.len()] - angles[i]).rem_euclid(2.0 * PI))
+        .collect();
+    let polygon: f64 = steps.iter().map(|d| r * r / 2.0 * d.sin()).sum();
+    assert!(
+        (vol - polygon * h).abs() < 1e-12 * vol,
+        "{vol} vs {}",
+        polygon * h
+    );
+    let deficit = 1.0 - vol / (PI * r * r * h);
+    let step_max = steps.iter().copied().fold(0.0, f64::max);
+    // Here Δθ ranges from 13.6° to 16.9°: deficit 1.167 %, bound 1.445 %.
+    assert!((0.01166..0.01168).contains(&deficit), "deficit {deficit}");
+    assert!(deficit <= step_max * step_max / 6.0);
+    assert!((step_max.to_degrees() - 16.87).abs() < 0.01);
+}
+
+#[test]
+fn cylinder_mesh_other_resolutions() {
+    // Including the coarsest (one cell from axis to rim: every cell is a corner cell).
+    for (h, nr, nz) in [(1.0, 1, 1), (0.3, 2, 5), (0.05, 6, 4), (0.1, 0, 0)] {
+        let m = generate::cylinder_mesh(h, nr, nz);
+        let (nr, nz) = (nr.max(1), nz.max(1));
+        assert_eq!(m.tets.len(), 24 * nr * nr * nz);
+        assert_manifold_solid(&m);
+        let vol: f64 = (0..m.tets.len()).map(|t| m.tet_volume(t)).sum();
+        let exact = core::f64::consts::PI * (h / 5.0) * (h / 5.0) * h;
+        // Coarsest: the inscribed square, 2/π of the disk.
+        let expect_min = if nr == 1 {
+            2.0 / core::f64::consts::PI
+        } else {
+            0.95
+        };
+        assert!(
+            vol < exact && vol / exact >= expect_min - 1e-12,
+            "{vol} vs {exact}"
+        );
+        assert!(
+            m.positions
+                .iter()
+                .all(|p| p[2] == 0.0 || p[2] >= h / nz as f64 * 0.999)
+        );
+        assert_eq!(
+            m.positions.iter().filter(|p| p[2] == h).count(),
+            (2 * nr + 1).pow(2)
+        );
+    }
+}
+
+#[test]
+fn organ_mesh_default() {
+    let cube = generate::ORGAN_CUBE_M;
+    let m = generate::organ_mesh(cube);
+    assert!(
+        (5000..=7000).contains(&m.tets.len()),
+        "{} tets",
+        m.tets.len()
+    );
+    assert_eq!(m.tets.len() % 6, 0);
+    assert_eq!((m.positions.len(), m.tets.len()), (1386, 5868));
+    assert_manifold_solid(&m);
+    // Every tet h³/6 and the volume the kept cubes' exactly (h = 3·2⁻⁸: no rounding anywhere).
+    let cubes = (m.tets.len() / 6) as f64;
+    assert!((0..m.tets.len()).all(|t| m.tet_volume(t) == cube * cube * cube / 6.0));
+    let vol: f64 = (0..m.tets.len()).map(|t| m.tet_volume(t)).sum();
+    assert_eq!(vol, cubes * cube * cube * cube);
+    assert!((vol - 1.574e-3).abs() < 1e-6, "volume {vol} m³");
+    // Liver-sized: about 0.2 m × 0.14 m × 0.1 m.
+    let extent = |a: usize| {
+        let (lo, hi) = m
+            .positions
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p[a]), h.max(p[a]))
+            });
+        hi - lo
+    };
+    assert_eq!([0, 1, 2].map(extent), [17.0, 12.0, 9.0].map(|n| n * cube));
+    // The two vertex sets: small, non-empty, disjoint, where they should be.
+    let patch = generate::organ_underside_patch(&m, generate::ORGAN_PATCH_RADIUS_M);
+    let lobe = generate::organ_left_lobe_tip(&m, generate::ORGAN_LOBE_TIP_DEPTH_M);
+    assert_eq!((patch.len(), lobe.len()), (8, 83));
+    assert!(patch.iter().all(|v| !lobe.contains(v)));
+    let z_min = m
+        .positions
+        .iter()
+        .map(|p| p[2])
+        .fold(f64::INFINITY, f64::min);
+    let x_min = m
+        .positions
+        .iter()
+        .map(|p| p[0])
+        .fold(f64::INFINITY, f64::min);
+    for &v in &patch {
+        let p = m.positions[v as usize];
+        assert!(p[2] == z_min && (p[0] - 0.03).hypot(p[1]) <= 0.02);
+    }
+    let surface = boundary_surface(&m).vertices;
+    for &v in &lobe {
+        assert!(surface.binary_search(&v).is_ok());
+        assert!(m.positions[v as usize][0] <= x_min + 0.03);
+    }
+    assert!(lobe.iter().all(|&v| m.positions[v as usize][0] < -0.06));
+}
+
+#[test]
+fn organ_mesh_other_resolutions() {
+    for cube in [0.008, 0.01, 0.015, 0.02] {
+        let m = generate::organ_mesh(cube);
+        assert_manifold_solid(&m);
+        let vol: f64 = (0..m.tets.len()).map(|t| m.tet_volume(t)).sum();
+        let kept = (m.tets.len() / 6) as f64 * cube * cube * cube;
+        assert!((vol - kept).abs() < 1e-12 * vol);
+        assert!((vol - 1.55e-3).abs() < 0.1e-3, "{cube}: {vol} m³");
+        assert!(!generate::organ_underside_patch(&m, generate::ORGAN_PATCH_RADIUS_M).is_empty());
+        assert!(!generate::organ_left_lobe_tip(&m, generate::ORGAN_LOBE_TIP_DEPTH_M).is_empty());
+    }
+}
+
+/// [`generate::voxel_mesh`] of the unit cubes listed in `cells` (on the lattice ℤ³).
+fn voxels_of(cells: &[[i32; 3]], hi: i32) -> TetMesh {
+    generate::voxel_mesh(1.0, [[0.0; 3], [f64::from(hi); 3]], |p| {
+        cells.contains(&p.map(|x| x.floor() as i32))
+    })
+}
+
+#[test]
+fn voxel_mesh_removes_non_manifold_contacts() {
+    // Two cubes sharing only an edge, or only a vertex: one is left.
+    for other in [[1, 1, 0], [1, 1, 1]] {
+        let m = voxels_of(&[[0, 0, 0], other], 2);
+        assert_eq!((m.positions.len(), m.tets.len()), (8, 6));
+        assert_eq!(m.positions[0], [0.0; 3]);
+    }
+    // A bar of three with a fourth cube touching its middle by an edge: the bar stays.
+    let m = voxels_of(&[[0, 0, 0], [1, 0, 0], [2, 0, 0], [1, 1, 1]], 3);
+    assert_eq!(m.tets.len(), 18);
+    assert_manifold_solid(&m);
+    // A 2×2×2 block without two opposite corners: the empty corners touch at the centre (a pinch);
+    // cubes go until the centre vertex is manifold.
+    let block: Vec<[i32; 3]> = (0..8)
+        .map(|b| [b & 1, b >> 1 & 1, b >> 2 & 1])
+        .filter(|c| *c != [0, 0, 0] && *c != [1, 1, 1])
+        .collect();
+    let m = voxels_of(&block, 2);
+    assert_eq!(m.tets.len(), 4 * 6);
+    assert_manifold_solid(&m);
+    // A ring of 7 cubes around an empty one, closed only across an edge: a cube of the contact
+    // goes, leaving a C of 6.
+    let m = voxels_of(
+        &[
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 2, 0],
+            [1, 2, 0],
+            [2, 1, 0],
+            [2, 0, 0],
+        ],
+        3,
+    );
+    assert_eq!(m.tets.len(), 6 * 6);
+    assert_manifold_solid(&m);
+    // Random blobs (55 % of a 6×6×6 box, full of edge and vertex contacts): whatever survives is
+    // a manifold solid.
+    let mut rng = XorShift(0x2545_F491_4F6C_DD1D);
+    let mut removed = 0;
+    for _ in 0..40 {
+        let cells: Vec<[i32; 3]> = (0..216)
+            .map(|c| [c % 6, c / 6 % 6, c / 36])
+            .filter(|_| rng.below(100) < 55)
+            .collect();
+        let m = voxels_of(&cells, 6);
+        assert!(!m.tets.is_empty());
+        assert_manifold_solid(&m);
+        removed += cells.len() - m.tets.len() / 6;
+    }
+    assert!(removed > 0);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,6 +1,8 @@
 //! Puts the firmware example's `memory.x` (QEMU mps2-an386) on the linker
-//! path, and copies the table named by `PALPATE_TABLE` to
-//! `$OUT_DIR/table.bin` (`tools/nopanic-check.sh` builds it).
+//! path, and copies the pre-computed table named by `PALPATE_TABLE` to
+//! `$OUT_DIR/table.bin` and the tensor-mass table named by
+//! `PALPATE_TENSOR_TABLE` to `$OUT_DIR/tensor_table.bin`
+//! (`tools/nopanic-check.sh` builds both).
 
 use std::path::PathBuf;
 
@@ -9,13 +11,20 @@ fn main() {
     std::fs::copy("../firmware-m4f/memory.x", out.join("memory.x")).expect("copy memory.x");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=../firmware-m4f/memory.x");
-    println!("cargo:rerun-if-env-changed=PALPATE_TABLE");
-    let Some(table) = std::env::var_os("PALPATE_TABLE") else {
-        panic!(
-            "set PALPATE_TABLE to a table built by `palpate tables build` (see tools/nopanic-check.sh)"
-        );
-    };
-    println!("cargo:rerun-if-changed={}", table.to_string_lossy());
-    std::fs::copy(&table, out.join("table.bin"))
-        .unwrap_or_else(|e| panic!("PALPATE_TABLE={}: {e}", table.to_string_lossy()));
+    for (var, file, command) in [
+        ("PALPATE_TABLE", "table.bin", "`palpate tables build`"),
+        (
+            "PALPATE_TENSOR_TABLE",
+            "tensor_table.bin",
+            "`palpate tables build --model tensor-mass`",
+        ),
+    ] {
+        println!("cargo:rerun-if-env-changed={var}");
+        let Some(table) = std::env::var_os(var) else {
+            panic!("set {var} to a table built by {command} (see tools/nopanic-check.sh)");
+        };
+        println!("cargo:rerun-if-changed={}", table.to_string_lossy());
+        std::fs::copy(&table, out.join(file))
+            .unwrap_or_else(|e| panic!("{var}={}: {e}", table.to_string_lossy()));
+    }
 }

@@ -2,6 +2,10 @@
 
 use palpate_kernel::Real;
 use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::table::format::{
+    EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
+};
+use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{StateBuffers, VertexMode};
 
 /// The mutable state of a tensor-mass model in vectors: what firmware keeps
@@ -15,10 +19,15 @@ pub struct OwnedState<T> {
     modes: Vec<VertexMode>,
     vectors: [Vec<[T; 3]>; 5],
     rk4_scratch: Vec<[T; 3]>,
+    vertex_terms: Vec<[T; VERTEX_TERMS_LEN]>,
+    edge_terms: Vec<[T; EDGE_TERMS_LEN]>,
+    triangle_terms: Vec<[T; TRIANGLE_TERMS_LEN]>,
+    tet_terms: Vec<[T; TET_TERMS_LEN]>,
 }
 
 impl<T: Real> OwnedState<T> {
-    /// Buffers of the right lengths for `table`, with RK4 scratch.
+    /// Buffers of the right lengths for `table`, with RK4 scratch and the
+    /// St Venant-Kirchhoff split terms (every law and integrator works).
     pub fn for_table(table: &TensorMassTable<'_, T>) -> Self {
         let n = table.vertex_count();
         let zero = [T::zero(); 3];
@@ -31,6 +40,10 @@ impl<T: Real> OwnedState<T> {
             modes: vec![VertexMode::Free; n],
             vectors: core::array::from_fn(|_| vec![zero; n]),
             rk4_scratch: vec![zero; 4 * n],
+            vertex_terms: vec![[T::zero(); VERTEX_TERMS_LEN]; n],
+            edge_terms: vec![[T::zero(); EDGE_TERMS_LEN]; table.edge_count()],
+            triangle_terms: vec![[T::zero(); TRIANGLE_TERMS_LEN]; table.mesh_triangles().len()],
+            tet_terms: vec![[T::zero(); TET_TERMS_LEN]; table.tet_count()],
         }
     }
 
@@ -50,6 +63,12 @@ impl<T: Real> OwnedState<T> {
             external_force_n: external,
             force_n: force,
             rk4_scratch: &mut self.rk4_scratch,
+            stvk_terms: TermArraysMut {
+                vertex: &mut self.vertex_terms,
+                edge: &mut self.edge_terms,
+                triangle: &mut self.triangle_terms,
+                tet: &mut self.tet_terms,
+            },
         }
     }
 }

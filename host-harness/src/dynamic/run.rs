@@ -5,7 +5,9 @@
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, Integrator, Limits, StepError, TensorMassModel};
+use palpate_kernel::tensor_mass::{
+    DynamicParams, ElasticLaw, Integrator, Limits, StepError, TensorMassModel,
+};
 use serde::Serialize;
 
 use super::OwnedState;
@@ -21,6 +23,10 @@ pub struct RunOptions {
     pub table: TensorMassOptions,
     /// Mass-proportional damping, 1/s.
     pub damping_per_s: f64,
+    /// The elastic force.
+    pub law: ElasticLaw,
+    /// Incompressibility penalty `γ`, N (`None`: off).
+    pub incompressibility_n: Option<f64>,
     /// Constant external forces `(vertex, N)`.
     pub loads: Vec<(u32, [f64; 3])>,
     /// Gravity, m/s².
@@ -58,6 +64,8 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
     let params = DynamicParams {
+        law: options.law,
+        incompressibility_n: options.incompressibility_n,
         gravity_m_s2: Vector3::from(options.gravity_m_s2),
         ..host_params(&mesh.positions, options.damping_per_s)
     };
@@ -116,11 +124,14 @@ pub fn f64_table(
     )?))
 }
 
-/// The host commands' parameters: damping `damping_per_s` (1/s), no gravity,
+/// The host commands' parameters: the linear law without penalty, damping
+/// `damping_per_s` (1/s), no gravity,
 /// divergence when a displacement exceeds the bounding-box diagonal of
 /// `positions` (m), kinetic energy unbounded.
 pub fn host_params(positions: &[[f64; 3]], damping_per_s: f64) -> DynamicParams<f64> {
     DynamicParams {
+        law: ElasticLaw::Linear,
+        incompressibility_n: None,
         damping_per_s,
         gravity_m_s2: Vector3::zeros(),
         limits: Limits {

@@ -1,7 +1,10 @@
 //! Tensor-mass arrays (RR-3510 §5, MODELS.md §1 and §3) and their table file:
 //! vertex tensors `K_ii`, edge tensors `K_ij` on a CSR edge list (each edge
 //! once), lumped masses, and per tet its vertices, edge references, rest
-//! shape data and face neighbours.
+//! shape data and face neighbours; and the St Venant-Kirchhoff cubic and
+//! quartic terms on vertices, edges, mesh triangles (every tet face once) and
+//! tets (Picinbono 2001 §3.1, table 1), each the sum of the kernel's
+//! `tet_terms` over the tets around the primitive.
 
 use std::collections::HashMap;
 
@@ -10,9 +13,11 @@ use bytemuck::Zeroable;
 use nalgebra::Vector3;
 use palpate_kernel::element::stiffness_block;
 use palpate_kernel::table::format::{
-    FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS, TET_SHAPE_LEN, TableKind,
+    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS,
+    TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN,
     tet_edge_vertices, tet_face_vertices,
 };
+use palpate_kernel::tensor_mass::stvk_terms::{TermArraysMut, TetPlace, tet_terms};
 
 use super::file::{Precision, Section, write_container};
 use crate::fem::element::shape_gradients;
@@ -41,13 +46,27 @@ pub struct TensorMassArrays {
     pub tet_shapes: Vec<[f64; TET_SHAPE_LEN]>,
     /// Tet across the face opposite each vertex, or `NO_NEIGHBOUR`.
     pub neighbours: Vec<[u32; 4]>,
+    /// St Venant-Kirchhoff terms of each vertex `[c.x, c.y, c.z, d]`
+    /// (N/m², N/m³), one per vertex.
+    pub vertex_terms: Vec<[f64; VERTEX_TERMS_LEN]>,
+    /// St Venant-Kirchhoff terms of each CSR edge (E).
+    pub edge_terms: Vec<[f64; EDGE_TERMS_LEN]>,
+    /// Every tet face once, ids ascending, sorted lexicographically.
+    pub mesh_triangles: Vec<[u32; 3]>,
+    /// St Venant-Kirchhoff terms of each mesh triangle.
+    pub triangle_terms: Vec<[f64; TRIANGLE_TERMS_LEN]>,
+    /// Mesh-triangle index of each tet's face opposite each local vertex.
+    pub tet_triangles: Vec<[u32; 4]>,
+    /// St Venant-Kirchhoff quartic terms of each tet (N/m³).
+    pub tet_terms: Vec<[f64; TET_TERMS_LEN]>,
 }
 
 impl TensorMassArrays {
     /// Assembles the arrays of `mesh` (positions in m) for `material`,
     /// density `density_kg_m3` and the `fixed` flags (one per vertex). Every
-    /// block comes from the kernel's `stiffness_block`, the formula the
-    /// kernel subtracts when it removes a tet.
+    /// block comes from the kernel's `stiffness_block`, and every
+    /// St Venant-Kirchhoff term from the kernel's `tet_terms`: the formulas
+    /// the kernel subtracts when it removes a tet.
     pub fn new(mesh: &TetMesh, material: &Material, density_kg_m3: f64, fixed: Vec<bool>) -> Self {
         let n = mesh.positions.len();
         let (lambda, mu) = material.lame();
@@ -58,6 +77,19 @@ impl TensorMassArrays {
             let row = &column[start as usize..row_start[lo as usize + 1] as usize];
             start + row.binary_search(&hi).expect("edge of a tet is in the CSR") as u32
         };
+        let mesh_triangles = mesh_triangles(&mesh.tets);
+        let tet_triangles: Vec<[u32; 4]> = mesh
+            .tets
+            .iter()
+            .map(|&tet| {
+                tet_face_vertices(tet).map(|mut face| {
+                    face.sort_unstable();
+                    mesh_triangles
+                        .binary_search(&face)
+                        .expect("face of a tet is a mesh triangle") as u32
+                })
+            })
+            .collect();
         let mut arrays = Self {
             fixed,
             masses_kg: vec![0.0; n],
@@ -67,6 +99,12 @@ impl TensorMassArrays {
             tet_shapes: Vec::with_capacity(mesh.tets.len()),
             neighbours: face_neighbours(&mesh.tets),
             row_start: row_start.clone(),
+            vertex_terms: vec![[0.0; VERTEX_TERMS_LEN]; n],
+            edge_terms: vec![[0.0; EDGE_TERMS_LEN]; column.len()],
+            triangle_terms: vec![[0.0; TRIANGLE_TERMS_LEN]; mesh_triangles.len()],
+            tet_terms: vec![[0.0; TET_TERMS_LEN]; mesh.tets.len()],
+            mesh_triangles,
+            tet_triangles,
             column: column.clone(),
         };
         for tet in &mesh.tets {
@@ -87,6 +125,22 @@ impl TensorMassArrays {
                 let (row, col) = if tet[j] < tet[k] { (j, k) } else { (k, j) };
                 add(&mut arrays.edge_tensors[e as usize], &block(row, col));
             }
+            let place = TetPlace {
+                tet: arrays.tet_edges.len() as u32,
+                vertices: *tet,
+                edges,
+                triangles: arrays.tet_triangles[arrays.tet_edges.len()],
+            };
+            let terms = tet_terms(*tet, &a, volume, lambda, mu);
+            terms.add_to(
+                &place,
+                &mut TermArraysMut {
+                    vertex: &mut arrays.vertex_terms,
+                    edge: &mut arrays.edge_terms,
+                    triangle: &mut arrays.triangle_terms,
+                    tet: &mut arrays.tet_terms,
+                },
+            );
             arrays.tet_edges.push(edges);
             let mut shape = [0.0; TET_SHAPE_LEN];
             for (j, aj) in a.iter().enumerate() {
@@ -123,6 +177,21 @@ fn edge_csr(n: usize, tets: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
         row_start[i + 1] += row_start[i];
     }
     (row_start, pairs.iter().map(|&[_, j]| j).collect())
+}
+
+/// Every face of every tet once, vertex ids ascending, sorted.
+fn mesh_triangles(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
+    let mut faces: Vec<[u32; 3]> = tets
+        .iter()
+        .flat_map(|&t| tet_face_vertices(t))
+        .map(|mut face| {
+            face.sort_unstable();
+            face
+        })
+        .collect();
+    faces.sort_unstable();
+    faces.dedup();
+    faces
 }
 
 /// For each tet and local face (opposite vertex `j`), the tet sharing it.
@@ -204,6 +273,7 @@ pub fn write_tensor_mass_table(
         poisson: options.material.poisson,
         density_kg_m3: options.density_kg_m3,
         mesh_hash: mesh.content_hash(),
+        mesh_triangle_count: arrays.mesh_triangles.len() as u64,
         ..RawHeader::zeroed()
     };
     let p = options.precision;
@@ -220,6 +290,12 @@ pub fn write_tensor_mass_table(
         Section::ints(SectionKind::TetEdge, &arrays.tet_edges),
         Section::floats(SectionKind::TetShape, &arrays.tet_shapes, p),
         Section::ints(SectionKind::TetNeighbour, &arrays.neighbours),
+        Section::floats(SectionKind::VertexTerms, &arrays.vertex_terms, p),
+        Section::floats(SectionKind::EdgeTerms, &arrays.edge_terms, p),
+        Section::ints(SectionKind::MeshTriangle, &arrays.mesh_triangles),
+        Section::floats(SectionKind::TriangleTerms, &arrays.triangle_terms, p),
+        Section::ints(SectionKind::TetTriangle, &arrays.tet_triangles),
+        Section::floats(SectionKind::TetTerms, &arrays.tet_terms, p),
     ];
     write_container(header, p, &sections)
 }

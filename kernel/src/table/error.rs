@@ -47,7 +47,8 @@ pub enum LoadError {
         found: u32,
     },
     /// Header counts contradict each other (free > vertices, touchable > free,
-    /// directory length, reserved field not zero).
+    /// directory length, reserved field not zero, mesh triangle count above
+    /// `u32::MAX` or not the number of distinct tet faces).
     InconsistentHeader,
     /// Material out of range (E ≤ 0, ν outside [0, 0.5), density < 0,
     /// non-finite).
@@ -110,6 +111,19 @@ pub enum LoadError {
     /// A tet references a vertex, edge or neighbour that does not exist or does
     /// not match, or has a non-positive rest volume.
     BadTet {
+        /// Tet index.
+        tet: u32,
+    },
+    /// A mesh triangle (tensor-mass `mesh-triangle` section) references a
+    /// vertex out of range, its ids are not strictly ascending, or it is not
+    /// after the previous triangle in lexicographic order (a duplicate).
+    BadMeshTriangle {
+        /// Mesh-triangle index.
+        triangle: u32,
+    },
+    /// A tet's `tet-triangle` entry is out of range or names a triangle that
+    /// is not the tet's face opposite that local vertex.
+    BadTetTriangle {
         /// Tet index.
         tet: u32,
     },
@@ -189,6 +203,14 @@ impl fmt::Display for LoadError {
             LoadError::BadTet { tet } => write!(
                 f,
                 "tet {tet}: bad vertex, edge or neighbour reference, or non-positive rest volume"
+            ),
+            LoadError::BadMeshTriangle { triangle } => write!(
+                f,
+                "mesh triangle {triangle}: vertex out of range, ids not strictly ascending, or not in ascending order (duplicate)"
+            ),
+            LoadError::BadTetTriangle { tet } => write!(
+                f,
+                "tet {tet}: mesh-triangle reference out of range or not the face opposite its vertex"
             ),
             LoadError::BadVertexData { vertex } => write!(
                 f,

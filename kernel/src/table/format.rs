@@ -1,9 +1,9 @@
-//! The table file format, version 1: one definition shared by the host writer
+//! The table file format, version 2: one definition shared by the host writer
 //! and the kernel reader.
 //!
 //! ```text
-//! offset 0            RawHeader (96 bytes)
-//! offset 96           SectionEntry × section_count (24 bytes each)
+//! offset 0            RawHeader (104 bytes)
+//! offset 104          SectionEntry × section_count (24 bytes each)
 //! …                   sections, each starting at a multiple of SECTION_ALIGN
 //! file_len - 4        CRC-32/ISO-HDLC of bytes [0, file_len - 4), little-endian
 //! ```
@@ -25,13 +25,19 @@
 //!   columns: column `k` holds rows `n = 0..=k` at index `k(k+1)/2 + n`;
 //! - [`SectionKind::ComplianceInterior`]: `I·S` blocks (`I = F − S`): column `k`
 //!   holds interior rows `i = 0..I` (free index `S + i`) at index `k·I + i`.
+//!
+//! Version history: 1 had a 96-byte header; 2 appends
+//! [`RawHeader::mesh_triangle_count`] and the St Venant-Kirchhoff term
+//! sections of tensor-mass tables ([`SectionKind::VertexTerms`] to
+//! [`SectionKind::TetTerms`], Picinbono 2001 §3.1, table 1; the monomial
+//! layouts are documented in [`crate::tensor_mass::stvk_terms`]).
 
 use bytemuck::{Pod, Zeroable};
 
 /// First 8 bytes of every table.
 pub const MAGIC: [u8; 8] = *b"PALPTBL\0";
 /// The format version this kernel reads and the host writes.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// Every section starts at a multiple of this many bytes from the file start.
 pub const SECTION_ALIGN: usize = 16;
 /// Size of the CRC-32 trailer.
@@ -81,11 +87,16 @@ pub struct RawHeader {
     pub mesh_hash: u64,
     /// Total file length in bytes, trailer included.
     pub file_len: u64,
+    /// Triangles of the whole mesh, every face of every tet once, interior
+    /// and boundary ([`SectionKind::MeshTriangle`]; tensor-mass tables, zero
+    /// otherwise). 64 bits so that the header has no padding; at most
+    /// `u32::MAX` (triangle indices are `u32`), checked at load.
+    pub mesh_triangle_count: u64,
 }
 
 /// Size of [`RawHeader`] in bytes.
 pub const HEADER_LEN: usize = core::mem::size_of::<RawHeader>();
-const _: () = assert!(HEADER_LEN == 96);
+const _: () = assert!(HEADER_LEN == 104);
 
 /// What a table is for; each kind has its own required sections.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -123,6 +134,12 @@ impl TableKind {
                 SectionKind::TetEdge,
                 SectionKind::TetShape,
                 SectionKind::TetNeighbour,
+                SectionKind::VertexTerms,
+                SectionKind::EdgeTerms,
+                SectionKind::MeshTriangle,
+                SectionKind::TriangleTerms,
+                SectionKind::TetTriangle,
+                SectionKind::TetTerms,
             ],
         }
     }
@@ -187,6 +204,27 @@ pub enum SectionKind {
     /// `[u32; 4]` × tet_count: the tet across the face opposite each vertex,
     /// or [`NO_NEIGHBOUR`] on the boundary.
     TetNeighbour = 24,
+    /// `[scalar; 4]` × N: St Venant-Kirchhoff cubic and quartic terms owned
+    /// by each vertex (Picinbono 2001 eq. 13–14, table 1), summed over its
+    /// tets: `[c.x, c.y, c.z, d]` (N/m², N/m³); layout in
+    /// [`crate::tensor_mass::stvk_terms`].
+    VertexTerms = 25,
+    /// `[scalar; 16]` × E: the terms owned by each edge `(i, j)`, `i < j`
+    /// (local position 0 is `i`), same order as [`SectionKind::EdgeColumn`].
+    EdgeTerms = 26,
+    /// `[u32; 3]` × mesh_triangle_count: every face of every tet once
+    /// (interior and boundary), vertex ids strictly ascending within a
+    /// triangle, triangles in strictly ascending lexicographic order.
+    MeshTriangle = 27,
+    /// `[scalar; 15]` × mesh_triangle_count: the terms owned by each mesh
+    /// triangle (local positions in its ascending vertex order).
+    TriangleTerms = 28,
+    /// `[u32; 4]` × tet_count: the [`SectionKind::MeshTriangle`] index of the
+    /// face opposite each local vertex ([`tet_face_vertices`] order).
+    TetTriangle = 29,
+    /// `[scalar; 3]` × tet_count: the quartic terms owned by each tet (local
+    /// positions in the tet's own vertex order), N/m³.
+    TetTerms = 30,
 }
 
 /// The vertex pairs of a tet's six edges, in [`SectionKind::TetEdge`] order:
@@ -210,10 +248,18 @@ pub const TET_EDGE_PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1,
 pub const NO_NEIGHBOUR: u32 = u32::MAX;
 /// Scalars per [`SectionKind::TetShape`] element.
 pub const TET_SHAPE_LEN: usize = 13;
+/// Scalars per [`SectionKind::VertexTerms`] element.
+pub const VERTEX_TERMS_LEN: usize = 4;
+/// Scalars per [`SectionKind::EdgeTerms`] element.
+pub const EDGE_TERMS_LEN: usize = 16;
+/// Scalars per [`SectionKind::TriangleTerms`] element.
+pub const TRIANGLE_TERMS_LEN: usize = 15;
+/// Scalars per [`SectionKind::TetTerms`] element.
+pub const TET_TERMS_LEN: usize = 3;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 15] = [
+    pub const ALL: [SectionKind; 21] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -229,6 +275,12 @@ impl SectionKind {
         SectionKind::TetEdge,
         SectionKind::TetShape,
         SectionKind::TetNeighbour,
+        SectionKind::VertexTerms,
+        SectionKind::EdgeTerms,
+        SectionKind::MeshTriangle,
+        SectionKind::TriangleTerms,
+        SectionKind::TetTriangle,
+        SectionKind::TetTerms,
     ];
 
     /// Bytes per element for a table whose floats have `scalar_bytes` bytes.
@@ -239,15 +291,19 @@ impl SectionKind {
             | SectionKind::EdgeRowStart
             | SectionKind::EdgeColumn => 4,
             SectionKind::RestPositions => 3 * scalar_bytes,
-            SectionKind::SurfaceTriangles => 12,
+            SectionKind::SurfaceTriangles | SectionKind::MeshTriangle => 12,
             SectionKind::ComplianceSurface
             | SectionKind::ComplianceInterior
             | SectionKind::VertexTensor
             | SectionKind::EdgeTensor => 9 * scalar_bytes,
             SectionKind::LumpedMass => scalar_bytes,
-            SectionKind::Tet | SectionKind::TetNeighbour => 16,
+            SectionKind::Tet | SectionKind::TetNeighbour | SectionKind::TetTriangle => 16,
             SectionKind::TetEdge => 24,
             SectionKind::TetShape => TET_SHAPE_LEN as u32 * scalar_bytes,
+            SectionKind::VertexTerms => VERTEX_TERMS_LEN as u32 * scalar_bytes,
+            SectionKind::EdgeTerms => EDGE_TERMS_LEN as u32 * scalar_bytes,
+            SectionKind::TriangleTerms => TRIANGLE_TERMS_LEN as u32 * scalar_bytes,
+            SectionKind::TetTerms => TET_TERMS_LEN as u32 * scalar_bytes,
         }
     }
 
@@ -262,13 +318,19 @@ impl SectionKind {
             SectionKind::VertexSlot
             | SectionKind::RestPositions
             | SectionKind::LumpedMass
-            | SectionKind::VertexTensor => Some(n),
+            | SectionKind::VertexTensor
+            | SectionKind::VertexTerms => Some(n),
             SectionKind::EdgeRowStart => n.checked_add(1),
-            SectionKind::EdgeColumn | SectionKind::EdgeTensor => Some(edges),
+            SectionKind::EdgeColumn | SectionKind::EdgeTensor | SectionKind::EdgeTerms => {
+                Some(edges)
+            }
             SectionKind::Tet
             | SectionKind::TetEdge
             | SectionKind::TetShape
-            | SectionKind::TetNeighbour => Some(tets),
+            | SectionKind::TetNeighbour
+            | SectionKind::TetTriangle
+            | SectionKind::TetTerms => Some(tets),
+            SectionKind::MeshTriangle | SectionKind::TriangleTerms => Some(h.mesh_triangle_count),
             SectionKind::FreeVertex => Some(f),
             SectionKind::SurfaceTriangles => Some(u64::from(h.triangle_count)),
             SectionKind::ComplianceSurface => s.checked_mul(s.checked_add(1)?).map(|x| x / 2),
@@ -294,6 +356,12 @@ impl SectionKind {
             SectionKind::TetEdge => "tet-edge",
             SectionKind::TetShape => "tet-shape",
             SectionKind::TetNeighbour => "tet-neighbour",
+            SectionKind::VertexTerms => "vertex-terms",
+            SectionKind::EdgeTerms => "edge-terms",
+            SectionKind::MeshTriangle => "mesh-triangle",
+            SectionKind::TriangleTerms => "triangle-terms",
+            SectionKind::TetTriangle => "tet-triangle",
+            SectionKind::TetTerms => "tet-terms",
         }
     }
 }

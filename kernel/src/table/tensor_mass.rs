@@ -5,7 +5,8 @@ use nalgebra::{Matrix3, Vector3};
 use super::LoadError;
 use super::container::{Container, check_finite};
 use super::format::{
-    FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_SHAPE_LEN, TableKind, tet_edge_vertices,
+    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_SHAPE_LEN, TET_TERMS_LEN,
+    TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN, tet_edge_vertices, tet_face_vertices,
 };
 use crate::Real;
 
@@ -18,6 +19,11 @@ use crate::Real;
 ///   exactly the edges of its vertex pairs ([`tet_edge_vertices`]), its
 ///   neighbours are `< tet_count` or [`NO_NEIGHBOUR`], and its rest volume is
 ///   positive;
+/// - the mesh triangles have vertices `< N`, strictly ascending within a
+///   triangle, and are in strictly ascending lexicographic order (so
+///   distinct); every tet's `tet-triangle` entry `j` names the triangle of its
+///   face opposite local vertex `j`, and every triangle is some tet's face
+///   (their number equals the distinct faces counted with the neighbours);
 /// - masses are `≥ 0`, vertex tensors symmetric, every float finite;
 /// - fixed vertices are marked [`FIXED_SLOT`] in the vertex-slot section and
 ///   their number matches the header's free count.
@@ -36,6 +42,12 @@ pub struct TensorMassTable<'a, T: Real> {
     tet_edges: &'a [[u32; 6]],
     tet_shapes: &'a [[T; TET_SHAPE_LEN]],
     neighbours: &'a [[u32; 4]],
+    vertex_terms: &'a [[T; VERTEX_TERMS_LEN]],
+    edge_terms: &'a [[T; EDGE_TERMS_LEN]],
+    mesh_triangles: &'a [[u32; 3]],
+    triangle_terms: &'a [[T; TRIANGLE_TERMS_LEN]],
+    tet_triangles: &'a [[u32; 4]],
+    tet_terms: &'a [[T; TET_TERMS_LEN]],
 }
 
 impl<'a, T: Real> TensorMassTable<'a, T> {
@@ -58,7 +70,16 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
             tet_edges: c.section(SectionKind::TetEdge)?,
             tet_shapes: c.section(SectionKind::TetShape)?,
             neighbours: c.section(SectionKind::TetNeighbour)?,
+            vertex_terms: c.section(SectionKind::VertexTerms)?,
+            edge_terms: c.section(SectionKind::EdgeTerms)?,
+            mesh_triangles: c.section(SectionKind::MeshTriangle)?,
+            triangle_terms: c.section(SectionKind::TriangleTerms)?,
+            tet_triangles: c.section(SectionKind::TetTriangle)?,
+            tet_terms: c.section(SectionKind::TetTerms)?,
         };
+        if table.header.mesh_triangle_count > u64::from(u32::MAX) {
+            return Err(LoadError::InconsistentHeader);
+        }
         let fixed = table
             .vertex_slot
             .iter()
@@ -71,9 +92,14 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         check_finite(SectionKind::VertexTensor, table.vertex_tensors)?;
         check_finite(SectionKind::EdgeTensor, table.edge_tensors)?;
         check_finite(SectionKind::TetShape, table.tet_shapes)?;
+        check_finite(SectionKind::VertexTerms, table.vertex_terms)?;
+        check_finite(SectionKind::EdgeTerms, table.edge_terms)?;
+        check_finite(SectionKind::TriangleTerms, table.triangle_terms)?;
+        check_finite(SectionKind::TetTerms, table.tet_terms)?;
         table.check_vertices()?;
         table.check_edges()?;
         table.check_tets()?;
+        table.check_mesh_triangles()?;
         if let Some(t) = table
             .triangles
             .iter()
@@ -177,6 +203,42 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         self.neighbours
     }
 
+    /// St Venant-Kirchhoff terms owned by each vertex of the uncut mesh,
+    /// `[c.x, c.y, c.z, d]` (N/m², N/m³; Picinbono 2001 eq. 14, table 1;
+    /// layout in [`crate::tensor_mass::stvk_terms`]).
+    pub fn vertex_terms(&self) -> &'a [[T; VERTEX_TERMS_LEN]] {
+        self.vertex_terms
+    }
+
+    /// St Venant-Kirchhoff terms owned by each edge `(i, j)`, `i < j`, of the
+    /// uncut mesh, in CSR order (N/m², N/m³).
+    pub fn edge_terms(&self) -> &'a [[T; EDGE_TERMS_LEN]] {
+        self.edge_terms
+    }
+
+    /// Every face of every tet once, vertex ids ascending, triangles in
+    /// ascending lexicographic order (find one with `binary_search`).
+    pub fn mesh_triangles(&self) -> &'a [[u32; 3]] {
+        self.mesh_triangles
+    }
+
+    /// St Venant-Kirchhoff terms owned by each mesh triangle of the uncut
+    /// mesh (N/m², N/m³).
+    pub fn triangle_terms(&self) -> &'a [[T; TRIANGLE_TERMS_LEN]] {
+        self.triangle_terms
+    }
+
+    /// Mesh-triangle index of each tet's face opposite each local vertex
+    /// ([`tet_face_vertices`] order).
+    pub fn tet_triangles(&self) -> &'a [[u32; 4]] {
+        self.tet_triangles
+    }
+
+    /// St Venant-Kirchhoff quartic terms owned by each tet (N/m³).
+    pub fn tet_terms(&self) -> &'a [[T; TET_TERMS_LEN]] {
+        self.tet_terms
+    }
+
     /// Rest shape-function gradients `a_0..a_3` (1/m) and rest volume (m³)
     /// of `tet`; `None` out of range.
     pub fn tet_shape(&self, tet: usize) -> Option<([Vector3<T>; 4], T)> {
@@ -261,6 +323,42 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
             if volume <= T::zero() {
                 return Err(bad);
             }
+        }
+        Ok(())
+    }
+
+    fn check_mesh_triangles(&self) -> Result<(), LoadError> {
+        let n = self.vertex_count() as u32;
+        let mut previous: Option<[u32; 3]> = None;
+        for (t, &tri) in self.mesh_triangles.iter().enumerate() {
+            let [p, q, r] = tri;
+            if !(p < q && q < r && r < n) || previous.is_some_and(|before| before >= tri) {
+                return Err(LoadError::BadMeshTriangle { triangle: t as u32 });
+            }
+            previous = Some(tri);
+        }
+        let rows = self
+            .tets
+            .iter()
+            .zip(self.tet_triangles)
+            .zip(self.neighbours);
+        let mut distinct_faces = 0u64;
+        for (t, ((&tet, triangles), neighbours)) in rows.enumerate() {
+            let faces = tet_face_vertices(tet).into_iter().zip(triangles);
+            for (mut face, &triangle) in faces {
+                face.sort_unstable();
+                if self.mesh_triangles.get(triangle as usize) != Some(&face) {
+                    return Err(LoadError::BadTetTriangle { tet: t as u32 });
+                }
+            }
+            // A face shared by two tets is counted by the lower-numbered one.
+            distinct_faces += neighbours
+                .iter()
+                .filter(|&&o| o == NO_NEIGHBOUR || o as usize > t)
+                .count() as u64;
+        }
+        if distinct_faces != self.mesh_triangles.len() as u64 {
+            return Err(LoadError::InconsistentHeader);
         }
         Ok(())
     }

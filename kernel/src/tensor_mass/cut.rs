@@ -1,14 +1,16 @@
 //! Local removal of tetrahedra (RR-3510 §5; Picinbono 2001 §3.1, MODELS.md
 //! §1 and §3): a removed tet's 4 vertex blocks, 6 edge blocks and 4 mass
-//! shares are subtracted from the current state, recomputed from the rest
-//! shape the table keeps for it, so the tensors equal those built from the
-//! mesh without the tet, to rounding.
+//! shares, and its St Venant-Kirchhoff split terms when the state keeps
+//! them (about 250 values), are subtracted from the current state,
+//! recomputed from the rest shape the table keeps for it, so the stored
+//! terms equal those built from the mesh without the tet, to rounding.
 
 use core::fmt;
 
 use nalgebra::Vector3;
 
 use super::model::TensorMassModel;
+use super::stvk_terms::{TetPlace, tet_terms};
 use crate::Real;
 use crate::element::stiffness_block;
 use crate::table::format::{NO_NEIGHBOUR, TET_EDGE_PAIRS, tet_face_vertices};
@@ -136,6 +138,15 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
             {
                 subtract_block(k, &stiffness_block(ar, ac, volume, lambda, mu));
             }
+        }
+        if let (true, Some(&triangles)) = (s.has_stvk_terms(), self.table.tet_triangles().get(t)) {
+            let place = TetPlace {
+                tet: t as u32,
+                vertices: tet,
+                edges: *edges,
+                triangles,
+            };
+            tet_terms(tet, &a, volume, lambda, mu).subtract_from(&place, &mut s.stvk_terms);
         }
         if let Some(alive) = s.tet_alive.get_mut(t) {
             *alive = false;

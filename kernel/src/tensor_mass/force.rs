@@ -4,7 +4,73 @@
 
 use nalgebra::Vector3;
 
+use super::law::{ElasticLaw, StvkForm};
+use super::stvk::TetPass;
+use super::stvk_terms::NonLinearTerms;
 use crate::Real;
+
+/// Everything the internal-force pass of a step reads, for the configured
+/// [`ElasticLaw`] and optional incompressibility penalty.
+pub(crate) struct InternalForces<'b, 'a, T: Real> {
+    pub(crate) stiffness: Stiffness<'b, T>,
+    pub(crate) tets: TetPass<'b, 'a, T>,
+    /// The current split terms (empty slices when not provided; the model
+    /// refuses [`StvkForm::Tensors`] then).
+    pub(crate) terms: NonLinearTerms<'b, T>,
+    pub(crate) law: ElasticLaw,
+    /// Lamé coefficients `(λ, μ)`, Pa.
+    pub(crate) lame: (T, T),
+    /// Penalty `γ` (N) of Picinbono 2001 §3.2, `None` when off.
+    pub(crate) incompressibility_n: Option<T>,
+}
+
+impl<T: Real> InternalForces<'_, '_, T> {
+    /// Overwrites `f` with the internal forces (N) of displacements `u` (m):
+    /// the elastic force of the law, plus the incompressibility penalty.
+    pub(crate) fn forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
+        let (lambda, mu) = self.lame;
+        match self.law {
+            ElasticLaw::Linear => self.stiffness.elastic_forces(u, f),
+            ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
+                self.tets.stvk_forces(lambda, mu, u, f)
+            }
+            ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
+                self.stiffness.elastic_forces(u, f);
+                self.terms.add_forces(u, f);
+            }
+        }
+        if let Some(gamma_n) = self.incompressibility_n {
+            self.tets.add_incompressibility(gamma_n, u, f);
+        }
+    }
+
+    /// The elastic energy (J) of displacements `u` (m) under the law; the
+    /// incompressibility penalty has no energy (its force is not a gradient)
+    /// and is not included. `scratch` (N entries) receives the linear
+    /// forces where the law needs them.
+    pub(crate) fn energy_j(&self, u: &[[T; 3]], scratch: &mut [[T; 3]]) -> T {
+        let (lambda, mu) = self.lame;
+        // ½ uᵀ K u = −½ Σ u·f with f = −K u.
+        let mut quadratic = || {
+            self.stiffness.elastic_forces(u, scratch);
+            let twice: T = u
+                .iter()
+                .zip(&*scratch)
+                .map(|(ui, fi)| vec3(ui).dot(&vec3(fi)))
+                .fold(T::zero(), |sum, x| sum + x);
+            -twice / T::of_f64(2.0)
+        };
+        match self.law {
+            ElasticLaw::Linear => quadratic(),
+            ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
+                self.tets.stvk_energy_j(lambda, mu, u)
+            }
+            ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
+                quadratic() + self.terms.energy_j(u)
+            }
+        }
+    }
+}
 
 /// The stiffness the force pass reads: current tensors and the CSR edge list.
 pub(crate) struct Stiffness<'t, T> {

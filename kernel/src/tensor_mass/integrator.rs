@@ -3,8 +3,9 @@
 
 use nalgebra::Vector3;
 
-use super::force::{Stiffness, vec3};
-use super::state::VertexMode;
+use super::force::{InternalForces, vec3};
+use super::model::Limits;
+use super::state::{Fault, VertexMode};
 use crate::Real;
 
 /// An explicit time integrator. All four are conditionally stable: the
@@ -73,13 +74,13 @@ impl<T: Real> Loads<'_, T> {
     /// cut keeps still).
     pub(crate) fn accelerations(
         &self,
-        stiffness: &Stiffness<'_, T>,
+        forces: &InternalForces<'_, '_, T>,
         damping_per_s: T,
         u: &[[T; 3]],
         v: &[[T; 3]],
         a: &mut [[T; 3]],
     ) {
-        stiffness.elastic_forces(u, a);
+        forces.forces(u, a);
         let per_vertex = a
             .iter_mut()
             .zip(v)
@@ -87,14 +88,79 @@ impl<T: Real> Loads<'_, T> {
             .zip(self.modes)
             .zip(self.external_force_n);
         for ((((ai, vi), &m), &mode), fext) in per_vertex {
-            *ai = if mode == VertexMode::Free && m > T::zero() {
-                let inverse_mass = T::one() / m;
-                ((vec3(ai) + vec3(fext)) * inverse_mass + self.gravity_m_s2
-                    - vec3(vi) * damping_per_s)
-                    .into()
-            } else {
-                [T::zero(); 3]
-            };
+            *ai = self
+                .acceleration(ai, vi, m, mode, fext, damping_per_s)
+                .into();
         }
+    }
+
+    /// One vertex's acceleration (m/s²) from its elastic force `f` (N),
+    /// velocity `v` (m/s), mass `m` (kg), mode and external force `fext` (N):
+    /// `(f + f_ext)/m + g − c v` for a free vertex with positive mass, zero
+    /// otherwise.
+    #[inline(always)]
+    pub(crate) fn acceleration(
+        &self,
+        f: &[T; 3],
+        v: &[T; 3],
+        m: T,
+        mode: VertexMode,
+        fext: &[T; 3],
+        damping_per_s: T,
+    ) -> Vector3<T> {
+        if mode == VertexMode::Free && m > T::zero() {
+            (vec3(f) + vec3(fext)) * (T::one() / m) + self.gravity_m_s2 - vec3(v) * damping_per_s
+        } else {
+            Vector3::zeros()
+        }
+    }
+}
+
+/// The divergence check of MODELS.md §6, accumulated vertex by vertex inside
+/// an integrator's last pass over the vertices (no separate pass): the first
+/// non-finite or out-of-bound vertex, and the kinetic energy.
+pub(crate) struct Watch<T> {
+    max_displacement2_m2: T,
+    max_kinetic_energy_j: T,
+    twice_kinetic_j: T,
+    fault: Option<Fault>,
+}
+
+impl<T: Real> Watch<T> {
+    pub(crate) fn new(limits: &Limits<T>) -> Self {
+        Self {
+            max_displacement2_m2: limits.max_displacement_m * limits.max_displacement_m,
+            max_kinetic_energy_j: limits.max_kinetic_energy_j,
+            twice_kinetic_j: T::zero(),
+            fault: None,
+        }
+    }
+
+    /// Checks vertex `vertex` with displacement `u` (m), velocity `v` (m/s)
+    /// and mass `m` (kg) after the update.
+    #[inline(always)]
+    pub(crate) fn visit(&mut self, vertex: usize, u: &[T; 3], v: &[T; 3], m: T) {
+        let (u2, v2) = (vec3(u).norm_squared(), vec3(v).norm_squared());
+        if self.fault.is_none() {
+            let vertex = vertex as u32;
+            if !(u2.finite() && v2.finite()) {
+                self.fault = Some(Fault::NonFinite { vertex });
+            } else if u2 > self.max_displacement2_m2 {
+                self.fault = Some(Fault::DisplacementBound { vertex });
+            }
+        }
+        self.twice_kinetic_j += m * v2;
+    }
+
+    /// The kinetic energy `½ Σ m |v|²` (J), or the first fault seen.
+    pub(crate) fn finish(self) -> Result<T, Fault> {
+        if let Some(fault) = self.fault {
+            return Err(fault);
+        }
+        let kinetic = self.twice_kinetic_j / T::of_f64(2.0);
+        if !kinetic.finite() || kinetic > self.max_kinetic_energy_j {
+            return Err(Fault::KineticEnergyBound);
+        }
+        Ok(kinetic)
     }
 }

@@ -15,10 +15,14 @@
 mod cut;
 mod force;
 mod integrator;
+mod law;
 mod model;
 mod state;
+mod stvk;
+pub mod stvk_terms;
 
 pub use cut::{CutReport, RemoveError, TearThresholds};
 pub use integrator::Integrator;
+pub use law::{ElasticLaw, StvkForm};
 pub use model::{DynamicParams, InputError, Limits, StepError, StepReport, TensorMassModel};
 pub use state::{Fault, StateBuffers, StateError, VertexMode};

@@ -4,9 +4,12 @@ use core::fmt;
 
 use nalgebra::Vector3;
 
-use super::force::{Stiffness, vec3};
-use super::integrator::{Integrator, Loads};
+use super::force::{InternalForces, Stiffness, vec3};
+use super::integrator::{Integrator, Loads, Watch};
+use super::law::{ElasticLaw, StvkForm};
 use super::state::{Fault, StateBuffers, StateError, VertexMode};
+use super::stvk::TetPass;
+use super::stvk_terms::{NonLinearTerms, TermArraysMut};
 use crate::Real;
 use crate::table::TensorMassTable;
 
@@ -24,6 +27,12 @@ pub struct Limits<T> {
 /// Parameters of the dynamics that are not in the table.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicParams<T> {
+    /// The elastic force: linear or St Venant-Kirchhoff.
+    pub law: ElasticLaw,
+    /// Incompressibility penalty `γ` (N) of Picinbono 2001 §3.2, `None`
+    /// when off: on each tet corner, `γ ((V − V₀)/V₀)²` along the normal of
+    /// the opposite face, restoring the rest volume.
+    pub incompressibility_n: Option<T>,
     /// Mass-proportional damping `c` (1/s): `γ_i = c m_i` in
     /// `m_i p̈_i = −γ_i ṗ_i + f_i + f_ext,i` (MODELS.md §3).
     pub damping_per_s: T,
@@ -134,9 +143,19 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
                 "max_kinetic_energy_j",
                 non_negative(params.limits.max_kinetic_energy_j),
             ),
+            (
+                "incompressibility_n",
+                params
+                    .incompressibility_n
+                    .is_none_or(|g| non_negative(g) && g.finite()),
+            ),
         ];
         if let Some((name, _)) = checks.iter().find(|(_, ok)| !ok) {
             return Err(StateError::BadParameter { name });
+        }
+        if params.law == ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) && !state.has_stvk_terms()
+        {
+            return Err(StateError::NoTermBuffers);
         }
         let mut model = Self {
             table,
@@ -159,6 +178,15 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         s.edge_tensors
             .copy_from_slice_checked(self.table.edge_tensors());
         s.masses_kg.copy_from_slice_checked(self.table.masses_kg());
+        let terms = &mut s.stvk_terms;
+        terms
+            .vertex
+            .copy_from_slice_checked(self.table.vertex_terms());
+        terms.edge.copy_from_slice_checked(self.table.edge_terms());
+        terms
+            .triangle
+            .copy_from_slice_checked(self.table.triangle_terms());
+        terms.tet.copy_from_slice_checked(self.table.tet_terms());
         s.tet_alive.fill(true);
         s.live_tets.fill(0);
         for tet in self.table.tets() {
@@ -322,19 +350,30 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         self.elastic_forces_of(self.state.displacement_m, out);
     }
 
-    /// The elastic forces `−K u` (N) of any displacement field `u` (m) with
-    /// the current stiffness (energy and eigenvalue estimates).
+    /// The internal forces (N) of any displacement field `u` (m) with the
+    /// current stiffness and the configured law and penalty (energy and
+    /// eigenvalue estimates, finite-difference checks).
     pub fn elastic_forces_of(&self, u: &[[T; 3]], out: &mut [[T; 3]]) {
-        self.stiffness().elastic_forces(u, out);
+        self.internal_forces().forces(u, out);
     }
 
-    fn stiffness(&self) -> Stiffness<'_, T> {
-        Stiffness {
-            vertex_tensors: self.state.vertex_tensors,
-            edge_tensors: self.state.edge_tensors,
-            row_start: self.table.edge_row_starts(),
-            column: self.table.edge_columns(),
-        }
+    /// The elastic energy (J) of any displacement field `u` (m) under the
+    /// configured law (the incompressibility penalty has none); `scratch`
+    /// must hold one entry per vertex.
+    pub fn elastic_energy_of(&self, u: &[[T; 3]], scratch: &mut [[T; 3]]) -> T {
+        self.internal_forces().energy_j(u, scratch)
+    }
+
+    fn internal_forces(&self) -> InternalForces<'_, 'a, T> {
+        let s = &self.state;
+        internal_forces(
+            &self.table,
+            s.vertex_tensors,
+            s.edge_tensors,
+            s.tet_alive,
+            &s.stvk_terms,
+            &self.params,
+        )
     }
 
     /// Advances the state by `dt_s` seconds with `integrator`, then checks
@@ -348,15 +387,15 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         if !(dt_s.finite() && dt_s > T::zero()) {
             return Err(StepError::BadTimeStep);
         }
-        match integrator {
+        let outcome = match integrator {
             Integrator::ExplicitEuler | Integrator::SymplecticEuler => {
                 self.step_euler(dt_s, integrator == Integrator::SymplecticEuler)
             }
-            Integrator::Rk4 => self.step_rk4(dt_s)?,
+            Integrator::Rk4 => self.step_rk4(dt_s).ok_or(StepError::NoRk4Scratch)?,
             Integrator::CentralDifference => self.step_central(dt_s),
-        }
+        };
         self.previous_valid = integrator == Integrator::CentralDifference;
-        match self.check() {
+        match outcome {
             Ok(kinetic_energy_j) => Ok(StepReport {
                 kinetic_energy_j,
                 force_evaluations: integrator.force_evaluations(),
@@ -368,32 +407,44 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         }
     }
 
-    /// Forward (`symplectic == false`) or semi-implicit Euler.
-    fn step_euler(&mut self, dt: T, symplectic: bool) {
-        let (stiffness, loads, s) = split(&self.table, &mut self.state, &self.params);
-        let (u, v, a) = (s.displacement_m, s.velocity_m_s, s.force_n);
-        loads.accelerations(&stiffness, self.params.damping_per_s, u, v, a);
-        for (((ui, vi), ai), mode) in u.iter_mut().zip(v.iter_mut()).zip(&*a).zip(loads.modes) {
-            if *mode != VertexMode::Free {
-                continue;
+    /// Forward (`symplectic == false`) or semi-implicit Euler: one force
+    /// pass, then one pass over the vertices that updates and checks each.
+    fn step_euler(&mut self, dt: T, symplectic: bool) -> Result<T, Fault> {
+        let (forces, loads, s) = split(&self.table, &mut self.state, &self.params);
+        let (u, v, f) = (s.displacement_m, s.velocity_m_s, s.force_n);
+        forces.forces(u, f);
+        let c = self.params.damping_per_s;
+        let mut watch = Watch::new(&self.params.limits);
+        let rows = u
+            .iter_mut()
+            .zip(v.iter_mut())
+            .zip(&*f)
+            .zip(loads.masses_kg)
+            .zip(loads.modes)
+            .zip(loads.external_force_n);
+        for (vertex, (((((ui, vi), fi), &m), &mode), fext)) in rows.enumerate() {
+            if mode == VertexMode::Free {
+                let v_old = vec3(vi);
+                let v_new = v_old + loads.acceleration(fi, vi, m, mode, fext, c) * dt;
+                let step = if symplectic { v_new } else { v_old };
+                *ui = (vec3(ui) + step * dt).into();
+                *vi = v_new.into();
             }
-            let v_old = vec3(vi);
-            let v_new = v_old + vec3(ai) * dt;
-            let step = if symplectic { v_new } else { v_old };
-            *ui = (vec3(ui) + step * dt).into();
-            *vi = v_new.into();
+            watch.visit(vertex, ui, vi, m);
         }
+        watch.finish()
     }
 
-    /// Classical RK4 on `y = (u, v)`, `ẏ = (v, a(u, v))`.
-    fn step_rk4(&mut self, dt: T) -> Result<(), StepError> {
+    /// Classical RK4 on `y = (u, v)`, `ẏ = (v, a(u, v))`; `None` without
+    /// RK4 scratch.
+    fn step_rk4(&mut self, dt: T) -> Option<Result<T, Fault>> {
         let n = self.state.displacement_m.len();
-        let (stiffness, loads, s) = split(&self.table, &mut self.state, &self.params);
+        let (forces, loads, s) = split(&self.table, &mut self.state, &self.params);
         let mut chunks = s.rk4_scratch.chunks_exact_mut(n.max(1));
         let (Some(su), Some(sv), Some(du), Some(dv)) =
             (chunks.next(), chunks.next(), chunks.next(), chunks.next())
         else {
-            return Err(StepError::NoRk4Scratch);
+            return None;
         };
         let (u, v, a) = (s.displacement_m, s.velocity_m_s, s.force_n);
         su.copy_from_slice_checked(u);
@@ -408,7 +459,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             (T::one(), T::zero()),
         ];
         for (weight, next) in stages {
-            loads.accelerations(&stiffness, self.params.damping_per_s, su, sv, a);
+            loads.accelerations(&forces, self.params.damping_per_s, su, sv, a);
             let rows = su
                 .iter_mut()
                 .zip(sv.iter_mut())
@@ -425,88 +476,66 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             }
         }
         let sixth = dt / T::of_f64(6.0);
-        for ((((ui, vi), dui), dvi), mode) in u
+        let mut watch = Watch::new(&self.params.limits);
+        let rows = u
             .iter_mut()
             .zip(v.iter_mut())
             .zip(&*du)
             .zip(&*dv)
             .zip(loads.modes)
-        {
+            .zip(loads.masses_kg);
+        for (vertex, (((((ui, vi), dui), dvi), mode), &m)) in rows.enumerate() {
             if *mode == VertexMode::Free {
                 *ui = (vec3(ui) + vec3(dui) * sixth).into();
                 *vi = (vec3(vi) + vec3(dvi) * sixth).into();
             }
+            watch.visit(vertex, ui, vi, m);
         }
-        Ok(())
+        Some(watch.finish())
     }
 
     /// Picinbono 2001 eq. (19), MODELS.md damping sign (see [`Integrator::CentralDifference`]).
-    fn step_central(&mut self, dt: T) {
+    fn step_central(&mut self, dt: T) -> Result<T, Fault> {
         let first = !self.previous_valid;
-        let (stiffness, loads, s) = split(&self.table, &mut self.state, &self.params);
-        let (u, v, prev, a) = (
+        let (forces, loads, s) = split(&self.table, &mut self.state, &self.params);
+        let (u, v, prev, f) = (
             s.displacement_m,
             s.velocity_m_s,
             s.previous_displacement_m,
             s.force_n,
         );
-        // Damping enters through the scheme's coefficients, not the acceleration.
-        loads.accelerations(&stiffness, T::zero(), u, v, a);
+        forces.forces(u, f);
         let c_half = self.params.damping_per_s * dt / T::of_f64(2.0);
         let two = T::of_f64(2.0);
+        let mut watch = Watch::new(&self.params.limits);
         let rows = u
             .iter_mut()
             .zip(v.iter_mut())
             .zip(prev.iter_mut())
-            .zip(&*a)
-            .zip(loads.modes);
-        for ((((ui, vi), pi), ai), mode) in rows {
-            if *mode != VertexMode::Free {
-                continue;
+            .zip(&*f)
+            .zip(loads.modes)
+            .zip(loads.masses_kg)
+            .zip(loads.external_force_n);
+        for (vertex, ((((((ui, vi), pi), fi), &mode), &m), fext)) in rows.enumerate() {
+            if mode == VertexMode::Free {
+                // Damping enters through the scheme's coefficients, not the acceleration.
+                let a = loads.acceleration(fi, vi, m, mode, fext, T::zero());
+                let u_now = vec3(ui);
+                // Start-up: u⁻ = u − Δt v (first step, or after another integrator).
+                let u_prev = if first {
+                    u_now - vec3(vi) * dt
+                } else {
+                    vec3(pi)
+                };
+                let u_next = (a * (dt * dt) + u_now * two - u_prev * (T::one() - c_half))
+                    / (T::one() + c_half);
+                *vi = ((u_next - u_prev) / (two * dt)).into();
+                *pi = u_now.into();
+                *ui = u_next.into();
             }
-            let u_now = vec3(ui);
-            // Start-up: u⁻ = u − Δt v (first step, or after another integrator).
-            let u_prev = if first {
-                u_now - vec3(vi) * dt
-            } else {
-                vec3(pi)
-            };
-            let u_next = (vec3(ai) * (dt * dt) + u_now * two - u_prev * (T::one() - c_half))
-                / (T::one() + c_half);
-            *vi = ((u_next - u_prev) / (two * dt)).into();
-            *pi = u_now.into();
-            *ui = u_next.into();
+            watch.visit(vertex, ui, vi, m);
         }
-    }
-
-    /// Kinetic energy, or the first divergence found (MODELS.md §6).
-    fn check(&self) -> Result<T, Fault> {
-        let limits = &self.params.limits;
-        let max_u2 = limits.max_displacement_m * limits.max_displacement_m;
-        let mut twice_kinetic = T::zero();
-        let s = &self.state;
-        let rows = s
-            .displacement_m
-            .iter()
-            .zip(&*s.velocity_m_s)
-            .zip(&*s.masses_kg);
-        for (vertex, ((u, v), &m)) in rows.enumerate() {
-            let vertex = vertex as u32;
-            let (u, v) = (vec3(u), vec3(v));
-            let (u2, v2) = (u.norm_squared(), v.norm_squared());
-            if !(u2.finite() && v2.finite()) {
-                return Err(Fault::NonFinite { vertex });
-            }
-            if u2 > max_u2 {
-                return Err(Fault::DisplacementBound { vertex });
-            }
-            twice_kinetic += m * v2;
-        }
-        let kinetic = twice_kinetic / T::of_f64(2.0);
-        if !kinetic.finite() || kinetic > limits.max_kinetic_energy_j {
-            return Err(Fault::KineticEnergyBound);
-        }
-        Ok(kinetic)
+        watch.finish()
     }
 }
 
@@ -520,17 +549,19 @@ struct Writable<'b, T> {
     rk4_scratch: &'b mut [[T; 3]],
 }
 
-fn split<'b, T: Real>(
-    table: &'b TensorMassTable<'_, T>,
+fn split<'b, 'a, T: Real>(
+    table: &'b TensorMassTable<'a, T>,
     state: &'b mut StateBuffers<'_, T>,
     params: &DynamicParams<T>,
-) -> (Stiffness<'b, T>, Loads<'b, T>, Writable<'b, T>) {
-    let stiffness = Stiffness {
-        vertex_tensors: state.vertex_tensors,
-        edge_tensors: state.edge_tensors,
-        row_start: table.edge_row_starts(),
-        column: table.edge_columns(),
-    };
+) -> (InternalForces<'b, 'a, T>, Loads<'b, T>, Writable<'b, T>) {
+    let forces = internal_forces(
+        table,
+        state.vertex_tensors,
+        state.edge_tensors,
+        state.tet_alive,
+        &state.stvk_terms,
+        params,
+    );
     let loads = Loads {
         masses_kg: state.masses_kg,
         modes: state.modes,
@@ -544,7 +575,42 @@ fn split<'b, T: Real>(
         force_n: state.force_n,
         rk4_scratch: state.rk4_scratch,
     };
-    (stiffness, loads, writable)
+    (forces, loads, writable)
+}
+
+/// The internal-force pass over the current tensors and live tets.
+fn internal_forces<'b, 'a, T: Real>(
+    table: &'b TensorMassTable<'a, T>,
+    vertex_tensors: &'b [[T; 9]],
+    edge_tensors: &'b [[T; 9]],
+    tet_alive: &'b [bool],
+    terms: &'b TermArraysMut<'_, T>,
+    params: &DynamicParams<T>,
+) -> InternalForces<'b, 'a, T> {
+    let terms = NonLinearTerms {
+        vertex_terms: terms.vertex,
+        edge_row_start: table.edge_row_starts(),
+        edge_column: table.edge_columns(),
+        edge_terms: terms.edge,
+        triangles: table.mesh_triangles(),
+        triangle_terms: terms.triangle,
+        tets: table.tets(),
+        tet_terms: terms.tet,
+        tet_alive,
+    };
+    InternalForces {
+        stiffness: Stiffness {
+            vertex_tensors,
+            edge_tensors,
+            row_start: table.edge_row_starts(),
+            column: table.edge_columns(),
+        },
+        tets: TetPass { table, tet_alive },
+        terms,
+        law: params.law,
+        lame: table.lame(),
+        incompressibility_n: params.incompressibility_n,
+    }
 }
 
 /// `copy_from_slice` without its length panic: copies the common prefix

@@ -2,6 +2,7 @@
 
 use core::fmt;
 
+use super::stvk_terms::TermArraysMut;
 use crate::Real;
 use crate::table::TensorMassTable;
 
@@ -48,6 +49,11 @@ pub struct StateBuffers<'s, T> {
     /// `4N` for RK4 (stage displacement, stage velocity, and the two weighted
     /// sums), or empty when RK4 is not needed (saves `48N` bytes in f32).
     pub rk4_scratch: &'s mut [[T; 3]],
+    /// Current St Venant-Kirchhoff split terms (Picinbono table 1) for
+    /// [`super::StvkForm::Tensors`]: one entry per vertex, edge, mesh
+    /// triangle and tet of the table, or all four empty when that form is
+    /// not used (saves `4·(4N + 16E + 15T + 3M)` bytes in f32).
+    pub stvk_terms: TermArraysMut<'s, T>,
 }
 
 /// A [`StateBuffers`] field has the wrong length for the table, or a
@@ -68,6 +74,9 @@ pub enum StateError {
         /// Which parameter.
         name: &'static str,
     },
+    /// [`super::StvkForm::Tensors`] was asked for without
+    /// [`StateBuffers::stvk_terms`].
+    NoTermBuffers,
 }
 
 impl fmt::Display for StateError {
@@ -82,6 +91,9 @@ impl fmt::Display for StateError {
                 "state buffer {buffer} holds {found} entries, the table needs {expected}"
             ),
             Self::BadParameter { name } => write!(f, "parameter {name} must be finite and >= 0"),
+            Self::NoTermBuffers => {
+                f.write_str("the tensors form of St Venant-Kirchhoff needs the stvk_terms buffers")
+            }
         }
     }
 }
@@ -89,6 +101,11 @@ impl fmt::Display for StateError {
 impl core::error::Error for StateError {}
 
 impl<T: Real> StateBuffers<'_, T> {
+    /// `true` if the split-term buffers are provided (non-empty vertex terms).
+    pub(crate) fn has_stvk_terms(&self) -> bool {
+        !self.stvk_terms.vertex.is_empty()
+    }
+
     /// Checks every length against `table`.
     pub(crate) fn check(&self, table: &TensorMassTable<'_, T>) -> Result<(), StateError> {
         let n = table.vertex_count();
@@ -97,6 +114,8 @@ impl<T: Real> StateBuffers<'_, T> {
         } else {
             4 * n
         };
+        let terms = &self.stvk_terms;
+        let has_terms = usize::from(self.has_stvk_terms());
         let lengths = [
             ("vertex_tensors", self.vertex_tensors.len(), n),
             ("edge_tensors", self.edge_tensors.len(), table.edge_count()),
@@ -114,6 +133,22 @@ impl<T: Real> StateBuffers<'_, T> {
             ("external_force_n", self.external_force_n.len(), n),
             ("force_n", self.force_n.len(), n),
             ("rk4_scratch", self.rk4_scratch.len(), rk4),
+            ("stvk_terms.vertex", terms.vertex.len(), n * has_terms),
+            (
+                "stvk_terms.edge",
+                terms.edge.len(),
+                table.edge_count() * has_terms,
+            ),
+            (
+                "stvk_terms.triangle",
+                terms.triangle.len(),
+                table.mesh_triangles().len() * has_terms,
+            ),
+            (
+                "stvk_terms.tet",
+                terms.tet.len(),
+                table.tet_count() * has_terms,
+            ),
         ];
         match lengths
             .iter()

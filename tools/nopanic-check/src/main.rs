@@ -1,25 +1,55 @@
-//! Link-time proof that the kernel's step path cannot panic.
+//! Link-time proof that the kernel's step paths cannot panic.
 //!
 //! The panic handler calls `palpate_step_path_can_panic`, a symbol defined
 //! nowhere. With `panic = "abort"`, LTO and optimisation, the linker keeps the
 //! handler only if some panic is reachable from `main`; then the link fails
 //! with "undefined symbol: palpate_step_path_can_panic". A successful link
-//! proves that no panic is reachable in what `main` calls:
+//! proves that no panic is reachable in what `main` calls.
+//!
+//! The pre-computed model (RR-3510 §4), on the f32 table of the firmware
+//! example's box (`$OUT_DIR/table.bin`, from `PALPATE_TABLE`):
 //! - table validation, `PrecomputedTable::load` (not the step path, but it runs
 //!   on bytes from flash or a file, so it is checked too);
 //! - the haptic force path, `PrecomputedModel::contact_forces::<MAX_CONTACTS>`;
 //! - the displacement updates, `PrecomputedModel::free_displacements` and
 //!   `PrecomputedModel::displacements`.
 //!
+//! The dynamic tensor-mass model (RR-3510 §5), on the f32 tensor-mass table of
+//! the same box (`$OUT_DIR/tensor_table.bin`, from `PALPATE_TENSOR_TABLE`):
+//! - table validation, `TensorMassTable::load`;
+//! - `TensorMassModel::new` (buffer-length and parameter checks) and `reset`, on
+//!   `StateBuffers` sliced from fixed-capacity arrays, with each
+//!   `ElasticLaw` (linear, St Venant-Kirchhoff) and the incompressibility
+//!   penalty on or off;
+//! - the inputs `set_external_force`, `set_velocity`, `impose`, `release`,
+//!   `clear_external_forces`;
+//! - `step` with each of the four `Integrator`s (explicit and symplectic
+//!   Euler, RK4, central difference) and the divergence faults;
+//! - topology changes: `remove_tet`, `cut_with_tool`, `tear`, and the live
+//!   `surface_triangles`;
+//! - the outputs `displacements_m`, `velocities_m_s`, `elastic_forces_n`,
+//!   `fault`.
+//!
 //! Why the proof holds for every input, not just one: every input (the table
-//! length, the contact count, each contact's kind, vertices, barycentric
-//! weights and imposed displacement, the output buffer lengths) is read with
-//! `core::ptr::read_volatile` from a `static mut` each time round the loop, so
-//! the optimiser must assume any value (a debugger could write them). Every
-//! result is written with `core::ptr::write_volatile`, so no computation can be
-//! dropped as dead. `core::hint::black_box` is not used: its documentation
-//! says it must not be relied on for correctness, and a too-weak barrier would
-//! make this check pass vacuously.
+//! lengths, the contact count, each contact's kind, vertices, barycentric
+//! weights and imposed displacement, the output buffer lengths; for the
+//! tensor-mass model every state-buffer length, the law and parameters, the
+//! number of rounds on one model and whether each resets it, each vertex
+//! index and value, the integrator, the time step, the tet index, the tool
+//! segment, radius and capacity, which tearing criteria are on, their
+//! thresholds and capacity) is read with `core::ptr::read_volatile` from a
+//! `static mut` each time round the loop, so the optimiser must assume any
+//! value (a debugger could write them). The tensor-mass calls run in a loop
+//! of a volatile number of rounds on one model, so each also runs on any
+//! state the others leave (tets removed, faulted, central-difference history
+//! valid). Every result is written with
+//! `core::ptr::write_volatile`, so no computation can be dropped as dead.
+//! `core::hint::black_box` is not used: its documentation says it must not be
+//! relied on for correctness, and a too-weak barrier would make this check
+//! pass vacuously. The table bytes themselves are link-time constants (only
+//! the length passed to `load` is opaque), so strictly the proof is for these
+//! two tables; the kernel does not rely on their values, as it reads every
+//! index taken from a table through `get`.
 //!
 //! Never run; only linked. `tools/nopanic-check.sh` builds it.
 #![no_std]
@@ -32,6 +62,15 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use cortex_m_rt::entry;
 use palpate_kernel::precomputed::Contact;
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::table::format::{
+    EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
+};
+use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
+use palpate_kernel::tensor_mass::{
+    DynamicParams, ElasticLaw, Fault, Integrator, Limits, StateBuffers, StvkForm, TearThresholds,
+    TensorMassModel, VertexMode,
+};
 use palpate_kernel::{MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
 /// The f32 table of the firmware example's box (64 vertices), 16-byte aligned
@@ -104,16 +143,22 @@ static mut OUTPUTS: Outputs = Outputs {
 #[entry]
 fn main() -> ! {
     let mut displacements = [[0.0f32; 3]; VERTICES];
+    let mut state = TensorState::new();
     loop {
-        // SAFETY: single-threaded, no interrupt touches INPUTS; a volatile
-        // read of a plain-old-data static is always valid.
+        // SAFETY: single-threaded, no interrupt touches INPUTS or
+        // TENSOR_INPUTS; a volatile read of a plain-old-data static is always
+        // valid.
         let inputs = unsafe { read_volatile(addr_of!(INPUTS)) };
-        step(&inputs, &mut displacements);
+        precomputed_step(&inputs, &mut displacements);
+        // SAFETY: as above.
+        let inputs = unsafe { read_volatile(addr_of!(TENSOR_INPUTS)) };
+        tensor_mass_step(&inputs, &mut state);
     }
 }
 
-/// One tick: load, contact forces, both displacement updates, on `inputs`.
-fn step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
+/// One tick of the pre-computed model: load, contact forces, both
+/// displacement updates, on `inputs`.
+fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
     let bytes = TABLE.get(..inputs.table_len).unwrap_or(TABLE);
     let Ok(table) = PrecomputedTable::<f32>::load(bytes) else {
         refused();
@@ -199,6 +244,442 @@ fn publish(displacements: &[[f32; 3]; VERTICES]) {
         for (u, o) in displacements.iter().zip((*out).displacements_m.iter_mut()) {
             write_volatile(o, *u);
         }
+    }
+}
+
+/// The f32 tensor-mass table of the same box (64 vertices, 279 edges, 162
+/// tets), 16-byte aligned as `load` requires.
+static TENSOR_TABLE: &[u8] =
+    palpate_kernel::include_table!(concat!(env!("OUT_DIR"), "/tensor_table.bin"));
+
+/// Capacity of the edge buffer: the checked table has 279 edges; one more
+/// than that, so that a too-long `edge_tensors` is reachable as well as a
+/// too-short one.
+const EDGES: usize = 280;
+
+/// Capacity of the per-tet buffer: the checked table has 162 tets.
+const TETS: usize = 162;
+
+/// Capacity of the RK4 scratch: `4N`.
+const RK4: usize = 4 * VERTICES;
+
+/// Capacity of the mesh-triangle term buffer: the checked table has 378
+/// triangles (every face of every tet once); one more, as for `EDGES`.
+const TRIANGLES: usize = 379;
+
+/// Capacity of the surface output: a live surface has at most `4 × tets`
+/// triangles.
+const SURFACE: usize = 4 * TETS;
+
+/// Entries given to each `StateBuffers` field, each clamped to its capacity
+/// (any other length than the table's is refused by `TensorMassModel::new`).
+#[derive(Clone, Copy)]
+struct BufferLengths {
+    vertex_tensors: usize,
+    edge_tensors: usize,
+    masses_kg: usize,
+    tet_alive: usize,
+    live_tets: usize,
+    modes: usize,
+    displacement_m: usize,
+    velocity_m_s: usize,
+    previous_displacement_m: usize,
+    external_force_n: usize,
+    force_n: usize,
+    /// Zero means no RK4 scratch (RK4 refused by `step`); `4N` is accepted.
+    rk4_scratch: usize,
+    /// St Venant-Kirchhoff split-term buffers: all zero means none (the
+    /// tensors form is refused by `new`); the table's counts are accepted.
+    vertex_terms: usize,
+    edge_terms: usize,
+    triangle_terms: usize,
+    tet_terms: usize,
+}
+
+/// Everything the tensor-mass path takes, opaque to the optimiser (see the
+/// crate docs). Integers stand in for booleans and enums so that any byte a
+/// debugger writes is a valid value.
+struct TensorInputs {
+    /// Bytes of `TENSOR_TABLE` passed to `load` (clamped to the table length).
+    table_len: usize,
+    /// State-buffer lengths.
+    lengths: BufferLengths,
+    /// Rounds per tick on one model (`tensor_mass_step`).
+    rounds: u32,
+    /// Non-zero: `reset` at the start of the round.
+    reset: u8,
+    /// `ElasticLaw` by index (any value: taken modulo 3; the tensor form of
+    /// St Venant-Kirchhoff is refused by `new` without the term buffers).
+    law: u8,
+    /// Non-zero: the incompressibility penalty is on, with this `γ`, N.
+    incompressibility_on: u8,
+    incompressibility_n: f32,
+    /// Mass-proportional damping, 1/s.
+    damping_per_s: f32,
+    /// Gravity, m/s².
+    gravity_m_s2: [f32; 3],
+    /// Divergence bound on a displacement norm, m.
+    max_displacement_m: f32,
+    /// Divergence bound on the kinetic energy, J.
+    max_kinetic_energy_j: f32,
+    /// `set_external_force`: vertex and force, N.
+    force_vertex: u32,
+    force_n: [f32; 3],
+    /// `set_velocity`: vertex and velocity, m/s.
+    velocity_vertex: u32,
+    velocity_m_s: [f32; 3],
+    /// `impose`: vertex and displacement, m.
+    impose_vertex: u32,
+    impose_m: [f32; 3],
+    /// `release`: vertex.
+    release_vertex: u32,
+    /// Non-zero: `clear_external_forces` before the step.
+    clear_forces: u8,
+    /// `Integrator` by index (any value: taken modulo 4).
+    integrator: u8,
+    /// Time step, s.
+    dt_s: f32,
+    /// `remove_tet`: tet index.
+    remove_tet: u32,
+    /// `cut_with_tool`: segment ends, m, radius, m, and capacity.
+    tool_a_m: [f32; 3],
+    tool_b_m: [f32; 3],
+    tool_radius_m: f32,
+    cut_capacity: u32,
+    /// `tear`: non-zero switches each criterion on (volume change, mean
+    /// elongation, max elongation), with its threshold; and the capacity.
+    tear_on: [u8; 3],
+    tear_thresholds: [f32; 3],
+    tear_capacity: u32,
+    /// Entries passed to `elastic_forces_n` (clamped to `VERTICES`).
+    forces_len: usize,
+}
+
+/// The tensor-mass inputs, read with `read_volatile` only.
+static mut TENSOR_INPUTS: TensorInputs = TensorInputs {
+    table_len: usize::MAX,
+    lengths: BufferLengths {
+        vertex_tensors: VERTICES,
+        edge_tensors: EDGES - 1,
+        masses_kg: VERTICES,
+        tet_alive: TETS,
+        live_tets: VERTICES,
+        modes: VERTICES,
+        displacement_m: VERTICES,
+        velocity_m_s: VERTICES,
+        previous_displacement_m: VERTICES,
+        external_force_n: VERTICES,
+        force_n: VERTICES,
+        rk4_scratch: RK4,
+        vertex_terms: VERTICES,
+        edge_terms: EDGES - 1,
+        triangle_terms: TRIANGLES - 1,
+        tet_terms: TETS,
+    },
+    rounds: 1,
+    reset: 0,
+    law: 0,
+    incompressibility_on: 0,
+    incompressibility_n: 0.0,
+    damping_per_s: 0.0,
+    gravity_m_s2: [0.0; 3],
+    max_displacement_m: f32::INFINITY,
+    max_kinetic_energy_j: f32::INFINITY,
+    force_vertex: 0,
+    force_n: [0.0; 3],
+    velocity_vertex: 0,
+    velocity_m_s: [0.0; 3],
+    impose_vertex: 0,
+    impose_m: [0.0; 3],
+    release_vertex: 0,
+    clear_forces: 0,
+    integrator: 0,
+    dt_s: 0.001,
+    remove_tet: 0,
+    tool_a_m: [0.0; 3],
+    tool_b_m: [0.0; 3],
+    tool_radius_m: 0.0,
+    cut_capacity: 0,
+    tear_on: [0; 3],
+    tear_thresholds: [0.0; 3],
+    tear_capacity: 0,
+    forces_len: VERTICES,
+};
+
+/// Where the tensor-mass results go, written with `write_volatile` only.
+struct TensorOutputs {
+    /// Displacements after the step, m.
+    displacements_m: [[f32; 3]; VERTICES],
+    /// Velocities after the step, m/s.
+    velocities_m_s: [[f32; 3]; VERTICES],
+    /// Elastic forces after the cuts, N.
+    elastic_forces_n: [[f32; 3]; VERTICES],
+    /// The fault: 0 none, 1 non-finite, 2 displacement bound, 3 kinetic
+    /// energy bound; then the vertex (0 for 3).
+    fault: [u32; 2],
+    /// Kinetic energy after the step, J, and its force evaluations.
+    kinetic_energy_j: f32,
+    force_evaluations: u32,
+    /// Tets removed by `remove_tet`, `cut_with_tool` and `tear`, and the
+    /// two `pending` flags.
+    removed: [u32; 3],
+    pending: [bool; 2],
+    /// The live surface: triangle count and the triangles.
+    surface_count: u32,
+    surface_triangles: [[u32; 3]; SURFACE],
+}
+
+/// The tensor-mass outputs.
+static mut TENSOR_OUTPUTS: TensorOutputs = TensorOutputs {
+    displacements_m: [[0.0; 3]; VERTICES],
+    velocities_m_s: [[0.0; 3]; VERTICES],
+    elastic_forces_n: [[0.0; 3]; VERTICES],
+    fault: [0; 2],
+    kinetic_energy_j: 0.0,
+    force_evaluations: 0,
+    removed: [0; 3],
+    pending: [false; 2],
+    surface_count: 0,
+    surface_triangles: [[0; 3]; SURFACE],
+};
+
+/// The storage behind `StateBuffers`: fixed-capacity arrays (on `main`'s
+/// stack), sliced to the volatile lengths each tick.
+struct TensorState {
+    vertex_tensors: [[f32; 9]; VERTICES],
+    edge_tensors: [[f32; 9]; EDGES],
+    masses_kg: [f32; VERTICES],
+    tet_alive: [bool; TETS],
+    live_tets: [u32; VERTICES],
+    modes: [VertexMode; VERTICES],
+    displacement_m: [[f32; 3]; VERTICES],
+    velocity_m_s: [[f32; 3]; VERTICES],
+    previous_displacement_m: [[f32; 3]; VERTICES],
+    external_force_n: [[f32; 3]; VERTICES],
+    force_n: [[f32; 3]; VERTICES],
+    rk4_scratch: [[f32; 3]; RK4],
+    vertex_terms: [[f32; VERTEX_TERMS_LEN]; VERTICES],
+    edge_terms: [[f32; EDGE_TERMS_LEN]; EDGES],
+    triangle_terms: [[f32; TRIANGLE_TERMS_LEN]; TRIANGLES],
+    tet_terms: [[f32; TET_TERMS_LEN]; TETS],
+}
+
+impl TensorState {
+    fn new() -> Self {
+        Self {
+            vertex_tensors: [[0.0; 9]; VERTICES],
+            edge_tensors: [[0.0; 9]; EDGES],
+            masses_kg: [0.0; VERTICES],
+            tet_alive: [false; TETS],
+            live_tets: [0; VERTICES],
+            modes: [VertexMode::Free; VERTICES],
+            displacement_m: [[0.0; 3]; VERTICES],
+            velocity_m_s: [[0.0; 3]; VERTICES],
+            previous_displacement_m: [[0.0; 3]; VERTICES],
+            external_force_n: [[0.0; 3]; VERTICES],
+            force_n: [[0.0; 3]; VERTICES],
+            rk4_scratch: [[0.0; 3]; RK4],
+            vertex_terms: [[0.0; VERTEX_TERMS_LEN]; VERTICES],
+            edge_terms: [[0.0; EDGE_TERMS_LEN]; EDGES],
+            triangle_terms: [[0.0; TRIANGLE_TERMS_LEN]; TRIANGLES],
+            tet_terms: [[0.0; TET_TERMS_LEN]; TETS],
+        }
+    }
+
+    /// The buffers, each the first `lengths` entries of its array.
+    fn buffers(&mut self, n: &BufferLengths) -> StateBuffers<'_, f32> {
+        StateBuffers {
+            vertex_tensors: prefix(&mut self.vertex_tensors, n.vertex_tensors),
+            edge_tensors: prefix(&mut self.edge_tensors, n.edge_tensors),
+            masses_kg: prefix(&mut self.masses_kg, n.masses_kg),
+            tet_alive: prefix(&mut self.tet_alive, n.tet_alive),
+            live_tets: prefix(&mut self.live_tets, n.live_tets),
+            modes: prefix(&mut self.modes, n.modes),
+            displacement_m: prefix(&mut self.displacement_m, n.displacement_m),
+            velocity_m_s: prefix(&mut self.velocity_m_s, n.velocity_m_s),
+            previous_displacement_m: prefix(
+                &mut self.previous_displacement_m,
+                n.previous_displacement_m,
+            ),
+            external_force_n: prefix(&mut self.external_force_n, n.external_force_n),
+            force_n: prefix(&mut self.force_n, n.force_n),
+            rk4_scratch: prefix(&mut self.rk4_scratch, n.rk4_scratch),
+            stvk_terms: TermArraysMut {
+                vertex: prefix(&mut self.vertex_terms, n.vertex_terms),
+                edge: prefix(&mut self.edge_terms, n.edge_terms),
+                triangle: prefix(&mut self.triangle_terms, n.triangle_terms),
+                tet: prefix(&mut self.tet_terms, n.tet_terms),
+            },
+        }
+    }
+}
+
+/// The first `n` entries of `s` (all of them if `n` is larger).
+fn prefix<E>(s: &mut [E], n: usize) -> &mut [E] {
+    let n = n.min(s.len());
+    &mut s[..n]
+}
+
+/// `None` unless `on` is non-zero.
+fn option(on: u8, value: f32) -> Option<f32> {
+    (on != 0).then_some(value)
+}
+
+/// One tick of the tensor-mass model: load and model on `inputs`, then
+/// `inputs.rounds` rounds on the same model, each on freshly read inputs
+/// (see [`tensor_mass_round`]), so that every call also runs on a state any
+/// earlier round may have left: tets removed, the central-difference history
+/// valid, the model faulted.
+fn tensor_mass_step(inputs: &TensorInputs, state: &mut TensorState) {
+    let bytes = TENSOR_TABLE.get(..inputs.table_len).unwrap_or(TENSOR_TABLE);
+    let Ok(table) = TensorMassTable::<f32>::load(bytes) else {
+        refused();
+        return;
+    };
+    let law = match inputs.law % 3 {
+        0 => ElasticLaw::Linear,
+        1 => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
+        _ => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
+    };
+    let params = DynamicParams {
+        law,
+        incompressibility_n: option(inputs.incompressibility_on, inputs.incompressibility_n),
+        damping_per_s: inputs.damping_per_s,
+        gravity_m_s2: inputs.gravity_m_s2.into(),
+        limits: Limits {
+            max_displacement_m: inputs.max_displacement_m,
+            max_kinetic_energy_j: inputs.max_kinetic_energy_j,
+        },
+    };
+    let Ok(mut model) = TensorMassModel::new(table, state.buffers(&inputs.lengths), params) else {
+        refused();
+        return;
+    };
+    for _ in 0..inputs.rounds {
+        // SAFETY: as in `main`.
+        let inputs = unsafe { read_volatile(addr_of!(TENSOR_INPUTS)) };
+        tensor_mass_round(&mut model, &inputs);
+    }
+}
+
+/// One round: optional reset, per-vertex inputs, one step, tet removal, cut,
+/// tear, surface, outputs.
+fn tensor_mass_round(model: &mut TensorMassModel<'_, '_, f32>, inputs: &TensorInputs) {
+    if inputs.reset != 0 {
+        model.reset();
+    }
+    let results = [
+        model.set_external_force(inputs.force_vertex, inputs.force_n.into()),
+        model.set_velocity(inputs.velocity_vertex, inputs.velocity_m_s.into()),
+        model.impose(inputs.impose_vertex, inputs.impose_m.into()),
+        model.release(inputs.release_vertex),
+    ];
+    for result in results {
+        if result.is_err() {
+            refused();
+        }
+    }
+    if inputs.clear_forces != 0 {
+        model.clear_external_forces();
+    }
+
+    let integrator = match inputs.integrator % 4 {
+        0 => Integrator::ExplicitEuler,
+        1 => Integrator::SymplecticEuler,
+        2 => Integrator::Rk4,
+        _ => Integrator::CentralDifference,
+    };
+    let out = addr_of_mut!(TENSOR_OUTPUTS);
+    match model.step(integrator, inputs.dt_s) {
+        // SAFETY (all volatile writes in this function): single-threaded,
+        // `out` points to a live static, every field is plain old data.
+        Ok(report) => unsafe {
+            write_volatile(
+                addr_of_mut!((*out).kinetic_energy_j),
+                report.kinetic_energy_j,
+            );
+            write_volatile(
+                addr_of_mut!((*out).force_evaluations),
+                report.force_evaluations,
+            );
+        },
+        Err(_) => refused(),
+    }
+    let fault = match model.fault() {
+        None => [0, 0],
+        Some(Fault::NonFinite { vertex }) => [1, vertex],
+        Some(Fault::DisplacementBound { vertex }) => [2, vertex],
+        Some(Fault::KineticEnergyBound) => [3, 0],
+    };
+    // SAFETY: see above.
+    unsafe { write_volatile(addr_of_mut!((*out).fault), fault) };
+    match model.displacements_m() {
+        // SAFETY: see above.
+        Ok(u) => unsafe { publish_vectors(u, addr_of_mut!((*out).displacements_m)) },
+        Err(_) => refused(),
+    }
+    match model.velocities_m_s() {
+        // SAFETY: see above.
+        Ok(v) => unsafe { publish_vectors(v, addr_of_mut!((*out).velocities_m_s)) },
+        Err(_) => refused(),
+    }
+
+    let removed = model.remove_tet(inputs.remove_tet).unwrap_or_else(|_| {
+        refused();
+        0
+    });
+    let cut = model.cut_with_tool(
+        inputs.tool_a_m.into(),
+        inputs.tool_b_m.into(),
+        inputs.tool_radius_m,
+        inputs.cut_capacity,
+    );
+    let [volume, mean, max] = inputs.tear_thresholds;
+    let [volume_on, mean_on, max_on] = inputs.tear_on;
+    let thresholds = TearThresholds {
+        volume_change: option(volume_on, volume),
+        mean_elongation: option(mean_on, mean),
+        max_elongation: option(max_on, max),
+    };
+    let tear = model.tear(&thresholds, inputs.tear_capacity);
+    // SAFETY: see above.
+    unsafe {
+        write_volatile(
+            addr_of_mut!((*out).removed),
+            [removed, cut.removed, tear.removed],
+        );
+        write_volatile(addr_of_mut!((*out).pending), [cut.pending, tear.pending]);
+    }
+
+    let mut count = 0u32;
+    // SAFETY: see above.
+    unsafe {
+        let triangles = &mut *addr_of_mut!((*out).surface_triangles);
+        for (triangle, o) in model.surface_triangles().zip(triangles.iter_mut()) {
+            write_volatile(o, triangle);
+            count += 1;
+        }
+        write_volatile(addr_of_mut!((*out).surface_count), count);
+    }
+
+    let mut forces = [[0.0f32; 3]; VERTICES];
+    let forces_len = inputs.forces_len.min(VERTICES);
+    model.elastic_forces_n(&mut forces[..forces_len]);
+    // SAFETY: see above.
+    unsafe { publish_vectors(&forces, addr_of_mut!((*out).elastic_forces_n)) };
+}
+
+/// Writes `values` to the output array at `out`, volatile, entry by entry
+/// (as many as both hold).
+///
+/// # Safety
+/// `out` points to a live output array no one else accesses meanwhile.
+unsafe fn publish_vectors(values: &[[f32; 3]], out: *mut [[f32; 3]; VERTICES]) {
+    // SAFETY: the caller's contract.
+    let out = unsafe { &mut *out };
+    for (u, o) in values.iter().zip(out.iter_mut()) {
+        // SAFETY: `o` is a valid, aligned element of `out`.
+        unsafe { write_volatile(o, *u) };
     }
 }
 

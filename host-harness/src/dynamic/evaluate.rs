@@ -1,0 +1,82 @@
+//! `palpate stvk forces`: the internal forces and elastic energy of one
+//! deformed configuration, through the kernel's force pass (f64).
+
+use anyhow::Context;
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, TensorMassModel};
+
+use super::OwnedState;
+use super::run::{f64_table, host_params};
+use crate::fem::material::Material;
+use crate::mesh::{MeshReport, TetMesh};
+use crate::tables::file::Precision;
+use crate::tables::tensor_mass::TensorMassOptions;
+
+/// Internal forces (N, one per vertex: the elastic force on each vertex,
+/// `−∂W/∂x`, plus the incompressibility penalty when `incompressibility_n` is
+/// given) and elastic energy `W` (J) of `mesh` deformed to `deformed_m`
+/// (positions, m, one per vertex), free body (no fixed vertices).
+pub fn forces_and_energy(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    material: Material,
+    law: ElasticLaw,
+    incompressibility_n: Option<f64>,
+    deformed_m: &[[f64; 3]],
+) -> anyhow::Result<(Vec<[f64; 3]>, f64)> {
+    anyhow::ensure!(
+        deformed_m.len() == mesh.positions.len(),
+        "{} deformed positions for {} mesh vertices",
+        deformed_m.len(),
+        mesh.positions.len()
+    );
+    let options = TensorMassOptions {
+        material,
+        // Mass plays no part in the forces; any positive density builds.
+        density_kg_m3: 1000.0,
+        fix: Vec::new(),
+        precision: Precision::F64,
+    };
+    let file = f64_table(mesh, report, &options)?;
+    let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
+    let mut state = OwnedState::for_table(&table);
+    let params = DynamicParams {
+        law,
+        incompressibility_n,
+        ..host_params(&mesh.positions, 0.0)
+    };
+    let model = TensorMassModel::new(table, state.buffers(), params)?;
+    let u: Vec<[f64; 3]> = deformed_m
+        .iter()
+        .zip(&mesh.positions)
+        .map(|(x, p)| [x[0] - p[0], x[1] - p[1], x[2] - p[2]])
+        .collect();
+    let mut forces = vec![[0.0; 3]; u.len()];
+    model.elastic_forces_of(&u, &mut forces);
+    let mut scratch = vec![[0.0; 3]; u.len()];
+    let energy = model.elastic_energy_of(&u, &mut scratch);
+    Ok((forces, energy))
+}
+
+/// Reads deformed positions: one line `x,y,z` (m) per mesh vertex, input
+/// order, no header. Errors name the file and the line.
+pub fn read_positions_csv(path: &std::path::Path) -> anyhow::Result<Vec<[f64; 3]>> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .with_context(|| path.display().to_string())?;
+    let mut positions = Vec::new();
+    for (index, record) in reader.deserialize::<[f64; 3]>().enumerate() {
+        let line = index + 1;
+        let p =
+            record.with_context(|| format!("{} line {line}: expected x,y,z", path.display()))?;
+        anyhow::ensure!(
+            p.iter().all(|c| c.is_finite()),
+            "{} line {line}: non-finite coordinate",
+            path.display()
+        );
+        positions.push(p);
+    }
+    Ok(positions)
+}

@@ -1,0 +1,5 @@
+//! Experiments that reproduce the papers' figures through the kernel.
+
+pub mod relax;
+pub mod scenes;
+pub mod volume_bend;
