@@ -239,6 +239,12 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         self.tet_terms
     }
 
+    /// Every tet's rest shape as stored: `a_0..a_3` (1/m, 12 values), then
+    /// the rest volume (m³).
+    pub fn tet_shapes(&self) -> &'a [[T; TET_SHAPE_LEN]] {
+        self.tet_shapes
+    }
+
     /// Rest shape-function gradients `a_0..a_3` (1/m) and rest volume (m³)
     /// of `tet`; `None` out of range.
     pub fn tet_shape(&self, tet: usize) -> Option<([Vector3<T>; 4], T)> {

@@ -32,7 +32,8 @@ impl<T: Real> InternalForces<'_, '_, T> {
         match self.law {
             ElasticLaw::Linear => self.stiffness.elastic_forces(u, f),
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
-                self.tets.stvk_forces(lambda, mu, u, f)
+                f.fill([T::zero(); 3]);
+                self.tets.add_stvk_forces(lambda, mu, u, f);
             }
             ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
                 self.stiffness.elastic_forces(u, f);
