@@ -10,9 +10,11 @@
 //! for `u`, `v`, `f`, masses `4·N`), measured in the same run.
 //!
 //! `tet_removal`: the cost of one cut, `remove_tet` over 100 consecutive
-//! tets (indices 2700–2799, a band of cells mid-height) of the 6000-tet cube (10 blocks and 4 mass shares
-//! each, plus the hanging check), reset untimed between runs; the figure is
-//! tets removed per microsecond.
+//! tets (indices 2700–2799, a band of cells mid-height) of the 6000-tet cube
+//! (10 blocks and 4 mass shares each, plus the hanging check), reset untimed
+//! between runs, without and with the St Venant-Kirchhoff split terms
+//! (about 250 more values per tet, recomputed from the rest shape); the
+//! figure is tets removed per microsecond.
 //!
 //! Run: `RUSTFLAGS="-C target-cpu=native" cargo bench -p palpate-benches --bench tensor_mass_step`.
 
@@ -100,24 +102,35 @@ fn tet_removal(c: &mut Criterion) {
     let file = table(10);
     let table = TensorMassTable::<f32>::load(file.bytes()).expect("table");
     let tets: Vec<u32> = (0..100).map(|i| 2700 + i).collect();
-    let mut state = OwnedState::for_table(&table);
-    let mut model = TensorMassModel::new(table, state.buffers(), params()).expect("model");
     let mut group = c.benchmark_group("tet_removal");
     group.throughput(criterion::Throughput::Elements(tets.len() as u64));
-    group.bench_function("100_tets_of_6000", |b| {
-        b.iter_custom(|iterations| {
-            let mut total = core::time::Duration::ZERO;
-            for _ in 0..iterations {
-                model.reset();
-                let start = std::time::Instant::now();
-                for &t in &tets {
-                    black_box(model.remove_tet(black_box(t)).ok());
+    for (name, state) in [
+        (
+            "100_tets_of_6000",
+            OwnedState::for_table(&table).without_split_terms(),
+        ),
+        (
+            "100_tets_of_6000_with_split_terms",
+            OwnedState::for_table(&table),
+        ),
+    ] {
+        let mut state = state;
+        let mut model = TensorMassModel::new(table, state.buffers(), params()).expect("model");
+        group.bench_function(name, |b| {
+            b.iter_custom(|iterations| {
+                let mut total = core::time::Duration::ZERO;
+                for _ in 0..iterations {
+                    model.reset();
+                    let start = std::time::Instant::now();
+                    for &t in &tets {
+                        black_box(model.remove_tet(black_box(t)).ok());
+                    }
+                    total += start.elapsed();
                 }
-                total += start.elapsed();
-            }
-            total
-        })
-    });
+                total
+            })
+        });
+    }
     group.finish();
 }
 

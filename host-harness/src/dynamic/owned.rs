@@ -47,6 +47,16 @@ impl<T: Real> OwnedState<T> {
         }
     }
 
+    /// The same without the St Venant-Kirchhoff split-term buffers: the
+    /// tensors form is then refused, and a cut skips the terms' subtraction.
+    pub fn without_split_terms(mut self) -> Self {
+        self.vertex_terms = Vec::new();
+        self.edge_terms = Vec::new();
+        self.triangle_terms = Vec::new();
+        self.tet_terms = Vec::new();
+        self
+    }
+
     /// The kernel's view of these buffers.
     pub fn buffers(&mut self) -> StateBuffers<'_, T> {
         let [u, v, previous, external, force] = &mut self.vectors;
