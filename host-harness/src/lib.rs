@@ -13,4 +13,5 @@ pub mod mesh;
 pub mod output;
 pub mod precomputed;
 pub mod replay;
+pub mod session;
 pub mod tables;

@@ -26,6 +26,7 @@
 )]
 
 pub mod element;
+pub mod haptic;
 pub mod precomputed;
 pub mod scalar;
 pub mod table;

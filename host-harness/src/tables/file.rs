@@ -1,6 +1,8 @@
 //! Writes the table file format defined in `palpate_kernel::table::format`.
 
 use bytemuck::Zeroable;
+
+use super::collision::collision_index;
 use palpate_kernel::table::format::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
     SectionEntry, SectionKind, TableKind,
@@ -45,8 +47,11 @@ pub struct TableContents<'a> {
 /// Serializes a pre-computed table (`TableKind::Precomputed`) with floats
 /// of `precision`.
 pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
+    let index = collision_index(c.positions, c.triangles);
     let header = RawHeader {
         table_kind: TableKind::Precomputed as u32,
+        grid_cell_count: (index.cell_start.len() - 1) as u32,
+        surface_vertex_count: index.grid_vertex.len() as u32,
         vertex_count: c.vertex_slot.len() as u32,
         tet_count: c.tet_count as u32,
         free_count: c.free_vertex.len() as u32,
@@ -64,6 +69,15 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         Section::ints(SectionKind::SurfaceTriangles, c.triangles),
         Section::floats(SectionKind::ComplianceSurface, c.surface, precision),
         Section::floats(SectionKind::ComplianceInterior, c.interior, precision),
+        Section::floats(SectionKind::SurfaceGrid, &[index.grid], precision),
+        Section::ints(SectionKind::GridDims, &[index.dims]),
+        Section::ints(SectionKind::GridCellStart, &index.cell_start),
+        Section::ints(SectionKind::GridVertex, &index.grid_vertex),
+        Section::ints(
+            SectionKind::VertexTriangleStart,
+            &index.vertex_triangle_start,
+        ),
+        Section::ints(SectionKind::VertexTriangle, &index.vertex_triangle),
     ];
     write_container(header, precision, &sections)
 }

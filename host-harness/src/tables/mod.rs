@@ -4,6 +4,7 @@
 
 pub mod build;
 pub mod cg;
+pub mod collision;
 pub mod compliance;
 pub mod file;
 pub mod load;

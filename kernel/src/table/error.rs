@@ -127,6 +127,21 @@ pub enum LoadError {
         /// Tet index.
         tet: u32,
     },
+    /// The surface-vertex grid is malformed (non-finite or non-positive
+    /// geometry, dimensions not matching the cell count, cell starts not
+    /// ascending, or a vertex filed more than one cell away from its
+    /// position).
+    BadSurfaceGrid {
+        /// Grid cell (or vertex, for a misfiled vertex) where it was found.
+        index: u32,
+    },
+    /// A vertex's list of surface triangles is malformed (starts not
+    /// ascending, a triangle out of range, not containing the vertex, or not
+    /// ascending).
+    BadVertexTriangles {
+        /// Vertex index.
+        vertex: u32,
+    },
     /// A lumped mass or vertex tensor is invalid (negative mass, asymmetric
     /// `K_ii`).
     BadVertexData {
@@ -207,6 +222,13 @@ impl fmt::Display for LoadError {
             LoadError::BadMeshTriangle { triangle } => write!(
                 f,
                 "mesh triangle {triangle}: vertex out of range, ids not strictly ascending, or not in ascending order (duplicate)"
+            ),
+            LoadError::BadSurfaceGrid { index } => {
+                write!(f, "surface grid malformed at cell or vertex {index}")
+            }
+            LoadError::BadVertexTriangles { vertex } => write!(
+                f,
+                "vertex {vertex}: surface-triangle list malformed (range, order, or a triangle without the vertex)"
             ),
             LoadError::BadTetTriangle { tet } => write!(
                 f,

@@ -92,11 +92,17 @@ pub struct RawHeader {
     /// otherwise). 64 bits so that the header has no padding; at most
     /// `u32::MAX` (triangle indices are `u32`), checked at load.
     pub mesh_triangle_count: u64,
+    /// Cells of the surface-vertex grid ([`SectionKind::GridCellStart`];
+    /// pre-computed tables, zero otherwise).
+    pub grid_cell_count: u32,
+    /// Distinct vertices of the boundary surface triangles
+    /// ([`SectionKind::GridVertex`]; pre-computed tables, zero otherwise).
+    pub surface_vertex_count: u32,
 }
 
 /// Size of [`RawHeader`] in bytes.
 pub const HEADER_LEN: usize = core::mem::size_of::<RawHeader>();
-const _: () = assert!(HEADER_LEN == 104);
+const _: () = assert!(HEADER_LEN == 112);
 
 /// What a table is for; each kind has its own required sections.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -120,6 +126,12 @@ impl TableKind {
                 SectionKind::SurfaceTriangles,
                 SectionKind::ComplianceSurface,
                 SectionKind::ComplianceInterior,
+                SectionKind::SurfaceGrid,
+                SectionKind::GridDims,
+                SectionKind::GridCellStart,
+                SectionKind::GridVertex,
+                SectionKind::VertexTriangleStart,
+                SectionKind::VertexTriangle,
             ],
             TableKind::TensorMass => &[
                 SectionKind::VertexSlot,
@@ -180,6 +192,22 @@ pub enum SectionKind {
     ComplianceSurface = 5,
     /// `[scalar; 9]` × (F−S)·S: compliance of interior rows, m/N.
     ComplianceInterior = 6,
+    /// `[scalar; 4]` × 1: the surface-vertex grid (Cotin 1999 collision
+    /// buckets): origin `x, y, z` and cell edge, m.
+    SurfaceGrid = 7,
+    /// `[u32; 3]` × 1: grid cells per axis; their product is the header's
+    /// `grid_cell_count`. Cell `(i, j, k)` has index `i + nx (j + ny k)`.
+    GridDims = 8,
+    /// `u32` × (grid_cell_count + 1): CSR starts of each cell's vertices.
+    GridCellStart = 9,
+    /// `u32` × surface_vertex_count: every surface vertex once, by cell.
+    GridVertex = 10,
+    /// `u32` × (N + 1): CSR starts of the surface triangles around each
+    /// vertex.
+    VertexTriangleStart = 11,
+    /// `u32` × 3·triangle_count: the surface triangles around each vertex,
+    /// ascending within a vertex.
+    VertexTriangle = 12,
     /// `scalar` × N: lumped vertex masses `m_i = ρ Σ_{tets ∋ i} V/4`, kg.
     LumpedMass = 16,
     /// `[scalar; 9]` × N: vertex tensors `K_ii`, row-major, N/m.
@@ -259,13 +287,19 @@ pub const TET_TERMS_LEN: usize = 3;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 21] = [
+    pub const ALL: [SectionKind; 27] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
         SectionKind::SurfaceTriangles,
         SectionKind::ComplianceSurface,
         SectionKind::ComplianceInterior,
+        SectionKind::SurfaceGrid,
+        SectionKind::GridDims,
+        SectionKind::GridCellStart,
+        SectionKind::GridVertex,
+        SectionKind::VertexTriangleStart,
+        SectionKind::VertexTriangle,
         SectionKind::LumpedMass,
         SectionKind::VertexTensor,
         SectionKind::EdgeRowStart,
@@ -291,7 +325,12 @@ impl SectionKind {
             | SectionKind::EdgeRowStart
             | SectionKind::EdgeColumn => 4,
             SectionKind::RestPositions => 3 * scalar_bytes,
-            SectionKind::SurfaceTriangles | SectionKind::MeshTriangle => 12,
+            SectionKind::SurfaceTriangles | SectionKind::MeshTriangle | SectionKind::GridDims => 12,
+            SectionKind::SurfaceGrid => 4 * scalar_bytes,
+            SectionKind::GridCellStart
+            | SectionKind::GridVertex
+            | SectionKind::VertexTriangleStart
+            | SectionKind::VertexTriangle => 4,
             SectionKind::ComplianceSurface
             | SectionKind::ComplianceInterior
             | SectionKind::VertexTensor
@@ -332,6 +371,11 @@ impl SectionKind {
             | SectionKind::TetTerms => Some(tets),
             SectionKind::MeshTriangle | SectionKind::TriangleTerms => Some(h.mesh_triangle_count),
             SectionKind::FreeVertex => Some(f),
+            SectionKind::SurfaceGrid | SectionKind::GridDims => Some(1),
+            SectionKind::GridCellStart => u64::from(h.grid_cell_count).checked_add(1),
+            SectionKind::GridVertex => Some(u64::from(h.surface_vertex_count)),
+            SectionKind::VertexTriangleStart => n.checked_add(1),
+            SectionKind::VertexTriangle => u64::from(h.triangle_count).checked_mul(3),
             SectionKind::SurfaceTriangles => Some(u64::from(h.triangle_count)),
             SectionKind::ComplianceSurface => s.checked_mul(s.checked_add(1)?).map(|x| x / 2),
             SectionKind::ComplianceInterior => f.checked_sub(s)?.checked_mul(s),
@@ -347,6 +391,12 @@ impl SectionKind {
             SectionKind::SurfaceTriangles => "surface-triangles",
             SectionKind::ComplianceSurface => "compliance-surface",
             SectionKind::ComplianceInterior => "compliance-interior",
+            SectionKind::SurfaceGrid => "surface-grid",
+            SectionKind::GridDims => "grid-dims",
+            SectionKind::GridCellStart => "grid-cell-start",
+            SectionKind::GridVertex => "grid-vertex",
+            SectionKind::VertexTriangleStart => "vertex-triangle-start",
+            SectionKind::VertexTriangle => "vertex-triangle",
             SectionKind::LumpedMass => "lumped-mass",
             SectionKind::VertexTensor => "vertex-tensor",
             SectionKind::EdgeRowStart => "edge-row-start",

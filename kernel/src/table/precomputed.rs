@@ -6,6 +6,7 @@ use super::LoadError;
 use super::container::{Container, check_finite};
 use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TableKind};
 use crate::Real;
+use crate::haptic::surface::{SurfaceIndex, SurfaceSections};
 
 /// A pre-computed table that passed every load-time check; the step path
 /// takes only this type.
@@ -26,6 +27,7 @@ pub struct PrecomputedTable<'a, T: Real> {
     triangles: &'a [[u32; 3]],
     surface: &'a [[T; 9]],
     interior: &'a [[T; 9]],
+    surface_index: SurfaceIndex<'a, T>,
 }
 
 impl<'a, T: Real> PrecomputedTable<'a, T> {
@@ -38,18 +40,30 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// Cost: linear in the table size. Not for the step path.
     pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
         let c = Container::parse::<T>(bytes, TableKind::Precomputed)?;
+        let rest_positions: &'a [[T; 3]] = c.section(SectionKind::RestPositions)?;
+        let triangles: &'a [[u32; 3]] = c.section(SectionKind::SurfaceTriangles)?;
+        let vertex_slot: &'a [u32] = c.section(SectionKind::VertexSlot)?;
+        check_triangles(triangles, vertex_slot.len())?;
+        check_finite(SectionKind::RestPositions, rest_positions)?;
+        let sections = SurfaceSections {
+            grid: c.section(SectionKind::SurfaceGrid)?,
+            dims: c.section(SectionKind::GridDims)?,
+            cell_start: c.section(SectionKind::GridCellStart)?,
+            grid_vertex: c.section(SectionKind::GridVertex)?,
+            vertex_triangle_start: c.section(SectionKind::VertexTriangleStart)?,
+            vertex_triangle: c.section(SectionKind::VertexTriangle)?,
+        };
         let table = Self {
             header: c.header,
-            vertex_slot: c.section(SectionKind::VertexSlot)?,
+            vertex_slot,
             free_vertex: c.section(SectionKind::FreeVertex)?,
-            rest_positions: c.section(SectionKind::RestPositions)?,
-            triangles: c.section(SectionKind::SurfaceTriangles)?,
+            rest_positions,
+            triangles,
             surface: c.section(SectionKind::ComplianceSurface)?,
             interior: c.section(SectionKind::ComplianceInterior)?,
+            surface_index: SurfaceIndex::new(&sections, rest_positions, triangles)?,
         };
         table.check_vertex_maps()?;
-        table.check_triangles()?;
-        check_finite(SectionKind::RestPositions, table.rest_positions)?;
         check_finite(SectionKind::ComplianceSurface, table.surface)?;
         check_finite(SectionKind::ComplianceInterior, table.interior)?;
         table.check_diagonal_blocks()?;
@@ -61,6 +75,12 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             T::BYTES
         );
         Ok(table)
+    }
+
+    /// The collision index: surface vertices in a grid, triangles around
+    /// each vertex (validated at load).
+    pub fn surface_index(&self) -> &SurfaceIndex<'a, T> {
+        &self.surface_index
     }
 
     /// The header as stored.
@@ -173,16 +193,6 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         Ok(())
     }
 
-    fn check_triangles(&self) -> Result<(), LoadError> {
-        let n = self.vertex_count();
-        for (t, tri) in self.triangles.iter().enumerate() {
-            if tri.iter().any(|&v| v as usize >= n) {
-                return Err(LoadError::BadTriangle { triangle: t as u32 });
-            }
-        }
-        Ok(())
-    }
-
     /// Every `C_kk` must be symmetric (to 1e-4 relative, well above f32
     /// rounding) and positive definite (a 3×3 Cholesky with positive pivots):
     /// a compliance of an elastic body with fixed vertices is SPD.
@@ -203,4 +213,14 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         }
         Ok(())
     }
+}
+
+/// Every surface triangle's vertices are `< n`.
+fn check_triangles(triangles: &[[u32; 3]], n: usize) -> Result<(), LoadError> {
+    for (t, tri) in triangles.iter().enumerate() {
+        if tri.iter().any(|&v| v as usize >= n) {
+            return Err(LoadError::BadTriangle { triangle: t as u32 });
+        }
+    }
+    Ok(())
 }

@@ -1,0 +1,807 @@
+//! Scene files: what a haptic session simulates, in TOML simple enough to write by hand.
+//!
+//! ```toml
+//! mesh = "block.msh"           # relative to the scene file's folder; or instead:
+//! # [generated]
+//! # box_m = [0.12, 0.12, 0.06] # a box [0, x] × [0, y] × [0, z], m (`box` is accepted too)
+//! # cells = [12, 12, 6]        # cells per axis, 6 tets each (mesh::generate::box_mesh)
+//! fix = ["z<0.001"]            # fixed-vertex predicates, the CLI's --fix syntax, mesh units
+//!
+//! [material]
+//! young_pa = 3000.0            # required
+//! poisson = 0.45               # required, 0 <= nu < 0.5
+//! density_kg_m3 = 1000.0       # default 1000 (used by the dynamic model)
+//!
+//! [model]                      # default: kind = "precomputed"
+//! kind = "dynamic"             # "precomputed" or "dynamic"; the keys below are dynamic-only
+//! law = "stvk"                 # "linear" (default), "stvk" or "stvk-incompressible"
+//! form = "per-tet"             # St Venant-Kirchhoff form: "per-tet" (default) or "tensors"
+//! integrator = "symplectic"    # "euler", "symplectic" (default), "rk4" or "central"
+//! dt_s = 0.0005                # default: the physics period (physics_every / haptic_hz)
+//! damping_per_s = 2.0          # required for kind = "dynamic"
+//! incompressibility_n = 0.5    # required for, and only for, law = "stvk-incompressible"
+//!
+//! [tool]
+//! points = 1                   # default 1, in 1..=4 (MAX_TOOL_POINTS)
+//! radius_m = 0.002             # default 0.002
+//!
+//! [rates]
+//! haptic_hz = 1000.0           # default 1000
+//! physics_every = 1            # default 1: a physics update every this many ticks
+//!
+//! [safety]
+//! max_force_n = 4.0            # default 4
+//! max_slew_n_per_s = 2000.0    # default 2000
+//! ```
+//!
+//! Unknown keys are refused, so a typo is an error, not a silently ignored setting. TOML integers
+//! are accepted where a real is expected (`young_pa = 3000`). Every error names the file and, for
+//! a syntax or type error, the line; for a value out of range, the key.
+
+use std::path::{Path, PathBuf};
+
+use palpate_kernel::MAX_CONTACTS;
+use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
+use serde::Deserialize;
+
+use crate::fem::material::{Material, MaterialError};
+use crate::fix::FixPredicate;
+use crate::mesh::generate::box_mesh;
+use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh};
+
+/// Largest number of tool points of a scene: the kernel's contact capacity
+/// ([`palpate_kernel::MAX_CONTACTS`]), one contact per tool point.
+pub const MAX_TOOL_POINTS: usize = MAX_CONTACTS;
+
+/// Largest vertex count of a `[generated]` box, so a typo cannot ask for a mesh that does not
+/// fit in memory (the table build is quadratic in the surface size long before this).
+pub const MAX_GENERATED_VERTICES: usize = 10_000_000;
+
+/// Largest number of dynamic-model steps per physics update (`physics period / dt_s`).
+pub const MAX_SUBSTEPS: u32 = 10_000;
+
+/// Why a scene could not be read. Every message starts with the file (or the source name given
+/// to [`Scene::from_toml_str_named`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read from disk.
+    #[error("{file}: cannot read scene: {err}")]
+    Io {
+        /// The scene file as given.
+        file: String,
+        /// Underlying I/O error.
+        #[source]
+        err: std::io::Error,
+    },
+    /// Not valid TOML, an unknown key, a missing required key or a value of the wrong type.
+    #[error("{file}: {}{msg}", line_prefix(.line))]
+    Syntax {
+        /// The scene file.
+        file: String,
+        /// 1-based line of the offending text, where the parser located it.
+        line: Option<usize>,
+        /// The parser's message (one line).
+        msg: String,
+    },
+    /// A well-formed value that is out of range or inconsistent with another.
+    #[error("{file}: {key}: {msg}")]
+    Invalid {
+        /// The scene file.
+        file: String,
+        /// The key, as `[table] key = value` (or `key = value` at the top level).
+        key: String,
+        /// What is wrong and what is expected.
+        msg: String,
+    },
+}
+
+/// `line 3: ` or empty.
+fn line_prefix(line: &Option<usize>) -> String {
+    match line {
+        Some(line) => format!("line {line}: "),
+        None => String::new(),
+    }
+}
+
+/// Where the tissue mesh comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshSource {
+    /// A mesh file (any format [`read_mesh`] reads), already resolved against the scene file's
+    /// folder.
+    File(PathBuf),
+    /// A generated box ([`box_mesh`]): `[0, size_m[0]] × [0, size_m[1]] × [0, size_m[2]]` in m,
+    /// `cells[i] ≥ 1` cells per axis.
+    GeneratedBox {
+        /// Box size, m, each finite and > 0.
+        size_m: [f64; 3],
+        /// Cells per axis, each ≥ 1 (6 tets per cell).
+        cells: [usize; 3],
+    },
+}
+
+/// The tissue material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialSpec {
+    /// Young's modulus `E`, Pa, finite and > 0.
+    pub young_pa: f64,
+    /// Poisson ratio `ν`, `0 ≤ ν < 0.5`.
+    pub poisson: f64,
+    /// Mass density, kg/m³, finite and > 0 (the dynamic model's lumped masses).
+    pub density_kg_m3: f64,
+}
+
+/// Which soft-tissue model the session runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ModelSpec {
+    /// The pre-computed quasi-static linear model (RR-3510 §4): a compliance table.
+    Precomputed,
+    /// The dynamic tensor-mass model (RR-3510 §5, Picinbono 2001).
+    Dynamic(DynamicSpec),
+}
+
+/// Parameters of the dynamic model (`kind = "dynamic"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicSpec {
+    /// The elastic law: `law = "linear"` → [`ElasticLaw::Linear`], `"stvk"` and
+    /// `"stvk-incompressible"` → [`ElasticLaw::StVenantKirchhoff`] in the given `form`.
+    pub law: ElasticLaw,
+    /// Incompressibility penalty `γ`, N (Picinbono 2001 §3.2): `Some` exactly for
+    /// `law = "stvk-incompressible"`, finite and ≥ 0.
+    pub incompressibility_n: Option<f64>,
+    /// The explicit integrator.
+    pub integrator: Integrator,
+    /// Time step, s, finite and > 0; the physics period is a whole number of steps
+    /// ([`Scene::dynamic_substeps`]).
+    pub dt_s: f64,
+    /// Mass-proportional damping `c`, 1/s, finite and ≥ 0 (damping force `−c·m_i·v_i`).
+    pub damping_per_s: f64,
+}
+
+/// The tool: a few points with a radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolSpec {
+    /// Number of tool points (probe tip = 1, grasper jaws = 2), in `1..=MAX_TOOL_POINTS`.
+    pub points: usize,
+    /// Radius of every tool point, m, finite and > 0.
+    pub radius_m: f64,
+}
+
+/// Loop rates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rates {
+    /// Haptic (tick) rate, Hz, finite and > 0.
+    pub haptic_hz: f64,
+    /// A physics update every this many ticks, ≥ 1 (force extrapolated in between).
+    pub physics_every: u32,
+}
+
+/// Limits of the safety supervisor on the device force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SafetyLimits {
+    /// Magnitude clamp of the device force, N, finite and > 0.
+    pub max_force_n: f64,
+    /// Largest change of the device force per second (slew limit), N/s, finite and > 0.
+    pub max_slew_n_per_s: f64,
+}
+
+/// A validated scene.
+///
+/// Invariants (checked by [`Scene::validate`], which every constructor runs): the ranges stated
+/// on each field's type; a pre-computed scene has at least one `fix` predicate (a free body has
+/// no compliance); a dynamic scene's physics period is a whole number (1..=[`MAX_SUBSTEPS`]) of
+/// `dt_s`. Fields are public for reading and for tests; after changing one, call
+/// [`Scene::validate`] again.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Names the scene in messages: the file as given, or `built-in scene`.
+    pub source: String,
+    /// The tissue mesh.
+    pub mesh: MeshSource,
+    /// Fixed-vertex predicates (mesh units); a vertex matching any is fixed.
+    pub fix: Vec<FixPredicate>,
+    /// The material.
+    pub material: MaterialSpec,
+    /// The model.
+    pub model: ModelSpec,
+    /// The tool.
+    pub tool: ToolSpec,
+    /// Loop rates.
+    pub rates: Rates,
+    /// Safety limits.
+    pub safety: SafetyLimits,
+}
+
+// ---- The file as written (serde), before validation. ----
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    mesh: Option<PathBuf>,
+    generated: Option<GeneratedFile>,
+    #[serde(default)]
+    fix: Vec<String>,
+    material: MaterialFile,
+    #[serde(default)]
+    model: ModelFile,
+    #[serde(default)]
+    tool: ToolFile,
+    #[serde(default)]
+    rates: RatesFile,
+    #[serde(default)]
+    safety: SafetyFile,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GeneratedFile {
+    #[serde(alias = "box")]
+    box_m: [f64; 3],
+    cells: [usize; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialFile {
+    young_pa: f64,
+    poisson: f64,
+    #[serde(default = "default_density")]
+    density_kg_m3: f64,
+}
+
+#[derive(Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum KindName {
+    #[default]
+    Precomputed,
+    Dynamic,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum LawName {
+    Linear,
+    Stvk,
+    StvkIncompressible,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum FormName {
+    PerTet,
+    Tensors,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum IntegratorName {
+    Euler,
+    Symplectic,
+    Rk4,
+    Central,
+}
+
+#[derive(Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelFile {
+    #[serde(default)]
+    kind: KindName,
+    law: Option<LawName>,
+    form: Option<FormName>,
+    integrator: Option<IntegratorName>,
+    dt_s: Option<f64>,
+    damping_per_s: Option<f64>,
+    incompressibility_n: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolFile {
+    #[serde(default = "default_points")]
+    points: usize,
+    #[serde(default = "default_radius")]
+    radius_m: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RatesFile {
+    #[serde(default = "default_haptic_hz")]
+    haptic_hz: f64,
+    #[serde(default = "default_physics_every")]
+    physics_every: u32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SafetyFile {
+    #[serde(default = "default_max_force")]
+    max_force_n: f64,
+    #[serde(default = "default_max_slew")]
+    max_slew_n_per_s: f64,
+}
+
+/// Default density, kg/m³ (water; soft tissue is 1000–1100).
+pub const DEFAULT_DENSITY_KG_M3: f64 = 1000.0;
+/// Default tool point count.
+pub const DEFAULT_TOOL_POINTS: usize = 1;
+/// Default tool point radius, m (a 4 mm probe tip).
+pub const DEFAULT_TOOL_RADIUS_M: f64 = 0.002;
+/// Default haptic rate, Hz.
+pub const DEFAULT_HAPTIC_HZ: f64 = 1000.0;
+/// Default physics update interval, ticks.
+pub const DEFAULT_PHYSICS_EVERY: u32 = 1;
+/// Default device force clamp, N (desktop haptic devices peak at 3–8 N).
+pub const DEFAULT_MAX_FORCE_N: f64 = 4.0;
+/// Default slew limit, N/s (full force in 2 ms).
+pub const DEFAULT_MAX_SLEW_N_PER_S: f64 = 2000.0;
+
+fn default_density() -> f64 {
+    DEFAULT_DENSITY_KG_M3
+}
+fn default_points() -> usize {
+    DEFAULT_TOOL_POINTS
+}
+fn default_radius() -> f64 {
+    DEFAULT_TOOL_RADIUS_M
+}
+fn default_haptic_hz() -> f64 {
+    DEFAULT_HAPTIC_HZ
+}
+fn default_physics_every() -> u32 {
+    DEFAULT_PHYSICS_EVERY
+}
+fn default_max_force() -> f64 {
+    DEFAULT_MAX_FORCE_N
+}
+fn default_max_slew() -> f64 {
+    DEFAULT_MAX_SLEW_N_PER_S
+}
+
+impl Default for ToolFile {
+    fn default() -> Self {
+        Self {
+            points: DEFAULT_TOOL_POINTS,
+            radius_m: DEFAULT_TOOL_RADIUS_M,
+        }
+    }
+}
+
+impl Default for RatesFile {
+    fn default() -> Self {
+        Self {
+            haptic_hz: DEFAULT_HAPTIC_HZ,
+            physics_every: DEFAULT_PHYSICS_EVERY,
+        }
+    }
+}
+
+impl Default for SafetyFile {
+    fn default() -> Self {
+        Self {
+            max_force_n: DEFAULT_MAX_FORCE_N,
+            max_slew_n_per_s: DEFAULT_MAX_SLEW_N_PER_S,
+        }
+    }
+}
+
+impl Scene {
+    /// The scene of `palpate demo`: a 12 × 12 × 6 cm generated block (12 × 12 × 6 cells: 1183
+    /// vertices, 5184 tets), E = 3000 Pa, ν = 0.45, density 1000 kg/m³, base fixed (`z<0.0001`),
+    /// the pre-computed model, 1 tool point of radius 2 mm, 1 kHz haptic rate with a physics
+    /// update every tick, force clamp 4 N, slew limit 2000 N/s.
+    pub fn built_in() -> Scene {
+        Scene {
+            source: "built-in scene".into(),
+            mesh: MeshSource::GeneratedBox {
+                size_m: [0.12, 0.12, 0.06],
+                cells: [12, 12, 6],
+            },
+            // Parses (a fixed literal); the base is the face z = 0 of the generated box.
+            fix: "z<0.0001".parse::<FixPredicate>().into_iter().collect(),
+            material: MaterialSpec {
+                young_pa: 3000.0,
+                poisson: 0.45,
+                density_kg_m3: DEFAULT_DENSITY_KG_M3,
+            },
+            model: ModelSpec::Precomputed,
+            tool: ToolSpec {
+                points: DEFAULT_TOOL_POINTS,
+                radius_m: DEFAULT_TOOL_RADIUS_M,
+            },
+            rates: Rates {
+                haptic_hz: DEFAULT_HAPTIC_HZ,
+                physics_every: DEFAULT_PHYSICS_EVERY,
+            },
+            safety: SafetyLimits {
+                max_force_n: DEFAULT_MAX_FORCE_N,
+                max_slew_n_per_s: DEFAULT_MAX_SLEW_N_PER_S,
+            },
+        }
+    }
+
+    /// Read and validate a scene file. A relative `mesh` path is resolved against the file's
+    /// folder. Messages name the file as `path` displays.
+    pub fn read(path: &Path) -> Result<Scene, SceneError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|err| SceneError::Io {
+            file: file.clone(),
+            err,
+        })?;
+        let base_dir = path.parent().unwrap_or(Path::new(""));
+        Self::from_toml_str_named(&text, &file, base_dir)
+    }
+
+    /// Parse and validate a scene from TOML text; a relative `mesh` path is resolved against
+    /// `base_dir`. Messages name the source `inline scene`.
+    pub fn from_toml_str(text: &str, base_dir: &Path) -> Result<Scene, SceneError> {
+        Self::from_toml_str_named(text, "inline scene", base_dir)
+    }
+
+    /// [`Scene::from_toml_str`], naming the source `source` in messages and in [`Scene::source`].
+    pub fn from_toml_str_named(
+        text: &str,
+        source: &str,
+        base_dir: &Path,
+    ) -> Result<Scene, SceneError> {
+        let raw: SceneFile = toml::from_str(text).map_err(|err| SceneError::Syntax {
+            file: source.to_owned(),
+            // No line when the error spans the whole document (a missing top-level key).
+            line: err
+                .span()
+                .filter(|span| !(span.start == 0 && span.end >= text.len()))
+                .and_then(|span| text.get(..span.start))
+                .map(|before| before.matches('\n').count() + 1),
+            msg: err.message().trim().replace('\n', "; "),
+        })?;
+        let invalid = |key: &str, msg: String| SceneError::Invalid {
+            file: source.to_owned(),
+            key: key.to_owned(),
+            msg,
+        };
+        let mesh = match (raw.mesh, raw.generated) {
+            (Some(path), None) => MeshSource::File(base_dir.join(path)),
+            (None, Some(g)) => MeshSource::GeneratedBox {
+                size_m: g.box_m,
+                cells: g.cells,
+            },
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "mesh",
+                    "give either `mesh = \"<file>\"` or a [generated] table, not both".into(),
+                ));
+            }
+            (None, None) => {
+                return Err(invalid(
+                    "mesh",
+                    "missing: give `mesh = \"<file>\"` or a [generated] table with box_m and cells"
+                        .into(),
+                ));
+            }
+        };
+        let fix = raw
+            .fix
+            .iter()
+            .enumerate()
+            .map(|(i, text)| {
+                text.parse::<FixPredicate>().map_err(|_| {
+                    invalid(
+                        &format!("fix[{i}] = {text:?}"),
+                        "expected x|y|z, then <, <=, > or >=, then a finite number, e.g. \"z<0.001\""
+                            .into(),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let model = model_spec(&raw.model, raw.rates.haptic_hz, raw.rates.physics_every)
+            .map_err(|(key, msg)| invalid(&key, msg))?;
+        let scene = Scene {
+            source: source.to_owned(),
+            mesh,
+            fix,
+            material: MaterialSpec {
+                young_pa: raw.material.young_pa,
+                poisson: raw.material.poisson,
+                density_kg_m3: raw.material.density_kg_m3,
+            },
+            model,
+            tool: ToolSpec {
+                points: raw.tool.points,
+                radius_m: raw.tool.radius_m,
+            },
+            rates: Rates {
+                haptic_hz: raw.rates.haptic_hz,
+                physics_every: raw.rates.physics_every,
+            },
+            safety: SafetyLimits {
+                max_force_n: raw.safety.max_force_n,
+                max_slew_n_per_s: raw.safety.max_slew_n_per_s,
+            },
+        };
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Check every invariant of [`Scene`]; the error names [`Scene::source`] and the key.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let invalid = |key: String, msg: &str| {
+            Err(SceneError::Invalid {
+                file: self.source.clone(),
+                key,
+                msg: msg.to_owned(),
+            })
+        };
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if let MeshSource::GeneratedBox { size_m, cells } = self.mesh {
+            if !size_m.iter().all(|&s| positive(s)) {
+                return invalid(
+                    format!("[generated] box_m = {size_m:?}"),
+                    "every size must be finite and > 0 m",
+                );
+            }
+            let vertices = cells.iter().try_fold(1usize, |n, &c| {
+                if c == 0 {
+                    None
+                } else {
+                    n.checked_mul(c.checked_add(1)?)
+                }
+            });
+            match vertices {
+                None if cells.contains(&0) => {
+                    return invalid(
+                        format!("[generated] cells = {cells:?}"),
+                        "every cell count must be >= 1",
+                    );
+                }
+                Some(n) if n <= MAX_GENERATED_VERTICES => {}
+                _ => {
+                    return invalid(
+                        format!("[generated] cells = {cells:?}"),
+                        &format!("too many vertices: at most {MAX_GENERATED_VERTICES}"),
+                    );
+                }
+            }
+        }
+        if self.fix.is_empty() && self.model == ModelSpec::Precomputed {
+            return invalid(
+                "fix = []".into(),
+                "the pre-computed model needs at least one fixed-vertex predicate (a free body has no compliance)",
+            );
+        }
+        let m = &self.material;
+        if let Err(err) = Material::new(m.young_pa, m.poisson) {
+            return match err {
+                MaterialError::YoungModulus(e) => invalid(
+                    format!("[material] young_pa = {e}"),
+                    "must be finite and > 0 Pa",
+                ),
+                MaterialError::PoissonRatio(nu) => invalid(
+                    format!("[material] poisson = {nu}"),
+                    "must satisfy 0 <= nu < 0.5",
+                ),
+            };
+        }
+        if !positive(m.density_kg_m3) {
+            return invalid(
+                format!("[material] density_kg_m3 = {}", m.density_kg_m3),
+                "must be finite and > 0 kg/m3",
+            );
+        }
+        if !(1..=MAX_TOOL_POINTS).contains(&self.tool.points) {
+            return invalid(
+                format!("[tool] points = {}", self.tool.points),
+                &format!("must be in 1..={MAX_TOOL_POINTS} (the kernel's contact capacity)"),
+            );
+        }
+        if !positive(self.tool.radius_m) {
+            return invalid(
+                format!("[tool] radius_m = {}", self.tool.radius_m),
+                "must be finite and > 0 m",
+            );
+        }
+        if !positive(self.rates.haptic_hz) {
+            return invalid(
+                format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
+                "must be finite and > 0 Hz",
+            );
+        }
+        if self.rates.physics_every == 0 {
+            return invalid(
+                "[rates] physics_every = 0".into(),
+                "must be >= 1 (a physics update every this many ticks)",
+            );
+        }
+        if !positive(self.safety.max_force_n) {
+            return invalid(
+                format!("[safety] max_force_n = {}", self.safety.max_force_n),
+                "must be finite and > 0 N",
+            );
+        }
+        if !positive(self.safety.max_slew_n_per_s) {
+            return invalid(
+                format!(
+                    "[safety] max_slew_n_per_s = {}",
+                    self.safety.max_slew_n_per_s
+                ),
+                "must be finite and > 0 N/s",
+            );
+        }
+        if let ModelSpec::Dynamic(d) = &self.model {
+            check_dynamic(d, self.physics_period_s()).map_err(|(key, msg)| {
+                SceneError::Invalid {
+                    file: self.source.clone(),
+                    key,
+                    msg,
+                }
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The validated elastic material (E, ν) for the table builders.
+    pub fn elastic_material(&self) -> Result<Material, MaterialError> {
+        Material::new(self.material.young_pa, self.material.poisson)
+    }
+
+    /// The tick period, s: `1 / haptic_hz`.
+    pub fn tick_s(&self) -> f64 {
+        1.0 / self.rates.haptic_hz
+    }
+
+    /// The physics period, s: `physics_every / haptic_hz`.
+    pub fn physics_period_s(&self) -> f64 {
+        f64::from(self.rates.physics_every) / self.rates.haptic_hz
+    }
+
+    /// For a dynamic scene, how many steps of `dt_s` make one physics period (≥ 1); `None` for
+    /// the pre-computed model.
+    pub fn dynamic_substeps(&self) -> Option<u32> {
+        match &self.model {
+            ModelSpec::Precomputed => None,
+            ModelSpec::Dynamic(d) => substeps(self.physics_period_s(), d.dt_s),
+        }
+    }
+
+    /// Load (or generate) the mesh. A generated box is built by [`box_mesh`] and satisfies the
+    /// [`TetMesh`] invariants by construction; its report names it (`generated box ...`) and is
+    /// otherwise empty. A file's errors name the file (see [`read_mesh`]).
+    pub fn load_mesh(&self) -> Result<(TetMesh, MeshReport), MeshError> {
+        match &self.mesh {
+            MeshSource::File(path) => read_mesh(path),
+            MeshSource::GeneratedBox { size_m, cells } => {
+                let mesh = box_mesh(*cells, *size_m);
+                let report = MeshReport {
+                    source: format!(
+                        "generated box {} x {} x {} m, {} x {} x {} cells",
+                        size_m[0], size_m[1], size_m[2], cells[0], cells[1], cells[2]
+                    ),
+                    ..MeshReport::default()
+                };
+                Ok((mesh, report))
+            }
+        }
+    }
+}
+
+/// Whole steps of `dt_s` in `period_s`, if `period_s / dt_s` is within 1e-9 (relative) of an
+/// integer in `1..=MAX_SUBSTEPS`.
+fn substeps(period_s: f64, dt_s: f64) -> Option<u32> {
+    let ratio = period_s / dt_s;
+    let n = ratio.round();
+    if ratio.is_finite()
+        && n >= 1.0
+        && n <= f64::from(MAX_SUBSTEPS)
+        && (ratio - n).abs() <= 1e-9 * n
+    {
+        // In 1..=MAX_SUBSTEPS, so the conversion is exact.
+        Some(n as u32)
+    } else {
+        None
+    }
+}
+
+/// The model of the `[model]` table; errors are `(key, message)`.
+fn model_spec(
+    raw: &ModelFile,
+    haptic_hz: f64,
+    physics_every: u32,
+) -> Result<ModelSpec, (String, String)> {
+    if raw.kind == KindName::Precomputed {
+        let dynamic_only = [
+            ("law", raw.law.is_some()),
+            ("form", raw.form.is_some()),
+            ("integrator", raw.integrator.is_some()),
+            ("dt_s", raw.dt_s.is_some()),
+            ("damping_per_s", raw.damping_per_s.is_some()),
+            ("incompressibility_n", raw.incompressibility_n.is_some()),
+        ];
+        if let Some((key, _)) = dynamic_only.iter().find(|(_, given)| *given) {
+            return Err((
+                format!("[model] {key}"),
+                "applies to kind = \"dynamic\" only (this scene is \"precomputed\")".into(),
+            ));
+        }
+        return Ok(ModelSpec::Precomputed);
+    }
+    let form = match raw.form {
+        None | Some(FormName::PerTet) => StvkForm::PerTet,
+        Some(FormName::Tensors) => StvkForm::Tensors,
+    };
+    let law_name = raw.law.unwrap_or(LawName::Linear);
+    if matches!(law_name, LawName::Linear) && raw.form.is_some() {
+        return Err((
+            "[model] form".into(),
+            "applies to law = \"stvk\" or \"stvk-incompressible\" only".into(),
+        ));
+    }
+    let (law, incompressibility_n) = match (law_name, raw.incompressibility_n) {
+        (LawName::Linear, None) => (ElasticLaw::Linear, None),
+        (LawName::Stvk, None) => (ElasticLaw::StVenantKirchhoff(form), None),
+        (LawName::StvkIncompressible, Some(gamma)) => {
+            (ElasticLaw::StVenantKirchhoff(form), Some(gamma))
+        }
+        (LawName::StvkIncompressible, None) => {
+            return Err((
+                "[model] incompressibility_n".into(),
+                "missing: law = \"stvk-incompressible\" needs the penalty gamma (N)".into(),
+            ));
+        }
+        (_, Some(_)) => {
+            return Err((
+                "[model] incompressibility_n".into(),
+                "applies to law = \"stvk-incompressible\" only".into(),
+            ));
+        }
+    };
+    let integrator = match raw.integrator.unwrap_or(IntegratorName::Symplectic) {
+        IntegratorName::Euler => Integrator::ExplicitEuler,
+        IntegratorName::Symplectic => Integrator::SymplecticEuler,
+        IntegratorName::Rk4 => Integrator::Rk4,
+        IntegratorName::Central => Integrator::CentralDifference,
+    };
+    let Some(damping_per_s) = raw.damping_per_s else {
+        return Err((
+            "[model] damping_per_s".into(),
+            "missing: kind = \"dynamic\" needs the mass-proportional damping (1/s)".into(),
+        ));
+    };
+    Ok(ModelSpec::Dynamic(DynamicSpec {
+        law,
+        incompressibility_n,
+        integrator,
+        dt_s: raw.dt_s.unwrap_or(f64::from(physics_every) / haptic_hz),
+        damping_per_s,
+    }))
+}
+
+/// The ranges of a [`DynamicSpec`]; errors are `(key, message)`.
+fn check_dynamic(d: &DynamicSpec, physics_period_s: f64) -> Result<(), (String, String)> {
+    if let Some(gamma) = d.incompressibility_n
+        && !(gamma.is_finite() && gamma >= 0.0)
+    {
+        return Err((
+            format!("[model] incompressibility_n = {gamma}"),
+            "must be finite and >= 0 N".into(),
+        ));
+    }
+    if !(d.damping_per_s.is_finite() && d.damping_per_s >= 0.0) {
+        return Err((
+            format!("[model] damping_per_s = {}", d.damping_per_s),
+            "must be finite and >= 0 1/s".into(),
+        ));
+    }
+    if !(d.dt_s.is_finite() && d.dt_s > 0.0) {
+        return Err((
+            format!("[model] dt_s = {}", d.dt_s),
+            "must be finite and > 0 s".into(),
+        ));
+    }
+    if substeps(physics_period_s, d.dt_s).is_none() {
+        return Err((
+            format!("[model] dt_s = {}", d.dt_s),
+            format!(
+                "the physics period ({physics_period_s} s = physics_every / haptic_hz) must be a whole number of steps, 1 to {MAX_SUBSTEPS}"
+            ),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,526 @@
+//! Tool trajectories: where each tool point is over time, from a CSV file or a generator.
+//!
+//! File format: a header line `t,tool,x,y,z`, then one sample per line: time (s), tool point
+//! index (0-based integer), position (m). Fields may be padded with blanks; blank lines and lines
+//! starting with `#` are skipped (line numbers stay the file's physical lines, the header being
+//! line 1 when nothing precedes it).
+//!
+//! ```text
+//! t,tool,x,y,z
+//! 0.0,0,0.06,0.06,0.07
+//! 0.0,1,0.07,0.06,0.07
+//! 0.5,0,0.06,0.06,0.055
+//! 0.5,1,0.07,0.06,0.055
+//! ```
+//!
+//! Rules checked by [`Trajectory::read`] (each error names the file and the line):
+//! - every value is finite;
+//! - time never decreases from one line to the next, whatever the tool point: the file is one
+//!   time-ordered stream, as a device log is. Samples of different tool points may share a time,
+//!   and so may two samples of the same point: that is a jump (see [`Trajectory::positions_at`]);
+//! - the tool index is below the scene's tool point count, and every tool point has at least one
+//!   sample;
+//! - exactly 5 fields per line, numbers that parse, the header first.
+//!
+//! [`Trajectory::read_unchecked`] is the lenient reader for robustness tests: it keeps non-finite
+//! values and backward times (reporting each such line as a finding) so that they can be fed to
+//! the kernel, which must fault and output zero force.
+
+use std::io;
+use std::path::Path;
+
+use super::scene::MAX_TOOL_POINTS;
+
+/// The header line's fields, in order.
+pub const HEADER: [&str; 5] = ["t", "tool", "x", "y", "z"];
+
+/// One line of a trajectory: tool point `tool` is at `position_m` at time `t_s`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Time, s.
+    pub t_s: f64,
+    /// Tool point index, 0-based.
+    pub tool: usize,
+    /// Position `[x, y, z]`, m.
+    pub position_m: [f64; 3],
+}
+
+/// A time-ordered list of samples of `tool_count` tool points.
+///
+/// Invariants: `1 ≤ tool_count ≤ MAX_TOOL_POINTS`; every sample's tool index is below
+/// `tool_count`; every tool point has at least one sample. For a checked trajectory (every
+/// constructor but the `*_unchecked` readers) also: every value is finite and times never
+/// decrease in sample order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trajectory {
+    /// All samples, in file order.
+    samples: Vec<Sample>,
+    /// Per tool point, its `(t_s, position_m)` in file order.
+    tracks: Vec<Vec<(f64, [f64; 3])>>,
+}
+
+/// What is wrong with one line.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LineProblem {
+    /// The first line is not the header.
+    #[error("expected the header `t,tool,x,y,z`, found `{0}`")]
+    MissingHeader(String),
+    /// Not exactly 5 fields.
+    #[error("expected 5 fields t,tool,x,y,z, found {0}")]
+    ColumnCount(usize),
+    /// A coordinate or time that does not parse as a number.
+    #[error("{column} = `{text}` is not a number")]
+    NotANumber {
+        /// `t`, `x`, `y` or `z`.
+        column: &'static str,
+        /// The field as written.
+        text: String,
+    },
+    /// A tool field that is not a non-negative integer.
+    #[error("tool = `{0}` is not a tool point index (an integer >= 0)")]
+    BadToolIndex(String),
+    /// NaN or infinite time or coordinate.
+    #[error("non-finite {column} = {value}")]
+    NonFinite {
+        /// `t`, `x`, `y` or `z`.
+        column: &'static str,
+        /// The value read.
+        value: f64,
+    },
+    /// A tool index at or above the scene's tool point count.
+    #[error("tool point {tool} does not exist: the scene has {count} (indices 0 to {})", .count.saturating_sub(1))]
+    UnknownTool {
+        /// The index read.
+        tool: usize,
+        /// The scene's tool point count.
+        count: usize,
+    },
+    /// A time before the previous line's.
+    #[error("time {t_s} s goes backwards: line {previous_line} is at {previous_s} s")]
+    TimeBackwards {
+        /// This line's time, s.
+        t_s: f64,
+        /// The previous sample's line.
+        previous_line: usize,
+        /// The previous sample's time, s.
+        previous_s: f64,
+    },
+    /// The CSV reader could not read the line (e.g. invalid UTF-8).
+    #[error("unreadable: {0}")]
+    Unreadable(String),
+}
+
+/// What is wrong with the file as a whole.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FileProblem {
+    /// No line at all (not even the header).
+    #[error("empty: expected the header line `t,tool,x,y,z`")]
+    Empty,
+    /// A header but no sample.
+    #[error("no samples after the header")]
+    NoSamples,
+    /// A tool point with no sample: its position would be unknown.
+    #[error("tool point {0} has no sample")]
+    ToolWithoutSamples(usize),
+    /// The tool point count asked for is out of range.
+    #[error("tool point count {0} out of range 1..={MAX_TOOL_POINTS}")]
+    BadToolCount(usize),
+}
+
+/// Why a trajectory could not be read or built. Every message starts with the file (or source
+/// name) and, for a line, its 1-based number.
+#[derive(Debug, thiserror::Error)]
+pub enum TrajectoryError {
+    /// The file could not be read or written.
+    #[error("{file}: cannot {action} trajectory: {err}")]
+    Io {
+        /// The file as given.
+        file: String,
+        /// `read` or `write`.
+        action: &'static str,
+        /// Underlying I/O error.
+        #[source]
+        err: io::Error,
+    },
+    /// A bad line.
+    #[error("{file}: line {line}: {problem}")]
+    Line {
+        /// The file.
+        file: String,
+        /// 1-based line number (the header is line 1 when nothing precedes it).
+        line: usize,
+        /// What is wrong.
+        problem: LineProblem,
+    },
+    /// A problem of the whole file.
+    #[error("{file}: {problem}")]
+    File {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        problem: FileProblem,
+    },
+}
+
+/// Whether the readers refuse non-finite values and backward times or only report them.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Checked,
+    Lenient,
+}
+
+/// Builds a trajectory sample by sample, applying the rules of the module doc.
+struct Builder<'a> {
+    file: &'a str,
+    mode: Mode,
+    samples: Vec<Sample>,
+    tracks: Vec<Vec<(f64, [f64; 3])>>,
+    /// Line and time of the last sample with a non-NaN time.
+    previous: Option<(usize, f64)>,
+    findings: Vec<TrajectoryError>,
+}
+
+impl<'a> Builder<'a> {
+    fn new(file: &'a str, tool_count: usize, mode: Mode) -> Result<Self, TrajectoryError> {
+        if !(1..=MAX_TOOL_POINTS).contains(&tool_count) {
+            return Err(TrajectoryError::File {
+                file: file.to_owned(),
+                problem: FileProblem::BadToolCount(tool_count),
+            });
+        }
+        Ok(Self {
+            file,
+            mode,
+            samples: Vec::new(),
+            tracks: vec![Vec::new(); tool_count],
+            previous: None,
+            findings: Vec::new(),
+        })
+    }
+
+    fn line_error(&self, line: usize, problem: LineProblem) -> TrajectoryError {
+        TrajectoryError::Line {
+            file: self.file.to_owned(),
+            line,
+            problem,
+        }
+    }
+
+    /// Refused in checked mode, a finding in lenient mode.
+    fn soft(&mut self, line: usize, problem: LineProblem) -> Result<(), TrajectoryError> {
+        let err = self.line_error(line, problem);
+        match self.mode {
+            Mode::Checked => Err(err),
+            Mode::Lenient => {
+                self.findings.push(err);
+                Ok(())
+            }
+        }
+    }
+
+    fn push(&mut self, line: usize, sample: Sample) -> Result<(), TrajectoryError> {
+        let count = self.tracks.len();
+        let values = [
+            ("t", sample.t_s),
+            ("x", sample.position_m[0]),
+            ("y", sample.position_m[1]),
+            ("z", sample.position_m[2]),
+        ];
+        if let Some(&(column, value)) = values.iter().find(|(_, v)| !v.is_finite()) {
+            self.soft(line, LineProblem::NonFinite { column, value })?;
+        }
+        if let Some((previous_line, previous_s)) = self.previous
+            && sample.t_s < previous_s
+        {
+            self.soft(
+                line,
+                LineProblem::TimeBackwards {
+                    t_s: sample.t_s,
+                    previous_line,
+                    previous_s,
+                },
+            )?;
+        }
+        if !sample.t_s.is_nan() {
+            self.previous = Some((line, sample.t_s));
+        }
+        let Some(track) = self.tracks.get_mut(sample.tool) else {
+            return Err(self.line_error(
+                line,
+                LineProblem::UnknownTool {
+                    tool: sample.tool,
+                    count,
+                },
+            ));
+        };
+        track.push((sample.t_s, sample.position_m));
+        self.samples.push(sample);
+        Ok(())
+    }
+
+    fn finish(self) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
+        let whole = |problem| TrajectoryError::File {
+            file: self.file.to_owned(),
+            problem,
+        };
+        if self.samples.is_empty() {
+            return Err(whole(FileProblem::NoSamples));
+        }
+        if let Some(tool) = self.tracks.iter().position(Vec::is_empty) {
+            return Err(whole(FileProblem::ToolWithoutSamples(tool)));
+        }
+        Ok((
+            Trajectory {
+                samples: self.samples,
+                tracks: self.tracks,
+            },
+            self.findings,
+        ))
+    }
+}
+
+/// Parse one data record (5 fields checked by the caller) into a sample.
+fn parse_record(record: &csv::StringRecord) -> Result<Sample, LineProblem> {
+    let field = |i: usize| record.get(i).unwrap_or("");
+    let number = |i: usize, column: &'static str| {
+        field(i)
+            .parse::<f64>()
+            .map_err(|_| LineProblem::NotANumber {
+                column,
+                text: field(i).to_owned(),
+            })
+    };
+    let t_s = number(0, "t")?;
+    let tool = field(1)
+        .parse::<usize>()
+        .map_err(|_| LineProblem::BadToolIndex(field(1).to_owned()))?;
+    Ok(Sample {
+        t_s,
+        tool,
+        position_m: [number(2, "x")?, number(3, "y")?, number(4, "z")?],
+    })
+}
+
+/// Read CSV from `reader` under `mode`; `file` names it in messages.
+fn read_csv<R: io::Read>(
+    reader: R,
+    file: &str,
+    tool_count: usize,
+    mode: Mode,
+) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
+    let mut builder = Builder::new(file, tool_count, mode)?;
+    let mut csv = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(reader);
+    let mut header_seen = false;
+    let mut record = csv::StringRecord::new();
+    loop {
+        match csv.read_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(err) => {
+                let line = err.position().map_or(0, |p| p.line() as usize);
+                let msg = err.to_string();
+                return Err(match err.into_kind() {
+                    csv::ErrorKind::Io(err) => TrajectoryError::Io {
+                        file: file.to_owned(),
+                        action: "read",
+                        err,
+                    },
+                    _ => builder.line_error(line, LineProblem::Unreadable(msg)),
+                });
+            }
+        }
+        let line = record.position().map_or(0, |p| p.line() as usize);
+        if !header_seen {
+            if record.iter().ne(HEADER) {
+                let found = record.iter().collect::<Vec<_>>().join(",");
+                return Err(builder.line_error(line, LineProblem::MissingHeader(found)));
+            }
+            header_seen = true;
+            continue;
+        }
+        if record.len() != HEADER.len() {
+            return Err(builder.line_error(line, LineProblem::ColumnCount(record.len())));
+        }
+        let sample = parse_record(&record).map_err(|problem| builder.line_error(line, problem))?;
+        builder.push(line, sample)?;
+    }
+    if !header_seen {
+        return Err(TrajectoryError::File {
+            file: file.to_owned(),
+            problem: FileProblem::Empty,
+        });
+    }
+    builder.finish()
+}
+
+/// Position on a track at `t_s` (see [`Trajectory::positions_at`]); a track is never empty in a
+/// [`Trajectory`], an empty one gives NaN.
+pub(crate) fn position_on(track: &[(f64, [f64; 3])], t_s: f64) -> [f64; 3] {
+    let i = track.partition_point(|&(t, _)| t <= t_s);
+    let before = i.checked_sub(1).and_then(|j| track.get(j));
+    match (before, track.get(i)) {
+        (Some(&(t0, p0)), Some(&(t1, p1))) => {
+            let s = (t_s - t0) / (t1 - t0);
+            [0, 1, 2].map(|k| p0[k] + (p1[k] - p0[k]) * s)
+        }
+        (Some(&(_, p)), None) | (None, Some(&(_, p))) => p,
+        (None, None) => [f64::NAN; 3],
+    }
+}
+
+impl Trajectory {
+    /// Read and check a trajectory file for a scene with `tool_count` tool points (see the
+    /// module doc for the rules). Messages name the file as `path` displays.
+    pub fn read(path: &Path, tool_count: usize) -> Result<Trajectory, TrajectoryError> {
+        let file = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|err| TrajectoryError::Io {
+            file: file.clone(),
+            action: "read",
+            err,
+        })?;
+        read_csv(bytes.as_slice(), &file, tool_count, Mode::Checked).map(|(t, _)| t)
+    }
+
+    /// [`Trajectory::read`] from text; `source` names it in messages.
+    pub fn from_csv_str(
+        text: &str,
+        source: &str,
+        tool_count: usize,
+    ) -> Result<Trajectory, TrajectoryError> {
+        read_csv(text.as_bytes(), source, tool_count, Mode::Checked).map(|(t, _)| t)
+    }
+
+    /// The lenient reader, for robustness tests: non-finite values and times going backwards
+    /// are kept, and each such problem is returned as a finding, in line order (the errors
+    /// [`Trajectory::read`] refuses with; a line can give two: a non-finite coordinate and a
+    /// backward time). A missing header, a wrong field count, a field that is
+    /// not a number, an unknown tool point or a tool point without a sample are still errors: there
+    /// is no value to keep.
+    pub fn read_unchecked(
+        path: &Path,
+        tool_count: usize,
+    ) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
+        let file = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|err| TrajectoryError::Io {
+            file: file.clone(),
+            action: "read",
+            err,
+        })?;
+        read_csv(bytes.as_slice(), &file, tool_count, Mode::Lenient)
+    }
+
+    /// [`Trajectory::read_unchecked`] from text; `source` names it in messages.
+    pub fn from_csv_str_unchecked(
+        text: &str,
+        source: &str,
+        tool_count: usize,
+    ) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
+        read_csv(text.as_bytes(), source, tool_count, Mode::Lenient)
+    }
+
+    /// A checked trajectory from samples in order. Errors name the source `samples` and the line
+    /// each sample would have in the file [`Trajectory::write_csv`] writes (sample `i` on line
+    /// `i + 2`).
+    pub fn from_samples(
+        samples: Vec<Sample>,
+        tool_count: usize,
+    ) -> Result<Trajectory, TrajectoryError> {
+        let mut builder = Builder::new("samples", tool_count, Mode::Checked)?;
+        for (i, sample) in samples.into_iter().enumerate() {
+            builder.push(i + 2, sample)?;
+        }
+        builder.finish().map(|(t, _)| t)
+    }
+
+    /// Several checked trajectories as one (e.g. a press by tool point 0 and another by tool
+    /// point 1): all samples, ordered by time (stable: at equal times, `parts` order, then each
+    /// part's order), with the largest tool point count of the parts. Every tool point must end
+    /// up with a sample, and the result is checked as [`Trajectory::from_samples`] does.
+    pub fn merged(parts: &[Trajectory]) -> Result<Trajectory, TrajectoryError> {
+        let tool_count = parts.iter().map(Trajectory::tool_count).max().unwrap_or(0);
+        let mut samples: Vec<Sample> = parts.iter().flat_map(|p| p.samples.clone()).collect();
+        samples.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        Self::from_samples(samples, tool_count)
+    }
+
+    /// Number of tool points: [`Trajectory::positions_at`] returns this many positions.
+    pub fn tool_count(&self) -> usize {
+        self.tracks.len()
+    }
+
+    /// All samples, in file order.
+    pub fn samples(&self) -> &[Sample] {
+        &self.samples
+    }
+
+    /// Earliest finite sample time, s (0 if there is none, which only an unchecked trajectory
+    /// can have).
+    pub fn start_s(&self) -> f64 {
+        let t = self.finite_times().fold(f64::INFINITY, f64::min);
+        if t.is_finite() { t } else { 0.0 }
+    }
+
+    /// Latest finite sample time, s (0 if there is none, which only an unchecked trajectory can
+    /// have). A session runs until then; every position holds afterwards.
+    pub fn end_s(&self) -> f64 {
+        let t = self.finite_times().fold(f64::NEG_INFINITY, f64::max);
+        if t.is_finite() { t } else { 0.0 }
+    }
+
+    fn finite_times(&self) -> impl Iterator<Item = f64> + '_ {
+        self.samples.iter().map(|s| s.t_s).filter(|t| t.is_finite())
+    }
+
+    /// Every tool point's position (m) at time `t_s`, by linear interpolation between the tool
+    /// point's own samples:
+    /// - between its samples `(t0, p0)` and `(t1, p1)` with `t0 ≤ t_s < t1`:
+    ///   `p0 + (p1 − p0)·(t_s − t0)/(t1 − t0)`, so exactly `p0` at `t_s = t0`;
+    /// - before its first sample: the first sample; at or after its last: the last (hold);
+    /// - two samples at the same time are a jump: from that time on the later one applies.
+    ///
+    /// Linear, not sample-and-hold, so that a trajectory sampled slower than the haptic rate
+    /// does not feed the force loop steps (each a force spike); generated trajectories are
+    /// piecewise linear, and reproduced exactly. A NaN `t_s` gives the first samples. On an
+    /// unchecked trajectory non-finite samples propagate (NaN or infinite positions, for the
+    /// kernel to refuse) and times out of order give a deterministic but unspecified mix of
+    /// samples; nothing panics.
+    pub fn positions_at(&self, t_s: f64) -> Vec<[f64; 3]> {
+        self.tracks.iter().map(|tr| position_on(tr, t_s)).collect()
+    }
+
+    /// [`Trajectory::positions_at`] into `out`, without allocating: fills
+    /// `min(out.len(), tool_count)` entries.
+    pub fn positions_at_into(&self, t_s: f64, out: &mut [[f64; 3]]) {
+        for (o, tr) in out.iter_mut().zip(&self.tracks) {
+            *o = position_on(tr, t_s);
+        }
+    }
+
+    /// Write the trajectory as CSV: the header, then every sample in order. Numbers use Rust's
+    /// shortest round-trip format, so reading the output back gives the same bits (non-finite
+    /// values are written `NaN`, `inf`, `-inf`, which [`Trajectory::read_unchecked`] reads back).
+    pub fn write_csv<W: io::Write>(&self, mut out: W) -> io::Result<()> {
+        writeln!(out, "{}", HEADER.join(","))?;
+        for s in &self.samples {
+            let [x, y, z] = s.position_m;
+            writeln!(out, "{},{},{x},{y},{z}", s.t_s, s.tool)?;
+        }
+        out.flush()
+    }
+
+    /// [`Trajectory::write_csv`] to a file (created or truncated).
+    pub fn write_csv_file(&self, path: &Path) -> Result<(), TrajectoryError> {
+        let io_error = |err| TrajectoryError::Io {
+            file: path.display().to_string(),
+            action: "write",
+            err,
+        };
+        let file = std::fs::File::create(path).map_err(io_error)?;
+        self.write_csv(io::BufWriter::new(file)).map_err(io_error)
+    }
+}

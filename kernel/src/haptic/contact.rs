@@ -1,0 +1,218 @@
+//! Contact detection and tracking on the rest surface of a pre-computed
+//! model (Cotin 1999 §4; MODELS.md §6). A tool point is a sphere of radius
+//! `r`; its contact is a point of a surface triangle (barycentric weights),
+//! created when the sphere's motion segment crosses the triangle from
+//! outside, moved with the tool (frictionless sliding: the contact point is
+//! the projection of the sphere's lowest point onto the surface, walking
+//! across triangle edges), and released when the sphere no longer
+//! penetrates.
+
+use nalgebra::Vector3;
+
+use super::surface::SurfaceIndex;
+use crate::Real;
+use crate::table::PrecomputedTable;
+
+/// Triangle edges crossed at most per tick while sliding (a bound on the
+/// walk; a contact that would slide further stops at the last triangle).
+pub const MAX_WALK_STEPS: u32 = 8;
+
+/// A tool point's contact: a surface triangle (index into the table's
+/// surface triangles) and the barycentric weights of the contact point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolContact<T> {
+    /// Surface triangle index.
+    pub triangle: u32,
+    /// Barycentric weights, each in `[0, 1]`, summing to 1.
+    pub weights: [T; 3],
+}
+
+/// Work done by detection and tracking (per-stage counters for the timing
+/// budget).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ContactWork {
+    /// Candidate triangles tested for a crossing.
+    pub triangles_tested: u32,
+    /// Triangle edges crossed while sliding.
+    pub walk_steps: u32,
+}
+
+/// The rest geometry of the surface.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceGeometry<'a, T: Real> {
+    positions: &'a [[T; 3]],
+    triangles: &'a [[u32; 3]],
+    index: &'a SurfaceIndex<'a, T>,
+    fixed: &'a PrecomputedTable<'a, T>,
+}
+
+/// Corners and unit outward normal of a triangle.
+struct Face<T: Real> {
+    vertices: [u32; 3],
+    corners: [Vector3<T>; 3],
+    normal: Vector3<T>,
+}
+
+/// Barycentric weights of `x`'s projection onto the plane of `c`.
+fn barycentric<T: Real>(c: &[Vector3<T>; 3], normal: &Vector3<T>, x: &Vector3<T>) -> [T; 3] {
+    let [a, b, cc] = c;
+    let area2 = (b - a).cross(&(cc - a)).dot(normal);
+    if area2 <= T::zero() {
+        return [T::zero(); 3];
+    }
+    let w0 = (b - x).cross(&(cc - x)).dot(normal) / area2;
+    let w1 = (cc - x).cross(&(a - x)).dot(normal) / area2;
+    [w0, w1, T::one() - w0 - w1]
+}
+
+/// Weights clamped to `[0, 1]` and renormalized.
+fn clamp_weights<T: Real>(w: [T; 3]) -> [T; 3] {
+    let c = w.map(|x| if x > T::zero() { x } else { T::zero() });
+    let sum = c[0] + c[1] + c[2];
+    if sum > T::zero() {
+        c.map(|x| x / sum)
+    } else {
+        [T::one() / T::of_f64(3.0); 3]
+    }
+}
+
+impl<'a, T: Real> SurfaceGeometry<'a, T> {
+    /// The surface of `table`.
+    pub fn new(table: &'a PrecomputedTable<'a, T>) -> Self {
+        Self {
+            positions: table.rest_positions(),
+            triangles: table.surface_triangles(),
+            index: table.surface_index(),
+            fixed: table,
+        }
+    }
+
+    fn face(&self, triangle: u32) -> Option<Face<T>> {
+        let vertices = *self.triangles.get(triangle as usize)?;
+        let mut corners = [Vector3::zeros(); 3];
+        for (c, &v) in corners.iter_mut().zip(&vertices) {
+            let p = self.positions.get(v as usize)?;
+            *c = Vector3::new(p[0], p[1], p[2]);
+        }
+        let [a, b, c] = &corners;
+        let n = (b - a).cross(&(c - a));
+        let length = n.norm();
+        (length > T::zero()).then(|| Face {
+            vertices,
+            corners,
+            normal: n / length,
+        })
+    }
+
+    /// Vertices and unit outward normal of a surface triangle.
+    pub fn triangle(&self, triangle: u32) -> Option<([u32; 3], Vector3<T>)> {
+        self.face(triangle).map(|f| (f.vertices, f.normal))
+    }
+
+    /// Rest position of a contact point, m.
+    pub fn point(&self, contact: &ToolContact<T>) -> Option<Vector3<T>> {
+        let f = self.face(contact.triangle)?;
+        let [a, b, c] = f.corners;
+        let [wa, wb, wc] = contact.weights;
+        Some(a * wa + b * wb + c * wc)
+    }
+
+    /// The first surface triangle that a sphere of radius `radius_m` moving
+    /// from `from_m` to `to_m` (its centre, m) hits from outside, with the
+    /// contact point; triangles with all three vertices fixed (a rigid
+    /// support, no compliance) are not touchable. Candidates: the triangles
+    /// around the surface vertices in the 27 grid cells around `to_m` and
+    /// around `from_m`. Bounded by `2 × 27 × max_bucket × max_valence`.
+    pub fn detect(
+        &self,
+        from_m: &Vector3<T>,
+        to_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+    ) -> Option<ToolContact<T>> {
+        let tolerance = T::WEIGHT_TOLERANCE;
+        let mut best: Option<(T, ToolContact<T>)> = None;
+        let candidates = self
+            .index
+            .vertices_near(to_m)
+            .chain(self.index.vertices_near(from_m));
+        for v in candidates {
+            for &t in self.index.triangles_of(v) {
+                work.triangles_tested = work.triangles_tested.saturating_add(1);
+                let Some(f) = self.face(t) else { continue };
+                if f.vertices.iter().all(|&v| self.fixed.is_fixed(v)) {
+                    continue;
+                }
+                let [a, _, _] = f.corners;
+                let s0 = (from_m - a).dot(&f.normal) - radius_m;
+                let s1 = (to_m - a).dot(&f.normal) - radius_m;
+                if !(s0 >= T::zero() && s1 < T::zero()) {
+                    continue;
+                }
+                let along = s0 / (s0 - s1);
+                if best.as_ref().is_some_and(|(b, _)| *b <= along) {
+                    continue;
+                }
+                let x = from_m + (to_m - from_m) * along - f.normal * radius_m;
+                let w = barycentric(&f.corners, &f.normal, &x);
+                if w.iter().all(|&wi| wi >= -tolerance) {
+                    let contact = ToolContact {
+                        triangle: t,
+                        weights: clamp_weights(w),
+                    };
+                    best = Some((along, contact));
+                }
+            }
+        }
+        best.map(|(_, c)| c)
+    }
+
+    /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
+    /// the sphere's lowest point `tip − r n` onto the surface, walking to
+    /// the neighbouring triangle across any edge it falls outside of (at
+    /// most [`MAX_WALK_STEPS`]). Returns the new contact and the signed gap
+    /// `(tip − x)·n − r` (m; negative while the sphere penetrates).
+    pub fn track(
+        &self,
+        contact: &ToolContact<T>,
+        tip_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+    ) -> Option<(ToolContact<T>, T)> {
+        let tolerance = T::WEIGHT_TOLERANCE;
+        let mut triangle = contact.triangle;
+        let mut face = self.face(triangle)?;
+        for _ in 0..MAX_WALK_STEPS {
+            let w = barycentric(
+                &face.corners,
+                &face.normal,
+                &(tip_m - face.normal * radius_m),
+            );
+            let Some(out) = (0..3).find(|&i| w.get(i).is_some_and(|&x| x < -tolerance)) else {
+                break;
+            };
+            // Cross the edge opposite corner `out` to the triangle sharing it.
+            let (Some(&j), Some(&k)) = (
+                face.vertices.get((out + 1) % 3),
+                face.vertices.get((out + 2) % 3),
+            ) else {
+                break;
+            };
+            let shared =
+                self.index.triangles_of(j).iter().find(|&&t| {
+                    t != triangle && self.index.triangles_of(k).binary_search(&t).is_ok()
+                });
+            let Some(next) = shared.and_then(|&t| self.face(t).map(|f| (t, f))) else {
+                break;
+            };
+            work.walk_steps = work.walk_steps.saturating_add(1);
+            (triangle, face) = next;
+        }
+        let x_plane = tip_m - face.normal * radius_m;
+        let weights = clamp_weights(barycentric(&face.corners, &face.normal, &x_plane));
+        let [a, b, c] = face.corners;
+        let x = a * weights[0] + b * weights[1] + c * weights[2];
+        let gap = (tip_m - x).dot(&face.normal) - radius_m;
+        Some((ToolContact { triangle, weights }, gap))
+    }
+}

@@ -1,0 +1,223 @@
+//! The collision index of a pre-computed table (Cotin 1999 §4, collision
+//! buckets; MODELS.md §6): the boundary-surface vertices filed in a regular
+//! grid over their bounding box, and the surface triangles around each
+//! vertex. Built offline (`palpate tables build`), validated once by
+//! [`SurfaceIndex::new`] (called from `PrecomputedTable::load`), then
+//! queried in bounded time: a query visits the 27 cells around a point,
+//! each holding at most [`SurfaceIndex::max_bucket`] vertices, each with at
+//! most [`SurfaceIndex::max_valence`] triangles.
+
+use nalgebra::Vector3;
+
+use crate::Real;
+use crate::table::LoadError;
+
+/// The validated collision index (a view into the table).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceIndex<'a, T> {
+    origin_m: Vector3<T>,
+    cell_m: T,
+    dims: [u32; 3],
+    cell_start: &'a [u32],
+    grid_vertex: &'a [u32],
+    vertex_triangle_start: &'a [u32],
+    vertex_triangle: &'a [u32],
+    max_bucket: u32,
+    max_valence: u32,
+}
+
+/// The raw sections of a collision index, before validation.
+pub(crate) struct SurfaceSections<'a, T> {
+    pub(crate) grid: &'a [[T; 4]],
+    pub(crate) dims: &'a [[u32; 3]],
+    pub(crate) cell_start: &'a [u32],
+    pub(crate) grid_vertex: &'a [u32],
+    pub(crate) vertex_triangle_start: &'a [u32],
+    pub(crate) vertex_triangle: &'a [u32],
+}
+
+/// `true` if `starts` begins at 0, never decreases and ends at `total`.
+fn csr_ok(starts: &[u32], total: usize) -> bool {
+    starts.first() == Some(&0)
+        && starts.windows(2).all(|w| w.first() <= w.get(1))
+        && starts.last().map(|&x| x as usize) == Some(total)
+}
+
+/// The largest row of a CSR list.
+fn max_row(starts: &[u32]) -> u32 {
+    starts
+        .windows(2)
+        .map(|w| match w {
+            [a, b] => b.saturating_sub(*a),
+            _ => 0,
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+impl<'a, T: Real> SurfaceIndex<'a, T> {
+    /// Validates the sections against the rest `positions` (m) and surface
+    /// `triangles` of the table. Cost: linear in the index size.
+    pub(crate) fn new(
+        s: &SurfaceSections<'a, T>,
+        positions: &[[T; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<Self, LoadError> {
+        let grid_error = |index: usize| LoadError::BadSurfaceGrid {
+            index: index as u32,
+        };
+        let (Some(&[x, y, z, cell_m]), Some(&dims)) = (s.grid.first(), s.dims.first()) else {
+            return Err(grid_error(0));
+        };
+        let cells = dims
+            .iter()
+            .try_fold(1usize, |n, &d| n.checked_mul(d as usize));
+        let geometry_ok = [x, y, z, cell_m].iter().all(|v| v.finite()) && cell_m > T::zero();
+        if !geometry_ok
+            || dims.contains(&0)
+            || cells.and_then(|c| c.checked_add(1)) != Some(s.cell_start.len())
+            || !csr_ok(s.cell_start, s.grid_vertex.len())
+        {
+            return Err(grid_error(0));
+        }
+        let index = Self {
+            origin_m: Vector3::new(x, y, z),
+            cell_m,
+            dims,
+            cell_start: s.cell_start,
+            grid_vertex: s.grid_vertex,
+            vertex_triangle_start: s.vertex_triangle_start,
+            vertex_triangle: s.vertex_triangle,
+            max_bucket: max_row(s.cell_start),
+            max_valence: max_row(s.vertex_triangle_start),
+        };
+        // Every filed vertex exists and lies within one cell of its own.
+        for (cell, bucket) in s.cell_start.windows(2).enumerate() {
+            let [start, end] = bucket else { continue };
+            let vertices = s
+                .grid_vertex
+                .get(*start as usize..*end as usize)
+                .unwrap_or(&[]);
+            for &v in vertices {
+                let p = positions.get(v as usize).ok_or(grid_error(v as usize))?;
+                let home = index.cell_of(&Vector3::new(p[0], p[1], p[2]));
+                let filed = index.coordinates(cell);
+                if home.iter().zip(filed).any(|(&a, b)| a.abs_diff(b) > 1) {
+                    return Err(grid_error(v as usize));
+                }
+            }
+        }
+        // Each vertex's triangles: in range, containing it, ascending.
+        let n = positions.len();
+        if s.vertex_triangle_start.len() != n + 1
+            || !csr_ok(s.vertex_triangle_start, s.vertex_triangle.len())
+        {
+            return Err(LoadError::BadVertexTriangles { vertex: 0 });
+        }
+        for (v, row) in s.vertex_triangle_start.windows(2).enumerate() {
+            let bad = LoadError::BadVertexTriangles { vertex: v as u32 };
+            let [start, end] = row else { continue };
+            let list = s
+                .vertex_triangle
+                .get(*start as usize..*end as usize)
+                .ok_or(bad)?;
+            if !list.windows(2).all(|w| w.first() < w.get(1)) {
+                return Err(bad);
+            }
+            for &t in list {
+                let tri = triangles.get(t as usize).ok_or(bad)?;
+                if !tri.contains(&(v as u32)) {
+                    return Err(bad);
+                }
+            }
+        }
+        Ok(index)
+    }
+
+    /// Grid origin, m.
+    pub fn origin_m(&self) -> Vector3<T> {
+        self.origin_m
+    }
+
+    /// Grid cell edge, m.
+    pub fn cell_m(&self) -> T {
+        self.cell_m
+    }
+
+    /// Cells per axis.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// Most vertices in one cell (a table-declared loop bound).
+    pub fn max_bucket(&self) -> u32 {
+        self.max_bucket
+    }
+
+    /// Most surface triangles around one vertex (a table-declared bound).
+    pub fn max_valence(&self) -> u32 {
+        self.max_valence
+    }
+
+    /// The cell containing `p` (m), clamped to the grid (a point outside
+    /// maps to the nearest border cell; non-finite coordinates map to 0).
+    pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
+        let mut cell = [0u32; 3];
+        for ((c, (&x, &o)), &d) in cell
+            .iter_mut()
+            .zip(p.iter().zip(self.origin_m.iter()))
+            .zip(&self.dims)
+        {
+            let f = ((x - o) / self.cell_m).floor();
+            let top = T::of_f64(f64::from(d.saturating_sub(1)));
+            // NaN fails both comparisons and stays at 0.
+            *c = if f > T::zero() {
+                let clamped = if f < top { f } else { top };
+                clamped.as_f64() as u32
+            } else {
+                0
+            };
+        }
+        cell
+    }
+
+    fn coordinates(&self, cell: usize) -> [u32; 3] {
+        let [nx, ny, _] = self.dims.map(|d| d.max(1) as usize);
+        [
+            (cell % nx) as u32,
+            ((cell / nx) % ny) as u32,
+            (cell / (nx * ny)) as u32,
+        ]
+    }
+
+    /// The surface vertices filed in the 27 cells around the cell of `p`
+    /// (m). Bounded by `27 × max_bucket`.
+    pub fn vertices_near(&self, p: &Vector3<T>) -> impl Iterator<Item = u32> + '_ {
+        let [cx, cy, cz] = self.cell_of(p);
+        let [nx, ny, nz] = self.dims;
+        let range = |c: u32, n: u32| c.saturating_sub(1)..=(c + 1).min(n.saturating_sub(1));
+        range(cz, nz).flat_map(move |k| {
+            range(cy, ny).flat_map(move |j| {
+                range(cx, nx).flat_map(move |i| {
+                    let cell = i as usize + nx as usize * (j as usize + ny as usize * k as usize);
+                    let start = self.cell_start.get(cell).copied().unwrap_or(0) as usize;
+                    let end = self.cell_start.get(cell + 1).copied().unwrap_or(0) as usize;
+                    self.grid_vertex
+                        .get(start..end)
+                        .unwrap_or(&[])
+                        .iter()
+                        .copied()
+                })
+            })
+        })
+    }
+
+    /// The surface triangles around `vertex` (indices into the table's
+    /// surface triangles), ascending. Bounded by `max_valence`.
+    pub fn triangles_of(&self, vertex: u32) -> &'a [u32] {
+        let v = vertex as usize;
+        let start = self.vertex_triangle_start.get(v).copied().unwrap_or(0) as usize;
+        let end = self.vertex_triangle_start.get(v + 1).copied().unwrap_or(0) as usize;
+        self.vertex_triangle.get(start..end).unwrap_or(&[])
+    }
+}
