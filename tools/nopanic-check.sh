@@ -32,7 +32,8 @@ if cargo build --release 2>"$log"; then
         "set_external_force, set_velocity, impose, release, clear_external_forces," \
         "step (explicit Euler, symplectic Euler, RK4, central difference; linear and" \
         "St Venant-Kirchhoff, incompressibility on and off), remove_tet, cut_with_tool," \
-        "tear, surface_triangles, displacements_m, velocities_m_s, elastic_forces_n, fault"
+        "tear, surface_triangles, displacements_m, velocities_m_s, elastic_forces_n, fault;" \
+        "HapticLoop::new, tick, reset"
     exit 0
 fi
 

@@ -1,5 +1,5 @@
-use std::path::Path;
 use palpate::session::Scene;
+use std::path::Path;
 
 #[test]
 fn probe() {
@@ -16,6 +16,11 @@ fn probe() {
         "mesh = \"a.msh\"\nfix=[\"z<1\"]\n[material]\nyoung_pa = 1\npoisson = 0.3\n[generated]\nbox_m = [1,1]\ncells = [1,1,1]",
     ];
     for c in cases {
-        println!("{:?}", Scene::from_toml_str_named(c, "bad.toml", Path::new("/s")).map(|_| ()).map_err(|e| e.to_string()));
+        println!(
+            "{:?}",
+            Scene::from_toml_str_named(c, "bad.toml", Path::new("/s"))
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        );
     }
 }

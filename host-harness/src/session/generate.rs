@@ -51,6 +51,10 @@ pub struct Keyframe {
 }
 
 /// A generator of a trajectory.
+///
+/// A single-point generator whose `tool` is not 0 gives a trajectory only together with the
+/// other tool points: concatenate the keyframes of one generator per tool point and call
+/// [`sample_keyframes`] (e.g. two probes: a [`PressHold`] with `tool: 0` and one with `tool: 1`).
 pub trait Generator {
     /// The path's keyframes, per tool point in time order (tool points interleaved).
     fn keyframes(&self) -> Result<Vec<Keyframe>, GenerateError>;
@@ -392,6 +396,7 @@ impl Default for Poke {
 
 impl Generator for Poke {
     fn keyframes(&self) -> Result<Vec<Keyframe>, GenerateError> {
+        check_tool(self.tool, "poke.tool")?;
         let keys = PressHold {
             tool: self.tool,
             press: self.press,
@@ -631,6 +636,8 @@ impl Default for Strike {
 
 impl Generator for Strike {
     fn keyframes(&self) -> Result<Vec<Keyframe>, GenerateError> {
+        check_tool(self.tool, "strike.tool")?;
+        check_finite_at_least(self.hold_s, 0.0, "strike.hold_s", "s")?;
         PressHold {
             tool: self.tool,
             press: self.press,

@@ -437,17 +437,6 @@ impl Trajectory {
         builder.finish().map(|(t, _)| t)
     }
 
-    /// Several checked trajectories as one (e.g. a press by tool point 0 and another by tool
-    /// point 1): all samples, ordered by time (stable: at equal times, `parts` order, then each
-    /// part's order), with the largest tool point count of the parts. Every tool point must end
-    /// up with a sample, and the result is checked as [`Trajectory::from_samples`] does.
-    pub fn merged(parts: &[Trajectory]) -> Result<Trajectory, TrajectoryError> {
-        let tool_count = parts.iter().map(Trajectory::tool_count).max().unwrap_or(0);
-        let mut samples: Vec<Sample> = parts.iter().flat_map(|p| p.samples.clone()).collect();
-        samples.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
-        Self::from_samples(samples, tool_count)
-    }
-
     /// Number of tool points: [`Trajectory::positions_at`] returns this many positions.
     pub fn tool_count(&self) -> usize {
         self.tracks.len()

@@ -182,12 +182,13 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     }
 
     fn coordinates(&self, cell: usize) -> [u32; 3] {
-        let [nx, ny, _] = self.dims.map(|d| d.max(1) as usize);
-        [
-            (cell % nx) as u32,
-            ((cell / nx) % ny) as u32,
-            (cell / (nx * ny)) as u32,
-        ]
+        let [nx, ny, _] = self.dims.map(|d| d as usize);
+        let (x, rest) = (cell.checked_rem(nx), cell.checked_div(nx));
+        let (y, z) = (
+            rest.and_then(|r| r.checked_rem(ny)),
+            rest.and_then(|r| r.checked_div(ny)),
+        );
+        [x, y, z].map(|c| c.unwrap_or(0) as u32)
     }
 
     /// The surface vertices filed in the 27 cells around the cell of `p`

@@ -28,7 +28,13 @@
 //! - topology changes: `remove_tet`, `cut_with_tool`, `tear`, and the live
 //!   `surface_triangles`;
 //! - the outputs `displacements_m`, `velocities_m_s`, `elastic_forces_n`,
-//!   `fault`.
+//!   `fault`;
+//!
+//! and of the haptic loop over the pre-computed table:
+//! - `HapticLoop::new` (configuration and limits from volatile inputs) and
+//!   `tick` (contact detection in the collision grid, sliding, the contact
+//!   solve with releases and refusals, the safety supervisor) on volatile
+//!   tool positions of two tool points, with `reset` on a volatile flag.
 //!
 //! Why the proof holds for every input, not just one: every input (the table
 //! lengths, the contact count, each contact's kind, vertices, barycentric
@@ -61,6 +67,9 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use cortex_m_rt::entry;
+use nalgebra::Vector3;
+use palpate_kernel::haptic::haptic_loop::{HapticLoop, LoopConfig};
+use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
 use palpate_kernel::precomputed::Contact;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
@@ -153,6 +162,98 @@ fn main() -> ! {
         // SAFETY: as above.
         let inputs = unsafe { read_volatile(addr_of!(TENSOR_INPUTS)) };
         tensor_mass_step(&inputs, &mut state);
+        // SAFETY: as above.
+        let inputs = unsafe { read_volatile(addr_of!(HAPTIC_INPUTS)) };
+        haptic_step(&inputs);
+    }
+}
+
+/// Tool points of the checked haptic loop (a grasper's two jaws).
+const TOOL_POINTS: usize = 2;
+
+/// Everything the haptic loop takes, opaque to the optimiser.
+struct HapticInputs {
+    /// Bytes of `TABLE` passed to `load` (clamped to the table length).
+    table_len: usize,
+    /// Tool sphere radius (m), haptic period (s), force clamp (N), slew (N/s).
+    config: [f32; 4],
+    /// Ticks per round on one loop.
+    ticks: u32,
+    /// Tool point positions each tick, m (read again every tick).
+    tool_m: [[f32; 3]; TOOL_POINTS],
+    /// Non-zero: `reset` before the tick.
+    reset: u8,
+}
+
+/// The haptic inputs, read with `read_volatile` only.
+static mut HAPTIC_INPUTS: HapticInputs = HapticInputs {
+    table_len: usize::MAX,
+    config: [0.002, 1e-3, 4.0, 2000.0],
+    ticks: 1,
+    tool_m: [[0.0; 3]; TOOL_POINTS],
+    reset: 0,
+};
+
+/// What the haptic loop produced, written with `write_volatile` only.
+struct HapticOutputs {
+    force_n: [f32; 3],
+    status: u8,
+    contacts: u8,
+    refused: u8,
+    solves: u32,
+}
+
+/// The haptic outputs.
+static mut HAPTIC_OUTPUTS: HapticOutputs = HapticOutputs {
+    force_n: [0.0; 3],
+    status: 0,
+    contacts: 0,
+    refused: 0,
+    solves: 0,
+};
+
+/// Load, build the loop, then tick on volatile tool positions (`reset` on
+/// a volatile flag), publishing every output.
+fn haptic_step(inputs: &HapticInputs) {
+    let bytes = TABLE.get(..inputs.table_len).unwrap_or(TABLE);
+    let Ok(table) = PrecomputedTable::<f32>::load(bytes) else {
+        refused();
+        return;
+    };
+    let [radius_m, dt_s, max_force_n, max_slew_n_per_s] = inputs.config;
+    let config = LoopConfig {
+        radius_m,
+        dt_s,
+        limits: SafetyLimits {
+            max_force_n,
+            max_slew_n_per_s,
+        },
+    };
+    let Ok(mut haptic) = HapticLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(&table, config) else {
+        refused();
+        return;
+    };
+    for _ in 0..inputs.ticks {
+        // SAFETY: single-threaded; plain-old-data static.
+        let tick = unsafe { read_volatile(addr_of!(HAPTIC_INPUTS)) };
+        if tick.reset != 0 {
+            haptic.reset();
+        }
+        let out = haptic.tick(&tick.tool_m.map(Vector3::from));
+        let status = match out.status {
+            OutputStatus::Ok => 0,
+            OutputStatus::Clamped => 1,
+            OutputStatus::Faulted(_) => 2,
+        };
+        let o = addr_of_mut!(HAPTIC_OUTPUTS);
+        // SAFETY: single-threaded; plain-old-data fields of a live static.
+        unsafe {
+            write_volatile(addr_of_mut!((*o).force_n), out.force_n.into());
+            write_volatile(addr_of_mut!((*o).status), status);
+            write_volatile(addr_of_mut!((*o).contacts), out.contacts);
+            write_volatile(addr_of_mut!((*o).refused), out.refused);
+            write_volatile(addr_of_mut!((*o).solves), haptic.counters().solves);
+        }
     }
 }
 
