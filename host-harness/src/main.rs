@@ -45,6 +45,9 @@ enum Command {
     /// Experiments that reproduce the papers' figures.
     #[command(subcommand)]
     Experiment(ExperimentCommand),
+    /// Haptic sessions: the kernel's fixed-timestep loop driven by a trajectory.
+    #[command(subcommand)]
+    Session(SessionCommand),
     /// Built-in scene: two-probe press and release, forces, timings, VTK series.
     Demo {
         /// Folder for the VTK series (created if absent).
@@ -179,6 +182,47 @@ impl DynamicModelArgs {
         };
         Ok((mesh, report, options))
     }
+}
+
+#[derive(Subcommand)]
+enum SessionCommand {
+    /// Drive the haptic loop tick by tick; write `t,fx,fy,fz,contacts,status` per tick.
+    Run {
+        /// Scene file (TOML), or `built-in` for the demo scene.
+        scene: String,
+        /// Trajectory file: CSV `t,tool,x,y,z` (s, tool point, m) with a header.
+        #[arg(long)]
+        trajectory: PathBuf,
+        /// Output CSV, one line per tick.
+        #[arg(long)]
+        out: PathBuf,
+        /// Folder for a VTK frame per physics update and `session.pvd`.
+        #[arg(long)]
+        vtk: Option<PathBuf>,
+        /// Keep non-finite values and backward times (reported on stderr) and
+        /// feed them to the kernel, for robustness runs.
+        #[arg(long)]
+        lenient: bool,
+    },
+    /// Write a generated trajectory for the built-in scene.
+    Generate {
+        /// Which path.
+        #[arg(value_enum)]
+        kind: TrajectoryKind,
+        /// Output CSV.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+    },
+}
+
+/// The trajectory generators.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum TrajectoryKind {
+    Poke,
+    PressHold,
+    Slide,
+    Pinch,
+    Strike,
 }
 
 #[derive(Subcommand)]
@@ -599,6 +643,66 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             } else {
                 print!("{}", volume_bend::table(&results));
             }
+            Ok(())
+        }
+        Command::Session(SessionCommand::Run {
+            scene,
+            trajectory,
+            out,
+            vtk,
+            lenient,
+        }) => {
+            use palpate::session::{Scene, Trajectory};
+            let scene = if scene == "built-in" {
+                Scene::built_in()
+            } else {
+                Scene::read(std::path::Path::new(&scene))?
+            };
+            let points = scene.tool.points;
+            let trajectory = if lenient {
+                let (t, findings) = Trajectory::read_unchecked(&trajectory, points)?;
+                for finding in findings {
+                    eprintln!("warning: {finding}");
+                }
+                t
+            } else {
+                Trajectory::read(&trajectory, points)?
+            };
+            if let Some(dir) = &vtk {
+                std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+            }
+            let file = std::fs::File::create(&out).with_context(|| out.display().to_string())?;
+            let mut writer = std::io::BufWriter::new(file);
+            let summary = palpate::session::run::run_session(
+                &scene,
+                &trajectory,
+                &mut writer,
+                vtk.as_deref(),
+            )?;
+            std::io::Write::flush(&mut writer)?;
+            eprintln!(
+                "{} ticks ({} in contact, {} clamped, {} faulted); max force {:.3} N, max jump {:.4} N per tick; {} VTK frames",
+                summary.ticks,
+                summary.ticks_in_contact,
+                summary.clamped,
+                summary.faulted,
+                summary.max_force_n,
+                summary.max_jump_n,
+                summary.frames
+            );
+            Ok(())
+        }
+        Command::Session(SessionCommand::Generate { kind, output }) => {
+            use palpate::session::{Generator, Pinch, Poke, PressHold, Slide, Strike};
+            let trajectory = match kind {
+                TrajectoryKind::Poke => Poke::default().trajectory(),
+                TrajectoryKind::PressHold => PressHold::default().trajectory(),
+                TrajectoryKind::Slide => Slide::default().trajectory(),
+                TrajectoryKind::Pinch => Pinch::default().trajectory(),
+                TrajectoryKind::Strike => Strike::default().trajectory(),
+            }
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            trajectory.write_csv_file(&output)?;
             Ok(())
         }
         Command::Demo { out } => palpate::demo::run(&out),

@@ -151,9 +151,15 @@ pub fn sample_keyframes(keyframes: &[Keyframe], rate_hz: f64) -> Result<Trajecto
     let tolerance_s = 1e-6 / rate_hz;
     let mut samples = Vec::new();
     for (tool, path) in paths.iter().enumerate() {
-        let grid = (0..grid_count)
-            .map(|k| k as f64 / rate_hz)
-            .filter(|t| path.iter().all(|&(tk, _)| (t - tk).abs() > tolerance_s));
+        let grid = (0..grid_count).map(|k| k as f64 / rate_hz).filter(|&t| {
+            // The keyframes nearest `t` (the path is time-ordered): none within tolerance.
+            let i = path.partition_point(|&(tk, _)| tk < t);
+            let near = |j: Option<usize>| {
+                j.and_then(|j| path.get(j))
+                    .is_some_and(|&(tk, _)| (t - tk).abs() <= tolerance_s)
+            };
+            !near(i.checked_sub(1)) && !near(Some(i))
+        });
         let mut times: Vec<f64> = grid.chain(path.iter().map(|&(t, _)| t)).collect();
         times.sort_by(f64::total_cmp);
         let mut keys = path.iter().peekable();

@@ -7,6 +7,7 @@
 //! ([`Trajectory::positions_at`]).
 
 pub mod generate;
+pub mod run;
 pub mod scene;
 pub mod trajectory;
 

@@ -445,10 +445,10 @@ impl Scene {
     ) -> Result<Scene, SceneError> {
         let raw: SceneFile = toml::from_str(text).map_err(|err| SceneError::Syntax {
             file: source.to_owned(),
-            // No line when the error spans the whole document (a missing top-level key).
+            // A missing top-level key is located at the document's start: no line then.
             line: err
                 .span()
-                .filter(|span| !(span.start == 0 && span.end >= text.len()))
+                .filter(|span| span.start > 0 || !err.message().starts_with("missing field"))
                 .and_then(|span| text.get(..span.start))
                 .map(|before| before.matches('\n').count() + 1),
             msg: err.message().trim().replace('\n', "; "),

@@ -1,9 +1,10 @@
 //! Tool trajectories: where each tool point is over time, from a CSV file or a generator.
 //!
 //! File format: a header line `t,tool,x,y,z`, then one sample per line: time (s), tool point
-//! index (0-based integer), position (m). Fields may be padded with blanks; blank lines and lines
-//! starting with `#` are skipped (line numbers stay the file's physical lines, the header being
-//! line 1 when nothing precedes it).
+//! index (0-based integer), position (m). One record per line (CSV quoting applies within a
+//! line); fields may be padded with blanks; blank lines and lines starting with `#` are skipped.
+//! Line numbers are the file's physical lines, 1-based: the header is line 1 when nothing
+//! precedes it.
 //!
 //! ```text
 //! t,tool,x,y,z
@@ -301,40 +302,37 @@ fn parse_record(record: &csv::StringRecord) -> Result<Sample, LineProblem> {
     })
 }
 
-/// Read CSV from `reader` under `mode`; `file` names it in messages.
-fn read_csv<R: io::Read>(
-    reader: R,
+/// Read CSV `bytes` under `mode`; `file` names it in messages.
+///
+/// Lines are split here (on `\n`, a trailing `\r` dropped) and each is read as one CSV record
+/// by the `csv` crate: the crate's own line count skips blank lines uncounted, and every message
+/// must name the file's physical line.
+fn read_csv(
+    bytes: &[u8],
     file: &str,
     tool_count: usize,
     mode: Mode,
 ) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
     let mut builder = Builder::new(file, tool_count, mode)?;
-    let mut csv = csv::ReaderBuilder::new()
+    let mut parser = csv::ReaderBuilder::new();
+    parser
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(reader);
+        .buffer_capacity(256);
     let mut header_seen = false;
     let mut record = csv::StringRecord::new();
-    loop {
-        match csv.read_record(&mut record) {
-            Ok(true) => {}
-            Ok(false) => break,
-            Err(err) => {
-                let line = err.position().map_or(0, |p| p.line() as usize);
-                let msg = err.to_string();
-                return Err(match err.into_kind() {
-                    csv::ErrorKind::Io(err) => TrajectoryError::Io {
-                        file: file.to_owned(),
-                        action: "read",
-                        err,
-                    },
-                    _ => builder.line_error(line, LineProblem::Unreadable(msg)),
-                });
-            }
+    for (index, text) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = index + 1;
+        let text = text.strip_suffix(b"\r").unwrap_or(text);
+        let content = text.trim_ascii();
+        if content.is_empty() || content.starts_with(b"#") {
+            continue;
         }
-        let line = record.position().map_or(0, |p| p.line() as usize);
+        let read = parser.from_reader(text).read_record(&mut record);
+        if let Err(err) = read {
+            return Err(builder.line_error(line, LineProblem::Unreadable(err.to_string())));
+        }
         if !header_seen {
             if record.iter().ne(HEADER) {
                 let found = record.iter().collect::<Vec<_>>().join(",");
@@ -364,6 +362,8 @@ pub(crate) fn position_on(track: &[(f64, [f64; 3])], t_s: f64) -> [f64; 3] {
     let i = track.partition_point(|&(t, _)| t <= t_s);
     let before = i.checked_sub(1).and_then(|j| track.get(j));
     match (before, track.get(i)) {
+        // At a sample's own time, that sample (even if the next one is not finite).
+        (Some(&(t0, p0)), _) if t_s == t0 => p0,
         (Some(&(t0, p0)), Some(&(t1, p1))) => {
             let s = (t_s - t0) / (t1 - t0);
             [0, 1, 2].map(|k| p0[k] + (p1[k] - p0[k]) * s)
@@ -383,7 +383,7 @@ impl Trajectory {
             action: "read",
             err,
         })?;
-        read_csv(bytes.as_slice(), &file, tool_count, Mode::Checked).map(|(t, _)| t)
+        read_csv(&bytes, &file, tool_count, Mode::Checked).map(|(t, _)| t)
     }
 
     /// [`Trajectory::read`] from text; `source` names it in messages.
@@ -411,7 +411,7 @@ impl Trajectory {
             action: "read",
             err,
         })?;
-        read_csv(bytes.as_slice(), &file, tool_count, Mode::Lenient)
+        read_csv(&bytes, &file, tool_count, Mode::Lenient)
     }
 
     /// [`Trajectory::read_unchecked`] from text; `source` names it in messages.
@@ -467,8 +467,8 @@ impl Trajectory {
 
     /// Every tool point's position (m) at time `t_s`, by linear interpolation between the tool
     /// point's own samples:
-    /// - between its samples `(t0, p0)` and `(t1, p1)` with `t0 ≤ t_s < t1`:
-    ///   `p0 + (p1 − p0)·(t_s − t0)/(t1 − t0)`, so exactly `p0` at `t_s = t0`;
+    /// - between its samples `(t0, p0)` and `(t1, p1)` with `t0 < t_s < t1`:
+    ///   `p0 + (p1 − p0)·(t_s − t0)/(t1 − t0)`; at `t_s = t0` exactly `p0`;
     /// - before its first sample: the first sample; at or after its last: the last (hold);
     /// - two samples at the same time are a jump: from that time on the later one applies.
     ///

@@ -46,6 +46,12 @@ pub struct SurfaceGeometry<'a, T: Real> {
     fixed: &'a PrecomputedTable<'a, T>,
 }
 
+/// Vertices and corners of a triangle.
+struct Corners<T: Real> {
+    vertices: [u32; 3],
+    corners: [Vector3<T>; 3],
+}
+
 /// Corners and unit outward normal of a triangle.
 struct Face<T: Real> {
     vertices: [u32; 3],
@@ -87,13 +93,19 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         }
     }
 
-    fn face(&self, triangle: u32) -> Option<Face<T>> {
+    /// Vertices and rest corners of a surface triangle.
+    fn corners(&self, triangle: u32) -> Option<Corners<T>> {
         let vertices = *self.triangles.get(triangle as usize)?;
         let mut corners = [Vector3::zeros(); 3];
         for (c, &v) in corners.iter_mut().zip(&vertices) {
             let p = self.positions.get(v as usize)?;
             *c = Vector3::new(p[0], p[1], p[2]);
         }
+        Some(Corners { vertices, corners })
+    }
+
+    fn face(&self, triangle: u32) -> Option<Face<T>> {
+        let Corners { vertices, corners } = self.corners(triangle)?;
         let [a, b, c] = &corners;
         let n = (b - a).cross(&(c - a));
         let length = n.norm();
@@ -122,7 +134,10 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// contact point; triangles with all three vertices fixed (a rigid
     /// support, no compliance) are not touchable. Candidates: the triangles
     /// around the surface vertices in the 27 grid cells around `to_m` and
-    /// around `from_m`. Bounded by `2 × 27 × max_bucket × max_valence`.
+    /// around `from_m` (once when both are in the same cell; none for a
+    /// point more than a cell plus the radius outside the grid). Bounded by
+    /// `2 × 27 × max_bucket × max_valence` triangle tests, most rejected
+    /// without a square root.
     pub fn detect(
         &self,
         from_m: &Vector3<T>,
@@ -131,30 +146,48 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         work: &mut ContactWork,
     ) -> Option<ToolContact<T>> {
         let tolerance = T::WEIGHT_TOLERANCE;
+        // A start exactly touching the surface may round to just inside it.
+        let slack_m = tolerance * self.index.cell_m();
         let mut best: Option<(T, ToolContact<T>)> = None;
+        let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
+        let near_grid = |p: &Vector3<T>| self.index.is_near(p, radius_m);
+        let (near_to, near_from) = (near_grid(to_m), !same_cell && near_grid(from_m));
         let candidates = self
             .index
             .vertices_near(to_m)
-            .chain(self.index.vertices_near(from_m));
+            .take_while(|_| near_to)
+            .chain(self.index.vertices_near(from_m).take_while(|_| near_from));
         for v in candidates {
             for &t in self.index.triangles_of(v) {
                 work.triangles_tested = work.triangles_tested.saturating_add(1);
-                let Some(f) = self.face(t) else { continue };
+                let Some(f) = self.corners(t) else { continue };
+                // Cheap rejections on the unnormalized normal `m` first: the
+                // sphere must move inwards, start outside the plane and end
+                // closer than `r` to it (squared, no square root).
+                let [a, b, c] = &f.corners;
+                let m = (b - a).cross(&(c - a));
+                let (s0, s1) = ((from_m - a).dot(&m), (to_m - a).dot(&m));
+                let reach2 = radius_m * radius_m * m.norm_squared();
+                let slack = slack_m * m.norm();
+                if !(s1 < s0 && s0 >= -slack && (s1 <= T::zero() || s1 * s1 < reach2)) {
+                    continue;
+                }
                 if f.vertices.iter().all(|&v| self.fixed.is_fixed(v)) {
                     continue;
                 }
-                let [a, _, _] = f.corners;
-                let s0 = (from_m - a).dot(&f.normal) - radius_m;
-                let s1 = (to_m - a).dot(&f.normal) - radius_m;
-                if !(s0 >= T::zero() && s1 < T::zero()) {
+                let length = m.norm();
+                let normal = m / length;
+                let (s0, s1) = (s0 / length - radius_m, s1 / length - radius_m);
+                if !(s0 >= -slack_m && s1 < T::zero()) {
                     continue;
                 }
+                let s0 = s0.max(T::zero());
                 let along = s0 / (s0 - s1);
                 if best.as_ref().is_some_and(|(b, _)| *b <= along) {
                     continue;
                 }
-                let x = from_m + (to_m - from_m) * along - f.normal * radius_m;
-                let w = barycentric(&f.corners, &f.normal, &x);
+                let x = from_m + (to_m - from_m) * along - normal * radius_m;
+                let w = barycentric(&f.corners, &normal, &x);
                 if w.iter().all(|&wi| wi >= -tolerance) {
                     let contact = ToolContact {
                         triangle: t,

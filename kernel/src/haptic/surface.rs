@@ -181,6 +181,19 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         cell
     }
 
+    /// `true` if `p` (m) lies within one cell edge plus `margin_m` of the
+    /// grid's box (a point farther out has no surface vertex within a cell).
+    pub fn is_near(&self, p: &Vector3<T>, margin_m: T) -> bool {
+        let reach = self.cell_m + margin_m;
+        p.iter()
+            .zip(self.origin_m.iter())
+            .zip(&self.dims)
+            .all(|((&x, &o), &d)| {
+                let extent = self.cell_m * T::of_f64(f64::from(d));
+                x >= o - reach && x <= o + extent + reach
+            })
+    }
+
     fn coordinates(&self, cell: usize) -> [u32; 3] {
         let [nx, ny, _] = self.dims.map(|d| d as usize);
         let (x, rest) = (cell.checked_rem(nx), cell.checked_div(nx));
