@@ -6,24 +6,30 @@
 #   x86_64-unknown-none (kernel cross-build) targets;
 # - llvm-tools (llvm-size, llvm-nm, llvm-objdump for the size report and the
 #   no-panic diagnostics, under $(rustc --print sysroot)/lib/rustlib/*/bin);
-# - qemu-system-arm (runs the firmware), from apt-get, with sudo when not root.
+# - qemu-system-arm (runs the firmware) and valgrind (callgrind instruction
+#   counts of `palpate budget` and its test), from apt-get, with sudo when
+#   not root.
 # Idempotent; a fast no-op when all is present.
 set -euo pipefail
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
 rustup component add llvm-tools
 
-if ! command -v qemu-system-arm >/dev/null; then
+missing=()
+command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
+command -v valgrind >/dev/null || missing+=(valgrind)
+if [ ${#missing[@]} -gt 0 ]; then
     sudo=""
     if [ "$(id -u)" != 0 ]; then
         if ! command -v sudo >/dev/null; then
-            echo "setup: qemu-system-arm is missing and installing it needs root (no sudo here)" >&2
+            echo "setup: ${missing[*]} missing and installing needs root (no sudo here)" >&2
             exit 1
         fi
         sudo="sudo"
     fi
     $sudo apt-get update -qq
     $sudo env DEBIAN_FRONTEND=noninteractive \
-        apt-get install -y -qq --no-install-recommends qemu-system-arm
+        apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 qemu-system-arm --version | head -1
+valgrind --version

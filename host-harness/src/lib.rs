@@ -4,6 +4,7 @@
 //! (P1 stiffness) → [`tables`] (compliance, table file) → the kernel
 //! (`palpate_kernel`) → [`precomputed`] / [`demo`] / [`replay`] (runs and reports).
 
+pub mod budget;
 pub mod demo;
 pub mod dynamic;
 pub mod experiment;

@@ -48,6 +48,22 @@ enum Command {
     /// Haptic sessions: the kernel's fixed-timestep loop driven by a trajectory.
     #[command(subcommand)]
     Session(SessionCommand),
+    /// Per-tick instruction counts (callgrind) of every generated trajectory
+    /// against the static bound from the table sizes and capacities.
+    Budget {
+        /// Scene file (TOML), or `built-in`.
+        scene: String,
+        /// Working folder for tables, trajectories and callgrind dumps.
+        #[arg(long, default_value = "budget-out")]
+        work_dir: PathBuf,
+        /// Print one JSON array instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Internal: run the ticks of this trajectory on this table (the
+        /// process callgrind measures).
+        #[arg(long, hide = true, num_args = 2, value_names = ["TABLE", "TRAJECTORY"])]
+        probe: Option<Vec<PathBuf>>,
+    },
     /// Built-in scene: two-probe press and release, forces, timings, VTK series.
     Demo {
         /// Folder for the VTK series (created if absent).
@@ -705,8 +721,158 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             trajectory.write_csv_file(&output)?;
             Ok(())
         }
+        Command::Budget {
+            scene,
+            work_dir,
+            json,
+            probe,
+        } => budget(&scene, &work_dir, json, probe.as_deref()),
         Command::Demo { out } => palpate::demo::run(&out),
     }
+}
+
+/// `palpate budget`: measure every generated trajectory on the scene's mesh
+/// (and, for a generated box, at half its resolution) under callgrind.
+fn budget(
+    scene_arg: &str,
+    work_dir: &std::path::Path,
+    json: bool,
+    probe: Option<&[PathBuf]>,
+) -> anyhow::Result<()> {
+    use palpate::budget::{BudgetRow, M4F_IPS, measure, tick_bound, trajectories};
+    use palpate::session::{MeshSource, Scene, Trajectory};
+    let mut scene = if scene_arg == "built-in" {
+        Scene::built_in()
+    } else {
+        Scene::read(std::path::Path::new(scene_arg))?
+    };
+    if let Some([table_path, trajectory_path]) = probe {
+        let bytes = palpate::tables::load::TableFile::read(table_path)?;
+        let table = palpate_kernel::PrecomputedTable::<f32>::load(bytes.bytes())
+            .map_err(|e| anyhow::anyhow!("{}: {e}", table_path.display()))?;
+        let trajectory = Trajectory::read(trajectory_path, scene.tool.points)?;
+        let counters = palpate::budget::probe(&table, &scene, &trajectory)?;
+        let lines: Vec<String> = counters
+            .iter()
+            .map(|c| {
+                format!(
+                    "{},{},{}",
+                    c.contact.triangles_tested, c.contact.walk_steps, c.solves
+                )
+            })
+            .collect();
+        std::fs::write(trajectory_path.with_extension("work"), lines.join("\n"))?;
+        return Ok(());
+    }
+    std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
+    let exe = std::env::current_exe()?;
+    let mut sizes = vec![scene.mesh.clone()];
+    if let MeshSource::GeneratedBox { size_m, cells } = &scene.mesh {
+        let coarse = cells.map(|c| (c / 2).max(1));
+        sizes.insert(
+            0,
+            MeshSource::GeneratedBox {
+                size_m: *size_m,
+                cells: coarse,
+            },
+        );
+    }
+    let points = scene.tool.points;
+    let mut rows: Vec<BudgetRow> = Vec::new();
+    for (s, source) in sizes.into_iter().enumerate() {
+        scene.mesh = source;
+        let (mesh, report) = scene.load_mesh()?;
+        let options = BuildOptions {
+            material: scene.elastic_material()?,
+            fix: scene.fix.clone(),
+            solver: Solver::Cholesky,
+            precision: Precision::F32,
+            progress: false,
+        };
+        let built = build_table(&mesh, &report, &options)?;
+        let table_path = work_dir.join(format!("table-{s}.bin"));
+        std::fs::write(&table_path, &built.bytes)?;
+        let file = TableFile::from_bytes(&built.bytes);
+        let table = palpate_kernel::PrecomputedTable::<f32>::load(file.bytes())
+            .map_err(|e| anyhow::anyhow!("table: {e}"))?;
+        let bound = tick_bound(&table, points as u64, points as u64);
+        for (name, trajectory) in trajectories(points)? {
+            let csv = work_dir.join(format!("{name}-{s}.csv"));
+            trajectory.write_csv_file(&csv)?;
+            let args: Vec<String> = vec![
+                "budget".into(),
+                scene_arg.into(),
+                "--probe".into(),
+                table_path.display().to_string(),
+                csv.display().to_string(),
+            ];
+            let irs = measure(&exe, &args, &work_dir.join(format!("cg-{name}-{s}")))?;
+            let work = std::fs::read_to_string(csv.with_extension("work"))?;
+            let mut max_work = [0u32; 3];
+            for line in work.lines() {
+                for (m, v) in max_work.iter_mut().zip(line.split(',')) {
+                    *m = (*m).max(v.parse().unwrap_or(0));
+                }
+            }
+            let max_ir = irs.iter().copied().max().unwrap_or(0);
+            let mean_ir = irs.iter().sum::<u64>() as f64 / irs.len().max(1) as f64;
+            rows.push(BudgetRow {
+                mesh: format!(
+                    "{} vertices, {} tets",
+                    mesh.positions.len(),
+                    mesh.tets.len()
+                ),
+                trajectory: name,
+                ticks: irs.len(),
+                max_ir,
+                mean_ir,
+                bound_ir: bound,
+                max_work,
+            });
+        }
+    }
+    if json {
+        println!("{}", serde_json::to_string(&rows)?);
+        return Ok(());
+    }
+    println!(
+        "{:<26} {:<11} {:>6} {:>9} {:>9} {:>9} {:>6} {:>10} {:>12}",
+        "mesh",
+        "trajectory",
+        "ticks",
+        "mean Ir",
+        "max Ir",
+        "bound Ir",
+        "max/b",
+        "bound@168M",
+        "tests/walk/solves"
+    );
+    for r in &rows {
+        println!(
+            "{:<26} {:<11} {:>6} {:>9.0} {:>9} {:>9} {:>6.3} {:>8.1} µs {:>5}/{}/{}",
+            r.mesh,
+            r.trajectory,
+            r.ticks,
+            r.mean_ir,
+            r.max_ir,
+            r.bound_ir,
+            r.max_ir as f64 / r.bound_ir as f64,
+            r.bound_ir as f64 / M4F_IPS * 1e6,
+            r.max_work[0],
+            r.max_work[1],
+            r.max_work[2]
+        );
+    }
+    if let Some(r) = rows.iter().find(|r| r.max_ir > r.bound_ir) {
+        anyhow::bail!(
+            "{} on {}: {} instructions exceed the bound {}",
+            r.trajectory,
+            r.mesh,
+            r.max_ir,
+            r.bound_ir
+        );
+    }
+    Ok(())
 }
 
 /// The `--contact` and `--contact-bary` values in command-line order.

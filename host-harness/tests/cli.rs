@@ -465,3 +465,37 @@ fn stvk_forces_prints_forces_and_energy() {
     ]);
     assert_one_line_error(&out, "line 2");
 }
+
+/// `palpate budget built-in --json`: every generated trajectory on both mesh
+/// sizes, every tick's callgrind instruction count at or below the static
+/// bound from the table sizes and capacities (needs valgrind:
+/// `tools/setup.sh` installs it). Instruction counts are deterministic, so
+/// this is not a timed test.
+#[test]
+fn budget_ticks_stay_within_the_static_bound() {
+    let dir = temp("budget");
+    let out = palpate(&[
+        "budget",
+        "built-in",
+        "--json",
+        "--work-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 8, "4 trajectories x 2 meshes");
+    for row in rows {
+        let (max, bound) = (
+            row["max_ir"].as_u64().unwrap(),
+            row["bound_ir"].as_u64().unwrap(),
+        );
+        println!("{} on {}: {max} <= {bound}", row["trajectory"], row["mesh"]);
+        assert!(row["ticks"].as_u64().unwrap() > 900);
+        assert!(max > 0 && max <= bound, "{row}");
+    }
+}

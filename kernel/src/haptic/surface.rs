@@ -24,6 +24,7 @@ pub struct SurfaceIndex<'a, T> {
     vertex_triangle: &'a [u32],
     max_bucket: u32,
     max_valence: u32,
+    max_query_triangles: u32,
 }
 
 /// The raw sections of a collision index, before validation.
@@ -90,6 +91,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             vertex_triangle: s.vertex_triangle,
             max_bucket: max_row(s.cell_start),
             max_valence: max_row(s.vertex_triangle_start),
+            max_query_triangles: 0,
         };
         // Every filed vertex exists and lies within one cell of its own.
         for (cell, bucket) in s.cell_start.windows(2).enumerate() {
@@ -131,7 +133,44 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                 }
             }
         }
+        // The most triangles one query can visit: over every cell, the
+        // triangles around the vertices of its 27-cell neighbourhood.
+        let mut index = index;
+        let [nx, ny, nz] = dims;
+        let mut worst = 0u32;
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let centre = index.cell_centre([i, j, k]);
+                    let count = index
+                        .vertices_near(&centre)
+                        .map(|v| index.triangles_of(v).len() as u32)
+                        .fold(0u32, u32::saturating_add);
+                    worst = worst.max(count);
+                }
+            }
+        }
+        index.max_query_triangles = worst;
         Ok(index)
+    }
+
+    /// Centre of cell `c`, m.
+    fn cell_centre(&self, c: [u32; 3]) -> Vector3<T> {
+        let half = T::of_f64(0.5);
+        let at = |axis: usize| {
+            let o = self.origin_m.get(axis).copied().unwrap_or(T::zero());
+            let i = c.get(axis).copied().unwrap_or(0);
+            o + (T::of_f64(f64::from(i)) + half) * self.cell_m
+        };
+        Vector3::new(at(0), at(1), at(2))
+    }
+
+    /// The most candidate triangles one point query
+    /// ([`Self::vertices_near`] then [`Self::triangles_of`]) visits, over
+    /// every cell of the grid (computed at load: the exact table-declared
+    /// bound of a detection's work, per query point).
+    pub fn max_query_triangles(&self) -> u32 {
+        self.max_query_triangles
     }
 
     /// Grid origin, m.
