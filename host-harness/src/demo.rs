@@ -1,8 +1,9 @@
-//! `palpate demo`: the built-in scene, needing no input file.
+//! `palpate demo`: the built-in scene ([`Scene::built_in`]), needing no
+//! input file.
 //!
-//! A 12 × 12 × 6 cm block of soft tissue (12 × 12 × 6 cells, 5184 tets, E = 3
-//! kPa, ν = 0.45, base fixed) is pressed by two probes at once, held and
-//! released. The table is built in memory with the same code as
+//! Its 12 × 12 × 6 cm block of soft tissue (12 × 12 × 6 cells, 5184 tets,
+//! E = 3 kPa, ν = 0.45, base fixed) is pressed by two probes at once, held
+//! and released. The table is built in memory with the same code as
 //! `tables build`, stored in `f32` as on firmware, loaded by the kernel, and
 //! every step runs the kernel's force path and displacement update.
 
@@ -14,10 +15,8 @@ use anyhow::Context;
 use nalgebra::Vector3;
 use palpate_kernel::{Contact, MAX_CONTACTS};
 
-use crate::fem::material::Material;
-use crate::fix::FixPredicate;
-use crate::mesh::{MeshReport, generate::box_mesh};
 use crate::output::vtk;
+use crate::session::{MeshSource, Scene};
 use crate::tables::build::{BuildOptions, build_table};
 use crate::tables::compliance::Solver;
 use crate::tables::file::Precision;
@@ -33,19 +32,15 @@ const FRAME_EVERY: usize = 4;
 /// Runs the demo, printing forces per phase and timings, and writing the VTK
 /// series into `out_dir`.
 pub fn run(out_dir: &Path) -> anyhow::Result<()> {
-    let size_m = [0.12, 0.12, 0.06];
-    let mesh = box_mesh([12, 12, 6], size_m);
-    let report = MeshReport {
-        source: "built-in block".into(),
-        ..MeshReport::default()
+    let scene = Scene::built_in();
+    let MeshSource::GeneratedBox { size_m, .. } = scene.mesh else {
+        anyhow::bail!("the built-in scene is a generated block");
     };
+    let (mesh, mut report) = scene.load_mesh()?;
+    report.source = "built-in block".into();
     let options = BuildOptions {
-        material: Material::new(3000.0, 0.45)?,
-        fix: vec![
-            "z<0.0001"
-                .parse::<FixPredicate>()
-                .map_err(anyhow::Error::msg)?,
-        ],
+        material: scene.elastic_material()?,
+        fix: scene.fix.clone(),
         solver: Solver::Cholesky,
         precision: Precision::F32,
         progress: false,
