@@ -18,6 +18,8 @@ pub struct CollisionIndex {
     pub vertex_triangle_start: Vec<u32>,
     /// Triangles around each vertex, ascending.
     pub vertex_triangle: Vec<u32>,
+    /// Each triangle's unit outward normal and offset `n·p₀` (m).
+    pub planes: Vec<[f64; 4]>,
 }
 
 /// Builds the index of the surface `triangles` over `positions` (m).
@@ -86,7 +88,29 @@ pub fn collision_index(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Collis
         }
     }
     let (vertex_triangle_start, vertex_triangle) = csr(&around);
+    let planes = triangles
+        .iter()
+        .map(|tri| {
+            let p = |i: usize| positions.get(tri[i] as usize).copied().unwrap_or([0.0; 3]);
+            let (a, b, c) = (p(0), p(1), p(2));
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let n = if len > 0.0 {
+                n.map(|x| x / len)
+            } else {
+                [0.0; 3]
+            };
+            [n[0], n[1], n[2], n[0] * a[0] + n[1] * a[1] + n[2] * a[2]]
+        })
+        .collect();
     CollisionIndex {
+        planes,
         grid: [lo[0], lo[1], lo[2], cell],
         dims,
         cell_start,

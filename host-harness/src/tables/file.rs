@@ -78,6 +78,7 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
             &index.vertex_triangle_start,
         ),
         Section::ints(SectionKind::VertexTriangle, &index.vertex_triangle),
+        Section::floats(SectionKind::SurfacePlane, &index.planes, precision),
     ];
     write_container(header, precision, &sections)
 }

@@ -106,13 +106,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
 
     fn face(&self, triangle: u32) -> Option<Face<T>> {
         let Corners { vertices, corners } = self.corners(triangle)?;
-        let [a, b, c] = &corners;
-        let n = (b - a).cross(&(c - a));
-        let length = n.norm();
-        (length > T::zero()).then(|| Face {
+        let (normal, _) = self.index.plane(triangle)?;
+        Some(Face {
             vertices,
             corners,
-            normal: n / length,
+            normal,
         })
     }
 
@@ -136,8 +134,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// around the surface vertices in the 27 grid cells around `to_m` and
     /// around `from_m` (once when both are in the same cell; none for a
     /// point more than a cell plus the radius outside the grid). Bounded by
-    /// `2 × 27 × max_bucket × max_valence` triangle tests, most rejected
-    /// without a square root.
+    /// `2 × max_query_triangles` triangle tests, most rejected by two dot
+    /// products with the stored plane.
     pub fn detect(
         &self,
         from_m: &Vector3<T>,
@@ -160,30 +158,22 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         for v in candidates {
             for &t in self.index.triangles_of(v) {
                 work.triangles_tested = work.triangles_tested.saturating_add(1);
-                let Some(f) = self.corners(t) else { continue };
-                // Cheap rejections on the unnormalized normal `m` first: the
-                // sphere must move inwards, start outside the plane and end
-                // closer than `r` to it (squared, no square root).
-                let [a, b, c] = &f.corners;
-                let m = (b - a).cross(&(c - a));
-                let (s0, s1) = ((from_m - a).dot(&m), (to_m - a).dot(&m));
-                let reach2 = radius_m * radius_m * m.norm_squared();
-                let slack = slack_m * m.norm();
-                if !(s1 < s0 && s0 >= -slack && (s1 <= T::zero() || s1 * s1 < reach2)) {
+                // The stored plane first: two dot products reject almost all.
+                let Some((normal, offset)) = self.index.plane(t) else {
                     continue;
-                }
-                if f.vertices.iter().all(|&v| self.fixed.is_fixed(v)) {
-                    continue;
-                }
-                let length = m.norm();
-                let normal = m / length;
-                let (s0, s1) = (s0 / length - radius_m, s1 / length - radius_m);
+                };
+                let s0 = normal.dot(from_m) - offset - radius_m;
+                let s1 = normal.dot(to_m) - offset - radius_m;
                 if !(s0 >= -slack_m && s1 < T::zero()) {
                     continue;
                 }
                 let s0 = s0.max(T::zero());
                 let along = s0 / (s0 - s1);
                 if best.as_ref().is_some_and(|(b, _)| *b <= along) {
+                    continue;
+                }
+                let Some(f) = self.corners(t) else { continue };
+                if f.vertices.iter().all(|&v| self.fixed.is_fixed(v)) {
                     continue;
                 }
                 let x = from_m + (to_m - from_m) * along - normal * radius_m;

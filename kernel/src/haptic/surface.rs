@@ -22,6 +22,7 @@ pub struct SurfaceIndex<'a, T> {
     grid_vertex: &'a [u32],
     vertex_triangle_start: &'a [u32],
     vertex_triangle: &'a [u32],
+    planes: &'a [[T; 4]],
     max_bucket: u32,
     max_valence: u32,
     max_query_triangles: u32,
@@ -35,6 +36,7 @@ pub(crate) struct SurfaceSections<'a, T> {
     pub(crate) grid_vertex: &'a [u32],
     pub(crate) vertex_triangle_start: &'a [u32],
     pub(crate) vertex_triangle: &'a [u32],
+    pub(crate) planes: &'a [[T; 4]],
 }
 
 /// `true` if `starts` begins at 0, never decreases and ends at `total`.
@@ -89,6 +91,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             grid_vertex: s.grid_vertex,
             vertex_triangle_start: s.vertex_triangle_start,
             vertex_triangle: s.vertex_triangle,
+            planes: s.planes,
             max_bucket: max_row(s.cell_start),
             max_valence: max_row(s.vertex_triangle_start),
             max_query_triangles: 0,
@@ -132,6 +135,34 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                     return Err(bad);
                 }
             }
+        }
+        // Each plane: finite, unit normal, through the triangle's corners,
+        // pointing along the corners' right-hand normal.
+        let tolerance = T::of_f64(1e-4);
+        for (t, (plane, tri)) in s.planes.iter().zip(triangles).enumerate() {
+            let bad = LoadError::BadSurfacePlane { triangle: t as u32 };
+            let [nx, ny, nz, d] = *plane;
+            let n = Vector3::new(nx, ny, nz);
+            let mut corners = [Vector3::zeros(); 3];
+            for (c, &v) in corners.iter_mut().zip(tri) {
+                let p = positions.get(v as usize).ok_or(bad)?;
+                *c = Vector3::new(p[0], p[1], p[2]);
+            }
+            let [a, b, c] = corners;
+            let through = corners
+                .iter()
+                .all(|p| (n.dot(p) - d).abs() <= tolerance * cell_m);
+            let unit = (n.norm_squared() - T::one()).abs() <= tolerance;
+            if !(plane.iter().all(|x| x.finite())
+                && unit
+                && through
+                && n.dot(&(b - a).cross(&(c - a))) > T::zero())
+            {
+                return Err(bad);
+            }
+        }
+        if s.planes.len() != triangles.len() {
+            return Err(LoadError::BadSurfacePlane { triangle: 0 });
         }
         // The most triangles one query can visit: over every cell, the
         // triangles around the vertices of its 27-cell neighbourhood.
@@ -263,6 +294,13 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                 })
             })
         })
+    }
+
+    /// The stored plane of surface triangle `t`: unit outward normal and
+    /// offset `n·p` (m).
+    pub fn plane(&self, t: u32) -> Option<(Vector3<T>, T)> {
+        let [x, y, z, d] = *self.planes.get(t as usize)?;
+        Some((Vector3::new(x, y, z), d))
     }
 
     /// The surface triangles around `vertex` (indices into the table's

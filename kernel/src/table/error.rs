@@ -135,6 +135,12 @@ pub enum LoadError {
         /// Grid cell (or vertex, for a misfiled vertex) where it was found.
         index: u32,
     },
+    /// A surface triangle's stored plane is not finite, not a unit normal,
+    /// or not the plane of its corners.
+    BadSurfacePlane {
+        /// Surface triangle index.
+        triangle: u32,
+    },
     /// A vertex's list of surface triangles is malformed (starts not
     /// ascending, a triangle out of range, not containing the vertex, or not
     /// ascending).
@@ -226,6 +232,10 @@ impl fmt::Display for LoadError {
             LoadError::BadSurfaceGrid { index } => {
                 write!(f, "surface grid malformed at cell or vertex {index}")
             }
+            LoadError::BadSurfacePlane { triangle } => write!(
+                f,
+                "surface triangle {triangle}: stored plane is not the unit outward plane of its corners"
+            ),
             LoadError::BadVertexTriangles { vertex } => write!(
                 f,
                 "vertex {vertex}: surface-triangle list malformed (range, order, or a triangle without the vertex)"

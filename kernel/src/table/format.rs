@@ -132,6 +132,7 @@ impl TableKind {
                 SectionKind::GridVertex,
                 SectionKind::VertexTriangleStart,
                 SectionKind::VertexTriangle,
+                SectionKind::SurfacePlane,
             ],
             TableKind::TensorMass => &[
                 SectionKind::VertexSlot,
@@ -208,6 +209,10 @@ pub enum SectionKind {
     /// `u32` × 3·triangle_count: the surface triangles around each vertex,
     /// ascending within a vertex.
     VertexTriangle = 12,
+    /// `[scalar; 4]` × triangle_count: each surface triangle's plane, the
+    /// unit outward normal `n` and the offset `n·p₀` (m), so a contact test
+    /// is two dot products.
+    SurfacePlane = 13,
     /// `scalar` × N: lumped vertex masses `m_i = ρ Σ_{tets ∋ i} V/4`, kg.
     LumpedMass = 16,
     /// `[scalar; 9]` × N: vertex tensors `K_ii`, row-major, N/m.
@@ -287,7 +292,7 @@ pub const TET_TERMS_LEN: usize = 3;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 27] = [
+    pub const ALL: [SectionKind; 28] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -300,6 +305,7 @@ impl SectionKind {
         SectionKind::GridVertex,
         SectionKind::VertexTriangleStart,
         SectionKind::VertexTriangle,
+        SectionKind::SurfacePlane,
         SectionKind::LumpedMass,
         SectionKind::VertexTensor,
         SectionKind::EdgeRowStart,
@@ -331,6 +337,7 @@ impl SectionKind {
             | SectionKind::GridVertex
             | SectionKind::VertexTriangleStart
             | SectionKind::VertexTriangle => 4,
+            SectionKind::SurfacePlane => 4 * scalar_bytes,
             SectionKind::ComplianceSurface
             | SectionKind::ComplianceInterior
             | SectionKind::VertexTensor
@@ -376,6 +383,7 @@ impl SectionKind {
             SectionKind::GridVertex => Some(u64::from(h.surface_vertex_count)),
             SectionKind::VertexTriangleStart => n.checked_add(1),
             SectionKind::VertexTriangle => u64::from(h.triangle_count).checked_mul(3),
+            SectionKind::SurfacePlane => Some(u64::from(h.triangle_count)),
             SectionKind::SurfaceTriangles => Some(u64::from(h.triangle_count)),
             SectionKind::ComplianceSurface => s.checked_mul(s.checked_add(1)?).map(|x| x / 2),
             SectionKind::ComplianceInterior => f.checked_sub(s)?.checked_mul(s),
@@ -397,6 +405,7 @@ impl SectionKind {
             SectionKind::GridVertex => "grid-vertex",
             SectionKind::VertexTriangleStart => "vertex-triangle-start",
             SectionKind::VertexTriangle => "vertex-triangle",
+            SectionKind::SurfacePlane => "surface-plane",
             SectionKind::LumpedMass => "lumped-mass",
             SectionKind::VertexTensor => "vertex-tensor",
             SectionKind::EdgeRowStart => "edge-row-start",

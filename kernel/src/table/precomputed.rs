@@ -52,6 +52,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             grid_vertex: c.section(SectionKind::GridVertex)?,
             vertex_triangle_start: c.section(SectionKind::VertexTriangleStart)?,
             vertex_triangle: c.section(SectionKind::VertexTriangle)?,
+            planes: c.section(SectionKind::SurfacePlane)?,
         };
         let table = Self {
             header: c.header,
