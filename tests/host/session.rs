@@ -1245,3 +1245,16 @@ fn every_generator_error_names_the_parameter() {
         "keyframes: no keyframe"
     );
 }
+
+/// A haptic rate so small that the tick period overflows to infinity is
+/// refused (found by fuzzing the scene parser).
+#[test]
+fn subnormal_haptic_rate_is_refused() {
+    let err = scene_err(
+        "generated = { box = [0.1, 0.1, 0.05], cells = [2, 2, 1] }\nfix = [\"z<0.001\"]\nmaterial = { young_pa = 3000, poisson = 0.45 }\nrates = { haptic_hz = 1e-310 }\n",
+    );
+    assert!(
+        err.contains("haptic_hz") && err.contains("too small"),
+        "{err}"
+    );
+}

@@ -610,6 +610,12 @@ impl Scene {
                 "must be >= 1 (a physics update every this many ticks)",
             );
         }
+        if !(positive(self.tick_s()) && positive(self.physics_period_s())) {
+            return invalid(
+                format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
+                "too small: 1/haptic_hz and physics_every/haptic_hz must be finite seconds",
+            );
+        }
         if !positive(self.safety.max_force_n) {
             return invalid(
                 format!("[safety] max_force_n = {}", self.safety.max_force_n),

@@ -21,7 +21,8 @@
 //!   and so may two samples of the same point: that is a jump (see [`Trajectory::positions_at`]);
 //! - the tool index is below the scene's tool point count, and every tool point has at least one
 //!   sample;
-//! - exactly 5 fields per line, numbers that parse, the header first.
+//! - exactly 5 fields per line, numbers that parse, the header first; one record per line (a
+//!   carriage return inside a line, outside quotes, would end the record: refused).
 //!
 //! [`Trajectory::read_unchecked`] is the lenient reader for robustness tests: it keeps non-finite
 //! values and backward times (reporting each such line as a finding) so that they can be fed to
@@ -322,6 +323,7 @@ fn read_csv(
         .buffer_capacity(256);
     let mut header_seen = false;
     let mut record = csv::StringRecord::new();
+    let mut extra = csv::ByteRecord::new();
     for (index, text) in bytes.split(|&b| b == b'\n').enumerate() {
         let line = index + 1;
         let text = text.strip_suffix(b"\r").unwrap_or(text);
@@ -329,9 +331,19 @@ fn read_csv(
         if content.is_empty() || content.starts_with(b"#") {
             continue;
         }
-        let read = parser.from_reader(text).read_record(&mut record);
-        if let Err(err) = read {
+        let mut reader = parser.from_reader(text);
+        if let Err(err) = reader.read_record(&mut record) {
             return Err(builder.line_error(line, LineProblem::Unreadable(err.to_string())));
+        }
+        // The CSV reader also ends a record at a bare `\r`: what follows it on the line would be
+        // a second record, silently dropped.
+        if !matches!(reader.read_byte_record(&mut extra), Ok(false)) {
+            return Err(builder.line_error(
+                line,
+                LineProblem::Unreadable(
+                    "a carriage return inside the line (one record per line)".into(),
+                ),
+            ));
         }
         if !header_seen {
             if record.iter().ne(HEADER) {
