@@ -26,9 +26,9 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::contact::MAX_WALK_STEPS;
-use palpate_kernel::haptic::haptic_loop::{ForceOutput, HapticLoop, LoopConfig, TickCounters};
-use palpate_kernel::haptic::safety::SafetyLimits;
+use palpate_kernel::haptic::haptic_loop::{ForceOutput, HapticLoop, TickCounters};
 
+use crate::session::run::{loop_config, ticks};
 use crate::session::{Scene, Trajectory};
 
 /// Instructions of a tick outside detection, tracking and solves.
@@ -61,18 +61,6 @@ pub fn budget_tick<const P: usize>(
     haptic.tick(tool_m)
 }
 
-/// The loop configuration of `scene` (f32).
-pub fn loop_config(scene: &Scene) -> LoopConfig<f32> {
-    LoopConfig {
-        radius_m: scene.tool.radius_m as f32,
-        dt_s: scene.tick_s() as f32,
-        limits: SafetyLimits {
-            max_force_n: scene.safety.max_force_n as f32,
-            max_slew_n_per_s: scene.safety.max_slew_n_per_s as f32,
-        },
-    }
-}
-
 /// Runs every tick of `trajectory` through [`budget_tick`] and returns each
 /// tick's work counters (the child side of [`measure`]).
 pub fn probe(
@@ -95,16 +83,8 @@ fn probe_with<const P: usize>(
 ) -> anyhow::Result<Vec<TickCounters>> {
     let mut haptic = HapticLoop::<f32, P, P>::new(table, loop_config(scene))
         .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
-    let mut positions = vec![[0.0; 3]; trajectory.tool_count()];
-    let tick_s = scene.tick_s();
-    let ticks = ((trajectory.end_s() - trajectory.start_s()) / tick_s + 1e-9).floor() as usize + 1;
-    let mut counters = Vec::with_capacity(ticks);
-    for k in 0..ticks {
-        trajectory.positions_at_into(trajectory.start_s() + k as f64 * tick_s, &mut positions);
-        let tool: [Vector3<f32>; P] = core::array::from_fn(|p| {
-            let x = positions.get(p).copied().unwrap_or([f64::NAN; 3]);
-            Vector3::new(x[0] as f32, x[1] as f32, x[2] as f32)
-        });
+    let mut counters = Vec::new();
+    for (_, tool) in ticks::<P>(trajectory, scene.tick_s()) {
         core::hint::black_box(budget_tick(&mut haptic, &tool));
         counters.push(*haptic.counters());
     }

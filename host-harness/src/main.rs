@@ -782,17 +782,10 @@ fn budget(
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
         let (mesh, report) = scene.load_mesh()?;
-        let options = BuildOptions {
-            material: scene.elastic_material()?,
-            fix: scene.fix.clone(),
-            solver: Solver::Cholesky,
-            precision: Precision::F32,
-            progress: false,
-        };
-        let built = build_table(&mesh, &report, &options)?;
+        let bytes = palpate::session::run::precomputed_table(&scene, &mesh, &report)?;
         let table_path = work_dir.join(format!("table-{s}.bin"));
-        std::fs::write(&table_path, &built.bytes)?;
-        let file = TableFile::from_bytes(&built.bytes);
+        std::fs::write(&table_path, &bytes)?;
+        let file = TableFile::from_bytes(&bytes);
         let table = palpate_kernel::PrecomputedTable::<f32>::load(file.bytes())
             .map_err(|e| anyhow::anyhow!("table: {e}"))?;
         let bound = tick_bound(&table, points as u64, points as u64);

@@ -19,11 +19,64 @@ use palpate_kernel::haptic::haptic_loop::{HapticLoop, LoopConfig};
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
 
 use super::{ModelSpec, Scene, Trajectory};
+use crate::mesh::{MeshReport, TetMesh};
 use crate::output::vtk;
 use crate::tables::build::{BuildOptions, build_table};
 use crate::tables::compliance::Solver;
 use crate::tables::file::Precision;
 use crate::tables::load::TableFile;
+
+/// The f32 pre-computed table of `scene` (the firmware precision), built
+/// in memory with the same pipeline as `palpate tables build`.
+pub fn precomputed_table(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<Vec<u8>> {
+    let options = BuildOptions {
+        material: scene.elastic_material()?,
+        fix: scene.fix.clone(),
+        solver: Solver::Cholesky,
+        precision: Precision::F32,
+        progress: false,
+    };
+    Ok(build_table(mesh, report, &options)
+        .with_context(|| scene.source.clone())?
+        .bytes)
+}
+
+/// The haptic loop configuration of `scene` (f32).
+pub fn loop_config(scene: &Scene) -> LoopConfig<f32> {
+    LoopConfig {
+        radius_m: scene.tool.radius_m as f32,
+        dt_s: scene.tick_s() as f32,
+        limits: SafetyLimits {
+            max_force_n: scene.safety.max_force_n as f32,
+            max_slew_n_per_s: scene.safety.max_slew_n_per_s as f32,
+        },
+    }
+}
+
+/// The ticks of `trajectory` at period `tick_s`: `(t_s, tool positions)`
+/// for `t = start + k·tick_s` up to the end; a tool point the trajectory
+/// lacks is NaN (the loop faults on it).
+pub fn ticks<const P: usize>(
+    trajectory: &Trajectory,
+    tick_s: f64,
+) -> impl Iterator<Item = (f64, [Vector3<f32>; P])> + '_ {
+    let start = trajectory.start_s();
+    let count = ((trajectory.end_s() - start) / tick_s + 1e-9).floor() as usize + 1;
+    let mut positions = vec![[0.0; 3]; trajectory.tool_count()];
+    (0..count).map(move |k| {
+        let t = start + k as f64 * tick_s;
+        trajectory.positions_at_into(t, &mut positions);
+        let tool = core::array::from_fn(|p| {
+            let x = positions.get(p).copied().unwrap_or([f64::NAN; 3]);
+            Vector3::new(x[0] as f32, x[1] as f32, x[2] as f32)
+        });
+        (t, tool)
+    })
+}
 
 /// What a session did.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -59,24 +112,9 @@ pub fn run_session(
         );
     }
     let (mesh, report) = scene.load_mesh()?;
-    let options = BuildOptions {
-        material: scene.elastic_material()?,
-        fix: scene.fix.clone(),
-        solver: Solver::Cholesky,
-        precision: Precision::F32,
-        progress: false,
-    };
-    let built = build_table(&mesh, &report, &options).with_context(|| scene.source.clone())?;
-    let file = TableFile::from_bytes(&built.bytes);
+    let file = TableFile::from_bytes(&precomputed_table(scene, &mesh, &report)?);
     let table = PrecomputedTable::<f32>::load(file.bytes()).context("session table")?;
-    let config = LoopConfig {
-        radius_m: scene.tool.radius_m as f32,
-        dt_s: scene.tick_s() as f32,
-        limits: SafetyLimits {
-            max_force_n: scene.safety.max_force_n as f32,
-            max_slew_n_per_s: scene.safety.max_slew_n_per_s as f32,
-        },
-    };
+    let config = loop_config(scene);
     let field = FieldOutput {
         rest: &mesh.positions,
         tets: &mesh.tets,
@@ -120,21 +158,11 @@ impl Runner<'_, '_> {
             .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
         let model = *haptic.model();
         let mut summary = SessionSummary::default();
-        let mut positions = vec![[0.0; 3]; self.trajectory.tool_count()];
         let mut field = vec![[0.0f32; 3]; self.field.rest.len()];
         let mut frames = Vec::new();
         let mut last = Vector3::<f32>::zeros();
         writeln!(out, "t,fx,fy,fz,contacts,status")?;
-        let start = self.trajectory.start_s();
-        let span = self.trajectory.end_s() - start;
-        let ticks = (span / self.tick_s + 1e-9).floor() as usize + 1;
-        for k in 0..ticks {
-            let t = start + k as f64 * self.tick_s;
-            self.trajectory.positions_at_into(t, &mut positions);
-            let tool: [Vector3<f32>; P] = core::array::from_fn(|p| {
-                let x = positions.get(p).copied().unwrap_or([f64::NAN; 3]);
-                Vector3::new(x[0] as f32, x[1] as f32, x[2] as f32)
-            });
+        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s).enumerate() {
             let output = haptic.tick(&tool);
             let f = output.force_n;
             let status = match output.status {
