@@ -301,16 +301,7 @@ fn cutting_equals_rebuilding_without_the_tets() {
         }
         let mut cut = vec![[0.0; 3]; u.len()];
         model.elastic_forces_of(&u, &mut cut);
-        let reduced = TetMesh {
-            positions: mesh.positions.clone(),
-            tets: mesh
-                .tets
-                .iter()
-                .zip(model.tet_alive())
-                .filter(|(_, alive)| **alive)
-                .map(|(t, _)| *t)
-                .collect(),
-        };
+        let reduced = palpate_tests::live_mesh(&mesh, model.tet_alive());
         let removed = mesh.tets.len() - reduced.tets.len();
         let (rebuilt, _) = evaluate(&reduced, stvk(form), &x);
         let (diff, scale) = max_diff(&cut, &rebuilt);

@@ -456,16 +456,7 @@ fn removal_equals_rebuild_and_keeps_the_mesh_conformal() {
         Err(palpate_kernel::tensor_mass::RemoveError::TetOutOfRange { tet: 750 })
     );
 
-    let live = TetMesh {
-        positions: mesh.positions.clone(),
-        tets: mesh
-            .tets
-            .iter()
-            .zip(model.tet_alive())
-            .filter(|(_, alive)| **alive)
-            .map(|(t, _)| *t)
-            .collect(),
-    };
+    let live = palpate_tests::live_mesh(&mesh, model.tet_alive());
     let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 0.001).collect();
     let rebuilt = TensorMassArrays::new(&live, &opts.material, DENSITY, fixed);
     let scale = rebuilt

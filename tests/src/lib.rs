@@ -223,3 +223,18 @@ pub fn max_entry_difference(
     };
     one_way(a, b).max(one_way(b, a))
 }
+
+/// `mesh` without the tets whose `alive` flag is false (same vertices and
+/// numbering): what a model built after a cut should equal.
+pub fn live_mesh(mesh: &palpate::mesh::TetMesh, alive: &[bool]) -> palpate::mesh::TetMesh {
+    palpate::mesh::TetMesh {
+        positions: mesh.positions.clone(),
+        tets: mesh
+            .tets
+            .iter()
+            .zip(alive)
+            .filter(|(_, a)| **a)
+            .map(|(t, _)| *t)
+            .collect(),
+    }
+}
