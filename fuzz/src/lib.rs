@@ -94,3 +94,14 @@ pub fn repair_container(data: &[u8]) -> Option<Vec<u8>> {
     bytes[body..].copy_from_slice(&crc.to_le_bytes());
     Some(bytes)
 }
+
+/// Calls `load` on `data` as given (16-byte aligned), then, when its
+/// container can be repaired, on the repaired copy aligned and 4 bytes past
+/// a 16-byte boundary: the three layouts every table target fuzzes.
+pub fn table_layouts(data: &[u8], mut load: impl FnMut(&[u8])) {
+    load(AlignedCopy::new(data, 0).bytes());
+    if let Some(repaired) = repair_container(data) {
+        load(AlignedCopy::new(&repaired, 0).bytes());
+        load(AlignedCopy::new(&repaired, 4).bytes());
+    }
+}
