@@ -6,7 +6,7 @@
 //!
 //! Target (issue 6): a full tick with up to 4 contacts in ≤ 2 µs on the
 //! host, independent of the mesh size. Printed after the group: the RAM of
-//! the loop state, `size_of::<HapticLoop<f32, P, P>>()`.
+//! the loop state, `size_of::<PrecomputedLoop<f32, P, P>>()`.
 //!
 //! Run: `RUSTFLAGS="-C target-cpu=native" cargo bench -p palpate-benches --bench haptic_tick`.
 
@@ -18,8 +18,9 @@ use palpate::tables::load::TableFile;
 use palpate_benches::cube_table;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::contact::{ContactWork, SurfaceGeometry};
-use palpate_kernel::haptic::haptic_loop::{HapticLoop, LoopConfig};
+use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
 use palpate_kernel::haptic::safety::SafetyLimits;
+use palpate_kernel::haptic::tissue::PrecomputedTissue;
 
 const RADIUS_M: f32 = 0.002;
 
@@ -50,7 +51,8 @@ fn tick_with<const P: usize>(
     table: &PrecomputedTable<'_, f32>,
     cells: usize,
 ) {
-    let mut haptic = HapticLoop::<f32, P, P>::new(table, config()).expect("loop");
+    let mut haptic =
+        PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(table), config()).expect("loop");
     // Approach from 1 mm above, then press to 2 mm: every point in contact.
     haptic.tick(&core::array::from_fn(|p| tool(p, -0.001)));
     for k in 0..=20 {
@@ -97,8 +99,8 @@ fn tick(c: &mut Criterion) {
     group.finish();
     println!(
         "loop state RAM: {} B (P = 1), {} B (P = 4), f32",
-        core::mem::size_of::<HapticLoop<'_, f32, 1, 1>>(),
-        core::mem::size_of::<HapticLoop<'_, f32, 4, 4>>()
+        core::mem::size_of::<PrecomputedLoop<'_, f32, 1, 1>>(),
+        core::mem::size_of::<PrecomputedLoop<'_, f32, 4, 4>>()
     );
 }
 

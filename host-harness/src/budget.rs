@@ -26,7 +26,8 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::contact::MAX_WALK_STEPS;
-use palpate_kernel::haptic::haptic_loop::{ForceOutput, HapticLoop, TickCounters};
+use palpate_kernel::haptic::haptic_loop::{ForceOutput, PrecomputedLoop, TickCounters};
+use palpate_kernel::haptic::tissue::PrecomputedTissue;
 
 use crate::session::run::{loop_config, ticks};
 use crate::session::{Scene, Trajectory};
@@ -55,7 +56,7 @@ pub fn tick_bound(table: &PrecomputedTable<'_, f32>, points: u64, capacity: u64)
 /// One tick, kept out of line so callgrind can collect exactly its cost.
 #[inline(never)]
 pub fn budget_tick<const P: usize>(
-    haptic: &mut HapticLoop<'_, f32, P, P>,
+    haptic: &mut PrecomputedLoop<'_, f32, P, P>,
     tool_m: &[Vector3<f32>; P],
 ) -> ForceOutput<f32> {
     haptic.tick(tool_m)
@@ -81,8 +82,9 @@ fn probe_with<const P: usize>(
     scene: &Scene,
     trajectory: &Trajectory,
 ) -> anyhow::Result<Vec<TickCounters>> {
-    let mut haptic = HapticLoop::<f32, P, P>::new(table, loop_config(scene))
-        .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+    let mut haptic =
+        PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(table), loop_config(scene))
+            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
     let mut counters = Vec::new();
     for (_, tool) in ticks::<P>(trajectory, scene.tick_s()) {
         core::hint::black_box(budget_tick(&mut haptic, &tool));

@@ -6,8 +6,9 @@
 use nalgebra::Vector3;
 use palpate::tables::file::Precision;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::haptic_loop::{HapticLoop, LoopConfig};
+use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyFault, SafetyLimits, Supervisor};
+use palpate_kernel::haptic::tissue::PrecomputedTissue;
 use palpate_kernel::{Contact, PrecomputedModel};
 use palpate_tests::reference_cube_table;
 use proptest::prelude::*;
@@ -66,7 +67,8 @@ fn supervisor_clamps_limits_slew_and_latches_faults() {
 fn probe_press_matches_the_direct_solve_and_releases() {
     let file = reference_cube_table(Precision::F64);
     let table = PrecomputedTable::<f64>::load(file.bytes()).expect("table");
-    let mut haptic = HapticLoop::<f64, 1, 1>::new(&table, config()).expect("loop");
+    let mut haptic =
+        PrecomputedLoop::<f64, 1, 1>::new(PrecomputedTissue::new(&table), config()).expect("loop");
     let model = PrecomputedModel::new(table);
     let at = |z: f64| [Vector3::new(0.41, 0.43, z)];
     let mut z = 1.02;
@@ -132,7 +134,9 @@ fn slide_walks_across_triangles_continuously_and_deterministically() {
     let file = reference_cube_table(Precision::F64);
     let table = PrecomputedTable::<f64>::load(file.bytes()).expect("table");
     let run = || {
-        let mut haptic = HapticLoop::<f64, 1, 1>::new(&table, config()).expect("loop");
+        let mut haptic =
+            PrecomputedLoop::<f64, 1, 1>::new(PrecomputedTissue::new(&table), config())
+                .expect("loop");
         let mut forces = Vec::new();
         let mut triangles = std::collections::BTreeSet::new();
         let mut walked = 0;
@@ -183,7 +187,7 @@ proptest! {
         let table = PrecomputedTable::<f32>::load(file.bytes()).expect("table");
         let limits = SafetyLimits { max_force_n: 20.0f32, max_slew_n_per_s: 10_000.0 };
         let config = LoopConfig { radius_m: 0.01f32, dt_s: 1e-3, limits };
-        let mut haptic = HapticLoop::<f32, 1, 1>::new(&table, config).expect("loop");
+        let mut haptic = PrecomputedLoop::<f32, 1, 1>::new(PrecomputedTissue::new(&table), config).expect("loop");
         for p in steps {
             let tip = Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32);
             let out = haptic.tick(&[tip]);

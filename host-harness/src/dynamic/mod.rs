@@ -7,4 +7,4 @@ mod owned;
 pub mod run;
 pub mod stability;
 
-pub use owned::OwnedState;
+pub use owned::{OwnedState, OwnedSurface};

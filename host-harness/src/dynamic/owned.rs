@@ -1,12 +1,14 @@
-//! Heap storage for [`StateBuffers`], sized from a table.
+//! Heap storage for [`StateBuffers`] and [`SurfaceBuffers`], sized from a
+//! table.
 
 use palpate_kernel::Real;
+use palpate_kernel::haptic::deforming::SurfaceBuffers;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
-use palpate_kernel::tensor_mass::{StateBuffers, VertexMode};
+use palpate_kernel::tensor_mass::{StateBuffers, TensorMassModel, VertexMode};
 
 /// The mutable state of a tensor-mass model in vectors: what firmware keeps
 /// in static arrays.
@@ -80,5 +82,56 @@ impl<T: Real> OwnedState<T> {
                 tet: &mut self.tet_terms,
             },
         }
+    }
+}
+
+/// Heap storage for a deforming surface's [`SurfaceBuffers`] and the
+/// dynamic tissue's force scratch (what firmware keeps in static arrays).
+pub struct OwnedSurface<T> {
+    positions_m: Vec<[T; 3]>,
+    planes: Vec<[T; 4]>,
+    vertex_triangle_start: Vec<u32>,
+    vertex_triangle: Vec<u32>,
+    cell_start: Vec<u32>,
+    grid_vertex: Vec<u32>,
+    forces_n: Vec<[T; 3]>,
+}
+
+impl<T: Real> OwnedSurface<T> {
+    /// Buffers for `model`'s table with a grid of up to one cell per
+    /// surface vertex (a bucket then holds a few vertices on average).
+    pub fn for_model(model: &TensorMassModel<'_, '_, T>) -> Self {
+        let surface_vertices = {
+            let mut seen = vec![false; model.table().vertex_count()];
+            for &v in model.table().surface_triangles().iter().flatten() {
+                seen[v as usize] = true;
+            }
+            seen.iter().filter(|&&s| s).count()
+        };
+        let n = SurfaceBuffers::<T>::lengths(model, surface_vertices);
+        Self {
+            positions_m: vec![[T::zero(); 3]; n.vertices],
+            planes: vec![[T::zero(); 4]; n.triangles],
+            vertex_triangle_start: vec![0; n.vertex_triangle_start],
+            vertex_triangle: vec![0; n.vertex_triangle],
+            cell_start: vec![0; n.cell_start],
+            grid_vertex: vec![0; n.vertices],
+            forces_n: vec![[T::zero(); 3]; n.vertices],
+        }
+    }
+
+    /// The kernel's view of the surface buffers and the force scratch.
+    pub fn buffers(&mut self) -> (SurfaceBuffers<'_, T>, &mut [[T; 3]]) {
+        (
+            SurfaceBuffers {
+                positions_m: &mut self.positions_m,
+                planes: &mut self.planes,
+                vertex_triangle_start: &mut self.vertex_triangle_start,
+                vertex_triangle: &mut self.vertex_triangle,
+                cell_start: &mut self.cell_start,
+                grid_vertex: &mut self.grid_vertex,
+            },
+            &mut self.forces_n,
+        )
     }
 }

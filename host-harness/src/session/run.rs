@@ -15,8 +15,9 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::haptic_loop::{HapticLoop, LoopConfig};
+use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
+use palpate_kernel::haptic::tissue::PrecomputedTissue;
 
 use super::{ModelSpec, Scene, Trajectory};
 use crate::mesh::{MeshReport, TetMesh};
@@ -154,9 +155,10 @@ struct Runner<'r, 't> {
 
 impl Runner<'_, '_> {
     fn go<const P: usize>(&self, out: &mut dyn Write) -> anyhow::Result<SessionSummary> {
-        let mut haptic = HapticLoop::<f32, P, P>::new(self.table, self.config)
-            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
-        let model = *haptic.model();
+        let mut haptic =
+            PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(self.table), self.config)
+                .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+        let model = *haptic.tissue().model();
         let mut summary = SessionSummary::default();
         let mut field = vec![[0.0f32; 3]; self.field.rest.len()];
         let mut frames = Vec::new();

@@ -1,5 +1,7 @@
-//! Contact detection and tracking on the rest surface of a pre-computed
-//! model (Cotin 1999 §4; MODELS.md §6). A tool point is a sphere of radius
+//! Contact detection and tracking on a tissue surface (Cotin 1999 §4;
+//! MODELS.md §6): the rest surface of a pre-computed model, or the deformed
+//! surface of a dynamic model at its last physics update
+//! ([`super::deforming::DeformingSurface`]). A tool point is a sphere of radius
 //! `r`; its contact is a point of a surface triangle (barycentric weights),
 //! created when the sphere's motion segment crosses the triangle from
 //! outside, moved with the tool (frictionless sliding: the contact point is
@@ -11,7 +13,7 @@ use nalgebra::Vector3;
 
 use super::surface::SurfaceIndex;
 use crate::Real;
-use crate::table::PrecomputedTable;
+use crate::table::{PrecomputedTable, TensorMassTable};
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
 /// walk; a contact that would slide further stops at the last triangle).
@@ -37,13 +39,33 @@ pub struct ContactWork {
     pub walk_steps: u32,
 }
 
-/// The rest geometry of the surface.
+/// The vertices a table holds fixed: a triangle with all three fixed is a
+/// rigid support (no compliance) and is not touchable.
+#[derive(Clone, Copy, Debug)]
+pub enum Supports<'a, T: Real> {
+    /// The fixed vertices of a pre-computed table.
+    Precomputed(&'a PrecomputedTable<'a, T>),
+    /// The fixed vertices of a tensor-mass table.
+    TensorMass(&'a TensorMassTable<'a, T>),
+}
+
+impl<T: Real> Supports<'_, T> {
+    fn is_fixed(&self, vertex: u32) -> bool {
+        match self {
+            Self::Precomputed(t) => t.is_fixed(vertex),
+            Self::TensorMass(t) => t.is_fixed(vertex),
+        }
+    }
+}
+
+/// A surface to touch: vertex positions (m), surface triangles, their
+/// collision index (whose planes match the positions) and the supports.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceGeometry<'a, T: Real> {
     positions: &'a [[T; 3]],
     triangles: &'a [[u32; 3]],
-    index: &'a SurfaceIndex<'a, T>,
-    fixed: &'a PrecomputedTable<'a, T>,
+    index: SurfaceIndex<'a, T>,
+    supports: Supports<'a, T>,
 }
 
 /// Vertices and corners of a triangle.
@@ -83,14 +105,35 @@ fn clamp_weights<T: Real>(w: [T; 3]) -> [T; 3] {
 }
 
 impl<'a, T: Real> SurfaceGeometry<'a, T> {
-    /// The surface of `table`.
+    /// The rest surface of a pre-computed `table`.
     pub fn new(table: &'a PrecomputedTable<'a, T>) -> Self {
+        Self::of_parts(
+            table.rest_positions(),
+            table.surface_triangles(),
+            *table.surface_index(),
+            Supports::Precomputed(table),
+        )
+    }
+
+    /// A surface from its parts; `index` must have been built over
+    /// `positions` and `triangles`.
+    pub(crate) fn of_parts(
+        positions: &'a [[T; 3]],
+        triangles: &'a [[u32; 3]],
+        index: SurfaceIndex<'a, T>,
+        supports: Supports<'a, T>,
+    ) -> Self {
         Self {
-            positions: table.rest_positions(),
-            triangles: table.surface_triangles(),
-            index: table.surface_index(),
-            fixed: table,
+            positions,
+            triangles,
+            index,
+            supports,
         }
+    }
+
+    /// The collision index.
+    pub fn index(&self) -> &SurfaceIndex<'a, T> {
+        &self.index
     }
 
     /// Vertices and rest corners of a surface triangle.
@@ -119,7 +162,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         self.face(triangle).map(|f| (f.vertices, f.normal))
     }
 
-    /// Rest position of a contact point, m.
+    /// Position of a contact point on this surface, m.
     pub fn point(&self, contact: &ToolContact<T>) -> Option<Vector3<T>> {
         let f = self.face(contact.triangle)?;
         let [a, b, c] = f.corners;
@@ -173,7 +216,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                     continue;
                 }
                 let Some(f) = self.corners(t) else { continue };
-                if f.vertices.iter().all(|&v| self.fixed.is_fixed(v)) {
+                if f.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
                     continue;
                 }
                 let x = from_m + (to_m - from_m) * along - normal * radius_m;

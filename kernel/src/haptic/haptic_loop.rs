@@ -1,23 +1,27 @@
-//! The fixed-timestep haptic loop over the pre-computed model (Cotin 1999;
-//! MODELS.md §6): each tick reads the tool points, detects and tracks
-//! contacts, solves the contact forces and passes the device force through
+//! The fixed-timestep haptic loop (Cotin 1999; MODELS.md §6): each tick
+//! reads the tool points, detects and tracks contacts on the tissue's
+//! surface, solves the contact forces and passes the device force through
 //! the safety supervisor.
 //!
-//! Force between physics updates: with the pre-computed model the contact
-//! solve *is* the local contact stiffness applied to the tool's current
-//! displacement (`g = C⁻¹ d`, exact for the linear model), and it costs well
-//! under a microsecond, so it runs every tick; what runs at the lower
-//! physics rate (every `physics_every` ticks, by the caller) is the
-//! deformation field, [`HapticLoop::solution`] into
-//! `PrecomputedModel::displacements`. The force is therefore continuous
-//! across physics updates: it never waits for them.
+//! Force between physics updates, per tissue model:
+//! - [`PrecomputedTissue`]: the contact solve *is* the local contact
+//!   stiffness applied to the tool's current displacement (`g = C⁻¹ d`,
+//!   exact for the linear model) and costs well under a microsecond, so it
+//!   runs every tick; what runs at the lower physics rate (every
+//!   `physics_every` ticks, by the caller) is the deformation field,
+//!   [`PrecomputedTissue::solution`] into `PrecomputedModel::displacements`.
+//! - [`DynamicTissue`]: the model steps at the physics rate
+//!   ([`HapticLoop::physics_update`]); in between, each tick extrapolates
+//!   the last update's force with the local contact stiffness and the
+//!   tool's motion since (see `dynamic_tissue`).
 
 use nalgebra::Vector3;
 
-use super::contact::{ContactWork, SurfaceGeometry, ToolContact};
+use super::contact::{ContactWork, ToolContact};
+use super::dynamic_tissue::{DynamicTissue, PhysicsError};
 use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
-use crate::precomputed::{Contact, ContactError, ContactSolution, PrecomputedModel};
-use crate::table::PrecomputedTable;
+use super::tissue::{ContactTarget, PrecomputedTissue, Refusal, Tissue};
+use crate::tensor_mass::StepReport;
 use crate::{MAX_CONTACTS, Real};
 
 /// What the device receives each tick.
@@ -74,24 +78,28 @@ impl core::fmt::Display for LoopError {
 
 impl core::error::Error for LoopError {}
 
-/// The haptic loop: `P` tool points, at most `M` simultaneous contacts.
-pub struct HapticLoop<'a, T: Real, const P: usize, const M: usize> {
-    model: PrecomputedModel<'a, T>,
-    surface: SurfaceGeometry<'a, T>,
+/// The haptic loop over tissue `B`: `P` tool points, at most `M`
+/// simultaneous contacts.
+pub struct HapticLoop<T: Real, B, const P: usize, const M: usize> {
+    tissue: B,
     config: LoopConfig<T>,
     supervisor: Supervisor<T>,
     previous_m: Option<[Vector3<T>; P]>,
     contacts: [Option<ToolContact<T>>; P],
-    solution: Option<ContactSolution<T, M>>,
     counters: TickCounters,
 }
 
-impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
-    /// A loop at rest (no contact, zero force) over `table`.
-    pub fn new(
-        table: &'a PrecomputedTable<'a, T>,
-        config: LoopConfig<T>,
-    ) -> Result<Self, LoopError> {
+/// The loop over the pre-computed model.
+pub type PrecomputedLoop<'a, T, const P: usize, const M: usize> =
+    HapticLoop<T, PrecomputedTissue<'a, T, M>, P, M>;
+
+/// The loop over the dynamic tensor-mass model.
+pub type DynamicLoop<'a, 's, T, const P: usize, const M: usize> =
+    HapticLoop<T, DynamicTissue<'a, 's, T, P>, P, M>;
+
+impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, P, M> {
+    /// A loop at rest (no contact, zero force) over `tissue`.
+    pub fn new(tissue: B, config: LoopConfig<T>) -> Result<Self, LoopError> {
         const {
             assert!(
                 P >= 1 && P <= MAX_CONTACTS,
@@ -104,20 +112,18 @@ impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
             return Err(LoopError::BadConfig);
         }
         Ok(Self {
-            model: PrecomputedModel::new(*table),
-            surface: SurfaceGeometry::new(table),
+            tissue,
             config,
             supervisor: Supervisor::new(config.limits).map_err(LoopError::BadLimits)?,
             previous_m: None,
             contacts: [None; P],
-            solution: None,
             counters: TickCounters::default(),
         })
     }
 
-    /// The model.
-    pub fn model(&self) -> &PrecomputedModel<'a, T> {
-        &self.model
+    /// The tissue.
+    pub fn tissue(&self) -> &B {
+        &self.tissue
     }
 
     /// Each tool point's contact.
@@ -125,29 +131,23 @@ impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
         &self.contacts
     }
 
-    /// The last contact solution (for the deformation field at the physics
-    /// rate), `None` before the first tick or after a fault.
-    pub fn solution(&self) -> Option<&ContactSolution<T, M>> {
-        self.solution.as_ref()
-    }
-
     /// The last tick's work.
     pub fn counters(&self) -> &TickCounters {
         &self.counters
     }
 
-    /// Clears a latched fault and every contact; the force ramps up from
-    /// zero at the slew limit.
+    /// Clears a latched fault and every contact and puts the tissue back at
+    /// rest; the force ramps up from zero at the slew limit.
     pub fn reset(&mut self) {
         self.supervisor.reset();
         self.contacts = [None; P];
         self.previous_m = None;
-        self.solution = None;
+        self.tissue.reset();
     }
 
     /// One haptic tick with the tool points at `tool_m` (sphere centres, m).
     /// Bounded: detection and tracking per point (see
-    /// [`SurfaceGeometry::detect`], [`SurfaceGeometry::track`]), then at
+    /// [`super::contact::SurfaceGeometry::detect`] and `track`), then at
     /// most `P + 1` contact solves of at most `M` contacts.
     pub fn tick(&mut self, tool_m: &[Vector3<T>; P]) -> ForceOutput<T> {
         self.counters = TickCounters::default();
@@ -155,16 +155,59 @@ impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
         if !tool_m.iter().all(|p| p.iter().all(|x| x.finite())) {
             self.contacts = [None; P];
             self.previous_m = None;
-            self.solution = None;
+            self.tissue.forget();
             return self.output(Err(SafetyFault::NonFiniteInput), dt, 0);
         }
         if self.supervisor.fault().is_some() {
             self.previous_m = Some(*tool_m);
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
+        let refused = self.track_and_detect(tool_m);
+        // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
+        // the model refuses, and solve again. Each pass removes one.
+        let mut refused = refused;
+        for _ in 0..=P {
+            self.counters.solves = self.counters.solves.saturating_add(1);
+            let (set, m) = match self.targets(tool_m) {
+                Ok(targets) => targets,
+                Err(p) => {
+                    self.drop_contact(p);
+                    refused = refused.saturating_add(1);
+                    continue;
+                }
+            };
+            let set = set.get(..m).unwrap_or(&[]);
+            match self.tissue.solve(set) {
+                Ok(solved) => {
+                    let adhesive = set
+                        .iter()
+                        .zip(&solved.tissue_forces_n)
+                        .find(|(t, g)| g.dot(&t.normal) > T::zero());
+                    match adhesive {
+                        Some((t, _)) => self.drop_contact(t.tool),
+                        None => return self.output(Ok(solved.device_force_n), dt, refused),
+                    }
+                }
+                Err(Refusal::Contact(q)) => {
+                    if let Some(t) = set.get(q) {
+                        self.drop_contact(t.tool);
+                    }
+                    refused = refused.saturating_add(1);
+                }
+                Err(Refusal::Fault) => break,
+            }
+        }
+        self.contacts = [None; P];
+        self.tissue.forget();
+        self.output(Err(SafetyFault::ModelFault), dt, refused)
+    }
+
+    /// Tracks existing contacts and detects new ones from the motion
+    /// segment; returns how many new contacts the capacity `M` refused.
+    fn track_and_detect(&mut self, tool_m: &[Vector3<T>; P]) -> u8 {
         let radius = self.config.radius_m;
+        let surface = self.tissue.geometry();
         let mut refused = 0u8;
-        // Track existing contacts; detect new ones from the motion segment.
         let mut active = 0usize;
         for (p, tip) in tool_m.iter().enumerate() {
             let Some(slot) = self.contacts.get_mut(p) else {
@@ -172,15 +215,14 @@ impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
             };
             let work = &mut self.counters.contact;
             *slot = match slot {
-                Some(c) => self
-                    .surface
+                Some(c) => surface
                     .track(c, tip, radius, work)
-                    .and_then(|(c, gap)| (gap < T::zero()).then_some(c)),
+                    .and_then(|(c, gap)| self.tissue.keeps(gap).then_some(c)),
                 None => self
                     .previous_m
                     .as_ref()
                     .and_then(|prev| prev.get(p))
-                    .and_then(|from| self.surface.detect(from, tip, radius, work)),
+                    .and_then(|from| surface.detect(from, tip, radius, work)),
             };
             if slot.is_some() {
                 if active < M {
@@ -192,77 +234,42 @@ impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
             }
         }
         self.previous_m = Some(*tool_m);
-        // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
-        // the model refuses, and solve again. Each pass removes one.
-        for _ in 0..=P {
-            self.counters.solves = self.counters.solves.saturating_add(1);
-            match self.solve(tool_m) {
-                Ok((solution, None)) => {
-                    let force = solution.device_force_n();
-                    self.solution = Some(solution);
-                    return self.output(Ok(force), dt, refused);
-                }
-                Ok((_, Some(adhesive))) => {
-                    if let Some(slot) = self.contacts.get_mut(adhesive) {
-                        *slot = None;
-                    }
-                }
-                Err(Refusal::Contact(p)) => {
-                    if let Some(slot) = self.contacts.get_mut(p) {
-                        *slot = None;
-                    }
-                    refused = refused.saturating_add(1);
-                }
-                Err(Refusal::Fault) => break,
-            }
-        }
-        self.contacts = [None; P];
-        self.solution = None;
-        self.output(Err(SafetyFault::ModelFault), dt, refused)
+        refused
     }
 
-    /// The contact set of the active contacts, solved; `Some(p)` names the
-    /// first adhesive contact's tool point.
-    fn solve(
-        &self,
-        tool_m: &[Vector3<T>; P],
-    ) -> Result<(ContactSolution<T, M>, Option<usize>), Refusal> {
+    fn drop_contact(&mut self, p: usize) {
+        if let Some(slot) = self.contacts.get_mut(p) {
+            *slot = None;
+        }
+    }
+
+    /// The active contacts as targets (at most `M`), with each contact
+    /// point's signed gap to its tool sphere; `Err(p)` names a tool point
+    /// whose contact no longer lies on the surface.
+    fn targets(&self, tool_m: &[Vector3<T>; P]) -> Result<([ContactTarget<T>; M], usize), usize> {
         let radius = self.config.radius_m;
-        let mut set = [Contact::at_vertex(0, Vector3::zeros()); M];
-        let mut owner = [0usize; M];
-        let mut normals = [Vector3::zeros(); M];
+        let surface = self.tissue.geometry();
+        let mut set = [ContactTarget::placeholder(); M];
         let mut m = 0usize;
         for (p, (contact, tip)) in self.contacts.iter().zip(tool_m).enumerate() {
             let Some(c) = contact else { continue };
             let (Some((vertices, normal)), Some(x)) =
-                (self.surface.triangle(c.triangle), self.surface.point(c))
+                (surface.triangle(c.triangle), surface.point(c))
             else {
-                return Err(Refusal::Contact(p));
+                return Err(p);
             };
-            let gap = (tip - x).dot(&normal) - radius;
-            if let (Some(s), Some(o), Some(nrm)) =
-                (set.get_mut(m), owner.get_mut(m), normals.get_mut(m))
-            {
-                *s = Contact::on_triangle(vertices, c.weights, normal * gap);
-                *o = p;
-                *nrm = normal;
+            if let Some(slot) = set.get_mut(m) {
+                *slot = ContactTarget {
+                    tool: p,
+                    contact: *c,
+                    vertices,
+                    normal,
+                    gap_m: (tip - x).dot(&normal) - radius,
+                };
                 m += 1;
             }
         }
-        let solution = self
-            .model
-            .contact_forces::<M>(set.get(..m).unwrap_or(&[]))
-            .map_err(|e| match contact_index(&e) {
-                Some(q) => Refusal::Contact(owner.get(q).copied().unwrap_or(0)),
-                None => Refusal::Fault,
-            })?;
-        let adhesive = solution
-            .contact_forces_n()
-            .iter()
-            .zip(&normals)
-            .position(|(g, n)| g.dot(n) > T::zero())
-            .and_then(|q| owner.get(q).copied());
-        Ok((solution, adhesive))
+        Ok((set, m))
     }
 
     fn output(
@@ -281,24 +288,25 @@ impl<'a, T: Real, const P: usize, const M: usize> HapticLoop<'a, T, P, M> {
     }
 }
 
-/// Why a contact set could not be solved.
-enum Refusal {
-    /// The contact of this tool point is at fault: drop it and retry.
-    Contact(usize),
-    /// No contact to blame (non-finite result).
-    Fault,
+impl<'a, T: Real, const P: usize, const M: usize> PrecomputedLoop<'a, T, P, M> {
+    /// The last contact solution (for the deformation field at the physics
+    /// rate), `None` before the first tick or after a fault.
+    pub fn solution(&self) -> Option<&crate::ContactSolution<T, M>> {
+        self.tissue.solution()
+    }
 }
 
-/// The index of the contact a [`ContactError`] names, if any.
-fn contact_index(e: &ContactError) -> Option<usize> {
-    match *e {
-        ContactError::VertexOutOfRange { contact, .. }
-        | ContactError::FixedVertex { contact, .. }
-        | ContactError::NotOnSurface { contact, .. }
-        | ContactError::BadWeights { contact }
-        | ContactError::NonFiniteInput { contact }
-        | ContactError::IllConditioned { contact } => Some(contact),
-        ContactError::DuplicateContact { second, .. } => Some(second),
-        ContactError::TooManyContacts { .. } | ContactError::NonFiniteResult => None,
+impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
+    /// One physics update of the dynamic model with the current contacts at
+    /// the last tick's tool positions (call it every `physics_every` ticks,
+    /// after the tick). On failure the next tick latches a model fault
+    /// (zero force) until [`Self::reset`].
+    pub fn physics_update(&mut self) -> Result<StepReport<T>, PhysicsError> {
+        let targets = self
+            .previous_m
+            .map(|tool| self.targets(&tool))
+            .unwrap_or(Ok(([ContactTarget::placeholder(); M], 0)));
+        let (set, m) = targets.unwrap_or(([ContactTarget::placeholder(); M], 0));
+        self.tissue.update(set.get(..m).unwrap_or(&[]))
     }
 }

@@ -39,6 +39,49 @@ pub(crate) struct SurfaceSections<'a, T> {
     pub(crate) planes: &'a [[T; 4]],
 }
 
+/// A regular grid over a box: origin (its lowest corner), cell edge and
+/// cells per axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Grid<T> {
+    pub(crate) origin_m: Vector3<T>,
+    pub(crate) cell_m: T,
+    pub(crate) dims: [u32; 3],
+}
+
+impl<T: Real> Grid<T> {
+    /// The cell containing `p` (m), clamped to the grid (a point outside
+    /// maps to the nearest border cell; non-finite coordinates map to 0).
+    pub(crate) fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
+        let mut cell = [0u32; 3];
+        for ((c, (&x, &o)), &d) in cell
+            .iter_mut()
+            .zip(p.iter().zip(self.origin_m.iter()))
+            .zip(&self.dims)
+        {
+            let f = ((x - o) / self.cell_m).floor();
+            let top = T::of_f64(f64::from(d.saturating_sub(1)));
+            // NaN fails both comparisons and stays at 0.
+            *c = if f > T::zero() {
+                let clamped = if f < top { f } else { top };
+                clamped.as_f64() as u32
+            } else {
+                0
+            };
+        }
+        cell
+    }
+}
+
+/// The lists of an index the kernel built itself (re-binning a deforming
+/// surface), consistent by construction.
+pub(crate) struct BuiltLists<'a, T> {
+    pub(crate) cell_start: &'a [u32],
+    pub(crate) grid_vertex: &'a [u32],
+    pub(crate) vertex_triangle_start: &'a [u32],
+    pub(crate) vertex_triangle: &'a [u32],
+    pub(crate) planes: &'a [[T; 4]],
+}
+
 /// `true` if `starts` begins at 0, never decreases and ends at `total`.
 fn csr_ok(starts: &[u32], total: usize) -> bool {
     starts.first() == Some(&0)
@@ -185,6 +228,31 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         Ok(index)
     }
 
+    /// An index over lists the kernel built (no validation needed: see
+    /// [`BuiltLists`]). Query bound: `27 × max_bucket × max_valence`, at
+    /// most every listed triangle reference.
+    pub(crate) fn assembled(grid: Grid<T>, lists: BuiltLists<'a, T>) -> Self {
+        let max_bucket = max_row(lists.cell_start);
+        let max_valence = max_row(lists.vertex_triangle_start);
+        let max_query_triangles = max_bucket
+            .saturating_mul(27)
+            .saturating_mul(max_valence)
+            .min(lists.vertex_triangle.len() as u32);
+        Self {
+            origin_m: grid.origin_m,
+            cell_m: grid.cell_m,
+            dims: grid.dims,
+            cell_start: lists.cell_start,
+            grid_vertex: lists.grid_vertex,
+            vertex_triangle_start: lists.vertex_triangle_start,
+            vertex_triangle: lists.vertex_triangle,
+            planes: lists.planes,
+            max_bucket,
+            max_valence,
+            max_query_triangles,
+        }
+    }
+
     /// Centre of cell `c`, m.
     fn cell_centre(&self, c: [u32; 3]) -> Vector3<T> {
         let half = T::of_f64(0.5);
@@ -232,23 +300,12 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
     pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
-        let mut cell = [0u32; 3];
-        for ((c, (&x, &o)), &d) in cell
-            .iter_mut()
-            .zip(p.iter().zip(self.origin_m.iter()))
-            .zip(&self.dims)
-        {
-            let f = ((x - o) / self.cell_m).floor();
-            let top = T::of_f64(f64::from(d.saturating_sub(1)));
-            // NaN fails both comparisons and stays at 0.
-            *c = if f > T::zero() {
-                let clamped = if f < top { f } else { top };
-                clamped.as_f64() as u32
-            } else {
-                0
-            };
+        Grid {
+            origin_m: self.origin_m,
+            cell_m: self.cell_m,
+            dims: self.dims,
         }
-        cell
+        .cell_of(p)
     }
 
     /// `true` if `p` (m) lies within one cell edge plus `margin_m` of the

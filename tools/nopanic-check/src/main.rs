@@ -68,7 +68,8 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use cortex_m_rt::entry;
 use nalgebra::Vector3;
-use palpate_kernel::haptic::haptic_loop::{HapticLoop, LoopConfig};
+use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
+use palpate_kernel::haptic::tissue::PrecomputedTissue;
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
 use palpate_kernel::precomputed::Contact;
 use palpate_kernel::table::TensorMassTable;
@@ -229,7 +230,10 @@ fn haptic_step(inputs: &HapticInputs) {
             max_slew_n_per_s,
         },
     };
-    let Ok(mut haptic) = HapticLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(&table, config) else {
+    let Ok(mut haptic) = PrecomputedLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(
+        PrecomputedTissue::new(&table),
+        config,
+    ) else {
         refused();
         return;
     };
