@@ -51,7 +51,7 @@ enum Command {
     /// Per-tick instruction counts (callgrind) of every generated trajectory
     /// against the static bound from the table sizes and capacities.
     Budget {
-        /// Scene file (TOML), or `built-in`.
+        /// Scene file (TOML) of the pre-computed model, or `built-in`.
         scene: String,
         /// Working folder for tables, trajectories and callgrind dumps.
         #[arg(long, default_value = "budget-out")]
@@ -204,7 +204,8 @@ impl DynamicModelArgs {
 enum SessionCommand {
     /// Drive the haptic loop tick by tick; write `t,fx,fy,fz,contacts,status` per tick.
     Run {
-        /// Scene file (TOML), or `built-in` for the demo scene.
+        /// Scene file (TOML), `built-in` (the demo block, pre-computed model) or
+        /// `built-in-dynamic` (the same block on the dynamic model).
         scene: String,
         /// Trajectory file: CSV `t,tool,x,y,z` (s, tool point, m) with a header.
         #[arg(long)]
@@ -669,11 +670,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
             lenient,
         }) => {
             use palpate::session::{Scene, Trajectory};
-            let scene = if scene == "built-in" {
-                Scene::built_in()
-            } else {
-                Scene::read(std::path::Path::new(&scene))?
-            };
+            let scene = Scene::named(&scene)?;
             let points = scene.tool.points;
             let trajectory = if lenient {
                 let (t, findings) = Trajectory::read_unchecked(&trajectory, points)?;
@@ -706,6 +703,9 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
                 summary.max_jump_n,
                 summary.frames
             );
+            if let Some(e) = summary.physics_error {
+                eprintln!("physics update failed at {e}; the force was zero from the next tick on");
+            }
             Ok(())
         }
         Command::Session(SessionCommand::Generate { kind, output }) => {
@@ -741,11 +741,13 @@ fn budget(
 ) -> anyhow::Result<()> {
     use palpate::budget::{BudgetRow, M4F_IPS, measure, tick_bound, trajectories};
     use palpate::session::{MeshSource, Scene, Trajectory};
-    let mut scene = if scene_arg == "built-in" {
-        Scene::built_in()
-    } else {
-        Scene::read(std::path::Path::new(scene_arg))?
-    };
+    let mut scene = Scene::named(scene_arg)?;
+    if scene.model != palpate::session::ModelSpec::Precomputed {
+        anyhow::bail!(
+            "{}: the budget measures the pre-computed model's tick (model.kind = \"precomputed\")",
+            scene.source
+        );
+    }
     if let Some([table_path, trajectory_path]) = probe {
         let bytes = palpate::tables::load::TableFile::read(table_path)?;
         let table = palpate_kernel::PrecomputedTable::<f32>::load(bytes.bytes())

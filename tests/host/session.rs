@@ -10,6 +10,7 @@ use palpate::session::{
     Poke, Press, PressHold, Rates, SafetyLimits, Sample, Scene, Slide, Strike, ToolSpec,
     Trajectory, TrajectoryError, sample_keyframes,
 };
+use palpate_kernel::haptic::dynamic_tissue::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use palpate_tests::reference_dir;
 
@@ -56,6 +57,7 @@ integrator = "central"
 dt_s = 0.0005
 damping_per_s = 2.5
 incompressibility_n = 0.75
+extrapolation = "instantaneous"
 
 [tool]
 points = 2
@@ -96,6 +98,7 @@ fn hand_written_scene_with_every_field() {
             integrator: Integrator::CentralDifference,
             dt_s: 0.0005,
             damping_per_s: 2.5,
+            extrapolation: Extrapolation::Instantaneous,
         })
     );
     assert_eq!(
@@ -211,6 +214,7 @@ fn dynamic_defaults_step_once_per_physics_period() {
             integrator: Integrator::SymplecticEuler,
             dt_s: 0.004,
             damping_per_s: 2.0,
+            extrapolation: Extrapolation::Secant,
         })
     );
     assert!(s.fix.is_empty());

@@ -4,28 +4,36 @@
 //! (s, N, N, N, count, `ok` | `clamped` | `faulted:<reason>`).
 //!
 //! The table is built in memory from the scene (f32, the firmware
-//! precision). Every `physics_every` ticks the deformation field is updated
-//! from the last contact solution (and written as a VTK frame with
-//! `--vtk`); the force is computed every tick (see the loop's docs).
-//! Only the pre-computed model is driven here; a dynamic scene is refused.
+//! precision), pre-computed or tensor-mass by the scene's model. The force
+//! is computed every tick (see the loop's docs); every `physics_every`
+//! ticks comes the physics update: for the pre-computed model the
+//! deformation field from the last contact solution, for the dynamic model
+//! a [`DynamicLoop::physics_update`] (steps, held forces, re-binning). With
+//! `--vtk` each update's field is written as a VTK frame.
 
 use std::io::Write;
 use std::path::Path;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
+use palpate_kernel::haptic::dynamic_tissue::{DynamicTissue, PhysicsConfig};
+use palpate_kernel::haptic::haptic_loop::{DynamicLoop, ForceOutput, LoopConfig, PrecomputedLoop};
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
 use palpate_kernel::haptic::tissue::PrecomputedTissue;
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::{DynamicParams, Limits, TensorMassModel};
 
-use super::{ModelSpec, Scene, Trajectory};
+use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
+use crate::dynamic::run::diagonal;
+use crate::dynamic::{OwnedState, OwnedSurface};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::vtk;
 use crate::tables::build::{BuildOptions, build_table};
 use crate::tables::compliance::Solver;
 use crate::tables::file::Precision;
 use crate::tables::load::TableFile;
+use crate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
 
 /// The f32 pre-computed table of `scene` (the firmware precision), built
 /// in memory with the same pipeline as `palpate tables build`.
@@ -44,6 +52,23 @@ pub fn precomputed_table(
     Ok(build_table(mesh, report, &options)
         .with_context(|| scene.source.clone())?
         .bytes)
+}
+
+/// The f32 tensor-mass table of `scene` (the firmware precision), built in
+/// memory with the same pipeline as `palpate tables build --kind
+/// tensor-mass`.
+pub fn tensor_mass_table(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<Vec<u8>> {
+    let options = TensorMassOptions {
+        material: scene.elastic_material()?,
+        density_kg_m3: scene.material.density_kg_m3,
+        fix: scene.fix.clone(),
+        precision: Precision::F32,
+    };
+    build_tensor_mass_table(mesh, report, &options).with_context(|| scene.source.clone())
 }
 
 /// The haptic loop configuration of `scene` (f32).
@@ -96,6 +121,9 @@ pub struct SessionSummary {
     pub max_jump_n: f64,
     /// VTK frames written.
     pub frames: usize,
+    /// The first failed physics update of a dynamic model (the loop
+    /// faulted from the next tick on).
+    pub physics_error: Option<String>,
 }
 
 /// Runs `trajectory` through the haptic loop of `scene`, writing the CSV to
@@ -106,106 +134,208 @@ pub fn run_session(
     out: &mut dyn Write,
     vtk_dir: Option<&Path>,
 ) -> anyhow::Result<SessionSummary> {
-    if !matches!(scene.model, ModelSpec::Precomputed) {
-        bail!(
-            "{}: session run drives the pre-computed model only (model.kind = \"precomputed\")",
-            scene.source
-        );
-    }
     let (mesh, report) = scene.load_mesh()?;
-    let file = TableFile::from_bytes(&precomputed_table(scene, &mesh, &report)?);
-    let table = PrecomputedTable::<f32>::load(file.bytes()).context("session table")?;
-    let config = loop_config(scene);
-    let field = FieldOutput {
+    let mut session = Session {
+        out,
+        summary: SessionSummary::default(),
+        last: Vector3::zeros(),
         rest: &mesh.positions,
         tets: &mesh.tets,
         dir: vtk_dir,
-        every: scene.rates.physics_every.max(1) as usize,
+        frames: Vec::new(),
     };
-    let run = Runner {
-        table: &table,
-        config,
+    writeln!(session.out, "t,fx,fy,fz,contacts,status")?;
+    let config = loop_config(scene);
+    let ticks = Ticks {
         trajectory,
         tick_s: scene.tick_s(),
-        field,
+        every: scene.rates.physics_every.max(1) as usize,
     };
-    match scene.tool.points {
-        1 => run.go::<1>(out),
-        2 => run.go::<2>(out),
-        3 => run.go::<3>(out),
-        _ => run.go::<4>(out),
+    match scene.model {
+        ModelSpec::Precomputed => {
+            let file = TableFile::from_bytes(&precomputed_table(scene, &mesh, &report)?);
+            let table = PrecomputedTable::<f32>::load(file.bytes()).context("session table")?;
+            match scene.tool.points {
+                1 => ticks.precomputed::<1>(&table, config, &mut session),
+                2 => ticks.precomputed::<2>(&table, config, &mut session),
+                3 => ticks.precomputed::<3>(&table, config, &mut session),
+                _ => ticks.precomputed::<4>(&table, config, &mut session),
+            }?;
+        }
+        ModelSpec::Dynamic(spec) => {
+            let file = TableFile::from_bytes(&tensor_mass_table(scene, &mesh, &report)?);
+            let table = TensorMassTable::<f32>::load(file.bytes()).context("session table")?;
+            let dynamic = Dynamic {
+                table,
+                params: dynamic_params(&spec, &mesh.positions),
+                physics: PhysicsConfig {
+                    extrapolation: spec.extrapolation,
+                    integrator: spec.integrator,
+                    dt_s: spec.dt_s as f32,
+                    substeps: scene
+                        .dynamic_substeps()
+                        .context("physics period is not a whole number of dt_s")?,
+                },
+                config,
+            };
+            match scene.tool.points {
+                1 => ticks.dynamic::<1>(&dynamic, &mut session),
+                2 => ticks.dynamic::<2>(&dynamic, &mut session),
+                3 => ticks.dynamic::<3>(&dynamic, &mut session),
+                _ => ticks.dynamic::<4>(&dynamic, &mut session),
+            }?;
+        }
+    }
+    session.finish()
+}
+
+/// The f32 dynamic parameters of a scene: its law, penalty and damping, no
+/// gravity (the tissue rests in its meshed shape), divergence when a
+/// displacement exceeds the mesh's bounding-box diagonal.
+fn dynamic_params(spec: &DynamicSpec, positions: &[[f64; 3]]) -> DynamicParams<f32> {
+    DynamicParams {
+        law: spec.law,
+        incompressibility_n: spec.incompressibility_n.map(|g| g as f32),
+        damping_per_s: spec.damping_per_s as f32,
+        gravity_m_s2: Vector3::zeros(),
+        limits: Limits {
+            max_displacement_m: diagonal(positions) as f32,
+            max_kinetic_energy_j: f32::INFINITY,
+        },
     }
 }
 
-/// Where the deformation field goes.
-struct FieldOutput<'m> {
-    rest: &'m [[f64; 3]],
-    tets: &'m [[u32; 4]],
-    dir: Option<&'m Path>,
+/// A dynamic scene's table and settings.
+struct Dynamic<'t> {
+    table: TensorMassTable<'t, f32>,
+    params: DynamicParams<f32>,
+    physics: PhysicsConfig<f32>,
+    config: LoopConfig<f32>,
+}
+
+/// The trajectory's ticks and the physics period in ticks.
+struct Ticks<'r> {
+    trajectory: &'r Trajectory,
+    tick_s: f64,
     every: usize,
 }
 
-struct Runner<'r, 't> {
-    table: &'r PrecomputedTable<'t, f32>,
-    config: LoopConfig<f32>,
-    trajectory: &'r Trajectory,
-    tick_s: f64,
-    field: FieldOutput<'r>,
-}
-
-impl Runner<'_, '_> {
-    fn go<const P: usize>(&self, out: &mut dyn Write) -> anyhow::Result<SessionSummary> {
-        let mut haptic =
-            PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(self.table), self.config)
-                .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+impl Ticks<'_> {
+    fn precomputed<const P: usize>(
+        &self,
+        table: &PrecomputedTable<'_, f32>,
+        config: LoopConfig<f32>,
+        session: &mut Session<'_>,
+    ) -> anyhow::Result<()> {
+        let mut haptic = PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(table), config)
+            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
         let model = *haptic.tissue().model();
-        let mut summary = SessionSummary::default();
-        let mut field = vec![[0.0f32; 3]; self.field.rest.len()];
-        let mut frames = Vec::new();
-        let mut last = Vector3::<f32>::zeros();
-        writeln!(out, "t,fx,fy,fz,contacts,status")?;
+        let mut field = vec![[0.0f32; 3]; session.rest.len()];
         for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s).enumerate() {
-            let output = haptic.tick(&tool);
-            let f = output.force_n;
-            let status = match output.status {
-                OutputStatus::Ok => "ok".to_string(),
-                OutputStatus::Clamped => {
-                    summary.clamped += 1;
-                    "clamped".to_string()
-                }
-                OutputStatus::Faulted(reason) => {
-                    summary.faulted += 1;
-                    format!("faulted:{reason}")
-                }
-            };
-            writeln!(
-                out,
-                "{t},{},{},{},{},{status}",
-                f.x, f.y, f.z, output.contacts
-            )?;
-            summary.ticks += 1;
-            summary.ticks_in_contact += usize::from(output.contacts > 0);
-            summary.max_force_n = summary.max_force_n.max(f64::from(f.norm()));
-            summary.max_jump_n = summary.max_jump_n.max(f64::from((f - last).norm()));
-            last = f;
-            if let (Some(dir), true) = (self.field.dir, k % self.field.every == 0) {
-                if let Some(solution) = haptic.solution() {
-                    model
+            session.record(t, &haptic.tick(&tool))?;
+            if session.dir.is_some() && k % self.every == 0 {
+                match haptic.solution() {
+                    Some(solution) => model
                         .displacements(solution, &mut field)
-                        .map_err(|e| anyhow::anyhow!("displacements: {e}"))?;
-                } else {
-                    field.fill([0.0; 3]);
+                        .map_err(|e| anyhow::anyhow!("displacements: {e}"))?,
+                    None => field.fill([0.0; 3]),
                 }
-                let u: Vec<[f64; 3]> = field.iter().map(|d| d.map(f64::from)).collect();
-                let path = dir.join(format!("frame_{:06}.vtk", frames.len()));
-                vtk::write_frame(&path, self.field.rest, self.field.tets, &u)?;
-                frames.push((t, path));
+                session.frame(t, &field)?;
             }
         }
-        if let Some(dir) = self.field.dir {
-            vtk::write_collection(&dir.join("session.pvd"), &frames)?;
+        Ok(())
+    }
+
+    fn dynamic<const P: usize>(
+        &self,
+        scene: &Dynamic<'_>,
+        session: &mut Session<'_>,
+    ) -> anyhow::Result<()> {
+        let mut state = OwnedState::for_table(&scene.table).without_split_terms();
+        let model = TensorMassModel::new(scene.table, state.buffers(), scene.params)
+            .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
+        let mut surface = OwnedSurface::for_model(&model);
+        let (buffers, forces) = surface.buffers();
+        let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, scene.physics)
+            .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?;
+        let mut haptic = DynamicLoop::<f32, P, P>::new(tissue, scene.config)
+            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s).enumerate() {
+            session.record(t, &haptic.tick(&tool))?;
+            if (k + 1) % self.every != 0 {
+                continue;
+            }
+            if let Err(e) = haptic.physics_update()
+                && session.summary.physics_error.is_none()
+            {
+                session.summary.physics_error = Some(format!("t = {t} s: {e}"));
+            }
+            if session.dir.is_some() {
+                let u = haptic.tissue().model().displacements_m().unwrap_or(&[]);
+                session.frame(t, u)?;
+            }
         }
-        summary.frames = frames.len();
-        Ok(summary)
+        Ok(())
+    }
+}
+
+/// The CSV, the summary and the VTK frames of a running session.
+struct Session<'o> {
+    out: &'o mut dyn Write,
+    summary: SessionSummary,
+    last: Vector3<f32>,
+    rest: &'o [[f64; 3]],
+    tets: &'o [[u32; 4]],
+    dir: Option<&'o Path>,
+    frames: Vec<(f64, std::path::PathBuf)>,
+}
+
+impl Session<'_> {
+    /// One tick's CSV line and its share of the summary.
+    fn record(&mut self, t: f64, output: &ForceOutput<f32>) -> anyhow::Result<()> {
+        let summary = &mut self.summary;
+        let status = match output.status {
+            OutputStatus::Ok => "ok".to_string(),
+            OutputStatus::Clamped => {
+                summary.clamped += 1;
+                "clamped".to_string()
+            }
+            OutputStatus::Faulted(reason) => {
+                summary.faulted += 1;
+                format!("faulted:{reason}")
+            }
+        };
+        let f = output.force_n;
+        writeln!(
+            self.out,
+            "{t},{},{},{},{},{status}",
+            f.x, f.y, f.z, output.contacts
+        )?;
+        summary.ticks += 1;
+        summary.ticks_in_contact += usize::from(output.contacts > 0);
+        summary.max_force_n = summary.max_force_n.max(f64::from(f.norm()));
+        summary.max_jump_n = summary.max_jump_n.max(f64::from((f - self.last).norm()));
+        self.last = f;
+        Ok(())
+    }
+
+    /// A VTK frame of displacement field `u` (m; zero where missing) at `t`.
+    fn frame(&mut self, t: f64, u: &[[f32; 3]]) -> anyhow::Result<()> {
+        let Some(dir) = self.dir else { return Ok(()) };
+        let u: Vec<[f64; 3]> = (0..self.rest.len())
+            .map(|v| u.get(v).map_or([0.0; 3], |d| d.map(f64::from)))
+            .collect();
+        let path = dir.join(format!("frame_{:06}.vtk", self.frames.len()));
+        vtk::write_frame(&path, self.rest, self.tets, &u)?;
+        self.frames.push((t, path));
+        Ok(())
+    }
+
+    fn finish(mut self) -> anyhow::Result<SessionSummary> {
+        if let Some(dir) = self.dir {
+            vtk::write_collection(&dir.join("session.pvd"), &self.frames)?;
+        }
+        self.summary.frames = self.frames.len();
+        Ok(self.summary)
     }
 }

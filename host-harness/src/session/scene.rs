@@ -20,6 +20,8 @@
 //! dt_s = 0.0005                # default: the physics period (physics_every / haptic_hz)
 //! damping_per_s = 2.0          # required for kind = "dynamic"
 //! incompressibility_n = 0.5    # required for, and only for, law = "stvk-incompressible"
+//! extrapolation = "secant"     # force between physics updates: "secant" (default) or
+//!                              # "instantaneous" (palpate_kernel::haptic::dynamic_tissue)
 //!
 //! [tool]
 //! points = 1                   # default 1, in 1..=4 (MAX_TOOL_POINTS)
@@ -41,6 +43,7 @@
 use std::path::{Path, PathBuf};
 
 use palpate_kernel::MAX_CONTACTS;
+use palpate_kernel::haptic::dynamic_tissue::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
 
@@ -155,6 +158,8 @@ pub struct DynamicSpec {
     pub dt_s: f64,
     /// Mass-proportional damping `c`, 1/s, finite and ≥ 0 (damping force `−c·m_i·v_i`).
     pub damping_per_s: f64,
+    /// The stiffness the force is extrapolated with between physics updates.
+    pub extrapolation: Extrapolation,
 }
 
 /// The tool: a few points with a radius.
@@ -280,6 +285,13 @@ enum IntegratorName {
     Central,
 }
 
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum ExtrapolationName {
+    Secant,
+    Instantaneous,
+}
+
 #[derive(Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ModelFile {
@@ -291,6 +303,7 @@ struct ModelFile {
     dt_s: Option<f64>,
     damping_per_s: Option<f64>,
     incompressibility_n: Option<f64>,
+    extrapolation: Option<ExtrapolationName>,
 }
 
 #[derive(Deserialize)]
@@ -416,6 +429,38 @@ impl Scene {
                 max_force_n: DEFAULT_MAX_FORCE_N,
                 max_slew_n_per_s: DEFAULT_MAX_SLEW_N_PER_S,
             },
+        }
+    }
+
+    /// The built-in block on the dynamic model: linear tensor-mass, symplectic Euler in 0.5 ms
+    /// steps, damping 30/s, physics at 100 Hz (every 10 ticks, the display rate; the force is
+    /// extrapolated in between with the secant stiffness).
+    pub fn built_in_dynamic() -> Scene {
+        Scene {
+            source: "built-in dynamic scene".into(),
+            model: ModelSpec::Dynamic(DynamicSpec {
+                law: ElasticLaw::Linear,
+                incompressibility_n: None,
+                integrator: Integrator::SymplecticEuler,
+                dt_s: 0.0005,
+                damping_per_s: 30.0,
+                extrapolation: Extrapolation::Secant,
+            }),
+            rates: Rates {
+                haptic_hz: DEFAULT_HAPTIC_HZ,
+                physics_every: 10,
+            },
+            ..Self::built_in()
+        }
+    }
+
+    /// The scene a command line names: `built-in` ([`Self::built_in`]), `built-in-dynamic`
+    /// ([`Self::built_in_dynamic`]), or a scene file ([`Self::read`]).
+    pub fn named(name: &str) -> Result<Scene, SceneError> {
+        match name {
+            "built-in" => Ok(Self::built_in()),
+            "built-in-dynamic" => Ok(Self::built_in_dynamic()),
+            path => Self::read(Path::new(path)),
         }
     }
 
@@ -719,6 +764,7 @@ fn model_spec(
             ("dt_s", raw.dt_s.is_some()),
             ("damping_per_s", raw.damping_per_s.is_some()),
             ("incompressibility_n", raw.incompressibility_n.is_some()),
+            ("extrapolation", raw.extrapolation.is_some()),
         ];
         if let Some((key, _)) = dynamic_only.iter().find(|(_, given)| *given) {
             return Err((
@@ -776,6 +822,10 @@ fn model_spec(
         integrator,
         dt_s: raw.dt_s.unwrap_or(f64::from(physics_every) / haptic_hz),
         damping_per_s,
+        extrapolation: match raw.extrapolation {
+            None | Some(ExtrapolationName::Secant) => Extrapolation::Secant,
+            Some(ExtrapolationName::Instantaneous) => Extrapolation::Instantaneous,
+        },
     }))
 }
 

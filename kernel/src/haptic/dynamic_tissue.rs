@@ -1,36 +1,41 @@
 //! The dynamic tensor-mass model as a tissue for the haptic loop
 //! (RR-3510 §5; Cotin 1999 §4; MODELS.md §6).
 //!
-//! Coupling (imposed displacement, Cotin 1999 §4: "the barycentric
-//! coordinates of the intersection point distribute the displacement to the
-//! vertices of the intersected triangle"): at each physics update, every
-//! contact's triangle vertices are held ([`TensorMassModel::impose`]) so that
-//! the contact point moves by `gap · n` onto the tool sphere; the
-//! minimum-norm distribution is `Δu_i = w_i / Σ_k w_k² · gap · n` over the
-//! triangle's free vertices. The model is then stepped, the force on the
-//! hand is the elastic force the held vertices resist, `F = Σ_i f_i`, and
-//! the surface is re-binned ([`DeformingSurface::rebin`]). Vertices no
-//! longer under a contact are released at the next update.
+//! Coupling (imposed displacement, Cotin 1999 §4: "the vertices of the
+//! intersected triangle receive the displacement of the intersection
+//! point"): at each physics update, the contact triangle's movable vertices
+//! are held ([`TensorMassModel::impose`]) and translated by `gap · n`, so the
+//! triangle keeps its orientation and the contact point (any barycentric
+//! weights) lands on the tool sphere. The model is then stepped and the
+//! surface re-binned ([`DeformingSurface::rebin`]). The tool is frictionless:
+//! the force on the hand is the normal part of the elastic force the held
+//! vertices resist, `F = (n · Σ_i f_i) n`. Vertices no longer under a
+//! contact are released at the next update.
 //!
 //! Force between physics updates (extrapolation from the local contact
 //! stiffness and the tool's motion, Cotin 1999 §6): each tick sends
-//! `F = F_update − α K_c n · gap`, where `gap` is the tool's normal motion
-//! since the last update (measured against that update's surface, zero
-//! right after it) and `K_c = Σ_{i,j ∈ triangle} K_ij w_j / Σw²` comes from
-//! the model's current vertex and edge tensors (RR-3510 §5.1). With the
-//! rest of the mesh frozen, moving the held vertices by
-//! `Δu_j = w_j / Σw² · gap · n` changes the force by exactly
+//! `F = (n · F_update − α k · gap) n`, where `gap` is the tool's normal
+//! motion since the last update (measured against that update's surface,
+//! zero right after it) and `k = n · K_c n`, `K_c = Σ_{i,j} K_ij` over the
+//! triangle's movable vertices, from the model's current vertex and edge
+//! tensors (RR-3510 §5.1). With the rest of the mesh frozen, translating
+//! the held vertices by `gap · n` changes the force by exactly
 //! `−K_c n · gap`, so `α = 1` ([`Extrapolation::Instantaneous`]) is the
 //! model's own force until the next step (exact for the linear law; for St
 //! Venant-Kirchhoff `K` is the rest tangent). But the free vertices then
 //! relax during the step, so the instantaneous stiffness overshoots and the
 //! force drops at every update (a saw-tooth at the physics rate).
 //! [`Extrapolation::Secant`] (the default) scales it by the ratio the
-//! tissue showed over the last period, `α = ΔF·n / (−gap · n·K_c n)`
-//! clamped to `[0, 1]` (kept when the tool moved less than
-//! [`SECANT_MIN_MOTION_M`]; 1 on a new contact), so the force follows the
-//! stiffness the tissue actually responds with and an update changes it
-//! only by the period's prediction error.
+//! tissue showed over the last period, `α = n · ΔF / (−k · gap)` clamped to
+//! `[0, 1]` (kept when the tool moved less than [`SECANT_MIN_MOTION_M`]; a
+//! new contact starts from zero force at `α = 1`), and spreads what an
+//! update corrects over the next period: the difference between the force
+//! sent on the last tick before the update and the update's force decays
+//! linearly to zero over as many ticks as the last period had (`1 − j/k`
+//! of it at the `j`-th of `k` ticks). The force
+//! the device receives is then continuous across updates by construction;
+//! the price is that a correction arrives over one physics period instead
+//! of at once.
 
 use core::fmt;
 
@@ -46,13 +51,13 @@ use crate::tensor_mass::{Integrator, StepError, StepReport, TensorMassModel};
 /// stiffness ratio (below it the ratio is noise: kept from before).
 pub const SECANT_MIN_MOTION_M: f64 = 1e-6;
 
-/// The stiffness the force is extrapolated with between physics updates
-/// (module docs).
+/// How the force is extrapolated between physics updates (module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Extrapolation {
     /// `K_c`: the model's force with the rest of the mesh frozen.
     Instantaneous,
-    /// `α K_c`, `α` the secant ratio of the last period.
+    /// `α K_c`, `α` the secant ratio of the last period, and each update's
+    /// correction spread over the next period.
     #[default]
     Secant,
 }
@@ -138,6 +143,9 @@ struct Held<T> {
     force_n: Vector3<T>,
     /// Extrapolation stiffness ratio `α`, in `[0, 1]`.
     scale: T,
+    /// Normal force sent just before the update minus the update's, N
+    /// (decays to zero over the next period; zero when instantaneous).
+    offset_n: T,
 }
 
 /// The dynamic model, its deforming surface and what each of the `P` tool
@@ -149,6 +157,9 @@ pub struct DynamicTissue<'a, 's, T: Real, const P: usize> {
     physics: PhysicsConfig<T>,
     held: [Option<Held<T>>; P],
     fault: Option<PhysicsError>,
+    /// Ticks since the last update, and in the period before it (≥ 1).
+    ticks_since_update: u32,
+    period_ticks: u32,
 }
 
 impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
@@ -179,6 +190,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             physics,
             held: [None; P],
             fault: None,
+            ticks_since_update: 0,
+            period_ticks: 1,
         })
     }
 
@@ -202,65 +215,61 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         !self.model.table().is_fixed(v)
     }
 
-    /// `Σ w_k²` over the target's movable vertices (0 when none is).
-    fn weight_norm2(&self, t: &ContactTarget<T>) -> T {
-        t.vertices
-            .iter()
-            .zip(&t.contact.weights)
-            .filter(|(v, _)| self.movable(**v))
-            .fold(T::zero(), |s, (_, &w)| s + w * w)
-    }
-
-    /// `K_c n` (N/m) of a target: the change of force on the hand per metre
-    /// of imposed normal displacement of its contact point (module docs).
-    /// Cost: 9 tensor products and 6 edge look-ups.
-    fn stiffness_along_normal(&self, t: &ContactTarget<T>) -> Vector3<T> {
-        let s = self.weight_norm2(t);
-        if s <= T::zero() {
-            return Vector3::zeros();
-        }
+    /// `k = n · K_c n` (N/m): the change of the normal force on the hand
+    /// per metre of normal translation of the target's movable vertices
+    /// (module docs). Cost: 9 tensor products and 6 edge look-ups.
+    fn normal_stiffness(&self, t: &ContactTarget<T>) -> T {
         let table = self.model.table();
-        let mut kn = Vector3::zeros();
+        let n = &t.normal;
+        let mut k = T::zero();
         for &i in t.vertices.iter().filter(|&&v| self.movable(v)) {
-            for (&j, &wj) in t.vertices.iter().zip(&t.contact.weights) {
-                if !self.movable(j) {
-                    continue;
-                }
-                let du = t.normal * (wj / s);
-                kn += if i == j {
+            for &j in t.vertices.iter().filter(|&&v| self.movable(v)) {
+                k += if i == j {
                     self.model
                         .vertex_tensors()
                         .get(i as usize)
-                        .map_or(Vector3::zeros(), |k| product(k, &du, false))
+                        .map_or(T::zero(), |kij| n.dot(&product(kij, n, false)))
                 } else {
                     // The stored edge tensor is K_{lo,hi}; K_{hi,lo} is its transpose.
                     table
                         .edge_index(i, j)
                         .and_then(|e| self.model.edge_tensors().get(e as usize))
-                        .map_or(Vector3::zeros(), |k| product(k, &du, i > j))
+                        .map_or(T::zero(), |kij| n.dot(&product(kij, n, i > j)))
                 };
             }
         }
-        kn
+        k
+    }
+
+    /// The normal force (N, along `t.normal`, positive pushing the tool
+    /// out) sent for target `t` at this tick (module docs).
+    fn normal_force(&self, t: &ContactTarget<T>) -> T {
+        let Some(h) = carried(&self.held, t) else {
+            return -self.normal_stiffness(t) * t.gap_m;
+        };
+        // 1 − j/period at the j-th tick after the update: zero by the next
+        // one, so corrections never accumulate.
+        let ticks = T::of_f64(f64::from(self.ticks_since_update));
+        let period = T::of_f64(f64::from(self.period_ticks));
+        let remaining = T::one() - ticks / period;
+        let blend = if remaining > T::zero() {
+            remaining
+        } else {
+            T::zero()
+        };
+        h.force_n.dot(&t.normal) - h.scale * self.normal_stiffness(t) * t.gap_m + blend * h.offset_n
     }
 
     /// The extrapolation ratio after an update that moved target `t` by
-    /// `gap` and changed its force from `before`'s to `force_n`.
-    fn secant_scale(
-        &self,
-        before: Option<Held<T>>,
-        t: &ContactTarget<T>,
-        force_n: &Vector3<T>,
-    ) -> T {
-        let Some(before) = before else {
-            return T::one();
-        };
+    /// `gap` and changed its force from `before`'s to `force_n` (a new
+    /// contact's `before` is zero force at `α = 1`).
+    fn secant_scale(&self, before: &Held<T>, t: &ContactTarget<T>, force_n: &Vector3<T>) -> T {
         if self.physics.extrapolation == Extrapolation::Instantaneous
             || t.gap_m.abs() < T::of_f64(SECANT_MIN_MOTION_M)
         {
             return before.scale;
         }
-        let predicted = -self.stiffness_along_normal(t).dot(&t.normal) * t.gap_m;
+        let predicted = -self.normal_stiffness(t) * t.gap_m;
         let measured = (force_n - before.force_n).dot(&t.normal);
         let ratio = measured / predicted;
         if !ratio.finite() {
@@ -292,6 +301,13 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             return Err(fault);
         }
         let previous = self.held;
+        // What the last tick sent, per target (the corrections' reference).
+        let mut sent = [T::zero(); P];
+        for t in set {
+            if let Some(x) = sent.get_mut(t.tool) {
+                *x = self.normal_force(t);
+            }
+        }
         // Release what no current contact holds.
         for held in previous.iter().flatten() {
             for &v in &held.vertices {
@@ -302,12 +318,11 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             }
         }
         self.held = [None; P];
-        // Impose: move each contact point by gap · n (minimum norm).
+        // Impose: translate each contact triangle by gap · n.
         for t in set {
-            let s = self.weight_norm2(t);
             let shift = t.normal * t.gap_m;
-            for (&v, &w) in t.vertices.iter().zip(&t.contact.weights) {
-                if !self.movable(v) || s <= T::zero() {
+            for &v in &t.vertices {
+                if !self.movable(v) {
                     continue;
                 }
                 let u = self
@@ -317,7 +332,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                     .get(v as usize)
                     .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]));
                 self.model
-                    .impose(v, u + shift * (w / s))
+                    .impose(v, u + shift)
                     .map_err(|_| PhysicsError::NonFiniteContact { tool: t.tool })?;
             }
         }
@@ -338,12 +353,26 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                     force_n += Vector3::new(f[0], f[1], f[2]);
                 }
             }
-            let scale = self.secant_scale(carried(&previous, t), t, &force_n);
+            // A new contact started from the surface at rest: zero force, α = 1.
+            let before = carried(&previous, t).unwrap_or(Held {
+                vertices: t.vertices,
+                force_n: Vector3::zeros(),
+                scale: T::one(),
+                offset_n: T::zero(),
+            });
+            let scale = self.secant_scale(&before, t, &force_n);
+            let offset_n = match self.physics.extrapolation {
+                Extrapolation::Instantaneous => T::zero(),
+                Extrapolation::Secant => {
+                    sent.get(t.tool).copied().unwrap_or(T::zero()) - force_n.dot(&t.normal)
+                }
+            };
             if let Some(slot) = self.held.get_mut(t.tool) {
                 *slot = Some(Held {
                     vertices: t.vertices,
                     force_n,
                     scale,
+                    offset_n,
                 });
             }
         }
@@ -352,6 +381,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             .displacements_m()
             .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
         self.surface.rebin(u).map_err(PhysicsError::Surface)?;
+        self.period_ticks = self.ticks_since_update.max(1);
+        self.ticks_since_update = 0;
         report.ok_or(PhysicsError::Step(StepError::BadTimeStep))
     }
 }
@@ -386,7 +417,8 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
         true
     }
 
-    /// `F_q = F_update − α K_c n · gap` per target (module docs); the force of
+    /// `F_q = (n · F_update − α k · gap + blend · offset) n` per target
+    /// (module docs); the force of
     /// the last update carries over while the contact stays on or next to
     /// the triangle it held (they share a vertex).
     fn solve(&mut self, set: &[ContactTarget<T>]) -> Result<Solved<T, M>, Refusal> {
@@ -398,13 +430,15 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
             tissue_forces_n: [Vector3::zeros(); M],
         };
         for (t, g) in set.iter().zip(solved.tissue_forces_n.iter_mut()) {
-            let (before, scale) = carried(&self.held, t)
-                .map_or((Vector3::zeros(), T::one()), |h| (h.force_n, h.scale));
-            let force_n = before - self.stiffness_along_normal(t) * (scale * t.gap_m);
+            let force_n = t.normal * self.normal_force(t);
             solved.device_force_n += force_n;
             *g = -force_n;
         }
         Ok(solved)
+    }
+
+    fn begin_tick(&mut self) {
+        self.ticks_since_update = self.ticks_since_update.saturating_add(1);
     }
 
     fn forget(&mut self) {}
@@ -414,6 +448,8 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
         self.model.reset();
         self.held = [None; P];
         self.fault = None;
+        self.ticks_since_update = 0;
+        self.period_ticks = 1;
         // Rest positions come from a validated table: finite.
         let _ = self.surface.rebin(&[]);
     }

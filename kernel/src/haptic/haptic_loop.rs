@@ -151,6 +151,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
     /// most `P + 1` contact solves of at most `M` contacts.
     pub fn tick(&mut self, tool_m: &[Vector3<T>; P]) -> ForceOutput<T> {
         self.counters = TickCounters::default();
+        self.tissue.begin_tick();
         let dt = self.config.dt_s;
         if !tool_m.iter().all(|p| p.iter().all(|x| x.finite())) {
             self.contacts = [None; P];

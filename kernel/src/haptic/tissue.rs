@@ -73,6 +73,9 @@ pub trait Tissue<T: Real, const M: usize> {
     fn keeps(&self, gap_m: T) -> bool;
     /// The forces of contact set `set` (at most `M` targets). Bounded.
     fn solve(&mut self, set: &[ContactTarget<T>]) -> Result<Solved<T, M>, Refusal>;
+    /// Called once at the start of every tick (a clock for models that
+    /// extrapolate between physics updates).
+    fn begin_tick(&mut self) {}
     /// Forgets the last solution (a fault dropped every contact).
     fn forget(&mut self);
     /// Back to the state at construction (rest, no contact).
