@@ -8,7 +8,9 @@
 # - the tensor-mass model: table load, model construction and reset, the
 #   per-vertex inputs, the step with each of the four integrators and each
 #   elastic law, tet removal, cutting, tearing, the live surface and the
-#   outputs, round after round on one model.
+#   outputs, round after round on one model;
+# - the haptic loop over each model: construction, tick, reset, and for the
+#   dynamic model the physics update with its deforming surface.
 # Both tables are built from the firmware example's box by tools/box-table.sh.
 #
 # On failure it rebuilds with `--features locate` (a panic handler that links)
@@ -33,7 +35,8 @@ if cargo build --release 2>"$log"; then
         "step (explicit Euler, symplectic Euler, RK4, central difference; linear and" \
         "St Venant-Kirchhoff, incompressibility on and off), remove_tet, cut_with_tool," \
         "tear, surface_triangles, displacements_m, velocities_m_s, elastic_forces_n, fault;" \
-        "HapticLoop::new, tick, reset"
+        "HapticLoop::new, tick, reset (pre-computed); DynamicTissue::new, HapticLoop::new, tick," \
+        "physics_update, reset (tensor-mass, deforming surface)"
     exit 0
 fi
 

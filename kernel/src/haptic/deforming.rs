@@ -416,8 +416,8 @@ fn prefix_sum(starts: &mut [u32]) {
 /// After filling with `starts[i]` as row `i`'s cursor (now the start of
 /// row `i + 1`): shifts every entry up by one and restores `starts[0] = 0`.
 fn shift_back(starts: &mut [u32]) {
-    starts.rotate_right(1);
-    if let Some(first) = starts.first_mut() {
-        *first = 0;
+    let mut previous = 0u32;
+    for s in starts.iter_mut() {
+        (*s, previous) = (previous, *s);
     }
 }

@@ -30,11 +30,17 @@
 //! - the outputs `displacements_m`, `velocities_m_s`, `elastic_forces_n`,
 //!   `fault`;
 //!
-//! and of the haptic loop over the pre-computed table:
-//! - `HapticLoop::new` (configuration and limits from volatile inputs) and
-//!   `tick` (contact detection in the collision grid, sliding, the contact
-//!   solve with releases and refusals, the safety supervisor) on volatile
-//!   tool positions of two tool points, with `reset` on a volatile flag.
+//! and of the haptic loop over each model:
+//! - over the pre-computed table, `HapticLoop::new` (configuration and limits
+//!   from volatile inputs) and `tick` (contact detection in the collision
+//!   grid, sliding, the contact solve with releases and refusals, the safety
+//!   supervisor) on volatile tool positions of two tool points, with `reset`
+//!   on a volatile flag;
+//! - over the tensor-mass table, `DynamicTissue::new` (every surface buffer
+//!   length volatile, so the length refusals are reachable; the physics
+//!   configuration volatile) with its `DeformingSurface`, then `tick`,
+//!   `physics_update` (impose, step, held forces, re-binning; on a volatile
+//!   flag) and `reset`, on volatile tool positions.
 //!
 //! Why the proof holds for every input, not just one: every input (the table
 //! lengths, the contact count, each contact's kind, vertices, barycentric
@@ -68,9 +74,11 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use cortex_m_rt::entry;
 use nalgebra::Vector3;
-use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
-use palpate_kernel::haptic::tissue::PrecomputedTissue;
+use palpate_kernel::haptic::deforming::SurfaceBuffers;
+use palpate_kernel::haptic::dynamic_tissue::{DynamicTissue, Extrapolation, PhysicsConfig};
+use palpate_kernel::haptic::haptic_loop::{DynamicLoop, ForceOutput, LoopConfig, PrecomputedLoop};
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
+use palpate_kernel::haptic::tissue::PrecomputedTissue;
 use palpate_kernel::precomputed::Contact;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
@@ -154,6 +162,7 @@ static mut OUTPUTS: Outputs = Outputs {
 fn main() -> ! {
     let mut displacements = [[0.0f32; 3]; VERTICES];
     let mut state = TensorState::new();
+    let mut surface = SurfaceState::new();
     loop {
         // SAFETY: single-threaded, no interrupt touches INPUTS or
         // TENSOR_INPUTS; a volatile read of a plain-old-data static is always
@@ -166,6 +175,14 @@ fn main() -> ! {
         // SAFETY: as above.
         let inputs = unsafe { read_volatile(addr_of!(HAPTIC_INPUTS)) };
         haptic_step(&inputs);
+        // SAFETY: as above.
+        let (tensor, dynamic) = unsafe {
+            (
+                read_volatile(addr_of!(TENSOR_INPUTS)),
+                read_volatile(addr_of!(DYNAMIC_INPUTS)),
+            )
+        };
+        dynamic_haptic_step(&tensor, &dynamic, &mut state, &mut surface);
     }
 }
 
@@ -213,6 +230,18 @@ static mut HAPTIC_OUTPUTS: HapticOutputs = HapticOutputs {
     solves: 0,
 };
 
+/// The loop configuration from `[radius m, tick s, max force N, slew N/s]`.
+fn loop_config([radius_m, dt_s, max_force_n, max_slew_n_per_s]: [f32; 4]) -> LoopConfig<f32> {
+    LoopConfig {
+        radius_m,
+        dt_s,
+        limits: SafetyLimits {
+            max_force_n,
+            max_slew_n_per_s,
+        },
+    }
+}
+
 /// Load, build the loop, then tick on volatile tool positions (`reset` on
 /// a volatile flag), publishing every output.
 fn haptic_step(inputs: &HapticInputs) {
@@ -221,18 +250,9 @@ fn haptic_step(inputs: &HapticInputs) {
         refused();
         return;
     };
-    let [radius_m, dt_s, max_force_n, max_slew_n_per_s] = inputs.config;
-    let config = LoopConfig {
-        radius_m,
-        dt_s,
-        limits: SafetyLimits {
-            max_force_n,
-            max_slew_n_per_s,
-        },
-    };
     let Ok(mut haptic) = PrecomputedLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(
         PrecomputedTissue::new(&table),
-        config,
+        loop_config(inputs.config),
     ) else {
         refused();
         return;
@@ -244,19 +264,161 @@ fn haptic_step(inputs: &HapticInputs) {
             haptic.reset();
         }
         let out = haptic.tick(&tick.tool_m.map(Vector3::from));
-        let status = match out.status {
-            OutputStatus::Ok => 0,
-            OutputStatus::Clamped => 1,
-            OutputStatus::Faulted(_) => 2,
-        };
-        let o = addr_of_mut!(HAPTIC_OUTPUTS);
-        // SAFETY: single-threaded; plain-old-data fields of a live static.
-        unsafe {
-            write_volatile(addr_of_mut!((*o).force_n), out.force_n.into());
-            write_volatile(addr_of_mut!((*o).status), status);
-            write_volatile(addr_of_mut!((*o).contacts), out.contacts);
-            write_volatile(addr_of_mut!((*o).refused), out.refused);
-            write_volatile(addr_of_mut!((*o).solves), haptic.counters().solves);
+        publish_tick(&out, haptic.counters().solves);
+    }
+}
+
+/// Writes a tick's output to `HAPTIC_OUTPUTS` (volatile).
+fn publish_tick(out: &ForceOutput<f32>, solves: u32) {
+    let status = match out.status {
+        OutputStatus::Ok => 0,
+        OutputStatus::Clamped => 1,
+        OutputStatus::Faulted(_) => 2,
+    };
+    let o = addr_of_mut!(HAPTIC_OUTPUTS);
+    // SAFETY: single-threaded; plain-old-data fields of a live static.
+    unsafe {
+        write_volatile(addr_of_mut!((*o).force_n), out.force_n.into());
+        write_volatile(addr_of_mut!((*o).status), status);
+        write_volatile(addr_of_mut!((*o).contacts), out.contacts);
+        write_volatile(addr_of_mut!((*o).refused), out.refused);
+        write_volatile(addr_of_mut!((*o).solves), solves);
+    }
+}
+
+/// Grid cells of the checked deforming surface's buffer.
+const CELLS: usize = 128;
+
+/// The dynamic haptic loop's inputs beyond the tensor-mass ones.
+struct DynamicInputs {
+    /// Entries given to `positions_m`, `planes`, `vertex_triangle_start`,
+    /// `vertex_triangle`, `cell_start`, `grid_vertex` and the force scratch
+    /// (each clamped to its capacity).
+    surface_lengths: [usize; 7],
+    /// Integrator (as `TensorInputs::integrator`), extrapolation (0:
+    /// secant, else instantaneous).
+    integrator: u8,
+    extrapolation: u8,
+    /// Physics step, s, and steps per update.
+    dt_s: f32,
+    substeps: u32,
+    /// Loop configuration, as `HapticInputs::config`.
+    config: [f32; 4],
+    /// Ticks per round.
+    ticks: u32,
+    /// Tool point positions each tick, m.
+    tool_m: [[f32; 3]; TOOL_POINTS],
+    /// Non-zero: `reset` before the tick; a physics update after it.
+    reset: u8,
+    update: u8,
+}
+
+/// The dynamic haptic inputs, read with `read_volatile` only.
+static mut DYNAMIC_INPUTS: DynamicInputs = DynamicInputs {
+    surface_lengths: [
+        VERTICES,
+        SURFACE,
+        VERTICES + 1,
+        3 * SURFACE,
+        CELLS + 1,
+        VERTICES,
+        VERTICES,
+    ],
+    integrator: 1,
+    extrapolation: 0,
+    dt_s: 1e-3,
+    substeps: 1,
+    config: [0.002, 1e-3, 4.0, 2000.0],
+    ticks: 1,
+    tool_m: [[0.0; 3]; TOOL_POINTS],
+    reset: 0,
+    update: 1,
+};
+
+/// The deforming surface's storage (fixed capacity, sliced to the volatile
+/// lengths).
+struct SurfaceState {
+    positions_m: [[f32; 3]; VERTICES],
+    planes: [[f32; 4]; SURFACE],
+    vertex_triangle_start: [u32; VERTICES + 1],
+    vertex_triangle: [u32; 3 * SURFACE],
+    cell_start: [u32; CELLS + 1],
+    grid_vertex: [u32; VERTICES],
+    forces_n: [[f32; 3]; VERTICES],
+}
+
+impl SurfaceState {
+    fn new() -> Self {
+        Self {
+            positions_m: [[0.0; 3]; VERTICES],
+            planes: [[0.0; 4]; SURFACE],
+            vertex_triangle_start: [0; VERTICES + 1],
+            vertex_triangle: [0; 3 * SURFACE],
+            cell_start: [0; CELLS + 1],
+            grid_vertex: [0; VERTICES],
+            forces_n: [[0.0; 3]; VERTICES],
+        }
+    }
+}
+
+/// Load, model, dynamic tissue and loop on volatile inputs, then ticks with
+/// physics updates and resets on volatile flags, publishing every output.
+fn dynamic_haptic_step(
+    tensor: &TensorInputs,
+    inputs: &DynamicInputs,
+    state: &mut TensorState,
+    surface: &mut SurfaceState,
+) {
+    let bytes = TENSOR_TABLE.get(..tensor.table_len).unwrap_or(TENSOR_TABLE);
+    let Ok(table) = TensorMassTable::<f32>::load(bytes) else {
+        refused();
+        return;
+    };
+    let Ok(model) = TensorMassModel::new(table, state.buffers(&tensor.lengths), params(tensor))
+    else {
+        refused();
+        return;
+    };
+    let [p, t, vs, vt, c, g, f] = inputs.surface_lengths;
+    let buffers = SurfaceBuffers {
+        positions_m: prefix(&mut surface.positions_m, p),
+        planes: prefix(&mut surface.planes, t),
+        vertex_triangle_start: prefix(&mut surface.vertex_triangle_start, vs),
+        vertex_triangle: prefix(&mut surface.vertex_triangle, vt),
+        cell_start: prefix(&mut surface.cell_start, c),
+        grid_vertex: prefix(&mut surface.grid_vertex, g),
+    };
+    let physics = PhysicsConfig {
+        extrapolation: if inputs.extrapolation == 0 {
+            Extrapolation::Secant
+        } else {
+            Extrapolation::Instantaneous
+        },
+        integrator: integrator(inputs.integrator),
+        dt_s: inputs.dt_s,
+        substeps: inputs.substeps,
+    };
+    let forces = prefix(&mut surface.forces_n, f);
+    let Ok(tissue) = DynamicTissue::<f32, TOOL_POINTS>::new(model, buffers, forces, physics) else {
+        refused();
+        return;
+    };
+    let Ok(mut haptic) =
+        DynamicLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(tissue, loop_config(inputs.config))
+    else {
+        refused();
+        return;
+    };
+    for _ in 0..inputs.ticks {
+        // SAFETY: single-threaded; plain-old-data static.
+        let tick = unsafe { read_volatile(addr_of!(DYNAMIC_INPUTS)) };
+        if tick.reset != 0 {
+            haptic.reset();
+        }
+        let out = haptic.tick(&tick.tool_m.map(Vector3::from));
+        publish_tick(&out, haptic.counters().solves);
+        if tick.update != 0 && haptic.physics_update().is_err() {
+            refused();
         }
     }
 }
@@ -630,6 +792,36 @@ fn option(on: u8, value: f32) -> Option<f32> {
     (on != 0).then_some(value)
 }
 
+/// The integrator a byte names.
+fn integrator(code: u8) -> Integrator {
+    match code % 4 {
+        0 => Integrator::ExplicitEuler,
+        1 => Integrator::SymplecticEuler,
+        2 => Integrator::Rk4,
+        _ => Integrator::CentralDifference,
+    }
+}
+
+/// The dynamic parameters of `inputs` (law, penalty, damping, gravity,
+/// divergence limits).
+fn params(inputs: &TensorInputs) -> DynamicParams<f32> {
+    let law = match inputs.law % 3 {
+        0 => ElasticLaw::Linear,
+        1 => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
+        _ => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
+    };
+    DynamicParams {
+        law,
+        incompressibility_n: option(inputs.incompressibility_on, inputs.incompressibility_n),
+        damping_per_s: inputs.damping_per_s,
+        gravity_m_s2: inputs.gravity_m_s2.into(),
+        limits: Limits {
+            max_displacement_m: inputs.max_displacement_m,
+            max_kinetic_energy_j: inputs.max_kinetic_energy_j,
+        },
+    }
+}
+
 /// One tick of the tensor-mass model: load and model on `inputs`, then
 /// `inputs.rounds` rounds on the same model, each on freshly read inputs
 /// (see [`tensor_mass_round`]), so that every call also runs on a state any
@@ -641,22 +833,8 @@ fn tensor_mass_step(inputs: &TensorInputs, state: &mut TensorState) {
         refused();
         return;
     };
-    let law = match inputs.law % 3 {
-        0 => ElasticLaw::Linear,
-        1 => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
-        _ => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
-    };
-    let params = DynamicParams {
-        law,
-        incompressibility_n: option(inputs.incompressibility_on, inputs.incompressibility_n),
-        damping_per_s: inputs.damping_per_s,
-        gravity_m_s2: inputs.gravity_m_s2.into(),
-        limits: Limits {
-            max_displacement_m: inputs.max_displacement_m,
-            max_kinetic_energy_j: inputs.max_kinetic_energy_j,
-        },
-    };
-    let Ok(mut model) = TensorMassModel::new(table, state.buffers(&inputs.lengths), params) else {
+    let Ok(mut model) = TensorMassModel::new(table, state.buffers(&inputs.lengths), params(inputs))
+    else {
         refused();
         return;
     };
@@ -688,14 +866,8 @@ fn tensor_mass_round(model: &mut TensorMassModel<'_, '_, f32>, inputs: &TensorIn
         model.clear_external_forces();
     }
 
-    let integrator = match inputs.integrator % 4 {
-        0 => Integrator::ExplicitEuler,
-        1 => Integrator::SymplecticEuler,
-        2 => Integrator::Rk4,
-        _ => Integrator::CentralDifference,
-    };
     let out = addr_of_mut!(TENSOR_OUTPUTS);
-    match model.step(integrator, inputs.dt_s) {
+    match model.step(integrator(inputs.integrator), inputs.dt_s) {
         // SAFETY (all volatile writes in this function): single-threaded,
         // `out` points to a live static, every field is plain old data.
         Ok(report) => unsafe {
