@@ -13,38 +13,12 @@
 use core::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use nalgebra::Vector3;
 use palpate::tables::load::TableFile;
-use palpate_benches::cube_table;
+use palpate_benches::{TOOL_RADIUS_M, cube_table, haptic_config as config, haptic_tool as tool};
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::contact::{ContactWork, SurfaceGeometry};
-use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
-use palpate_kernel::haptic::safety::SafetyLimits;
+use palpate_kernel::haptic::haptic_loop::PrecomputedLoop;
 use palpate_kernel::haptic::tissue::PrecomputedTissue;
-
-const RADIUS_M: f32 = 0.002;
-
-fn config() -> LoopConfig<f32> {
-    LoopConfig {
-        radius_m: RADIUS_M,
-        dt_s: 1e-3,
-        limits: SafetyLimits {
-            max_force_n: 50.0,
-            max_slew_n_per_s: 1e6,
-        },
-    }
-}
-
-/// Tool points over the top face (z = 0.1 m) at the quarter points.
-fn tool(p: usize, depth_m: f32) -> Vector3<f32> {
-    let [x, y] = [
-        [0.031, 0.029],
-        [0.071, 0.069],
-        [0.029, 0.072],
-        [0.068, 0.031],
-    ][p];
-    Vector3::new(x, y, 0.1 + RADIUS_M - depth_m)
-}
 
 fn tick_with<const P: usize>(
     c: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
@@ -92,7 +66,12 @@ fn tick(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("detect", format!("{cells}cells")), |b| {
             b.iter(|| {
                 let mut work = ContactWork::default();
-                black_box(surface.detect(black_box(&from), black_box(&to), RADIUS_M, &mut work))
+                black_box(surface.detect(
+                    black_box(&from),
+                    black_box(&to),
+                    TOOL_RADIUS_M,
+                    &mut work,
+                ))
             })
         });
     }

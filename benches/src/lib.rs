@@ -2,12 +2,16 @@
 //! base fixed, built into tables through the same pipeline as
 //! `palpate tables build`.
 
+use nalgebra::Vector3;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
 use palpate::tables::build::{BuildOptions, BuiltTable, build_table};
 use palpate::tables::compliance::Solver;
 use palpate::tables::file::Precision;
+use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+use palpate_kernel::haptic::haptic_loop::LoopConfig;
+use palpate_kernel::haptic::safety::SafetyLimits;
 
 /// A cube of `cells³` Kuhn cells, 0.1 m wide, soft tissue (E = 3000 Pa,
 /// ν = 0.45), its base `z = 0` fixed.
@@ -36,4 +40,43 @@ pub fn top_vertices(cells: usize) -> [u32; 4] {
     let at = |i: usize, j: usize| (i + n * (j + n * cells)) as u32;
     let (a, b) = (cells / 4, 3 * cells / 4);
     [at(a, a), at(b, b), at(a, b), at(b, a)]
+}
+
+/// The f32 tensor-mass table of [`tissue_cube`]`(cells)`, density 1000 kg/m³.
+pub fn tensor_cube_table(cells: usize) -> Vec<u8> {
+    let (mesh, report, options) = tissue_cube(cells);
+    let options = TensorMassOptions {
+        material: options.material,
+        density_kg_m3: 1000.0,
+        fix: options.fix,
+        precision: Precision::F32,
+    };
+    build_tensor_mass_table(&mesh, &report, &options).expect("tensor-mass table")
+}
+
+/// Tool sphere radius of the haptic benches, m.
+pub const TOOL_RADIUS_M: f32 = 0.002;
+
+/// The haptic benches' loop: 1 kHz, limits high enough never to clamp.
+pub fn haptic_config() -> LoopConfig<f32> {
+    LoopConfig {
+        radius_m: TOOL_RADIUS_M,
+        dt_s: 1e-3,
+        limits: SafetyLimits {
+            max_force_n: 50.0,
+            max_slew_n_per_s: 1e6,
+        },
+    }
+}
+
+/// Tool point `p` (0..4) over the cube's top face (z = 0.1 m) at a quarter
+/// point, `depth_m` below first touch.
+pub fn haptic_tool(p: usize, depth_m: f32) -> Vector3<f32> {
+    let [x, y] = [
+        [0.031, 0.029],
+        [0.071, 0.069],
+        [0.029, 0.072],
+        [0.068, 0.031],
+    ][p % 4];
+    Vector3::new(x, y, 0.1 + TOOL_RADIUS_M - depth_m)
 }

@@ -2,8 +2,8 @@
 //! (`palpate_kernel::haptic::{deforming, dynamic_tissue}`): the re-binned
 //! surface against moved geometry, the extrapolated force against the
 //! model's own force pass, the held force at rest against the pre-computed
-//! model's static solve, continuity across physics updates, and the
-//! divergence fault.
+//! model's static solve, continuity across physics updates, the
+//! divergence fault, and robustness to any tool input (proptest).
 
 use nalgebra::Vector3;
 use palpate::dynamic::run::f64_table;
@@ -24,6 +24,7 @@ use palpate_kernel::haptic::safety::{OutputStatus, SafetyFault, SafetyLimits};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, Limits, TensorMassModel};
 use palpate_kernel::{Contact, PrecomputedModel, PrecomputedTable};
+use proptest::prelude::*;
 
 /// A 6 × 6 × 3 cm block of 648 tets (1 cm cells), bottom fixed, E = 3 kPa,
 /// ν = 0.45, ρ = 1000 kg/m³ (soft tissue).
@@ -389,4 +390,77 @@ fn divergence_faults_the_loop_until_reset() {
         (OutputStatus::Ok, Vector3::zeros())
     );
     assert!(haptic.tissue().fault().is_none());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// Any sequence of tool positions for two tool points, including NaN,
+    /// infinities and huge jumps, with a physics update after each tick
+    /// (f32, the firmware precision): every force is finite and within the
+    /// clamp, a non-finite input is a fault with zero force, and the model
+    /// never diverges silently (a failed update faults the next tick).
+    #[test]
+    fn any_input_gives_a_bounded_finite_force(
+        steps in prop::collection::vec(
+            (
+                prop_oneof![
+                    8 => (0.0..0.06f64, 0.0..0.06f64, 0.02..0.035f64).prop_map(|(x, y, z)| [x, y, z]),
+                    1 => Just([f64::NAN, 0.03, 0.03]),
+                    1 => Just([0.03, f64::INFINITY, 0.03]),
+                    1 => (-1e9..1e9f64, -1e9..1e9f64, -1e9..1e9f64).prop_map(|(x, y, z)| [x, y, z]),
+                ],
+                (0.0..0.06f64, 0.0..0.06f64, 0.02..0.035f64).prop_map(|(x, y, z)| [x, y, z]),
+            ),
+            1..40,
+        )
+    ) {
+        let mesh = box_mesh([6, 6, 3], SIZE_M);
+        let options = TensorMassOptions {
+            material: Material::new(3000.0, 0.45).expect("material"),
+            density_kg_m3: 1000.0,
+            fix: vec!["z<0.001".parse().expect("predicate")],
+            precision: Precision::F32,
+        };
+        let bytes = palpate::tables::tensor_mass::build_tensor_mass_table(&mesh, &MeshReport::default(), &options)
+            .expect("table");
+        let file = TableFile::from_bytes(&bytes);
+        let table = TensorMassTable::<f32>::load(file.bytes()).expect("table");
+        let mut state = OwnedState::for_table(&table).without_split_terms();
+        let params = DynamicParams {
+            law: ElasticLaw::Linear,
+            incompressibility_n: None,
+            damping_per_s: 30.0f32,
+            gravity_m_s2: Vector3::zeros(),
+            limits: Limits { max_displacement_m: 0.1, max_kinetic_energy_j: f32::INFINITY },
+        };
+        let model = TensorMassModel::new(table, state.buffers(), params).expect("model");
+        let mut owned = OwnedSurface::for_model(&model);
+        let (buffers, forces) = owned.buffers();
+        let physics = PhysicsConfig {
+            extrapolation: Extrapolation::Secant,
+            integrator: Integrator::SymplecticEuler,
+            dt_s: 5e-4f32,
+            substeps: 2,
+        };
+        let tissue = DynamicTissue::<f32, 2>::new(model, buffers, forces, physics).expect("tissue");
+        let limits = SafetyLimits { max_force_n: 4.0f32, max_slew_n_per_s: 2000.0 };
+        let config = LoopConfig { radius_m: 0.002f32, dt_s: 1e-3, limits };
+        let mut haptic = DynamicLoop::<f32, 2, 2>::new(tissue, config).expect("loop");
+        for (a, b) in steps {
+            let tool = [a, b].map(|p| Vector3::new(p[0] as f32, p[1] as f32, p[2] as f32));
+            let out = haptic.tick(&tool);
+            prop_assert!(out.force_n.iter().all(|x| x.is_finite()));
+            prop_assert!(out.force_n.norm() <= 4.0 * (1.0 + 1e-6));
+            if !tool.iter().all(|p| p.iter().all(|x| x.is_finite())) {
+                prop_assert_eq!(out.status, OutputStatus::Faulted(SafetyFault::NonFiniteInput));
+                prop_assert_eq!(out.force_n, Vector3::zeros());
+                haptic.reset();
+            } else if haptic.physics_update().is_err() {
+                let next = haptic.tick(&tool);
+                prop_assert_eq!(next.status, OutputStatus::Faulted(SafetyFault::ModelFault));
+                prop_assert_eq!(next.force_n, Vector3::zeros());
+                haptic.reset();
+            }
+        }
+    }
 }
