@@ -17,7 +17,7 @@ use core::fmt;
 use nalgebra::Vector3;
 
 use super::contact::{Supports, SurfaceGeometry};
-use super::surface::{BuiltLists, Grid, SurfaceIndex};
+use super::surface::{BuiltLists, Grid, SurfaceIndex, max_row};
 use crate::Real;
 use crate::tensor_mass::TensorMassModel;
 
@@ -125,6 +125,10 @@ pub struct DeformingSurface<'a, 's, T: Real> {
     cells: usize,
     /// Surface vertices filed (the used prefix of `grid_vertex`).
     filed: usize,
+    /// Most vertices in one cell of the current grid; most triangles
+    /// around one vertex.
+    max_bucket: u32,
+    max_valence: u32,
 }
 
 impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
@@ -177,8 +181,11 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             },
             cells: 1,
             filed: 0,
+            max_bucket: 0,
+            max_valence: 0,
         };
         surface.build_vertex_triangles();
+        surface.max_valence = max_row(surface.buffers.vertex_triangle_start);
         // The rest state is finite (validated table), so this bins.
         let displacement = model.displacements_m().unwrap_or(&[]);
         surface
@@ -366,18 +373,21 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
         }
         shift_back(cell_start);
         self.filed = cell_start.last().copied().unwrap_or(0) as usize;
+        self.max_bucket = max_row(cell_start);
     }
 
-    /// The index over the current lists, with `cells` cells in use.
-    fn index_with(&self, filed: usize) -> SurfaceIndex<'_, T> {
+    /// The index over the current lists (constant time).
+    fn index(&self) -> SurfaceIndex<'_, T> {
         SurfaceIndex::assembled(
             self.grid,
             BuiltLists {
                 cell_start: self.buffers.cell_start.get(..=self.cells).unwrap_or(&[]),
-                grid_vertex: self.buffers.grid_vertex.get(..filed).unwrap_or(&[]),
+                grid_vertex: self.buffers.grid_vertex.get(..self.filed).unwrap_or(&[]),
                 vertex_triangle_start: self.buffers.vertex_triangle_start,
                 vertex_triangle: self.buffers.vertex_triangle,
                 planes: self.buffers.planes,
+                max_bucket: self.max_bucket,
+                max_valence: self.max_valence,
             },
         )
     }
@@ -393,7 +403,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
         SurfaceGeometry::of_parts(
             self.buffers.positions_m,
             self.triangles,
-            self.index_with(self.filed),
+            self.index(),
             supports,
         )
     }

@@ -80,6 +80,9 @@ pub(crate) struct BuiltLists<'a, T> {
     pub(crate) vertex_triangle_start: &'a [u32],
     pub(crate) vertex_triangle: &'a [u32],
     pub(crate) planes: &'a [[T; 4]],
+    /// The largest row of `cell_start` and of `vertex_triangle_start`.
+    pub(crate) max_bucket: u32,
+    pub(crate) max_valence: u32,
 }
 
 /// `true` if `starts` begins at 0, never decreases and ends at `total`.
@@ -90,7 +93,7 @@ fn csr_ok(starts: &[u32], total: usize) -> bool {
 }
 
 /// The largest row of a CSR list.
-fn max_row(starts: &[u32]) -> u32 {
+pub(crate) fn max_row(starts: &[u32]) -> u32 {
     starts
         .windows(2)
         .map(|w| match w {
@@ -229,11 +232,14 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     }
 
     /// An index over lists the kernel built (no validation needed: see
-    /// [`BuiltLists`]). Query bound: `27 × max_bucket × max_valence`, at
-    /// most every listed triangle reference.
+    /// [`BuiltLists`]). Constant time. Query bound: `27 × max_bucket ×
+    /// max_valence`, at most every listed triangle reference.
     pub(crate) fn assembled(grid: Grid<T>, lists: BuiltLists<'a, T>) -> Self {
-        let max_bucket = max_row(lists.cell_start);
-        let max_valence = max_row(lists.vertex_triangle_start);
+        let BuiltLists {
+            max_bucket,
+            max_valence,
+            ..
+        } = lists;
         let max_query_triangles = max_bucket
             .saturating_mul(27)
             .saturating_mul(max_valence)
