@@ -170,6 +170,10 @@ pub struct BudgetRow {
     pub mean_ir: f64,
     /// The static bound.
     pub bound_ir: u64,
+    /// The bound's time on this host, µs: `bound_ir` times the host's
+    /// wall time per instruction on this trajectory run natively (an
+    /// estimate, printed, never asserted: these machines are shared).
+    pub bound_host_us: f64,
     /// Largest per-tick triangle tests, edge crossings and solves seen.
     pub max_work: [u32; 3],
 }

@@ -810,7 +810,12 @@ fn budget(
                 }
             }
             let max_ir = irs.iter().copied().max().unwrap_or(0);
-            let mean_ir = irs.iter().sum::<u64>() as f64 / irs.len().max(1) as f64;
+            let total_ir = irs.iter().sum::<u64>();
+            let mean_ir = total_ir as f64 / irs.len().max(1) as f64;
+            // The host's time per instruction on this trajectory, run natively.
+            let started = std::time::Instant::now();
+            palpate::budget::probe(&table, &scene, &trajectory)?;
+            let host_ns_per_ir = started.elapsed().as_secs_f64() * 1e9 / total_ir.max(1) as f64;
             rows.push(BudgetRow {
                 mesh: format!(
                     "{} vertices, {} tets",
@@ -822,6 +827,7 @@ fn budget(
                 max_ir,
                 mean_ir,
                 bound_ir: bound,
+                bound_host_us: bound as f64 * host_ns_per_ir / 1e3,
                 max_work,
             });
         }
@@ -831,7 +837,7 @@ fn budget(
         return Ok(());
     }
     println!(
-        "{:<26} {:<11} {:>6} {:>9} {:>9} {:>9} {:>6} {:>10} {:>12}",
+        "{:<26} {:<11} {:>6} {:>9} {:>9} {:>9} {:>6} {:>11} {:>11} {:>12}",
         "mesh",
         "trajectory",
         "ticks",
@@ -840,11 +846,12 @@ fn budget(
         "bound Ir",
         "max/b",
         "bound@168M",
+        "bound@host",
         "tests/walk/solves"
     );
     for r in &rows {
         println!(
-            "{:<26} {:<11} {:>6} {:>9.0} {:>9} {:>9} {:>6.3} {:>8.1} µs {:>5}/{}/{}",
+            "{:<26} {:<11} {:>6} {:>9.0} {:>9} {:>9} {:>6.3} {:>8.1} µs {:>8.2} µs {:>5}/{}/{}",
             r.mesh,
             r.trajectory,
             r.ticks,
@@ -853,6 +860,7 @@ fn budget(
             r.bound_ir,
             r.max_ir as f64 / r.bound_ir as f64,
             r.bound_ir as f64 / M4F_IPS * 1e6,
+            r.bound_host_us,
             r.max_work[0],
             r.max_work[1],
             r.max_work[2]

@@ -499,3 +499,52 @@ fn budget_ticks_stay_within_the_static_bound() {
         assert!(max > 0 && max <= bound, "{row}");
     }
 }
+
+/// `session generate` then `session run` on both built-in scenes: the CSV
+/// contract `t,fx,fy,fz,contacts,status`, one line per 1 ms tick over the
+/// trajectory's 1 s, every status `ok`, contact on part of the run; and
+/// `budget` refuses a dynamic scene with one line (it measures the
+/// pre-computed tick).
+#[test]
+fn session_run_drives_both_models_through_the_cli() {
+    let dir = temp("session-cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let poke = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", poke.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for scene in ["built-in", "built-in-dynamic"] {
+        let forces = dir.join(format!("{scene}.csv"));
+        let out = palpate(&[
+            "session",
+            "run",
+            scene,
+            "--trajectory",
+            poke.to_str().unwrap(),
+            "--out",
+            forces.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = std::fs::read_to_string(&forces).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("t,fx,fy,fz,contacts,status"));
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(rows.len(), 1001, "{scene}");
+        assert!(rows.iter().all(|r| r.len() == 6 && r[5] == "ok"), "{scene}");
+        assert!(rows.iter().filter(|r| r[4] == "1").count() > 100, "{scene}");
+    }
+    let out = palpate(&[
+        "budget",
+        "built-in-dynamic",
+        "--work-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&out, "pre-computed");
+}

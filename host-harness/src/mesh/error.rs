@@ -12,7 +12,6 @@ pub enum MeshError {
         /// File name as given by the caller.
         file: String,
         /// Underlying I/O error.
-        #[source]
         err: std::io::Error,
     },
     /// The file extension or the format version is not supported.

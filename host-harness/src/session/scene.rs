@@ -73,7 +73,6 @@ pub enum SceneError {
         /// The scene file as given.
         file: String,
         /// Underlying I/O error.
-        #[source]
         err: std::io::Error,
     },
     /// Not valid TOML, an unknown key, a missing required key or a value of the wrong type.

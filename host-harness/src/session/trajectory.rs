@@ -141,7 +141,6 @@ pub enum TrajectoryError {
         /// `read` or `write`.
         action: &'static str,
         /// Underlying I/O error.
-        #[source]
         err: io::Error,
     },
     /// A bad line.
