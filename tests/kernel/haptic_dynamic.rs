@@ -67,6 +67,25 @@ fn loop_config() -> LoopConfig<f64> {
     }
 }
 
+/// Runs `body` on a one-point loop over the block (f64) with `physics`
+/// and divergence beyond `max_displacement_m`; it also gets the table.
+fn with_loop<R>(
+    physics: PhysicsConfig<f64>,
+    max_displacement_m: f64,
+    body: impl FnOnce(&mut DynamicLoop<'_, '_, f64, 1, 1>, &TensorMassTable<'_, f64>) -> R,
+) -> R {
+    let file = block_table();
+    let table = TensorMassTable::<f64>::load(file.bytes()).expect("table");
+    let mut state = OwnedState::for_table(&table);
+    let params = params(max_displacement_m);
+    let model = TensorMassModel::new(table, state.buffers(), params).expect("model");
+    let mut owned = OwnedSurface::for_model(&model);
+    let (buffers, forces) = owned.buffers();
+    let tissue = DynamicTissue::<f64, 1>::new(model, buffers, forces, physics).expect("tissue");
+    let mut haptic = DynamicLoop::<f64, 1, 1>::new(tissue, loop_config()).expect("loop");
+    body(&mut haptic, &table)
+}
+
 /// The tool above the block's top centre, `depth_m` below first touch.
 fn tool_at(depth_m: f64) -> [Vector3<f64>; 1] {
     // Off the grid lines, so the contact is inside one triangle.
@@ -135,68 +154,62 @@ fn rebinned_surface_follows_the_deformation() {
 /// minimum-norm share of `gap · n`. Measured 1e-15 relative; bound 1e-10.
 #[test]
 fn extrapolated_force_equals_the_model_force_between_updates() {
-    let file = block_table();
-    let table = TensorMassTable::<f64>::load(file.bytes()).expect("table");
-    let mut state = OwnedState::for_table(&table);
-    let model = TensorMassModel::new(table, state.buffers(), params(1.0)).expect("model");
-    let mut owned = OwnedSurface::for_model(&model);
-    let (buffers, forces) = owned.buffers();
     let physics = PhysicsConfig {
         extrapolation: Extrapolation::Instantaneous,
         integrator: Integrator::SymplecticEuler,
         dt_s: 5e-4,
         substeps: 2,
     };
-    let tissue = DynamicTissue::<f64, 1>::new(model, buffers, forces, physics).expect("tissue");
-    let mut haptic = DynamicLoop::<f64, 1, 1>::new(tissue, loop_config()).expect("loop");
-    let mut last = None;
-    for k in 0..=40 {
-        let depth = (k as f64 - 5.0) * 1e-4; // 0.1 mm per tick, touching at k = 5
-        let out = haptic.tick(&tool_at(depth));
-        assert_eq!(out.status, OutputStatus::Ok, "tick {k}");
-        haptic.physics_update().expect("stable");
-        last = Some(out);
-    }
-    assert_eq!(last.expect("ran").contacts, 1);
-    // The next tick presses 0.3 mm further without an update.
-    let tool = tool_at(35.0e-4 + 3.0e-4);
-    let out = haptic.tick(&tool);
-    let contact = haptic.contacts()[0].expect("held");
-    let tissue = haptic.tissue();
-    let model = tissue.model();
-    let positions = tissue.surface().positions_m();
-    let tri = table.surface_triangles()[contact.triangle as usize];
-    let p = tri.map(|v| Vector3::from(positions[v as usize]));
-    let normal = (p[1] - p[0]).cross(&(p[2] - p[0])).normalize();
-    let w = contact.weights;
-    let x = p[0] * w[0] + p[1] * w[1] + p[2] * w[2];
-    let gap = (tool[0] - x).dot(&normal) - RADIUS_M;
-    assert!(gap < -2e-4, "pressed further: gap {gap}");
-    let movable: Vec<bool> = tri.iter().map(|&v| !table.is_fixed(v)).collect();
-    let mut u = model.displacements_m().expect("finite").to_vec();
-    for (&v, &m) in tri.iter().zip(&movable) {
-        if m {
-            for (a, d) in u[v as usize].iter_mut().zip((normal * gap).iter()) {
-                *a += d;
+    with_loop(physics, 1.0, |haptic, table| {
+        let mut last = None;
+        for k in 0..=40 {
+            let depth = (k as f64 - 5.0) * 1e-4; // 0.1 mm per tick, touching at k = 5
+            let out = haptic.tick(&tool_at(depth));
+            assert_eq!(out.status, OutputStatus::Ok, "tick {k}");
+            haptic.physics_update().expect("stable");
+            last = Some(out);
+        }
+        assert_eq!(last.expect("ran").contacts, 1);
+        // The next tick presses 0.3 mm further without an update.
+        let tool = tool_at(35.0e-4 + 3.0e-4);
+        let out = haptic.tick(&tool);
+        let contact = haptic.contacts()[0].expect("held");
+        let tissue = haptic.tissue();
+        let model = tissue.model();
+        let positions = tissue.surface().positions_m();
+        let tri = table.surface_triangles()[contact.triangle as usize];
+        let p = tri.map(|v| Vector3::from(positions[v as usize]));
+        let normal = (p[1] - p[0]).cross(&(p[2] - p[0])).normalize();
+        let w = contact.weights;
+        let x = p[0] * w[0] + p[1] * w[1] + p[2] * w[2];
+        let gap = (tool[0] - x).dot(&normal) - RADIUS_M;
+        assert!(gap < -2e-4, "pressed further: gap {gap}");
+        let movable: Vec<bool> = tri.iter().map(|&v| !table.is_fixed(v)).collect();
+        let mut u = model.displacements_m().expect("finite").to_vec();
+        for (&v, &m) in tri.iter().zip(&movable) {
+            if m {
+                for (a, d) in u[v as usize].iter_mut().zip((normal * gap).iter()) {
+                    *a += d;
+                }
             }
         }
-    }
-    let mut f = vec![[0.0; 3]; u.len()];
-    model.elastic_forces_of(&u, &mut f);
-    let total: Vector3<f64> = tri
-        .iter()
-        .zip(&movable)
-        .filter(|(_, m)| **m)
-        .map(|(&v, _)| Vector3::from(f[v as usize]))
-        .sum();
-    let truth = normal * total.dot(&normal);
-    let error = (out.force_n - truth).norm() / truth.norm();
-    println!(
-        "extrapolated {:?} N, model {:?} N, relative error {error:.2e}",
-        out.force_n, truth
-    );
-    assert!(truth.z > 0.0, "the tissue pushes the tool up");
-    assert!(error < 1e-10, "relative error {error:.3e}");
+        let mut f = vec![[0.0; 3]; u.len()];
+        model.elastic_forces_of(&u, &mut f);
+        let total: Vector3<f64> = tri
+            .iter()
+            .zip(&movable)
+            .filter(|(_, m)| **m)
+            .map(|(&v, _)| Vector3::from(f[v as usize]))
+            .sum();
+        let truth = normal * total.dot(&normal);
+        let error = (out.force_n - truth).norm() / truth.norm();
+        println!(
+            "extrapolated {:?} N, model {:?} N, relative error {error:.2e}",
+            out.force_n, truth
+        );
+        assert!(truth.z > 0.0, "the tissue pushes the tool up");
+        assert!(error < 1e-10, "relative error {error:.3e}");
+    })
 }
 
 /// Press 2 mm and hold until the damped tissue is at rest (1.5 s, physics
@@ -209,89 +222,78 @@ fn extrapolated_force_equals_the_model_force_between_updates() {
 /// press, the rest is rounding).
 #[test]
 fn held_force_at_rest_matches_the_static_solve() {
-    let file = block_table();
-    let table = TensorMassTable::<f64>::load(file.bytes()).expect("table");
-    let mut state = OwnedState::for_table(&table);
-    let model = TensorMassModel::new(table, state.buffers(), params(1.0)).expect("model");
-    let mut owned = OwnedSurface::for_model(&model);
-    let (buffers, forces) = owned.buffers();
     let physics = PhysicsConfig {
         extrapolation: Extrapolation::Secant,
         integrator: Integrator::SymplecticEuler,
         dt_s: 5e-4,
         substeps: 2,
     };
-    let tissue = DynamicTissue::<f64, 1>::new(model, buffers, forces, physics).expect("tissue");
-    let mut haptic = DynamicLoop::<f64, 1, 1>::new(tissue, loop_config()).expect("loop");
-    let mut force = Vector3::zeros();
-    for k in 0..1600 {
-        let depth = ((k as f64 - 5.0) * 2e-5).min(2e-3);
-        let out = haptic.tick(&tool_at(depth));
-        assert_eq!(out.status, OutputStatus::Ok);
-        haptic.physics_update().expect("stable");
-        force = out.force_n;
-    }
-    let contact = haptic.contacts()[0].expect("held");
-    let tri = table.surface_triangles()[contact.triangle as usize];
-    let u = haptic.tissue().model().displacements_m().expect("finite");
-    let contacts: Vec<Contact<f64>> = tri
-        .iter()
-        .map(|&v| Contact::at_vertex(v, Vector3::from(u[v as usize])))
-        .collect();
-    let mesh = box_mesh([6, 6, 3], SIZE_M);
-    let options = BuildOptions {
-        material: Material::new(3000.0, 0.45).expect("material"),
-        fix: vec!["z<0.001".parse().expect("predicate")],
-        solver: Solver::Cholesky,
-        precision: Precision::F64,
-        progress: false,
-    };
-    let built = build_table(&mesh, &MeshReport::default(), &options).expect("pre-computed table");
-    let bytes = TableFile::from_bytes(&built.bytes);
-    let static_table = PrecomputedTable::<f64>::load(bytes.bytes()).expect("load");
-    let solution = PrecomputedModel::new(static_table)
-        .contact_forces::<3>(&contacts)
-        .expect("static solve");
-    let reaction = solution.device_force_n();
-    let normal = force.normalize();
-    let error = (force.norm() - reaction.dot(&normal)).abs() / force.norm();
-    println!(
-        "held 2 mm: dynamic {:.6e} N, static solve {:.6e} N along the normal, relative {error:.2e}",
-        force.norm(),
-        reaction.dot(&normal)
-    );
-    assert!(force.z > 0.1, "pressed: {force:?}");
-    assert!(error < 1e-6, "relative error {error:.3e}");
+    with_loop(physics, 1.0, |haptic, table| {
+        let mut force = Vector3::zeros();
+        for k in 0..1600 {
+            let depth = ((k as f64 - 5.0) * 2e-5).min(2e-3);
+            let out = haptic.tick(&tool_at(depth));
+            assert_eq!(out.status, OutputStatus::Ok);
+            haptic.physics_update().expect("stable");
+            force = out.force_n;
+        }
+        let contact = haptic.contacts()[0].expect("held");
+        let tri = table.surface_triangles()[contact.triangle as usize];
+        let u = haptic.tissue().model().displacements_m().expect("finite");
+        let contacts: Vec<Contact<f64>> = tri
+            .iter()
+            .map(|&v| Contact::at_vertex(v, Vector3::from(u[v as usize])))
+            .collect();
+        let mesh = box_mesh([6, 6, 3], SIZE_M);
+        let options = BuildOptions {
+            material: Material::new(3000.0, 0.45).expect("material"),
+            fix: vec!["z<0.001".parse().expect("predicate")],
+            solver: Solver::Cholesky,
+            precision: Precision::F64,
+            progress: false,
+        };
+        let built =
+            build_table(&mesh, &MeshReport::default(), &options).expect("pre-computed table");
+        let bytes = TableFile::from_bytes(&built.bytes);
+        let static_table = PrecomputedTable::<f64>::load(bytes.bytes()).expect("load");
+        let solution = PrecomputedModel::new(static_table)
+            .contact_forces::<3>(&contacts)
+            .expect("static solve");
+        let reaction = solution.device_force_n();
+        let normal = force.normalize();
+        let error = (force.norm() - reaction.dot(&normal)).abs() / force.norm();
+        println!(
+            "held 2 mm: dynamic {:.6e} N, static solve {:.6e} N along the normal, relative {error:.2e}",
+            force.norm(),
+            reaction.dot(&normal)
+        );
+        assert!(force.z > 0.1, "pressed: {force:?}");
+        assert!(error < 1e-6, "relative error {error:.3e}");
+    })
 }
 
 /// Forces of a press at 20 mm/s with a physics update every `every` ticks
 /// (1 kHz ticks, 1 ms of physics per tick in 0.5 ms steps).
 fn press_forces(every: usize, extrapolation: Extrapolation) -> Vec<f64> {
-    let file = block_table();
-    let table = TensorMassTable::<f64>::load(file.bytes()).expect("table");
-    let mut state = OwnedState::for_table(&table);
-    let model = TensorMassModel::new(table, state.buffers(), params(1.0)).expect("model");
-    let mut owned = OwnedSurface::for_model(&model);
-    let (buffers, forces) = owned.buffers();
     let physics = PhysicsConfig {
         extrapolation,
         integrator: Integrator::SymplecticEuler,
         dt_s: 5e-4,
         substeps: 2 * every as u32,
     };
-    let tissue = DynamicTissue::<f64, 1>::new(model, buffers, forces, physics).expect("tissue");
-    let mut haptic = DynamicLoop::<f64, 1, 1>::new(tissue, loop_config()).expect("loop");
-    (0..300)
-        .map(|k| {
-            let depth = (k as f64 - 10.0) * 2e-5;
-            let out = haptic.tick(&tool_at(depth));
-            assert_eq!(out.status, OutputStatus::Ok);
-            if (k + 1) % every == 0 {
-                haptic.physics_update().expect("stable");
-            }
-            out.force_n.z
-        })
-        .collect()
+    with_loop(physics, 1.0, |haptic, _| {
+        (0..300)
+            .map(|k| {
+                let depth = (k as f64 - 10.0) * 2e-5;
+                let out = haptic.tick(&tool_at(depth));
+                assert_eq!(out.status, OutputStatus::Ok);
+                if (k + 1) % every == 0 {
+                    haptic.physics_update().expect("stable");
+                }
+                out.force_n.z
+            })
+            .collect()
+    })
 }
 
 /// The largest tick-to-tick force change at the first tick after a
@@ -355,41 +357,35 @@ fn force_is_continuous_across_physics_updates() {
 /// brings the tissue back to rest with the force at zero.
 #[test]
 fn divergence_faults_the_loop_until_reset() {
-    let file = block_table();
-    let table = TensorMassTable::<f64>::load(file.bytes()).expect("table");
-    let mut state = OwnedState::for_table(&table);
-    let model = TensorMassModel::new(table, state.buffers(), params(0.01)).expect("model");
-    let mut owned = OwnedSurface::for_model(&model);
-    let (buffers, forces) = owned.buffers();
     let physics = PhysicsConfig {
         extrapolation: Extrapolation::Secant,
         integrator: Integrator::SymplecticEuler,
         dt_s: 0.05,
         substeps: 1,
     };
-    let tissue = DynamicTissue::<f64, 1>::new(model, buffers, forces, physics).expect("tissue");
-    let mut haptic = DynamicLoop::<f64, 1, 1>::new(tissue, loop_config()).expect("loop");
-    let mut failed = None;
-    for k in 0..200 {
-        let out = haptic.tick(&tool_at((k as f64 - 2.0) * 1e-4));
-        if let OutputStatus::Faulted(reason) = out.status {
-            assert_eq!(reason, SafetyFault::ModelFault);
-            assert_eq!(out.force_n, Vector3::zeros());
-            failed = Some(k);
-            break;
+    with_loop(physics, 0.01, |haptic, _| {
+        let mut failed = None;
+        for k in 0..200 {
+            let out = haptic.tick(&tool_at((k as f64 - 2.0) * 1e-4));
+            if let OutputStatus::Faulted(reason) = out.status {
+                assert_eq!(reason, SafetyFault::ModelFault);
+                assert_eq!(out.force_n, Vector3::zeros());
+                failed = Some(k);
+                break;
+            }
+            assert!(out.force_n.norm().is_finite());
+            let _ = haptic.physics_update();
         }
-        assert!(out.force_n.norm().is_finite());
-        let _ = haptic.physics_update();
-    }
-    let k = failed.expect("diverged within 200 updates");
-    assert!(haptic.tissue().fault().is_some(), "fault at tick {k}");
-    haptic.reset();
-    let out = haptic.tick(&tool_at(-1e-3));
-    assert_eq!(
-        (out.status, out.force_n),
-        (OutputStatus::Ok, Vector3::zeros())
-    );
-    assert!(haptic.tissue().fault().is_none());
+        let k = failed.expect("diverged within 200 updates");
+        assert!(haptic.tissue().fault().is_some(), "fault at tick {k}");
+        haptic.reset();
+        let out = haptic.tick(&tool_at(-1e-3));
+        assert_eq!(
+            (out.status, out.force_n),
+            (OutputStatus::Ok, Vector3::zeros())
+        );
+        assert!(haptic.tissue().fault().is_none());
+    })
 }
 
 proptest! {
