@@ -1,27 +1,32 @@
 //! The dynamic tensor-mass model as a tissue for the haptic loop
 //! (RR-3510 §5; Cotin 1999 §4; MODELS.md §6).
 //!
-//! Coupling (imposed displacement, Cotin 1999 §4: "the vertices of the
-//! intersected triangle receive the displacement of the intersection
-//! point"): at each physics update, the contact triangle's movable vertices
-//! are held ([`TensorMassModel::impose`]) and translated by `gap · n`, so the
-//! triangle keeps its orientation and the contact point (any barycentric
-//! weights) lands on the tool sphere. The model is then stepped and the
-//! surface re-binned ([`DeformingSurface::rebin`]). The tool is frictionless:
-//! the force on the hand is the normal part of the elastic force the held
-//! vertices resist, `F = (n · Σ_i f_i) n`. Vertices no longer under a
-//! contact are released at the next update.
+//! Coupling (imposed displacement with barycentric weights, Cotin 1999 §4;
+//! MODELS.md §6): at each physics update, each contact point is moved by
+//! `gap · n` onto the tool sphere. The displacement is shared out over its
+//! triangle's movable vertices as the minimum-norm solution of
+//! `Σ w_i u_i = d`, `Δu_i = s_i d` with `s_i = w_i / Σ_k w_k²`, and those
+//! vertices are held ([`TensorMassModel::impose`]); vertices no contact
+//! holds any more are released. The model is then stepped and the surface
+//! re-binned ([`DeformingSurface::rebin`]). `n` is the triangle's normal at
+//! rest, which keeps the force direction and the held displacement steady
+//! while the dimple under the tool tilts the deformed triangles. The tool is
+//! frictionless and the force on the hand is the work-conjugate of the
+//! contact point's displacement: the normal part of `Σ_i s_i f_i` over the
+//! held vertices' elastic forces. A vertex's share goes to zero as the
+//! contact point reaches the opposite edge, so sliding onto the next
+//! triangle changes the held set without a jump in the displacement field.
 //!
 //! Force between physics updates (extrapolation from the local contact
 //! stiffness and the tool's motion, Cotin 1999 §6): each tick sends
-//! `F = (n · F_update − α k · gap) n`, where `gap` is the tool's normal
-//! motion since the last update (measured against that update's surface,
-//! zero right after it) and `k = n · K_c n`, `K_c = Σ_{i,j} K_ij` over the
-//! triangle's movable vertices, from the model's current vertex and edge
-//! tensors (RR-3510 §5.1). With the rest of the mesh frozen, translating
-//! the held vertices by `gap · n` changes the force by exactly
-//! `−K_c n · gap`, so `α = 1` ([`Extrapolation::Instantaneous`]) is the
-//! model's own force until the next step (exact for the linear law; for St
+//! `F = (n · F_update − α k · gap + blend · offset) n`. `gap` is the tool's
+//! motion along the held normal since the update (zero right after it, and
+//! independent of which triangle tracking has reached since), and
+//! `k = Σ_ij s_i s_j n · K_ij n` comes from the model's current vertex and
+//! edge tensors (RR-3510 §5.1). With the rest of the mesh frozen, moving the
+//! held vertices by `s_i gap n` changes the force by exactly `−k gap n`, so
+//! `α = 1` with no blend ([`Extrapolation::Instantaneous`]) is the model's
+//! own force until the next step (exact for the linear law; for St
 //! Venant-Kirchhoff `K` is the rest tangent). But the free vertices then
 //! relax during the step, so the instantaneous stiffness overshoots and the
 //! force drops at every update (a saw-tooth at the physics rate).
@@ -32,10 +37,9 @@
 //! update corrects over the next period: the difference between the force
 //! sent on the last tick before the update and the update's force decays
 //! linearly to zero over as many ticks as the last period had (`1 − j/k`
-//! of it at the `j`-th of `k` ticks). The force
-//! the device receives is then continuous across updates by construction;
-//! the price is that a correction arrives over one physics period instead
-//! of at once.
+//! of it at the `j`-th of `k` ticks). The force the device receives is then
+//! continuous across updates by construction; the price is that a
+//! correction arrives over one physics period instead of at once.
 
 use core::fmt;
 
@@ -137,15 +141,27 @@ impl core::error::Error for PhysicsError {}
 
 /// What a tool point's contact held at the last physics update.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Held<T> {
-    vertices: [u32; 3],
-    /// Force on the hand from these vertices after the update, N.
-    force_n: Vector3<T>,
+pub struct HeldContact<T> {
+    /// The held triangle's vertices.
+    pub vertices: [u32; 3],
+    /// The contact point's barycentric weights at the update.
+    pub weights: [T; 3],
+    /// Each vertex's share `s_i` of the contact point's displacement.
+    pub shares: [T; 3],
+    /// Unit normal of the held triangle at rest: the direction of the
+    /// force and of the held displacement.
+    pub normal: Vector3<T>,
+    /// The tool sphere's centre at the update, m (the contact point then
+    /// touches it: the gap is zero).
+    pub tip_m: Vector3<T>,
+    /// Force on the hand after the update, `Σ s_i f_i` over the held
+    /// vertices' elastic forces, N.
+    pub force_n: Vector3<T>,
     /// Extrapolation stiffness ratio `α`, in `[0, 1]`.
-    scale: T,
+    pub scale: T,
     /// Normal force sent just before the update minus the update's, N
     /// (decays to zero over the next period; zero when instantaneous).
-    offset_n: T,
+    pub offset_n: T,
 }
 
 /// The dynamic model, its deforming surface and what each of the `P` tool
@@ -155,7 +171,7 @@ pub struct DynamicTissue<'a, 's, T: Real, const P: usize> {
     surface: DeformingSurface<'a, 's, T>,
     forces_n: &'s mut [[T; 3]],
     physics: PhysicsConfig<T>,
-    held: [Option<Held<T>>; P],
+    held: [Option<HeldContact<T>>; P],
     fault: Option<PhysicsError>,
     /// Ticks since the last update, and in the period before it (≥ 1).
     ticks_since_update: u32,
@@ -205,6 +221,11 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         &self.surface
     }
 
+    /// What each tool point held at the last physics update.
+    pub fn held(&self) -> &[Option<HeldContact<T>>; P] {
+        &self.held
+    }
+
     /// The fault of the last physics update, if any (cleared by reset).
     pub fn fault(&self) -> Option<PhysicsError> {
         self.fault
@@ -215,16 +236,62 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         !self.model.table().is_fixed(v)
     }
 
-    /// `k = n · K_c n` (N/m): the change of the normal force on the hand
-    /// per metre of normal translation of the target's movable vertices
-    /// (module docs). Cost: 9 tensor products and 6 edge look-ups.
-    fn normal_stiffness(&self, t: &ContactTarget<T>) -> T {
+    /// Each vertex's share of the contact point's displacement, the
+    /// minimum-norm solution of `Σ w_i u_i = d`: `s_i = w_i / Σ_k w_k²`
+    /// over the movable vertices, 0 for a fixed one (and all 0 when none
+    /// moves).
+    fn shares(&self, t: &ContactTarget<T>) -> [T; 3] {
+        let movable = t.vertices.map(|v| self.movable(v));
+        let w = t.contact.weights;
+        let norm2 = w
+            .iter()
+            .zip(&movable)
+            .filter(|(_, m)| **m)
+            .fold(T::zero(), |a, (w, _)| a + *w * *w);
+        let mut s = [T::zero(); 3];
+        if norm2 > T::zero() {
+            for ((s, w), m) in s.iter_mut().zip(&w).zip(&movable) {
+                if *m {
+                    *s = *w / norm2;
+                }
+            }
+        }
+        s
+    }
+
+    /// `t` with the normal of its triangle at rest and the gap measured
+    /// along it (module docs: the rest normal keeps the force direction
+    /// and the held translation steady while the dimple under the tool
+    /// tilts the deformed triangles).
+    fn in_rest_frame(&self, t: &ContactTarget<T>) -> ContactTarget<T> {
+        let rest = self.model.table().rest_positions();
+        let at = |v: u32| rest.get(v as usize).map(|p| Vector3::new(p[0], p[1], p[2]));
+        let [a, b, c] = t.vertices.map(at);
+        let normal = match (a, b, c) {
+            (Some(a), Some(b), Some(c)) => (b - a).cross(&(c - a)).try_normalize(T::zero()),
+            _ => None,
+        }
+        .unwrap_or(t.normal);
+        ContactTarget {
+            normal,
+            gap_m: t.gap_m + (t.tip_m - t.point_m).dot(&(normal - t.normal)),
+            ..*t
+        }
+    }
+
+    /// `k = Σ_ij s_i s_j n · K_ij n` (N/m): the change of the normal force
+    /// on the hand per metre of normal displacement of the contact point,
+    /// shared out as `s` over `vertices` (module docs). Cost: 9 tensor
+    /// products and 6 edge look-ups.
+    fn normal_stiffness(&self, vertices: &[u32; 3], shares: &[T; 3], n: &Vector3<T>) -> T {
         let table = self.model.table();
-        let n = &t.normal;
         let mut k = T::zero();
-        for &i in t.vertices.iter().filter(|&&v| self.movable(v)) {
-            for &j in t.vertices.iter().filter(|&&v| self.movable(v)) {
-                k += if i == j {
+        for (&i, &si) in vertices.iter().zip(shares) {
+            for (&j, &sj) in vertices.iter().zip(shares) {
+                if si == T::zero() || sj == T::zero() {
+                    continue;
+                }
+                let nkn = if i == j {
                     self.model
                         .vertex_tensors()
                         .get(i as usize)
@@ -236,16 +303,21 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                         .and_then(|e| self.model.edge_tensors().get(e as usize))
                         .map_or(T::zero(), |kij| n.dot(&product(kij, n, i > j)))
                 };
+                k += si * sj * nkn;
             }
         }
         k
     }
 
-    /// The normal force (N, along `t.normal`, positive pushing the tool
-    /// out) sent for target `t` at this tick (module docs).
-    fn normal_force(&self, t: &ContactTarget<T>) -> T {
+    /// The force sent for target `t` (in the rest frame) at this tick: its
+    /// direction and its normal component, N, positive pushing the tool out
+    /// (module docs). With a held triangle the gap is the tool's motion
+    /// along the held normal since the update, whatever triangle tracking
+    /// has reached since; a new contact uses its own triangle and gap.
+    fn extrapolate(&self, t: &ContactTarget<T>) -> (Vector3<T>, T) {
         let Some(h) = carried(&self.held, t) else {
-            return -self.normal_stiffness(t) * t.gap_m;
+            let k = self.normal_stiffness(&t.vertices, &self.shares(t), &t.normal);
+            return (t.normal, -k * t.gap_m);
         };
         // 1 − j/period at the j-th tick after the update: zero by the next
         // one, so corrections never accumulate.
@@ -257,20 +329,34 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         } else {
             T::zero()
         };
-        h.force_n.dot(&t.normal) - h.scale * self.normal_stiffness(t) * t.gap_m + blend * h.offset_n
+        let n = h.normal;
+        let gap = (t.tip_m - h.tip_m).dot(&n);
+        let k = self.normal_stiffness(&h.vertices, &h.shares, &n);
+        (
+            n,
+            h.force_n.dot(&n) - h.scale * k * gap + blend * h.offset_n,
+        )
     }
 
-    /// The extrapolation ratio after an update that moved target `t` by
-    /// `gap` and changed its force from `before`'s to `force_n` (a new
-    /// contact's `before` is zero force at `α = 1`).
-    fn secant_scale(&self, before: &Held<T>, t: &ContactTarget<T>, force_n: &Vector3<T>) -> T {
+    /// The extrapolation ratio after an update that changed the force from
+    /// `before`'s to `force_n` while the tool moved from `before.tip_m` to
+    /// `t.tip_m` (a new contact's `before` is zero force at `α = 1`, the
+    /// tool's motion its gap).
+    fn secant_scale(
+        &self,
+        before: &HeldContact<T>,
+        t: &ContactTarget<T>,
+        force_n: &Vector3<T>,
+    ) -> T {
+        let n = before.normal;
+        let motion = (t.tip_m - before.tip_m).dot(&n);
         if self.physics.extrapolation == Extrapolation::Instantaneous
-            || t.gap_m.abs() < T::of_f64(SECANT_MIN_MOTION_M)
+            || motion.abs() < T::of_f64(SECANT_MIN_MOTION_M)
         {
             return before.scale;
         }
-        let predicted = -self.normal_stiffness(t) * t.gap_m;
-        let measured = (force_n - before.force_n).dot(&t.normal);
+        let predicted = -self.normal_stiffness(&before.vertices, &before.shares, &n) * motion;
+        let measured = (force_n - before.force_n).dot(&n);
         let ratio = measured / predicted;
         if !ratio.finite() {
             before.scale
@@ -300,12 +386,17 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         if let Some(fault) = self.fault {
             return Err(fault);
         }
+        let mut rest_frame = [ContactTarget::placeholder(); P];
+        for (r, t) in rest_frame.iter_mut().zip(set) {
+            *r = self.in_rest_frame(t);
+        }
+        let set = rest_frame.get(..set.len()).unwrap_or(&rest_frame);
         let previous = self.held;
         // What the last tick sent, per target (the corrections' reference).
         let mut sent = [T::zero(); P];
         for t in set {
             if let Some(x) = sent.get_mut(t.tool) {
-                *x = self.normal_force(t);
+                *x = self.extrapolate(t).1;
             }
         }
         // Release what no current contact holds.
@@ -318,13 +409,14 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             }
         }
         self.held = [None; P];
-        // Impose: translate each contact triangle by gap · n.
+        // Impose: move each contact point by gap · n, shared out over its
+        // triangle's vertices.
         for t in set {
-            let shift = t.normal * t.gap_m;
-            for &v in &t.vertices {
-                if !self.movable(v) {
+            for (&v, &share) in t.vertices.iter().zip(&self.shares(t)) {
+                if share == T::zero() {
                     continue;
                 }
+                let shift = t.normal * (t.gap_m * share);
                 let u = self
                     .model
                     .displacements_m()
@@ -347,15 +439,22 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         // The force each contact's held vertices resist.
         self.model.elastic_forces_n(self.forces_n);
         for t in set {
+            // The work-conjugate of the contact point's displacement: Σ s_i f_i.
+            let shares = self.shares(t);
             let mut force_n = Vector3::zeros();
-            for &v in t.vertices.iter().filter(|&&v| self.movable(v)) {
+            for (&v, &share) in t.vertices.iter().zip(&shares) {
                 if let Some(f) = self.forces_n.get(v as usize) {
-                    force_n += Vector3::new(f[0], f[1], f[2]);
+                    force_n += Vector3::new(f[0], f[1], f[2]) * share;
                 }
             }
-            // A new contact started from the surface at rest: zero force, α = 1.
-            let before = carried(&previous, t).unwrap_or(Held {
+            // A new contact started touching (gap 0, zero force) at α = 1,
+            // the tool then `gap` further along the normal.
+            let before = carried(&previous, t).unwrap_or(HeldContact {
                 vertices: t.vertices,
+                weights: t.contact.weights,
+                shares,
+                normal: t.normal,
+                tip_m: t.tip_m - t.normal * t.gap_m,
                 force_n: Vector3::zeros(),
                 scale: T::one(),
                 offset_n: T::zero(),
@@ -368,8 +467,12 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 }
             };
             if let Some(slot) = self.held.get_mut(t.tool) {
-                *slot = Some(Held {
+                *slot = Some(HeldContact {
                     vertices: t.vertices,
+                    weights: t.contact.weights,
+                    shares,
+                    normal: t.normal,
+                    tip_m: t.tip_m,
                     force_n,
                     scale,
                     offset_n,
@@ -390,9 +493,9 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
 /// What tool point `t.tool` held at the last update, if its contact is
 /// still on or next to that triangle (they share a vertex).
 fn carried<T: Real, const P: usize>(
-    held: &[Option<Held<T>>; P],
+    held: &[Option<HeldContact<T>>; P],
     t: &ContactTarget<T>,
-) -> Option<Held<T>> {
+) -> Option<HeldContact<T>> {
     held.get(t.tool)
         .copied()
         .flatten()
@@ -430,7 +533,8 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
             tissue_forces_n: [Vector3::zeros(); M],
         };
         for (t, g) in set.iter().zip(solved.tissue_forces_n.iter_mut()) {
-            let force_n = t.normal * self.normal_force(t);
+            let (normal, force) = self.extrapolate(&self.in_rest_frame(t));
+            let force_n = normal * force;
             solved.device_force_n += force_n;
             *g = -force_n;
         }

@@ -266,6 +266,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                     vertices,
                     normal,
                     gap_m: (tip - x).dot(&normal) - radius,
+                    point_m: x,
+                    tip_m: *tip,
                 };
                 m += 1;
             }

@@ -27,6 +27,10 @@ pub struct ContactTarget<T> {
     /// current surface): the contact point's imposed displacement is
     /// `gap · normal`.
     pub gap_m: T,
+    /// The contact point on the tissue's current surface, m.
+    pub point_m: Vector3<T>,
+    /// The tool sphere's centre, m.
+    pub tip_m: Vector3<T>,
 }
 
 impl<T: Real> ContactTarget<T> {
@@ -41,6 +45,8 @@ impl<T: Real> ContactTarget<T> {
             vertices: [0; 3],
             normal: Vector3::zeros(),
             gap_m: T::zero(),
+            point_m: Vector3::zeros(),
+            tip_m: Vector3::zeros(),
         }
     }
 }
