@@ -192,7 +192,7 @@ fn dynamic_non_finite_input_faults_with_zero_force() {
 /// deformed field. Sliding onto the next triangle changes the held set at
 /// the next update, and that correction is spread over the following
 /// period: the largest tick-to-tick change stays below 30 mN (measured
-/// 18.4 mN) against a force of about 0.6 N.
+/// 22.4 mN) against a force of about 0.6 N.
 #[test]
 fn dynamic_slide_crosses_triangles_and_writes_frames() {
     let scene = Scene::built_in_dynamic();

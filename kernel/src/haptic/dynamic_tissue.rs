@@ -399,10 +399,18 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 *x = self.extrapolate(t).1;
             }
         }
-        // Release what no current contact holds.
+        // Release what no current contact holds (a vertex whose share fell
+        // to zero at the contact point's far edge included).
         for held in previous.iter().flatten() {
             for &v in &held.vertices {
-                if !set.iter().any(|t| t.vertices.contains(&v)) {
+                let holds = |t: &ContactTarget<T>| {
+                    let shares = self.shares(t);
+                    t.vertices
+                        .iter()
+                        .zip(&shares)
+                        .any(|(&u, &s)| u == v && s != T::zero())
+                };
+                if !set.iter().any(holds) {
                     // A fixed vertex was never imposed: nothing to release.
                     let _ = self.model.release(v);
                 }
