@@ -67,6 +67,16 @@ fn loop_config() -> LoopConfig<f64> {
     }
 }
 
+/// Symplectic Euler in steps of `dt_s`, `substeps` per physics update.
+fn symplectic(extrapolation: Extrapolation, dt_s: f64, substeps: u32) -> PhysicsConfig<f64> {
+    PhysicsConfig {
+        extrapolation,
+        integrator: Integrator::SymplecticEuler,
+        dt_s,
+        substeps,
+    }
+}
+
 /// Runs `body` on a one-point loop over the block (f64) with `physics`
 /// and divergence beyond `max_displacement_m`.
 fn with_loop<R>(
@@ -155,12 +165,7 @@ fn rebinned_surface_follows_the_deformation() {
 /// `gap · n`. Measured 2.6e-16 relative; bound 1e-10 (rounding).
 #[test]
 fn extrapolated_force_equals_the_model_force_between_updates() {
-    let physics = PhysicsConfig {
-        extrapolation: Extrapolation::Instantaneous,
-        integrator: Integrator::SymplecticEuler,
-        dt_s: 5e-4,
-        substeps: 2,
-    };
+    let physics = symplectic(Extrapolation::Instantaneous, 5e-4, 2);
     with_loop(physics, 1.0, |haptic| {
         let mut last = None;
         for k in 0..=40 {
@@ -227,12 +232,7 @@ fn extrapolated_force_equals_the_model_force_between_updates() {
 /// press, the rest is rounding).
 #[test]
 fn held_force_at_rest_matches_the_static_solve() {
-    let physics = PhysicsConfig {
-        extrapolation: Extrapolation::Secant,
-        integrator: Integrator::SymplecticEuler,
-        dt_s: 5e-4,
-        substeps: 2,
-    };
+    let physics = symplectic(Extrapolation::Secant, 5e-4, 2);
     with_loop(physics, 1.0, |haptic| {
         let mut force = Vector3::zeros();
         for k in 0..1600 {
@@ -289,12 +289,7 @@ fn held_force_at_rest_matches_the_static_solve() {
 /// Forces of a press at 20 mm/s with a physics update every `every` ticks
 /// (1 kHz ticks, 1 ms of physics per tick in 0.5 ms steps).
 fn press_forces(every: usize, extrapolation: Extrapolation) -> Vec<f64> {
-    let physics = PhysicsConfig {
-        extrapolation,
-        integrator: Integrator::SymplecticEuler,
-        dt_s: 5e-4,
-        substeps: 2 * every as u32,
-    };
+    let physics = symplectic(extrapolation, 5e-4, 2 * every as u32);
     with_loop(physics, 1.0, |haptic| {
         (0..300)
             .map(|k| {
@@ -371,12 +366,7 @@ fn force_is_continuous_across_physics_updates() {
 /// brings the tissue back to rest with the force at zero.
 #[test]
 fn divergence_faults_the_loop_until_reset() {
-    let physics = PhysicsConfig {
-        extrapolation: Extrapolation::Secant,
-        integrator: Integrator::SymplecticEuler,
-        dt_s: 0.05,
-        substeps: 1,
-    };
+    let physics = symplectic(Extrapolation::Secant, 0.05, 1);
     with_loop(physics, 0.01, |haptic| {
         let mut failed = None;
         for k in 0..200 {
