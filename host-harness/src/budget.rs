@@ -16,8 +16,19 @@
 //! this build (x86-64, `cargo build`, the workspace's opt-level 2 for our
 //! crates) on the built-in scene's trajectories, rounded up: an idle tick
 //! 469 Ir, a tracked contact with its solve 2420 Ir, each edge crossed
-//! 602 Ir, each triangle tested ≤ 113 Ir, the new contact and its solve
+//! 602 Ir (724 on the dynamic model's surface), each triangle tested
+//! ≤ 113 Ir, the new contact and its solve
 //! included (`palpate budget built-in`).
+//!
+//! The dynamic model's tick (between physics updates, which run outside the
+//! measured function) has the bound `BASE + P · (TRIANGLE · 6T + WALK ·
+//! MAX_WALK_STEPS + DYNAMIC_TRACK) + (P + 1) · DYNAMIC_SOLVE · M`: a
+//! detection on the re-binned grid tests at most every triangle reference
+//! twice (`T` surface triangles), since compression can crowd a bucket, and
+//! a solve is linear in the contacts (no factorization). Measured on
+//! `palpate budget built-in-dynamic`: a tracked contact with its solve
+//! 1987 Ir over the idle 655, an edge crossed ≤ 724 Ir, a triangle tested
+//! ≤ 124 Ir; the worst tick 12 910 Ir.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -26,18 +37,20 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::contact::MAX_WALK_STEPS;
-use palpate_kernel::haptic::haptic_loop::{ForceOutput, PrecomputedLoop, TickCounters};
-use palpate_kernel::haptic::tissue::PrecomputedTissue;
+use palpate_kernel::haptic::haptic_loop::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters};
+use palpate_kernel::haptic::tissue::{PrecomputedTissue, Tissue};
+use palpate_kernel::table::TensorMassTable;
 
-use crate::session::run::{loop_config, ticks};
-use crate::session::{Scene, Trajectory};
+use crate::mesh::{MeshReport, TetMesh};
+use crate::session::run::{DynamicSetup, loop_config, precomputed_table, tensor_mass_table, ticks};
+use crate::session::{ModelSpec, Scene, Trajectory};
 
 /// Instructions of a tick outside detection, tracking and solves.
 pub const BASE_IR: u64 = 600;
 /// Instructions per candidate triangle tested in a detection.
 pub const TRIANGLE_IR: u64 = 125;
 /// Instructions per triangle edge crossed while sliding.
-pub const WALK_IR: u64 = 700;
+pub const WALK_IR: u64 = 800;
 /// Instructions to track one contact (projection, gap).
 pub const TRACK_IR: u64 = 1000;
 /// Instructions per contact solve, per cubed contact capacity (the block
@@ -53,22 +66,71 @@ pub fn tick_bound(table: &PrecomputedTable<'_, f32>, points: u64, capacity: u64)
         + (points + 1) * SOLVE_IR_PER_M3 * capacity * capacity * capacity
 }
 
-/// One tick, kept out of line so callgrind can collect exactly its cost.
+/// Instructions to track one contact on the dynamic model's deforming
+/// surface (projection, gap).
+pub const DYNAMIC_TRACK_IR: u64 = 1000;
+/// Instructions per contact per solve on the dynamic model (the rest-frame
+/// normal, the stiffness `k` from 9 tensors and 6 edge look-ups, the
+/// extrapolated force).
+pub const DYNAMIC_SOLVE_IR: u64 = 1500;
+
+/// The static per-tick bound (instructions) of the dynamic model's tick,
+/// between physics updates, for `points` tool points and capacity
+/// `capacity` over `table`. A detection tests at most every triangle
+/// reference of the surface twice (`2 × 3T`): the re-binned grid's buckets
+/// depend on the deformation, so no tighter bound holds for any state.
+pub fn dynamic_tick_bound(table: &TensorMassTable<'_, f32>, points: u64, capacity: u64) -> u64 {
+    let detection = 2 * 3 * table.surface_triangles().len() as u64;
+    BASE_IR
+        + points
+            * (TRIANGLE_IR * detection + WALK_IR * u64::from(MAX_WALK_STEPS) + DYNAMIC_TRACK_IR)
+        + (points + 1) * DYNAMIC_SOLVE_IR * capacity
+}
+
+/// The f32 table of `scene` on `mesh` (pre-computed or tensor-mass, by its
+/// model) and the static bound of its tick.
+pub fn budget_table(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<(Vec<u8>, u64)> {
+    let points = scene.tool.points as u64;
+    Ok(match scene.model {
+        ModelSpec::Precomputed => {
+            let bytes = precomputed_table(scene, mesh, report)?;
+            let file = crate::tables::load::TableFile::from_bytes(&bytes);
+            let table = PrecomputedTable::<f32>::load(file.bytes())
+                .map_err(|e| anyhow::anyhow!("table: {e}"))?;
+            let bound = tick_bound(&table, points, points);
+            (bytes, bound)
+        }
+        ModelSpec::Dynamic(_) => {
+            let bytes = tensor_mass_table(scene, mesh, report)?;
+            let file = crate::tables::load::TableFile::from_bytes(&bytes);
+            let table = TensorMassTable::<f32>::load(file.bytes())
+                .map_err(|e| anyhow::anyhow!("table: {e}"))?;
+            let bound = dynamic_tick_bound(&table, points, points);
+            (bytes, bound)
+        }
+    })
+}
+
+/// One tick, kept out of line so callgrind can collect exactly its cost
+/// (a dynamic model's physics updates run outside it).
 #[inline(never)]
-pub fn budget_tick<const P: usize>(
-    haptic: &mut PrecomputedLoop<'_, f32, P, P>,
+pub fn budget_tick<B: Tissue<f32, P>, const P: usize>(
+    haptic: &mut HapticLoop<f32, B, P, P>,
     tool_m: &[Vector3<f32>; P],
 ) -> ForceOutput<f32> {
     haptic.tick(tool_m)
 }
 
-/// Runs every tick of `trajectory` through [`budget_tick`] and returns each
-/// tick's work counters (the child side of [`measure`]).
-pub fn probe(
-    table: &PrecomputedTable<'_, f32>,
-    scene: &Scene,
-    trajectory: &Trajectory,
-) -> anyhow::Result<Vec<TickCounters>> {
+/// Runs every tick of `trajectory` through [`budget_tick`] on the loop of
+/// `scene` over `table` (a table's bytes, aligned: `TableFile::bytes`) and
+/// returns each tick's work counters (the child side of [`measure`]) and
+/// the wall time spent in the ticks. A dynamic scene's physics updates run
+/// every `physics_every` ticks, after the tick and outside [`budget_tick`].
+pub fn probe(table: &[u8], scene: &Scene, trajectory: &Trajectory) -> anyhow::Result<Probe> {
     match scene.tool.points {
         1 => probe_with::<1>(table, scene, trajectory),
         2 => probe_with::<2>(table, scene, trajectory),
@@ -77,20 +139,61 @@ pub fn probe(
     }
 }
 
+/// What [`probe`] saw.
+pub struct Probe {
+    /// Each tick's work counters.
+    pub counters: Vec<TickCounters>,
+    /// Wall time inside the ticks, s (physics updates excluded).
+    pub ticks_s: f64,
+}
+
 fn probe_with<const P: usize>(
-    table: &PrecomputedTable<'_, f32>,
+    bytes: &[u8],
     scene: &Scene,
     trajectory: &Trajectory,
-) -> anyhow::Result<Vec<TickCounters>> {
-    let mut haptic =
-        PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(table), loop_config(scene))
+) -> anyhow::Result<Probe> {
+    let load = |e| anyhow::anyhow!("table: {e}");
+    match scene.model {
+        ModelSpec::Precomputed => {
+            let table = PrecomputedTable::<f32>::load(bytes).map_err(load)?;
+            let mut haptic = PrecomputedLoop::<f32, P, P>::new(
+                PrecomputedTissue::new(&table),
+                loop_config(scene),
+            )
             .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
-    let mut counters = Vec::new();
-    for (_, tool) in ticks::<P>(trajectory, scene.tick_s()) {
-        core::hint::black_box(budget_tick(&mut haptic, &tool));
-        counters.push(*haptic.counters());
+            Ok(probe_ticks(&mut haptic, scene, trajectory, |_| {}))
+        }
+        ModelSpec::Dynamic(spec) => {
+            let table = TensorMassTable::<f32>::load(bytes).map_err(load)?;
+            DynamicSetup::of(scene, &spec, table)?.with_loop::<P, _>(|haptic| {
+                // A failed update faults the following ticks: measured too.
+                Ok(probe_ticks(haptic, scene, trajectory, |h| {
+                    let _ = h.physics_update();
+                }))
+            })
+        }
     }
-    Ok(counters)
+}
+
+fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
+    haptic: &mut HapticLoop<f32, B, P, P>,
+    scene: &Scene,
+    trajectory: &Trajectory,
+    mut physics: impl FnMut(&mut HapticLoop<f32, B, P, P>),
+) -> Probe {
+    let every = scene.rates.physics_every.max(1) as usize;
+    let mut counters = Vec::new();
+    let mut ticks_s = 0.0;
+    for (k, (_, tool)) in ticks::<P>(trajectory, scene.tick_s()).enumerate() {
+        let started = std::time::Instant::now();
+        core::hint::black_box(budget_tick(haptic, &tool));
+        ticks_s += started.elapsed().as_secs_f64();
+        counters.push(*haptic.counters());
+        if (k + 1) % every == 0 {
+            physics(haptic);
+        }
+    }
+    Probe { counters, ticks_s }
 }
 
 /// Per-tick instruction counts of `args` (a `palpate budget --probe …`

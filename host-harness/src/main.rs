@@ -51,7 +51,7 @@ enum Command {
     /// Per-tick instruction counts (callgrind) of every generated trajectory
     /// against the static bound from the table sizes and capacities.
     Budget {
-        /// Scene file (TOML) of the pre-computed model, or `built-in`.
+        /// Scene file (TOML), `built-in` or `built-in-dynamic`.
         scene: String,
         /// Working folder for tables, trajectories and callgrind dumps.
         #[arg(long, default_value = "budget-out")]
@@ -739,21 +739,15 @@ fn budget(
     json: bool,
     probe: Option<&[PathBuf]>,
 ) -> anyhow::Result<()> {
-    use palpate::budget::{BudgetRow, M4F_IPS, measure, tick_bound, trajectories};
+    use palpate::budget::{BudgetRow, M4F_IPS, budget_table, measure, trajectories};
     use palpate::session::{MeshSource, Scene, Trajectory};
     let mut scene = Scene::named(scene_arg)?;
-    if scene.model != palpate::session::ModelSpec::Precomputed {
-        anyhow::bail!(
-            "{}: the budget measures the pre-computed model's tick (model.kind = \"precomputed\")",
-            scene.source
-        );
-    }
     if let Some([table_path, trajectory_path]) = probe {
         let bytes = palpate::tables::load::TableFile::read(table_path)?;
-        let table = palpate_kernel::PrecomputedTable::<f32>::load(bytes.bytes())
-            .map_err(|e| anyhow::anyhow!("{}: {e}", table_path.display()))?;
         let trajectory = Trajectory::read(trajectory_path, scene.tool.points)?;
-        let counters = palpate::budget::probe(&table, &scene, &trajectory)?;
+        let counters = palpate::budget::probe(bytes.bytes(), &scene, &trajectory)
+            .with_context(|| table_path.display().to_string())?
+            .counters;
         let lines: Vec<String> = counters
             .iter()
             .map(|c| {
@@ -784,13 +778,10 @@ fn budget(
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
         let (mesh, report) = scene.load_mesh()?;
-        let bytes = palpate::session::run::precomputed_table(&scene, &mesh, &report)?;
+        let (bytes, bound) = budget_table(&scene, &mesh, &report)?;
         let table_path = work_dir.join(format!("table-{s}.bin"));
         std::fs::write(&table_path, &bytes)?;
         let file = TableFile::from_bytes(&bytes);
-        let table = palpate_kernel::PrecomputedTable::<f32>::load(file.bytes())
-            .map_err(|e| anyhow::anyhow!("table: {e}"))?;
-        let bound = tick_bound(&table, points as u64, points as u64);
         for (name, trajectory) in trajectories(points)? {
             let csv = work_dir.join(format!("{name}-{s}.csv"));
             trajectory.write_csv_file(&csv)?;
@@ -812,10 +803,9 @@ fn budget(
             let max_ir = irs.iter().copied().max().unwrap_or(0);
             let total_ir = irs.iter().sum::<u64>();
             let mean_ir = total_ir as f64 / irs.len().max(1) as f64;
-            // The host's time per instruction on this trajectory, run natively.
-            let started = std::time::Instant::now();
-            palpate::budget::probe(&table, &scene, &trajectory)?;
-            let host_ns_per_ir = started.elapsed().as_secs_f64() * 1e9 / total_ir.max(1) as f64;
+            // The host's time per instruction in the ticks, run natively.
+            let native = palpate::budget::probe(file.bytes(), &scene, &trajectory)?;
+            let host_ns_per_ir = native.ticks_s * 1e9 / total_ir.max(1) as f64;
             rows.push(BudgetRow {
                 mesh: format!(
                     "{} vertices, {} tets",

@@ -165,19 +165,7 @@ pub fn run_session(
         ModelSpec::Dynamic(spec) => {
             let file = TableFile::from_bytes(&tensor_mass_table(scene, &mesh, &report)?);
             let table = TensorMassTable::<f32>::load(file.bytes()).context("session table")?;
-            let dynamic = Dynamic {
-                table,
-                params: dynamic_params(&spec, &mesh.positions),
-                physics: PhysicsConfig {
-                    extrapolation: spec.extrapolation,
-                    integrator: spec.integrator,
-                    dt_s: spec.dt_s as f32,
-                    substeps: scene
-                        .dynamic_substeps()
-                        .context("physics period is not a whole number of dt_s")?,
-                },
-                config,
-            };
+            let dynamic = DynamicSetup::of(scene, &spec, table)?;
             match scene.tool.points {
                 1 => ticks.dynamic::<1>(&dynamic, &mut session),
                 2 => ticks.dynamic::<2>(&dynamic, &mut session),
@@ -189,28 +177,70 @@ pub fn run_session(
     session.finish()
 }
 
-/// The f32 dynamic parameters of a scene: its law, penalty and damping, no
-/// gravity (the tissue rests in its meshed shape), divergence when a
-/// displacement exceeds the mesh's bounding-box diagonal.
-fn dynamic_params(spec: &DynamicSpec, positions: &[[f64; 3]]) -> DynamicParams<f32> {
-    DynamicParams {
-        law: spec.law,
-        incompressibility_n: spec.incompressibility_n.map(|g| g as f32),
-        damping_per_s: spec.damping_per_s as f32,
-        gravity_m_s2: Vector3::zeros(),
-        limits: Limits {
-            max_displacement_m: diagonal(positions) as f32,
-            max_kinetic_energy_j: f32::INFINITY,
-        },
-    }
-}
-
-/// A dynamic scene's table and settings.
-struct Dynamic<'t> {
+/// A dynamic scene's table and settings: everything to build its loop.
+pub struct DynamicSetup<'t> {
     table: TensorMassTable<'t, f32>,
     params: DynamicParams<f32>,
     physics: PhysicsConfig<f32>,
     config: LoopConfig<f32>,
+}
+
+impl<'t> DynamicSetup<'t> {
+    /// The settings of dynamic `scene` (model `spec`) over `table`: its law,
+    /// penalty and damping, no gravity (the tissue rests in its meshed
+    /// shape), divergence when a displacement exceeds the mesh's
+    /// bounding-box diagonal; the physics period in steps of `dt_s`.
+    pub fn of(
+        scene: &Scene,
+        spec: &DynamicSpec,
+        table: TensorMassTable<'t, f32>,
+    ) -> anyhow::Result<Self> {
+        let rest: Vec<[f64; 3]> = table
+            .rest_positions()
+            .iter()
+            .map(|p| p.map(f64::from))
+            .collect();
+        Ok(Self {
+            table,
+            params: DynamicParams {
+                law: spec.law,
+                incompressibility_n: spec.incompressibility_n.map(|g| g as f32),
+                damping_per_s: spec.damping_per_s as f32,
+                gravity_m_s2: Vector3::zeros(),
+                limits: Limits {
+                    max_displacement_m: diagonal(&rest) as f32,
+                    max_kinetic_energy_j: f32::INFINITY,
+                },
+            },
+            physics: PhysicsConfig {
+                extrapolation: spec.extrapolation,
+                integrator: spec.integrator,
+                dt_s: spec.dt_s as f32,
+                substeps: scene
+                    .dynamic_substeps()
+                    .context("physics period is not a whole number of dt_s")?,
+            },
+            config: loop_config(scene),
+        })
+    }
+
+    /// Builds the model, its surface and the loop at rest on heap buffers
+    /// and runs `body` on the loop.
+    pub fn with_loop<const P: usize, R>(
+        &self,
+        body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P>) -> anyhow::Result<R>,
+    ) -> anyhow::Result<R> {
+        let mut state = OwnedState::for_table(&self.table).without_split_terms();
+        let model = TensorMassModel::new(self.table, state.buffers(), self.params)
+            .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
+        let mut surface = OwnedSurface::for_model(&model);
+        let (buffers, forces) = surface.buffers();
+        let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, self.physics)
+            .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?;
+        let mut haptic = DynamicLoop::<f32, P, P>::new(tissue, self.config)
+            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+        body(&mut haptic)
+    }
 }
 
 /// The trajectory's ticks and the physics period in ticks.
@@ -248,18 +278,17 @@ impl Ticks<'_> {
 
     fn dynamic<const P: usize>(
         &self,
-        scene: &Dynamic<'_>,
+        setup: &DynamicSetup<'_>,
         session: &mut Session<'_>,
     ) -> anyhow::Result<()> {
-        let mut state = OwnedState::for_table(&scene.table).without_split_terms();
-        let model = TensorMassModel::new(scene.table, state.buffers(), scene.params)
-            .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
-        let mut surface = OwnedSurface::for_model(&model);
-        let (buffers, forces) = surface.buffers();
-        let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, scene.physics)
-            .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?;
-        let mut haptic = DynamicLoop::<f32, P, P>::new(tissue, scene.config)
-            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+        setup.with_loop::<P, _>(|haptic| self.dynamic_ticks(haptic, session))
+    }
+
+    fn dynamic_ticks<const P: usize>(
+        &self,
+        haptic: &mut DynamicLoop<'_, '_, f32, P, P>,
+        session: &mut Session<'_>,
+    ) -> anyhow::Result<()> {
         for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s).enumerate() {
             session.record(t, &haptic.tick(&tool))?;
             if (k + 1) % self.every != 0 {

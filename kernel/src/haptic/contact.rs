@@ -236,7 +236,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
     /// the sphere's lowest point `tip − r n` onto the surface, walking to
     /// the neighbouring triangle across any edge it falls outside of (at
-    /// most [`MAX_WALK_STEPS`]). Returns the new contact and the signed gap
+    /// most [`MAX_WALK_STEPS`]; never straight back, which over a concave
+    /// fold would swing between the two triangles). Returns the new contact and the signed gap
     /// `(tip − x)·n − r` (m; negative while the sphere penetrates).
     pub fn track(
         &self,
@@ -248,6 +249,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let tolerance = T::WEIGHT_TOLERANCE;
         let mut triangle = contact.triangle;
         let mut face = self.face(triangle)?;
+        let mut came_from = None;
         for _ in 0..MAX_WALK_STEPS {
             let w = barycentric(
                 &face.corners,
@@ -268,10 +270,16 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 self.index.triangles_of(j).iter().find(|&&t| {
                     t != triangle && self.index.triangles_of(k).binary_search(&t).is_ok()
                 });
+            // Back where it came from: the point lies over a concave fold
+            // between the two (a dimple's valley); stay, clamped to the edge.
+            if shared.copied() == came_from {
+                break;
+            }
             let Some(next) = shared.and_then(|&t| self.face(t).map(|f| (t, f))) else {
                 break;
             };
             work.walk_steps = work.walk_steps.saturating_add(1);
+            came_from = Some(triangle);
             (triangle, face) = next;
         }
         let x_plane = tip_m - face.normal * radius_m;
