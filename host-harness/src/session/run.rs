@@ -22,7 +22,7 @@ use palpate_kernel::haptic::haptic_loop::{DynamicLoop, ForceOutput, LoopConfig, 
 use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
 use palpate_kernel::haptic::tissue::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, Limits, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Limits, StvkForm, TensorMassModel};
 
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
 use crate::dynamic::run::diagonal;
@@ -230,7 +230,13 @@ impl<'t> DynamicSetup<'t> {
         &self,
         body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P>) -> anyhow::Result<R>,
     ) -> anyhow::Result<R> {
-        let mut state = OwnedState::for_table(&self.table).without_split_terms();
+        // The split-term buffers only for the form that reads them.
+        let state = OwnedState::for_table(&self.table);
+        let mut state = if self.params.law == ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) {
+            state
+        } else {
+            state.without_split_terms()
+        };
         let model = TensorMassModel::new(self.table, state.buffers(), self.params)
             .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
         let mut surface = OwnedSurface::for_model(&model);

@@ -60,8 +60,9 @@ pub const MAX_TOOL_POINTS: usize = MAX_CONTACTS;
 /// fit in memory (the table build is quadratic in the surface size long before this).
 pub const MAX_GENERATED_VERTICES: usize = 10_000_000;
 
-/// Largest number of dynamic-model steps per physics update (`physics period / dt_s`).
-pub const MAX_SUBSTEPS: u32 = 10_000;
+/// Largest number of dynamic-model steps per physics update (`physics period / dt_s`): the
+/// kernel's bound on a physics update's loop.
+pub const MAX_SUBSTEPS: u32 = palpate_kernel::haptic::dynamic_tissue::MAX_SUBSTEPS;
 
 /// Why a scene could not be read. Every message starts with the file (or the source name given
 /// to [`Scene::from_toml_str_named`]).

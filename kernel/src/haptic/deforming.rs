@@ -4,9 +4,10 @@
 //! bucket data structure must be updated" for a deformed mesh; MODELS.md
 //! §6).
 //!
-//! Bounded re-binning: [`DeformingSurface::rebin`] is one pass over the
-//! `N` vertices, one over the `T` surface triangles, two over the surface
-//! vertices and one over the `C` grid cells of the caller's buffer; the
+//! Bounded re-binning: [`DeformingSurface::rebin`] is four passes over the
+//! `N` vertices (positions, bounding box, the two counting-sort passes),
+//! one over the `T` surface triangles and two over the `C` grid cells of
+//! the caller's buffer; the
 //! cell edge is the longest current surface edge (so the 27 cells around a
 //! point hold every vertex of a triangle under it, as in the table-built
 //! index), enlarged by doubling (at most [`MAX_CELL_DOUBLINGS`] times) until

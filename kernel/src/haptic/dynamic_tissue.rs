@@ -16,6 +16,8 @@
 //! held vertices' elastic forces. A vertex's share goes to zero as the
 //! contact point reaches the opposite edge, so sliding onto the next
 //! triangle changes the held set without a jump in the displacement field.
+//! Near a fixed vertex the shares would grow without bound, so a contact
+//! with `Σ w² < MIN_MOVABLE_WEIGHT2` over the movable vertices is refused.
 //!
 //! Force between physics updates (extrapolation from the local contact
 //! stiffness and the tool's motion, Cotin 1999 §6): each tick sends
@@ -37,9 +39,10 @@
 //! update corrects over the next period: the difference between the force
 //! sent on the last tick before the update and the update's force decays
 //! linearly to zero over as many ticks as the last period had (`1 − j/k`
-//! of it at the `j`-th of `k` ticks). The force the device receives is then
-//! continuous across updates by construction; the price is that a
-//! correction arrives over one physics period instead of at once.
+//! of it at the `j`-th of `k` ticks), so an update's correction reaches the
+//! device in `k` equal steps instead of one jump; the price is that it
+//! arrives over one physics period instead of at once. (The offset is
+//! taken from the force the tissue last requested, before the supervisor.)
 
 use core::fmt;
 
@@ -50,6 +53,17 @@ use super::deforming::{DeformingSurface, NonFinitePosition, SurfaceBufferError, 
 use super::tissue::{ContactTarget, Refusal, Solved, Tissue};
 use crate::Real;
 use crate::tensor_mass::{Integrator, StepError, StepReport, TensorMassModel};
+
+/// Least `Σ w_i²` over a contact triangle's movable vertices for the
+/// tissue to hold it: below it (a contact point near a fixed vertex) the
+/// shares `w_i / Σ w²` would exceed 3 and grow without bound, so the
+/// contact is refused, as the pre-computed model refuses an ill-conditioned
+/// one. With all three vertices movable `Σ w² ≥ 1/3`.
+pub const MIN_MOVABLE_WEIGHT2: f64 = 1.0 / 9.0;
+
+/// Most model steps per physics update (a compile-time bound on the
+/// update's loop; `PhysicsConfig::substeps` above it is refused).
+pub const MAX_SUBSTEPS: u32 = 10_000;
 
 /// Least normal tool motion over a physics period, m, for a new secant
 /// stiffness ratio (below it the ratio is noise: kept from before).
@@ -75,8 +89,8 @@ pub struct PhysicsConfig<T> {
     pub integrator: Integrator,
     /// Step, s (finite, > 0; below the integrator's critical step).
     pub dt_s: T,
-    /// Steps per physics update (≥ 1; the physics period is
-    /// `substeps · dt_s`).
+    /// Steps per physics update (in `1..=MAX_SUBSTEPS`; the physics period
+    /// is `substeps · dt_s`).
     pub substeps: u32,
 }
 
@@ -92,7 +106,8 @@ pub enum DynamicTissueError {
         /// Entries given.
         found: usize,
     },
-    /// `dt_s` not finite and positive, or `substeps` zero.
+    /// `dt_s` not finite and positive, or `substeps` not in
+    /// `1..=MAX_SUBSTEPS`.
     BadPhysics,
 }
 
@@ -103,7 +118,9 @@ impl fmt::Display for DynamicTissueError {
             Self::ForceBuffer { expected, found } => {
                 write!(f, "force buffer: length {found}, expected {expected}")
             }
-            Self::BadPhysics => f.write_str("physics dt_s must be finite and > 0, substeps >= 1"),
+            Self::BadPhysics => {
+                f.write_str("physics dt_s must be finite and > 0, substeps in 1..=MAX_SUBSTEPS")
+            }
         }
     }
 }
@@ -194,7 +211,10 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 found: forces_n.len(),
             });
         }
-        if !(physics.dt_s.finite() && physics.dt_s > T::zero() && physics.substeps >= 1) {
+        if !(physics.dt_s.finite()
+            && physics.dt_s > T::zero()
+            && (1..=MAX_SUBSTEPS).contains(&physics.substeps))
+        {
             return Err(DynamicTissueError::BadPhysics);
         }
         let surface =
@@ -238,8 +258,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
 
     /// Each vertex's share of the contact point's displacement, the
     /// minimum-norm solution of `Σ w_i u_i = d`: `s_i = w_i / Σ_k w_k²`
-    /// over the movable vertices, 0 for a fixed one (and all 0 when none
-    /// moves).
+    /// over the movable vertices, 0 for a fixed one; all 0 when
+    /// `Σ_k w_k² < MIN_MOVABLE_WEIGHT2` (the solve refuses such a contact).
     fn shares(&self, t: &ContactTarget<T>) -> [T; 3] {
         let movable = t.vertices.map(|v| self.movable(v));
         let w = t.contact.weights;
@@ -249,7 +269,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             .filter(|(_, m)| **m)
             .fold(T::zero(), |a, (w, _)| a + *w * *w);
         let mut s = [T::zero(); 3];
-        if norm2 > T::zero() {
+        if norm2 >= T::of_f64(MIN_MOVABLE_WEIGHT2) {
             for ((s, w), m) in s.iter_mut().zip(&w).zip(&movable) {
                 if *m {
                     *s = *w / norm2;
@@ -418,21 +438,32 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         }
         self.held = [None; P];
         // Impose: move each contact point by gap · n, shared out over its
-        // triangle's vertices.
-        for t in set {
-            for (&v, &share) in t.vertices.iter().zip(&self.shares(t)) {
-                if share == T::zero() {
-                    continue;
+        // triangle's vertices; a vertex two contacts share gets the sum of
+        // both shifts from where it was (at most 3P entries, 9P² sums).
+        let mut moves = [[(u32::MAX, Vector3::zeros(), Vector3::zeros()); 3]; P];
+        for (t, slots) in set.iter().zip(moves.iter_mut()) {
+            let u = self
+                .model
+                .displacements_m()
+                .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
+            for ((slot, &v), &share) in slots.iter_mut().zip(&t.vertices).zip(&self.shares(t)) {
+                if share != T::zero() {
+                    let from = u
+                        .get(v as usize)
+                        .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]));
+                    *slot = (v, from, t.normal * (t.gap_m * share));
                 }
-                let shift = t.normal * (t.gap_m * share);
-                let u = self
-                    .model
-                    .displacements_m()
-                    .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?
-                    .get(v as usize)
-                    .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]));
+            }
+        }
+        for (t, slots) in set.iter().zip(&moves) {
+            for &(v, from, _) in slots.iter().filter(|(v, _, _)| *v != u32::MAX) {
+                let shift = moves
+                    .iter()
+                    .flatten()
+                    .filter(|(w, _, _)| *w == v)
+                    .fold(Vector3::zeros(), |a, (_, _, s)| a + s);
                 self.model
-                    .impose(v, u + shift)
+                    .impose(v, from + shift)
                     .map_err(|_| PhysicsError::NonFiniteContact { tool: t.tool })?;
             }
         }
@@ -540,7 +571,14 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
             device_force_n: Vector3::zeros(),
             tissue_forces_n: [Vector3::zeros(); M],
         };
-        for (t, g) in set.iter().zip(solved.tissue_forces_n.iter_mut()) {
+        for (q, (t, g)) in set
+            .iter()
+            .zip(solved.tissue_forces_n.iter_mut())
+            .enumerate()
+        {
+            if self.shares(t) == [T::zero(); 3] {
+                return Err(Refusal::Contact(q));
+            }
             let (normal, force) = self.extrapolate(&self.in_rest_frame(t));
             let force_n = normal * force;
             solved.device_force_n += force_n;

@@ -160,6 +160,9 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             return self.output(Err(SafetyFault::NonFiniteInput), dt, 0);
         }
         if self.supervisor.fault().is_some() {
+            // Latched: no contact is held (a physics update releases them).
+            self.contacts = [None; P];
+            self.tissue.forget();
             self.previous_m = Some(*tool_m);
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }

@@ -84,7 +84,7 @@ pub trait Tissue<T: Real, const M: usize> {
     fn begin_tick(&mut self) {}
     /// Forgets the last solution (a fault dropped every contact).
     fn forget(&mut self);
-    /// Back to the state at construction (rest, no contact).
+    /// Back to rest with no contact.
     fn reset(&mut self);
 }
 
