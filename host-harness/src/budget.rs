@@ -28,7 +28,7 @@
 //! a solve is linear in the contacts (no factorization). Measured on
 //! `palpate budget built-in-dynamic`: a tracked contact with its solve
 //! 1987 Ir over the idle 655, an edge crossed ≤ 724 Ir, a triangle tested
-//! ≤ 124 Ir; the worst tick 12 910 Ir.
+//! ≤ 124 Ir; the worst tick 12 930 Ir.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
