@@ -174,6 +174,9 @@ pub struct HeldContact<T> {
     /// Force on the hand after the update, `Σ s_i f_i` over the held
     /// vertices' elastic forces, N.
     pub force_n: Vector3<T>,
+    /// `k = Σ_ij s_i s_j n · K_ij n` of the held vertices along `normal`,
+    /// N/m (computed once per update: the tensors change only by cuts).
+    pub stiffness_n_per_m: T,
     /// Extrapolation stiffness ratio `α`, in `[0, 1]`.
     pub scale: T,
     /// Normal force sent just before the update minus the update's, N
@@ -351,10 +354,9 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         };
         let n = h.normal;
         let gap = (t.tip_m - h.tip_m).dot(&n);
-        let k = self.normal_stiffness(&h.vertices, &h.shares, &n);
         (
             n,
-            h.force_n.dot(&n) - h.scale * k * gap + blend * h.offset_n,
+            h.force_n.dot(&n) - h.scale * h.stiffness_n_per_m * gap + blend * h.offset_n,
         )
     }
 
@@ -375,7 +377,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         {
             return before.scale;
         }
-        let predicted = -self.normal_stiffness(&before.vertices, &before.shares, &n) * motion;
+        let predicted = -before.stiffness_n_per_m * motion;
         let measured = (force_n - before.force_n).dot(&n);
         let ratio = measured / predicted;
         if !ratio.finite() {
@@ -480,6 +482,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         for t in set {
             // The work-conjugate of the contact point's displacement: Σ s_i f_i.
             let shares = self.shares(t);
+            let stiffness_n_per_m = self.normal_stiffness(&t.vertices, &shares, &t.normal);
             let mut force_n = Vector3::zeros();
             for (&v, &share) in t.vertices.iter().zip(&shares) {
                 if let Some(f) = self.forces_n.get(v as usize) {
@@ -495,6 +498,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 normal: t.normal,
                 tip_m: t.tip_m - t.normal * t.gap_m,
                 force_n: Vector3::zeros(),
+                stiffness_n_per_m,
                 scale: T::one(),
                 offset_n: T::zero(),
             });
@@ -513,6 +517,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                     normal: t.normal,
                     tip_m: t.tip_m,
                     force_n,
+                    stiffness_n_per_m,
                     scale,
                     offset_n,
                 });

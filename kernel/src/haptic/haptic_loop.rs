@@ -166,40 +166,34 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             self.previous_m = Some(*tool_m);
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
-        let refused = self.track_and_detect(tool_m);
+        let mut refused = self.track_and_detect(tool_m);
+        let (mut set, mut m) = self.targets(tool_m, &mut refused);
         // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
         // the model refuses, and solve again. Each pass removes one.
-        let mut refused = refused;
         for _ in 0..=P {
             self.counters.solves = self.counters.solves.saturating_add(1);
-            let (set, m) = match self.targets(tool_m) {
-                Ok(targets) => targets,
-                Err(p) => {
-                    self.drop_contact(p);
-                    refused = refused.saturating_add(1);
-                    continue;
-                }
-            };
-            let set = set.get(..m).unwrap_or(&[]);
-            match self.tissue.solve(set) {
+            let active = set.get(..m).unwrap_or(&[]);
+            let dropped = match self.tissue.solve(active) {
                 Ok(solved) => {
-                    let adhesive = set
+                    let adhesive = active
                         .iter()
                         .zip(&solved.tissue_forces_n)
-                        .find(|(t, g)| g.dot(&t.normal) > T::zero());
-                    match adhesive {
-                        Some((t, _)) => self.drop_contact(t.tool),
-                        None => return self.output(Ok(solved.device_force_n), dt, refused),
-                    }
+                        .position(|(t, g)| g.dot(&t.normal) > T::zero());
+                    let Some(q) = adhesive else {
+                        return self.output(Ok(solved.device_force_n), dt, refused);
+                    };
+                    q
                 }
                 Err(Refusal::Contact(q)) => {
-                    if let Some(t) = set.get(q) {
-                        self.drop_contact(t.tool);
-                    }
                     refused = refused.saturating_add(1);
+                    q
                 }
                 Err(Refusal::Fault) => break,
+            };
+            if let Some(t) = set.get(dropped) {
+                self.drop_contact(t.tool);
             }
+            m = remove_at(&mut set, m, dropped);
         }
         self.contacts = [None; P];
         self.tissue.forget();
@@ -247,20 +241,26 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         }
     }
 
-    /// The active contacts as targets (at most `M`), with each contact
-    /// point's signed gap to its tool sphere; `Err(p)` names a tool point
-    /// whose contact no longer lies on the surface.
-    fn targets(&self, tool_m: &[Vector3<T>; P]) -> Result<([ContactTarget<T>; M], usize), usize> {
+    /// The active contacts as targets (at most `M`, in tool-point order),
+    /// with each contact point's signed gap to its tool sphere. A contact
+    /// whose triangle cannot be read is dropped and counted in `refused`.
+    fn targets(
+        &mut self,
+        tool_m: &[Vector3<T>; P],
+        refused: &mut u8,
+    ) -> ([ContactTarget<T>; M], usize) {
         let radius = self.config.radius_m;
         let surface = self.tissue.geometry();
         let mut set = [ContactTarget::placeholder(); M];
         let mut m = 0usize;
-        for (p, (contact, tip)) in self.contacts.iter().zip(tool_m).enumerate() {
+        for (p, (contact, tip)) in self.contacts.iter_mut().zip(tool_m).enumerate() {
             let Some(c) = contact else { continue };
             let (Some((vertices, normal)), Some(x)) =
                 (surface.triangle(c.triangle), surface.point(c))
             else {
-                return Err(p);
+                *contact = None;
+                *refused = refused.saturating_add(1);
+                continue;
             };
             if let Some(slot) = set.get_mut(m) {
                 *slot = ContactTarget {
@@ -275,7 +275,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                 m += 1;
             }
         }
-        Ok((set, m))
+        (set, m)
     }
 
     fn output(
@@ -308,11 +308,24 @@ impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
     /// after the tick). On failure the next tick latches a model fault
     /// (zero force) until [`Self::reset`].
     pub fn physics_update(&mut self) -> Result<StepReport<T>, PhysicsError> {
-        let targets = self
-            .previous_m
-            .map(|tool| self.targets(&tool))
-            .unwrap_or(Ok(([ContactTarget::placeholder(); M], 0)));
-        let (set, m) = targets.unwrap_or(([ContactTarget::placeholder(); M], 0));
+        let (set, m) = match self.previous_m {
+            Some(tool) => self.targets(&tool, &mut 0),
+            None => ([ContactTarget::placeholder(); M], 0),
+        };
         self.tissue.update(set.get(..m).unwrap_or(&[]))
     }
+}
+
+/// Removes entry `q` of the first `len` entries of `items` (keeping their
+/// order); returns the new length (`len` when `q` is not among them).
+fn remove_at<E: Copy>(items: &mut [E], len: usize, q: usize) -> usize {
+    if q >= len {
+        return len;
+    }
+    for i in q..len.saturating_sub(1) {
+        if let (Some(next), Some(slot)) = (items.get(i + 1).copied(), items.get_mut(i)) {
+            *slot = next;
+        }
+    }
+    len.saturating_sub(1)
 }
