@@ -16,10 +16,9 @@ use nalgebra::Vector3;
 use palpate_kernel::{Contact, MAX_CONTACTS};
 
 use crate::output::vtk;
+use crate::session::run::precomputed_options;
 use crate::session::{MeshSource, Scene};
-use crate::tables::build::{BuildOptions, build_table};
-use crate::tables::compliance::Solver;
-use crate::tables::file::Precision;
+use crate::tables::build::build_table;
 use crate::tables::load::{AnyModel, TableFile};
 
 /// Steps of each phase of the scripted press-and-release.
@@ -38,13 +37,7 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
     };
     let (mesh, mut report) = scene.load_mesh()?;
     report.source = "built-in block".into();
-    let options = BuildOptions {
-        material: scene.elastic_material()?,
-        fix: scene.fix.clone(),
-        solver: Solver::Cholesky,
-        precision: Precision::F32,
-        progress: false,
-    };
+    let options = precomputed_options(&scene)?;
     println!(
         "scene: {:.0}x{:.0}x{:.0} cm block, {} vertices, {} tets, E = {} Pa, nu = {}, base fixed",
         size_m[0] * 100.0,

@@ -580,16 +580,7 @@ fn assert_conformal(model: &TensorMassModel<'_, '_, f64>, mesh: &TetMesh) {
             );
         }
     }
-    let live = TetMesh {
-        positions: mesh.positions.clone(),
-        tets: mesh
-            .tets
-            .iter()
-            .zip(alive)
-            .filter(|(_, a)| **a)
-            .map(|(t, _)| *t)
-            .collect(),
-    };
+    let live = palpate_tests::live_mesh(mesh, alive);
     let canonical = |mut faces: Vec<[u32; 3]>| {
         for f in &mut faces {
             let min = (0..3).min_by_key(|&i| f[i]).unwrap();

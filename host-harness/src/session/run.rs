@@ -35,20 +35,26 @@ use crate::tables::file::Precision;
 use crate::tables::load::TableFile;
 use crate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
 
-/// The f32 pre-computed table of `scene` (the firmware precision), built
-/// in memory with the same pipeline as `palpate tables build`.
-pub fn precomputed_table(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<Vec<u8>> {
-    let options = BuildOptions {
+/// The build options of `scene`'s pre-computed table: its material and
+/// supports, sparse Cholesky, f32 (the firmware precision), quiet.
+pub fn precomputed_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
+    Ok(BuildOptions {
         material: scene.elastic_material()?,
         fix: scene.fix.clone(),
         solver: Solver::Cholesky,
         precision: Precision::F32,
         progress: false,
-    };
+    })
+}
+
+/// The f32 pre-computed table of `scene`, built in memory with the same
+/// pipeline as `palpate tables build`.
+pub fn precomputed_table(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<Vec<u8>> {
+    let options = precomputed_options(scene)?;
     Ok(build_table(mesh, report, &options)
         .with_context(|| scene.source.clone())?
         .bytes)

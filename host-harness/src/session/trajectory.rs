@@ -384,17 +384,26 @@ pub(crate) fn position_on(track: &[(f64, [f64; 3])], t_s: f64) -> [f64; 3] {
     }
 }
 
+/// Reads the file at `path` in `mode`; messages name it as `path` displays.
+fn read_file(
+    path: &Path,
+    tool_count: usize,
+    mode: Mode,
+) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|err| TrajectoryError::Io {
+        file: file.clone(),
+        action: "read",
+        err,
+    })?;
+    read_csv(&bytes, &file, tool_count, mode)
+}
+
 impl Trajectory {
     /// Read and check a trajectory file for a scene with `tool_count` tool points (see the
     /// module doc for the rules). Messages name the file as `path` displays.
     pub fn read(path: &Path, tool_count: usize) -> Result<Trajectory, TrajectoryError> {
-        let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|err| TrajectoryError::Io {
-            file: file.clone(),
-            action: "read",
-            err,
-        })?;
-        read_csv(&bytes, &file, tool_count, Mode::Checked).map(|(t, _)| t)
+        read_file(path, tool_count, Mode::Checked).map(|(t, _)| t)
     }
 
     /// [`Trajectory::read`] from text; `source` names it in messages.
@@ -416,13 +425,7 @@ impl Trajectory {
         path: &Path,
         tool_count: usize,
     ) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
-        let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|err| TrajectoryError::Io {
-            file: file.clone(),
-            action: "read",
-            err,
-        })?;
-        read_csv(&bytes, &file, tool_count, Mode::Lenient)
+        read_file(path, tool_count, Mode::Lenient)
     }
 
     /// [`Trajectory::read_unchecked`] from text; `source` names it in messages.
