@@ -16,7 +16,7 @@
 //! this build (x86-64, `cargo build`, the workspace's opt-level 2 for our
 //! crates) on the built-in scene's trajectories, rounded up: an idle tick
 //! 469 Ir, a tracked contact with its solve 2420 Ir, each edge crossed
-//! 602 Ir (724 on the dynamic model's surface), each triangle tested
+//! 602 Ir (564 on the dynamic model's surface), each triangle tested
 //! ≤ 113 Ir, the new contact and its solve
 //! included (`palpate budget built-in`).
 //!
@@ -27,8 +27,8 @@
 //! twice (`T` surface triangles), since compression can crowd a bucket, and
 //! a solve is linear in the contacts (no factorization). Measured on
 //! `palpate budget built-in-dynamic`: a tracked contact with its solve
-//! 1987 Ir over the idle 655, an edge crossed ≤ 724 Ir, a triangle tested
-//! ≤ 124 Ir; the worst tick 12 930 Ir.
+//! 1192 Ir over the idle 680, an edge crossed ≤ 564 Ir, a triangle tested
+//! ≤ 113 Ir; the worst tick 12 939 Ir.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -50,7 +50,7 @@ pub const BASE_IR: u64 = 600;
 /// Instructions per candidate triangle tested in a detection.
 pub const TRIANGLE_IR: u64 = 125;
 /// Instructions per triangle edge crossed while sliding.
-pub const WALK_IR: u64 = 800;
+pub const WALK_IR: u64 = 700;
 /// Instructions to track one contact (projection, gap).
 pub const TRACK_IR: u64 = 1000;
 /// Instructions per contact solve, per cubed contact capacity (the block
