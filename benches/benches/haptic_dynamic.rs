@@ -18,26 +18,16 @@
 use core::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use nalgebra::Vector3;
 use palpate::dynamic::{OwnedState, OwnedSurface};
 use palpate::tables::load::TableFile;
 use palpate_benches::{haptic_config, haptic_tool, tensor_cube_table};
-use palpate_kernel::haptic::dynamic_tissue::{DynamicTissue, Extrapolation, PhysicsConfig};
-use palpate_kernel::haptic::haptic_loop::DynamicLoop;
+use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
+use palpate_kernel::haptic::DynamicLoop;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, Limits, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
 
 fn params() -> DynamicParams<f32> {
-    DynamicParams {
-        law: ElasticLaw::Linear,
-        incompressibility_n: None,
-        damping_per_s: 30.0,
-        gravity_m_s2: Vector3::zeros(),
-        limits: Limits {
-            max_displacement_m: 0.2,
-            max_kinetic_energy_j: f32::INFINITY,
-        },
-    }
+    DynamicParams::linear(30.0, 0.2)
 }
 
 const PHYSICS: PhysicsConfig<f32> = PhysicsConfig {
@@ -113,7 +103,7 @@ fn dynamic(c: &mut Criterion) {
         let model = TensorMassModel::new(table, state.buffers(), params()).expect("model");
         let mut owned = OwnedSurface::for_model(&model);
         let (buffers, _) = owned.buffers();
-        let mut surface = palpate_kernel::haptic::deforming::DeformingSurface::new(&model, buffers)
+        let mut surface = palpate_kernel::tensor_mass::DeformingSurface::new(&model, buffers)
             .expect("surface");
         let u = vec![[0.0f32, 0.0, 0.001]; table.vertex_count()];
         group.bench_function(BenchmarkId::new("rebin", format!("{cells}cells")), |b| {

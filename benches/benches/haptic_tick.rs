@@ -16,9 +16,9 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use palpate::tables::load::TableFile;
 use palpate_benches::{TOOL_RADIUS_M, cube_table, haptic_config as config, haptic_tool as tool};
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::contact::{ContactWork, SurfaceGeometry};
-use palpate_kernel::haptic::haptic_loop::PrecomputedLoop;
-use palpate_kernel::haptic::tissue::PrecomputedTissue;
+use palpate_kernel::contact::{ContactWork, SurfaceGeometry};
+use palpate_kernel::haptic::PrecomputedLoop;
+use palpate_kernel::precomputed::PrecomputedTissue;
 
 fn tick_with<const P: usize>(
     c: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
@@ -67,6 +67,7 @@ fn tick(c: &mut Criterion) {
             b.iter(|| {
                 let mut work = ContactWork::default();
                 black_box(surface.detect(
+                    0,
                     black_box(&from),
                     black_box(&to),
                     TOOL_RADIUS_M,

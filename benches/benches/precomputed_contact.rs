@@ -28,7 +28,7 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use palpate::tables::load::{AnyModel, TableFile};
 use palpate_benches::{cube_table, top_vertices};
-use palpate_kernel::{Contact, MAX_CONTACTS, PrecomputedModel};
+use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel};
 
 fn model_of(file: &TableFile) -> PrecomputedModel<'_, f32> {
     match file.model().expect("valid table") {
@@ -37,11 +37,11 @@ fn model_of(file: &TableFile) -> PrecomputedModel<'_, f32> {
     }
 }
 
-fn contacts(cells: usize, m: usize) -> Vec<Contact<f32>> {
+fn contacts(cells: usize, m: usize) -> Vec<Constraint<f32>> {
     top_vertices(cells)
         .iter()
         .take(m)
-        .map(|&v| Contact::at_vertex(v, Vector3::new(0.0005, -0.0003, -0.004)))
+        .map(|&v| Constraint::at_vertex(v, Vector3::new(0.0005, -0.0003, -0.004)))
         .collect()
 }
 
@@ -66,7 +66,7 @@ fn force_path(c: &mut Criterion) {
         let n = cells as u32 + 1;
         // A top-face triangle of the Kuhn split: (i, j), (i+1, j), (i+1, j+1).
         let triangle = [a, a + 1, a + n + 1];
-        let set = [Contact::on_triangle(
+        let set = [Constraint::on_triangle(
             triangle,
             [0.2, 0.3, 0.5],
             Vector3::new(0.0, 0.0, -0.003),
@@ -196,7 +196,7 @@ fn cold_ratio(cells: usize) -> (usize, usize, f64, f64) {
     let solutions: Vec<_> = touchable
         .iter()
         .map(|&v| {
-            let contact = Contact::at_vertex(v, Vector3::new(0.0, 0.0, -0.002));
+            let contact = Constraint::at_vertex(v, Vector3::new(0.0, 0.0, -0.002));
             model
                 .contact_forces::<MAX_CONTACTS>(&[contact])
                 .expect("solve")

@@ -28,7 +28,7 @@ use palpate::tables::load::TableFile;
 use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, Integrator, Limits, StvkForm, TensorMassModel,
+    DynamicParams, ElasticLaw, Integrator, StvkForm, TensorMassModel,
 };
 
 /// The laws timed, with their penalty γ (N) and a name.
@@ -79,12 +79,7 @@ fn params(law: ElasticLaw, incompressibility_n: Option<f32>) -> DynamicParams<f3
     DynamicParams {
         law,
         incompressibility_n,
-        damping_per_s: 5.0,
-        gravity_m_s2: Vector3::zeros(),
-        limits: Limits {
-            max_displacement_m: 10.0,
-            max_kinetic_energy_j: f32::INFINITY,
-        },
+        ..DynamicParams::linear(5.0, 10.0)
     }
 }
 

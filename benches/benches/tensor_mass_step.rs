@@ -30,7 +30,7 @@ use palpate::tables::file::Precision;
 use palpate::tables::load::TableFile;
 use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, Limits, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
 
 fn table(cells: usize) -> TableFile {
     let mesh = box_mesh([cells; 3], [0.1; 3]);
@@ -46,14 +46,8 @@ fn table(cells: usize) -> TableFile {
 
 fn params() -> DynamicParams<f32> {
     DynamicParams {
-        law: ElasticLaw::Linear,
-        incompressibility_n: None,
-        damping_per_s: 5.0,
         gravity_m_s2: Vector3::new(0.0, 0.0, -9.81),
-        limits: Limits {
-            max_displacement_m: 1.0,
-            max_kinetic_energy_j: f32::INFINITY,
-        },
+        ..DynamicParams::linear(5.0, 1.0)
     }
 }
 

@@ -10,8 +10,8 @@ use palpate::tables::build::{BuildOptions, BuiltTable, build_table};
 use palpate::tables::compliance::Solver;
 use palpate::tables::file::Precision;
 use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
-use palpate_kernel::haptic::haptic_loop::LoopConfig;
-use palpate_kernel::haptic::safety::SafetyLimits;
+use palpate_kernel::haptic::LoopConfig;
+use palpate_kernel::haptic::SafetyLimits;
 
 /// A cube of `cells³` Kuhn cells, 0.1 m wide, soft tissue (E = 3000 Pa,
 /// ν = 0.45), its base `z = 0` fixed.

@@ -10,7 +10,8 @@
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Vector3;
 use palpate_fuzz::table_layouts;
-use palpate_kernel::{Contact, PrecomputedModel, PrecomputedTable, Real};
+use palpate_kernel::table::VertexSlot;
+use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable, Real};
 
 fuzz_target!(|data: &[u8]| table_layouts(data, load_both));
 
@@ -40,12 +41,12 @@ fn check<T: Real>(table: &PrecomputedTable<'_, T>) {
     // The vertex maps are inverse; the touchable vertices come first, ascending.
     let free = table.free_vertices();
     for (i, &v) in free.iter().enumerate() {
-        assert_eq!(table.free_index(v), Some(Some(i as u32)));
+        assert!(matches!(table.slot(v), Some(VertexSlot::Free(f)) if f.get() == i));
         assert!(!table.is_fixed(v));
     }
     let fixed = (0..n as u32).filter(|&v| table.is_fixed(v)).count();
     assert_eq!(fixed + f, n);
-    assert_eq!(table.free_index(n as u32), None);
+    assert_eq!(table.slot(n as u32), None);
     assert!(!table.is_fixed(u32::MAX));
     assert!(free[..s].windows(2).all(|w| w[0] < w[1]));
 
@@ -107,20 +108,20 @@ fn check<T: Real>(table: &PrecomputedTable<'_, T>) {
     let d = Vector3::new(T::zero(), T::zero(), T::of_f64(-1e-3));
     let mut contacts = Vec::new();
     if let Some(&v) = free.first().filter(|_| s > 0) {
-        contacts.push(Contact::at_vertex(v, d));
+        contacts.push(Constraint::at_vertex(v, d));
     }
     if let Some(&tri) = triangles.first() {
         let third = T::of_f64(1.0 / 3.0);
-        contacts.push(Contact::on_triangle(tri, [third; 3], d));
+        contacts.push(Constraint::on_triangle(tri, [third; 3], d));
     }
     for k in 0..=contacts.len() {
         solve(&model, &contacts[..k], f, n);
     }
-    let out_of_range = Contact::at_vertex(n as u32, d);
+    let out_of_range = Constraint::at_vertex(n as u32, d);
     assert!(model.contact_forces::<4>(&[out_of_range]).is_err());
 }
 
-fn solve<T: Real>(model: &PrecomputedModel<'_, T>, contacts: &[Contact<T>], f: usize, n: usize) {
+fn solve<T: Real>(model: &PrecomputedModel<'_, T>, contacts: &[Constraint<T>], f: usize, n: usize) {
     let Ok(solution) = model.contact_forces::<4>(contacts) else {
         return;
     };

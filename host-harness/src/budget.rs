@@ -36,9 +36,10 @@ use std::process::Command;
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::contact::MAX_WALK_STEPS;
-use palpate_kernel::haptic::haptic_loop::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters};
-use palpate_kernel::haptic::tissue::{PrecomputedTissue, Tissue};
+use palpate_kernel::contact::MAX_WALK_STEPS;
+use palpate_kernel::haptic::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters};
+use palpate_kernel::contact::Tissue;
+use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 
 use crate::mesh::{MeshReport, TetMesh};

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use nalgebra::Vector3;
-use palpate_kernel::{Contact, MAX_CONTACTS};
+use palpate_kernel::{Constraint, MAX_CONTACTS};
 
 use crate::output::vtk;
 use crate::session::run::precomputed_options;
@@ -107,10 +107,10 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
                 "hold" => 1.0,
                 _ => 1.0 - i as f32 / steps as f32,
             };
-            let contacts: Vec<Contact<f32>> = probes
+            let contacts: Vec<Constraint<f32>> = probes
                 .iter()
                 .zip(&full_press_m)
-                .map(|(&v, d)| Contact::at_vertex(v, d * amount))
+                .map(|(&v, d)| Constraint::at_vertex(v, d * amount))
                 .collect();
             let t0 = Instant::now();
             let solution = model.contact_forces::<MAX_CONTACTS>(&contacts)?;

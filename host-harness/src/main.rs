@@ -15,7 +15,7 @@ use palpate::tables::file::Precision;
 use palpate::tables::load::{AnyModel, TableFile};
 use palpate::tables::tensor_mass::TensorMassOptions;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
-use palpate_kernel::{Contact, Real};
+use palpate_kernel::{Constraint, Real};
 
 #[derive(Parser)]
 #[command(
@@ -869,7 +869,7 @@ fn budget(
 }
 
 /// The `--contact` and `--contact-bary` values in command-line order.
-fn contacts<T: Real>(solve: &ArgMatches) -> anyhow::Result<Vec<Contact<T>>> {
+fn contacts<T: Real>(solve: &ArgMatches) -> anyhow::Result<Vec<Constraint<T>>> {
     let mut all: Vec<(usize, bool, &String)> = Vec::new();
     for (id, bary) in [("contact", false), ("contact_bary", true)] {
         if let (Some(indices), Some(values)) = (solve.indices_of(id), solve.get_many::<String>(id))

@@ -1,7 +1,7 @@
 //! `palpate precomputed solve`: one contact set through the kernel's code path.
 
 use nalgebra::Vector3;
-use palpate_kernel::{Contact, MAX_CONTACTS, PrecomputedModel, Real};
+use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel, Real};
 use serde::Serialize;
 
 /// The JSON object `precomputed solve --json` prints (a CLI contract).
@@ -19,7 +19,7 @@ pub struct SolveOutput<T> {
 /// vertex displacement, exactly as the kernel does on firmware.
 pub fn solve<T: Real + Serialize>(
     model: &PrecomputedModel<'_, T>,
-    contacts: &[Contact<T>],
+    contacts: &[Constraint<T>],
 ) -> anyhow::Result<SolveOutput<T>> {
     let solution = model.contact_forces::<MAX_CONTACTS>(contacts)?;
     let mut displacements = vec![[T::zero(); 3]; model.table().vertex_count()];

@@ -1,12 +1,24 @@
 //! Palpate kernel: the `no_std`, allocation-free part of a real-time soft-tissue
 //! simulator for haptic surgery training.
 //!
+//! Layers, each depending only on those above it in this list:
+//! - [`math`]: the scalar, the P1 element, the small dense Cholesky;
+//! - [`table`]: the byte format and the validated views (pre-computed,
+//!   tensor-mass, collision index), checked once at load;
+//! - [`contact`]: the collision grid builder, detection and tracking, the one
+//!   [`contact::Contact`] type and its bounded set, the [`contact::Tissue`]
+//!   trait;
+//! - [`precomputed`] and [`tensor_mass`]: the two models, each with its
+//!   tissue adapter for the haptic loop;
+//! - [`haptic`]: the fixed-timestep loop and the safety supervisor.
+//!
 //! Data flow: table bytes (built offline by the host harness, linked into
 //! flash or read from a file) → [`table::PrecomputedTable::load`] validates them
 //! once → [`precomputed::PrecomputedModel`] answers contact queries in bounded
 //! time: the contact forces the haptic device needs ([`precomputed::PrecomputedModel::contact_forces`])
 //! and, separately, the displacement of every vertex
-//! ([`precomputed::PrecomputedModel::displacements`]).
+//! ([`precomputed::PrecomputedModel::displacements`]); tool positions at the
+//! haptic rate → [`haptic::HapticLoop::tick`] → a clamped device force.
 //!
 //! The physics is `MODELS.md` sections 1, 2 and 6; the source is Cotin,
 //! Delingette and Ayache, *Efficient linear elastic models of soft tissues for
@@ -25,18 +37,26 @@
     clippy::indexing_slicing
 )]
 
-pub mod element;
+pub mod contact;
 pub mod haptic;
+pub mod math;
 pub mod precomputed;
-pub mod scalar;
 pub mod table;
 pub mod tensor_mass;
 
-pub use precomputed::{Contact, ContactError, ContactPoint, ContactSolution, PrecomputedModel};
-pub use scalar::Real;
+pub use math::Real;
+pub use precomputed::{
+    AsConstraint, Constraint, ContactError, ContactPoint, ContactSolution, PrecomputedModel,
+};
 pub use table::{LoadError, PrecomputedTable};
 
-/// Default compile-time capacity of simultaneous contacts (`M` in
-/// [`precomputed::PrecomputedModel::contact_forces`]): a probe tip and a
-/// grasper's two jaws with one spare. The solver accepts any `1..=16`.
+/// Default compile-time capacity of simultaneous contacts (`M` of the
+/// haptic loop and of [`precomputed::PrecomputedTissue`]): a probe tip and a
+/// grasper's two jaws with one spare.
 pub const MAX_CONTACTS: usize = 4;
+
+/// Largest capacity `M` the pre-computed solve
+/// ([`precomputed::PrecomputedModel::contact_forces`]) accepts: its
+/// `3M × 3M` system lives on the stack as `M²` 3×3 blocks, and its work
+/// grows as `M³`.
+pub const MAX_CONTACT_CAPACITY: usize = 16;

@@ -10,7 +10,7 @@ use palpate::session::{
     Poke, Press, PressHold, Rates, SafetyLimits, Sample, Scene, Slide, Strike, ToolSpec,
     Trajectory, TrajectoryError, sample_keyframes,
 };
-use palpate_kernel::haptic::dynamic_tissue::Extrapolation;
+use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use palpate_tests::reference_dir;
 

@@ -6,10 +6,10 @@
 use nalgebra::Vector3;
 use palpate::tables::file::Precision;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::haptic_loop::{LoopConfig, PrecomputedLoop};
-use palpate_kernel::haptic::safety::{OutputStatus, SafetyFault, SafetyLimits, Supervisor};
-use palpate_kernel::haptic::tissue::PrecomputedTissue;
-use palpate_kernel::{Contact, PrecomputedModel};
+use palpate_kernel::haptic::{LoopConfig, PrecomputedLoop};
+use palpate_kernel::haptic::{OutputStatus, SafetyFault, SafetyLimits, Supervisor};
+use palpate_kernel::precomputed::PrecomputedTissue;
+use palpate_kernel::{Constraint, PrecomputedModel};
 use palpate_tests::reference_cube_table;
 use proptest::prelude::*;
 
@@ -87,7 +87,7 @@ fn probe_press_matches_the_direct_solve_and_releases() {
             assert!((normal.z - 1.0).abs() < 1e-12, "a top-face triangle");
             let depth = z - 0.01 - 1.0;
             let direct = model
-                .contact_forces::<1>(&[Contact::on_triangle(vertices, c.weights, normal * depth)])
+                .contact_forces::<1>(&[Constraint::on_triangle(vertices, c.weights, normal * depth)])
                 .expect("solve")
                 .device_force_n();
             let diff = (out.force_n - direct).norm();

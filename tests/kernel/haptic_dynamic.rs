@@ -1,5 +1,5 @@
 //! The haptic loop over the dynamic tensor-mass model
-//! (`palpate_kernel::haptic::{deforming, dynamic_tissue}`): the re-binned
+//! (`palpate_kernel::tensor_mass::{DeformingSurface, DynamicTissue}`): the re-binned
 //! surface against moved geometry, the extrapolated force against the
 //! model's own force pass, the held force at rest against the pre-computed
 //! model's static solve, continuity across physics updates, the
@@ -16,14 +16,14 @@ use palpate::tables::compliance::Solver;
 use palpate::tables::file::Precision;
 use palpate::tables::load::TableFile;
 use palpate::tables::tensor_mass::TensorMassOptions;
-use palpate_kernel::haptic::contact::{ContactWork, Supports};
-use palpate_kernel::haptic::deforming::DeformingSurface;
-use palpate_kernel::haptic::dynamic_tissue::{DynamicTissue, Extrapolation, PhysicsConfig};
-use palpate_kernel::haptic::haptic_loop::{DynamicLoop, LoopConfig};
-use palpate_kernel::haptic::safety::{OutputStatus, SafetyFault, SafetyLimits};
+use palpate_kernel::contact::{ContactWork, Supports};
+use palpate_kernel::tensor_mass::DeformingSurface;
+use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
+use palpate_kernel::haptic::{DynamicLoop, LoopConfig};
+use palpate_kernel::haptic::{OutputStatus, SafetyFault, SafetyLimits};
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, Limits, TensorMassModel};
-use palpate_kernel::{Contact, PrecomputedModel, PrecomputedTable};
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
+use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable};
 use proptest::prelude::*;
 
 /// A 6 × 6 × 3 cm block of 648 tets (1 cm cells), bottom fixed, E = 3 kPa,
@@ -44,16 +44,7 @@ fn block_table() -> TableFile {
 }
 
 fn params(max_displacement_m: f64) -> DynamicParams<f64> {
-    DynamicParams {
-        law: ElasticLaw::Linear,
-        incompressibility_n: None,
-        damping_per_s: 30.0,
-        gravity_m_s2: Vector3::zeros(),
-        limits: Limits {
-            max_displacement_m,
-            max_kinetic_energy_j: f64::INFINITY,
-        },
-    }
+    DynamicParams::linear(30.0, max_displacement_m)
 }
 
 fn loop_config() -> LoopConfig<f64> {
@@ -122,12 +113,13 @@ fn rebinned_surface_follows_the_deformation() {
         |surface: &DeformingSurface<'_, '_, f64>, x: f64, top_m: f64, work: &mut ContactWork| {
             let geometry = surface.geometry(Supports::TensorMass(&table));
             let contact = geometry.detect(
+                0,
                 &Vector3::new(x, 0.0291, top_m + RADIUS_M + 1e-3),
                 &Vector3::new(x, 0.0291, top_m + RADIUS_M - 1e-3),
                 RADIUS_M,
                 work,
             );
-            contact.and_then(|c| geometry.point(&c))
+            contact.map(|c| c.point_m)
         };
     let lifted: Vec<[f64; 3]> = rest.iter().map(|_| [0.0, 0.0, 0.05]).collect();
     surface.rebin(&lifted).expect("finite");
@@ -183,19 +175,19 @@ fn extrapolated_force_equals_the_model_force_between_updates() {
         let held = haptic.tissue().held()[0].expect("held");
         let model = haptic.tissue().model();
         // The top's rest normal, and shares solving Σ w_i u_i = d.
-        assert!((held.normal - Vector3::z()).norm() < 1e-12);
+        assert!((held.contact.normal - Vector3::z()).norm() < 1e-12);
         let moved: f64 = held
             .shares
             .iter()
-            .zip(&held.weights)
+            .zip(&held.contact.weights)
             .map(|(s, w)| s * w)
             .sum();
         assert!((moved - 1.0).abs() < 1e-12, "Σ w_i s_i = {moved}");
-        let normal = held.normal;
-        let gap = (tool[0] - held.tip_m).dot(&normal);
+        let normal = held.contact.normal;
+        let gap = (tool[0] - held.contact.tip_m).dot(&normal);
         assert!(gap < -2e-4, "pressed further: gap {gap}");
         let mut u = model.displacements_m().expect("finite").to_vec();
-        for (&v, &share) in held.vertices.iter().zip(&held.shares) {
+        for (&v, &share) in held.contact.vertices.iter().zip(&held.shares) {
             for (a, d) in u[v as usize]
                 .iter_mut()
                 .zip((normal * (gap * share)).iter())
@@ -206,7 +198,7 @@ fn extrapolated_force_equals_the_model_force_between_updates() {
         let mut f = vec![[0.0; 3]; u.len()];
         model.elastic_forces_of(&u, &mut f);
         let total: Vector3<f64> = held
-            .vertices
+            .contact.vertices
             .iter()
             .zip(&held.shares)
             .map(|(&v, &share)| Vector3::from(f[v as usize]) * share)
@@ -245,12 +237,12 @@ fn held_force_at_rest_matches_the_static_solve() {
         let held = haptic.tissue().held()[0].expect("held");
         let u = haptic.tissue().model().displacements_m().expect("finite");
         // The vertices with a share are the held ones.
-        let (contacts, shares): (Vec<Contact<f64>>, Vec<f64>) = held
-            .vertices
+        let (contacts, shares): (Vec<Constraint<f64>>, Vec<f64>) = held
+            .contact.vertices
             .iter()
             .zip(&held.shares)
             .filter(|(_, s)| **s != 0.0)
-            .map(|(&v, &s)| (Contact::at_vertex(v, Vector3::from(u[v as usize])), s))
+            .map(|(&v, &s)| (Constraint::at_vertex(v, Vector3::from(u[v as usize])), s))
             .unzip();
         let mesh = box_mesh([6, 6, 3], SIZE_M);
         let options = BuildOptions {
@@ -274,7 +266,7 @@ fn held_force_at_rest_matches_the_static_solve() {
             .zip(&shares)
             .map(|(g, s)| -g * *s)
             .sum();
-        let normal = held.normal;
+        let normal = held.contact.normal;
         let error = (force.norm() - reaction.dot(&normal)).abs() / force.norm();
         println!(
             "held 2 mm: dynamic {:.6e} N, static solve {:.6e} N along the normal, relative {error:.2e}",
@@ -429,13 +421,7 @@ proptest! {
         let file = TableFile::from_bytes(&bytes);
         let table = TensorMassTable::<f32>::load(file.bytes()).expect("table");
         let mut state = OwnedState::for_table(&table).without_split_terms();
-        let params = DynamicParams {
-            law: ElasticLaw::Linear,
-            incompressibility_n: None,
-            damping_per_s: 30.0f32,
-            gravity_m_s2: Vector3::zeros(),
-            limits: Limits { max_displacement_m: 0.1, max_kinetic_energy_j: f32::INFINITY },
-        };
+        let params = DynamicParams::linear(30.0f32, 0.1);
         let model = TensorMassModel::new(table, state.buffers(), params).expect("model");
         let mut owned = OwnedSurface::for_model(&model);
         let (buffers, forces) = owned.buffers();
@@ -458,9 +444,9 @@ proptest! {
             // shares bounded, and below 100 N (the 2 mm press at rest gives
             // 0.19 N; scaled linearly to the block's whole 3.5 cm, 3.3 N).
             for h in haptic.tissue().held().iter().flatten() {
-                prop_assert!(h.force_n.iter().all(|x| x.is_finite()));
+                prop_assert!(h.contact.force_n.iter().all(|x| x.is_finite()));
                 prop_assert!(h.shares.iter().all(|s| s.abs() <= 3.0 + 1e-3));
-                prop_assert!(h.force_n.norm() < 100.0, "{:?}", h);
+                prop_assert!(h.contact.force_n.norm() < 100.0, "{:?}", h);
             }
             if !tool.iter().all(|p| p.iter().all(|x| x.is_finite())) {
                 prop_assert_eq!(out.status, OutputStatus::Faulted(SafetyFault::NonFiniteInput));
@@ -533,9 +519,9 @@ fn sliding_moves_the_held_triangle_smoothly() {
                 haptic.physics_update().expect("stable");
             }
             if let Some(h) = haptic.tissue().held()[0]
-                && triangles.last() != Some(&h.vertices)
+                && triangles.last() != Some(&h.contact.vertices)
             {
-                triangles.push(h.vertices);
+                triangles.push(h.contact.vertices);
             }
             if k >= 300 {
                 assert_eq!(out.contacts, 1, "tick {k}");

@@ -18,7 +18,7 @@ use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
 use palpate::tables::file::Precision;
 use palpate::tables::load::{AnyModel, TableFile};
-use palpate_kernel::{Contact, ContactError, MAX_CONTACTS, PrecomputedModel, Real};
+use palpate_kernel::{Constraint, ContactError, MAX_CONTACTS, PrecomputedModel, Real};
 use palpate_tests::{json_rows, read_reference_json, reference_cube_table, rel_max_diff};
 use proptest::prelude::*;
 
@@ -44,9 +44,9 @@ fn solve<T: Real>(
     model: &PrecomputedModel<'_, T>,
     contacts: &[(u32, [f64; 3])],
 ) -> Result<(Rows, Rows), ContactError> {
-    let contacts: Vec<Contact<T>> = contacts
+    let contacts: Vec<Constraint<T>> = contacts
         .iter()
-        .map(|(v, d)| Contact::at_vertex(*v, Vector3::from(d.map(T::of_f64))))
+        .map(|(v, d)| Constraint::at_vertex(*v, Vector3::from(d.map(T::of_f64))))
         .collect();
     let solution = model.contact_forces::<MAX_CONTACTS>(&contacts)?;
     let mut u = vec![[T::zero(); 3]; model.table().vertex_count()];
@@ -211,7 +211,7 @@ fn barycentric_contact_at_a_vertex_is_a_vertex_contact() {
     };
     let d = Vector3::new(0.001, -0.002, -0.007);
     let vertex = m
-        .contact_forces::<4>(&[Contact::at_vertex(194, d)])
+        .contact_forces::<4>(&[Constraint::at_vertex(194, d)])
         .unwrap();
     // Triangle 194-195-200 on the top face, all weight on 194, in each slot.
     for weights in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
@@ -219,7 +219,7 @@ fn barycentric_contact_at_a_vertex_is_a_vertex_contact() {
         let slot = weights.iter().position(|&w| w == 1.0).unwrap();
         tri[slot] = 194;
         let bary = m
-            .contact_forces::<4>(&[Contact::on_triangle(tri, weights, d)])
+            .contact_forces::<4>(&[Constraint::on_triangle(tri, weights, d)])
             .unwrap();
         assert_eq!(bary.contact_forces_n(), vertex.contact_forces_n());
     }
@@ -236,8 +236,8 @@ fn barycentric_point_moves_by_the_imposed_displacement() {
     let d = Vector3::new(0.001, 0.0, -0.005);
     let s = m
         .contact_forces::<4>(&[
-            Contact::on_triangle(tri, weights, d),
-            Contact::at_vertex(205, Vector3::new(0.0, 0.0, -0.003)),
+            Constraint::on_triangle(tri, weights, d),
+            Constraint::at_vertex(205, Vector3::new(0.0, 0.0, -0.003)),
         ])
         .unwrap();
     let mut u = vec![[0.0; 3]; m.table().vertex_count()];
@@ -267,13 +267,13 @@ fn free_displacements_are_the_vertex_displacements_by_free_index() {
     };
     let s = m
         .contact_forces::<4>(&[
-            Contact::on_triangle(
+            Constraint::on_triangle(
                 [194, 195, 200],
                 [0.2, 0.5, 0.3],
                 Vector3::new(0.0, 0.001, -0.004),
             ),
-            Contact::at_vertex(205, Vector3::new(0.0, 0.0, -0.003)),
-            Contact::at_vertex(185, Vector3::new(0.002, 0.0, -0.001)),
+            Constraint::at_vertex(205, Vector3::new(0.0, 0.0, -0.003)),
+            Constraint::at_vertex(185, Vector3::new(0.002, 0.0, -0.001)),
         ])
         .unwrap();
     let mut by_vertex = vec![[f32::NAN; 3]; m.table().vertex_count()];
@@ -303,37 +303,37 @@ fn contact_errors_are_typed() {
         unreachable!()
     };
     let d = Vector3::new(0.0f32, 0.0, -0.001);
-    let err = |contacts: &[Contact<f32>]| m.contact_forces::<4>(contacts).unwrap_err();
+    let err = |contacts: &[Constraint<f32>]| m.contact_forces::<4>(contacts).unwrap_err();
     // Vertex 0 is on the fixed base; 216 is past the end; 43 = (1,1,1)/5 is interior.
     assert_eq!(
-        err(&[Contact::at_vertex(0, d)]),
+        err(&[Constraint::at_vertex(0, d)]),
         ContactError::FixedVertex {
             contact: 0,
             vertex: 0
         }
     );
     assert_eq!(
-        err(&[Contact::at_vertex(194, d), Contact::at_vertex(216, d)]),
+        err(&[Constraint::at_vertex(194, d), Constraint::at_vertex(216, d)]),
         ContactError::VertexOutOfRange {
             contact: 1,
             vertex: 216
         }
     );
     assert_eq!(
-        err(&[Contact::at_vertex(43, d)]),
+        err(&[Constraint::at_vertex(43, d)]),
         ContactError::NotOnSurface {
             contact: 0,
             vertex: 43
         }
     );
     assert_eq!(
-        err(&[Contact::at_vertex(194, d), Contact::at_vertex(194, d)]),
+        err(&[Constraint::at_vertex(194, d), Constraint::at_vertex(194, d)]),
         ContactError::DuplicateContact {
             first: 0,
             second: 1
         }
     );
-    let five = [Contact::at_vertex(194, d); 5];
+    let five = [Constraint::at_vertex(194, d); 5];
     assert_eq!(
         err(&five),
         ContactError::TooManyContacts {
@@ -343,28 +343,28 @@ fn contact_errors_are_typed() {
     );
     let nan = Vector3::new(f32::NAN, 0.0, 0.0);
     assert_eq!(
-        err(&[Contact::at_vertex(194, nan)]),
+        err(&[Constraint::at_vertex(194, nan)]),
         ContactError::NonFiniteInput { contact: 0 }
     );
-    let inf = Contact::on_triangle([194, 195, 200], [f32::INFINITY, 0.0, 0.0], d);
+    let inf = Constraint::on_triangle([194, 195, 200], [f32::INFINITY, 0.0, 0.0], d);
     assert_eq!(err(&[inf]), ContactError::NonFiniteInput { contact: 0 });
-    let bad = Contact::on_triangle([194, 195, 200], [0.5, 0.6, 0.0], d);
+    let bad = Constraint::on_triangle([194, 195, 200], [0.5, 0.6, 0.0], d);
     assert_eq!(err(&[bad]), ContactError::BadWeights { contact: 0 });
-    let negative = Contact::on_triangle([194, 195, 200], [1.2, -0.2, 0.0], d);
+    let negative = Constraint::on_triangle([194, 195, 200], [1.2, -0.2, 0.0], d);
     assert_eq!(err(&[negative]), ContactError::BadWeights { contact: 0 });
     // The same point twice through different triangles: singular system.
-    let p1 = Contact::on_triangle([194, 195, 200], [0.5, 0.5, 0.0], d);
-    let p2 = Contact::on_triangle([195, 194, 201], [0.5, 0.5, 0.0], d);
+    let p1 = Constraint::on_triangle([194, 195, 200], [0.5, 0.5, 0.0], d);
+    let p2 = Constraint::on_triangle([195, 194, 201], [0.5, 0.5, 0.0], d);
     assert_eq!(err(&[p1, p2]), ContactError::IllConditioned { contact: 1 });
     // All weight on fixed base vertices (0, 1, 6 are on z = 0): zero compliance.
-    let on_base = Contact::on_triangle([0, 1, 6], [0.3, 0.3, 0.4], d);
+    let on_base = Constraint::on_triangle([0, 1, 6], [0.3, 0.3, 0.4], d);
     assert_eq!(err(&[on_base]), ContactError::IllConditioned { contact: 0 });
     // An empty set is a well-defined zero force.
-    let none = m.contact_forces::<4>(&[]).unwrap();
+    let none = m.contact_forces::<4>(&[] as &[Constraint<f32>]).unwrap();
     assert_eq!(none.device_force_n(), Vector3::zeros());
     // A wrong output length is refused, not truncated.
     let s = m
-        .contact_forces::<4>(&[Contact::at_vertex(194, d)])
+        .contact_forces::<4>(&[Constraint::at_vertex(194, d)])
         .unwrap();
     assert!(m.displacements(&s, &mut [[0.0f32; 3]; 10]).is_err());
 }
@@ -397,14 +397,14 @@ proptest! {
         FILE.with(|file| {
             let AnyModel::F32(m) = file.model().unwrap() else { unreachable!() };
             let touchable = touchable_vertices(&m);
-            let contacts: Vec<Contact<f32>> = picks.iter().zip(&ds).map(|(&(a, b, c, wa, wb, bary), d)| {
+            let contacts: Vec<Constraint<f32>> = picks.iter().zip(&ds).map(|(&(a, b, c, wa, wb, bary), d)| {
                 let v = |i: usize| touchable[i % touchable.len()];
                 let d = Vector3::from(*d);
                 if bary {
                     let (wa, wb) = (wa * 0.5, wb * 0.5);
-                    Contact::on_triangle([v(a), v(b), v(c)], [wa, wb, 1.0 - wa - wb], d)
+                    Constraint::on_triangle([v(a), v(b), v(c)], [wa, wb, 1.0 - wa - wb], d)
                 } else {
-                    Contact::at_vertex(v(a), d)
+                    Constraint::at_vertex(v(a), d)
                 }
             }).collect();
             match m.contact_forces::<4>(&contacts) {

@@ -53,7 +53,7 @@ fn table_file(mesh: &TetMesh) -> TableFile {
 }
 
 fn lame() -> (f64, f64) {
-    palpate_kernel::element::lame(YOUNG_PA, POISSON)
+    palpate_kernel::math::element::lame(YOUNG_PA, POISSON)
 }
 
 /// xorshift64*, uniform in [-1, 1).

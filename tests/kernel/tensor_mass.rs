@@ -17,7 +17,7 @@ use palpate::tables::tensor_mass::{
 use palpate_kernel::LoadError;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, Fault, Integrator, Limits, StepError, TensorMassModel,
+    DynamicParams, Fault, Integrator, StepError, TensorMassModel,
 };
 use palpate_tests::{
     json_rows, max_entry_difference, read_reference_json, read_reference_stiffness, reference_dir,
@@ -45,16 +45,7 @@ fn cube_table(fix: &[&str]) -> TableFile {
 }
 
 fn params(damping_per_s: f64) -> DynamicParams<f64> {
-    DynamicParams {
-        law: ElasticLaw::Linear,
-        incompressibility_n: None,
-        damping_per_s,
-        gravity_m_s2: Vector3::zeros(),
-        limits: Limits {
-            max_displacement_m: f64::INFINITY,
-            max_kinetic_energy_j: f64::INFINITY,
-        },
-    }
+    DynamicParams::linear(damping_per_s, f64::INFINITY)
 }
 
 /// `K u` assembled from the vertex and edge tensors equals scikit-fem's K

@@ -10,7 +10,7 @@
 use nalgebra::Vector3;
 use palpate::tables::file::Precision;
 use palpate::tables::load::AnyModel;
-use palpate_kernel::{Contact, PrecomputedModel};
+use palpate_kernel::{Constraint, PrecomputedModel};
 use palpate_script::{ParseError, ReplayError, parse_contact, parse_step, replay, steps};
 use palpate_tests::{json_rows, read_reference_json, reference_cube_table};
 
@@ -20,11 +20,11 @@ const F32_TOL: f64 = 1e-6;
 fn contacts_parse_to_exact_values() {
     assert_eq!(
         parse_contact::<f64>("194:0,0,-0.01"),
-        Ok(Contact::at_vertex(194, Vector3::new(0.0, 0.0, -0.01)))
+        Ok(Constraint::at_vertex(194, Vector3::new(0.0, 0.0, -0.01)))
     );
     assert_eq!(
         parse_contact::<f32>(" 1, 2 ,3@0.2,0.5,0.3:1e-3, -2e-3,0 "),
-        Ok(Contact::on_triangle(
+        Ok(Constraint::on_triangle(
             [1, 2, 3],
             [0.2, 0.5, 0.3],
             Vector3::new(1e-3, -2e-3, 0.0)

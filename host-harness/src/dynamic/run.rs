@@ -6,7 +6,7 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, Integrator, Limits, StepError, TensorMassModel,
+    DynamicParams, ElasticLaw, Integrator, StepError, TensorMassModel,
 };
 use serde::Serialize;
 
@@ -129,16 +129,7 @@ pub fn f64_table(
 /// divergence when a displacement exceeds the bounding-box diagonal of
 /// `positions` (m), kinetic energy unbounded.
 pub fn host_params(positions: &[[f64; 3]], damping_per_s: f64) -> DynamicParams<f64> {
-    DynamicParams {
-        law: ElasticLaw::Linear,
-        incompressibility_n: None,
-        damping_per_s,
-        gravity_m_s2: Vector3::zeros(),
-        limits: Limits {
-            max_displacement_m: diagonal(positions),
-            max_kinetic_energy_j: f64::INFINITY,
-        },
-    }
+    DynamicParams::linear(damping_per_s, diagonal(positions))
 }
 
 /// Bounding-box diagonal, m.

@@ -1,7 +1,7 @@
 //! The linear P1 tetrahedron (`MODELS.md` §1; Cotin RR-3510 §4).
 
 use nalgebra::Vector3;
-use palpate_kernel::element::stiffness_block;
+use palpate_kernel::math::element::stiffness_block;
 
 use super::material::Material;
 

@@ -36,6 +36,6 @@ impl Material {
     /// Lamé coefficients `(lambda, mu)` in Pa (`MODELS.md` §1):
     /// `lambda = E nu / ((1 + nu)(1 - 2 nu))`, `mu = E / (2 (1 + nu))`.
     pub fn lame(&self) -> (f64, f64) {
-        palpate_kernel::element::lame(self.young_pa, self.poisson)
+        palpate_kernel::math::element::lame(self.young_pa, self.poisson)
     }
 }

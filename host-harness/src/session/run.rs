@@ -1,5 +1,5 @@
 //! `palpate session run`: drives the kernel's haptic loop
-//! ([`palpate_kernel::haptic::haptic_loop::HapticLoop`]) tick by tick from a
+//! ([`palpate_kernel::haptic::HapticLoop`]) tick by tick from a
 //! trajectory and writes one CSV line per tick, `t,fx,fy,fz,contacts,status`
 //! (s, N, N, N, count, `ok` | `clamped` | `faulted:<reason>`).
 //!
@@ -17,12 +17,12 @@ use std::path::Path;
 use anyhow::Context;
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::haptic::dynamic_tissue::{DynamicTissue, PhysicsConfig};
-use palpate_kernel::haptic::haptic_loop::{DynamicLoop, ForceOutput, LoopConfig, PrecomputedLoop};
-use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
-use palpate_kernel::haptic::tissue::PrecomputedTissue;
+use palpate_kernel::tensor_mass::{DynamicTissue, PhysicsConfig};
+use palpate_kernel::haptic::{DynamicLoop, ForceOutput, LoopConfig, PrecomputedLoop};
+use palpate_kernel::haptic::{OutputStatus, SafetyLimits};
+use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Limits, StvkForm, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, StvkForm, TensorMassModel};
 
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
 use crate::dynamic::run::diagonal;
@@ -211,12 +211,7 @@ impl<'t> DynamicSetup<'t> {
             params: DynamicParams {
                 law: spec.law,
                 incompressibility_n: spec.incompressibility_n.map(|g| g as f32),
-                damping_per_s: spec.damping_per_s as f32,
-                gravity_m_s2: Vector3::zeros(),
-                limits: Limits {
-                    max_displacement_m: diagonal(&rest) as f32,
-                    max_kinetic_energy_j: f32::INFINITY,
-                },
+                ..DynamicParams::linear(spec.damping_per_s as f32, diagonal(&rest) as f32)
             },
             physics: PhysicsConfig {
                 extrapolation: spec.extrapolation,

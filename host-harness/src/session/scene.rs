@@ -21,7 +21,7 @@
 //! damping_per_s = 2.0          # required for kind = "dynamic"
 //! incompressibility_n = 0.5    # required for, and only for, law = "stvk-incompressible"
 //! extrapolation = "secant"     # force between physics updates: "secant" (default) or
-//!                              # "instantaneous" (palpate_kernel::haptic::dynamic_tissue)
+//!                              # "instantaneous" (palpate_kernel::tensor_mass::tissue)
 //!
 //! [tool]
 //! points = 1                   # default 1, in 1..=4 (MAX_TOOL_POINTS)
@@ -43,7 +43,7 @@
 use std::path::{Path, PathBuf};
 
 use palpate_kernel::MAX_CONTACTS;
-use palpate_kernel::haptic::dynamic_tissue::Extrapolation;
+use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
 
@@ -62,7 +62,7 @@ pub const MAX_GENERATED_VERTICES: usize = 10_000_000;
 
 /// Largest number of dynamic-model steps per physics update (`physics period / dt_s`): the
 /// kernel's bound on a physics update's loop.
-pub const MAX_SUBSTEPS: u32 = palpate_kernel::haptic::dynamic_tissue::MAX_SUBSTEPS;
+pub const MAX_SUBSTEPS: u32 = palpate_kernel::tensor_mass::MAX_SUBSTEPS;
 
 /// Why a scene could not be read. Every message starts with the file (or the source name given
 /// to [`Scene::from_toml_str_named`]).

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use anyhow::bail;
 use bytemuck::Zeroable;
 use nalgebra::Vector3;
-use palpate_kernel::element::stiffness_block;
+use palpate_kernel::math::element::stiffness_block;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS,
     TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN,

@@ -17,11 +17,10 @@
 
 use nalgebra::Vector3;
 
-use super::contact::{ContactWork, ToolContact};
-use super::dynamic_tissue::{DynamicTissue, PhysicsError};
 use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
-use super::tissue::{ContactTarget, PrecomputedTissue, Refusal, Tissue};
-use crate::tensor_mass::StepReport;
+use crate::contact::{Contact, ContactSet, ContactWork, Refusal, Tissue};
+use crate::precomputed::{ContactSolution, PrecomputedTissue};
+use crate::tensor_mass::{DynamicTissue, PhysicsError, StepReport};
 use crate::{MAX_CONTACTS, Real};
 
 /// What the device receives each tick.
@@ -85,7 +84,7 @@ pub struct HapticLoop<T: Real, B, const P: usize, const M: usize> {
     config: LoopConfig<T>,
     supervisor: Supervisor<T>,
     previous_m: Option<[Vector3<T>; P]>,
-    contacts: [Option<ToolContact<T>>; P],
+    contacts: [Option<Contact<T>>; P],
     counters: TickCounters,
 }
 
@@ -127,7 +126,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
     }
 
     /// Each tool point's contact.
-    pub fn contacts(&self) -> &[Option<ToolContact<T>>; P] {
+    pub fn contacts(&self) -> &[Option<Contact<T>>; P] {
         &self.contacts
     }
 
@@ -147,7 +146,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
 
     /// One haptic tick with the tool points at `tool_m` (sphere centres, m).
     /// Bounded: detection and tracking per point (see
-    /// [`super::contact::SurfaceGeometry::detect`] and `track`), then at
+    /// [`crate::contact::SurfaceGeometry::detect`] and `track`), then at
     /// most `P + 1` contact solves of at most `M` contacts.
     pub fn tick(&mut self, tool_m: &[Vector3<T>; P]) -> ForceOutput<T> {
         self.counters = TickCounters::default();
@@ -167,33 +166,31 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
         let mut refused = self.track_and_detect(tool_m);
-        let (mut set, mut m) = self.targets(tool_m, &mut refused);
+        let mut set = self.contact_set();
         // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
         // the model refuses, and solve again. Each pass removes one.
         for _ in 0..=P {
             self.counters.solves = self.counters.solves.saturating_add(1);
-            let active = set.get(..m).unwrap_or(&[]);
-            let dropped = match self.tissue.solve(active) {
-                Ok(solved) => {
-                    let adhesive = active
+            let dropped = match self.tissue.solve(&mut set) {
+                Ok(device_force_n) => {
+                    let adhesive = set
                         .iter()
-                        .zip(&solved.tissue_forces_n)
-                        .position(|(t, g)| g.dot(&t.normal) > T::zero());
-                    let Some(q) = adhesive else {
-                        return self.output(Ok(solved.device_force_n), dt, refused);
+                        .find(|c| c.force_n.dot(&c.normal) > T::zero())
+                        .map(|c| c.tool);
+                    let Some(tool) = adhesive else {
+                        return self.output(Ok(device_force_n), dt, refused);
                     };
-                    q
+                    tool
                 }
                 Err(Refusal::Contact(q)) => {
                     refused = refused.saturating_add(1);
-                    q
+                    let Some(c) = set.get(q) else { break };
+                    c.tool
                 }
                 Err(Refusal::Fault) => break,
             };
-            if let Some(t) = set.get(dropped) {
-                self.drop_contact(t.tool);
-            }
-            m = remove_at(&mut set, m, dropped);
+            self.drop_contact(dropped);
+            set.retain(|c| c.tool != dropped);
         }
         self.contacts = [None; P];
         self.tissue.forget();
@@ -215,12 +212,12 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             *slot = match slot {
                 Some(c) => surface
                     .track(c, tip, radius, work)
-                    .and_then(|(c, gap)| self.tissue.keeps(gap).then_some(c)),
+                    .filter(|c| self.tissue.keeps(c.gap_m)),
                 None => self
                     .previous_m
                     .as_ref()
                     .and_then(|prev| prev.get(p))
-                    .and_then(|from| surface.detect(from, tip, radius, work)),
+                    .and_then(|from| surface.detect(p, from, tip, radius, work)),
             };
             if slot.is_some() {
                 if active < M {
@@ -241,41 +238,15 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         }
     }
 
-    /// The active contacts as targets (at most `M`, in tool-point order),
-    /// with each contact point's signed gap to its tool sphere. A contact
-    /// whose triangle cannot be read is dropped and counted in `refused`.
-    fn targets(
-        &mut self,
-        tool_m: &[Vector3<T>; P],
-        refused: &mut u8,
-    ) -> ([ContactTarget<T>; M], usize) {
-        let radius = self.config.radius_m;
-        let surface = self.tissue.geometry();
-        let mut set = [ContactTarget::placeholder(); M];
-        let mut m = 0usize;
-        for (p, (contact, tip)) in self.contacts.iter_mut().zip(tool_m).enumerate() {
-            let Some(c) = contact else { continue };
-            let (Some((vertices, normal)), Some(x)) =
-                (surface.triangle(c.triangle), surface.point(c))
-            else {
-                *contact = None;
-                *refused = refused.saturating_add(1);
-                continue;
-            };
-            if let Some(slot) = set.get_mut(m) {
-                *slot = ContactTarget {
-                    tool: p,
-                    contact: *c,
-                    vertices,
-                    normal,
-                    gap_m: (tip - x).dot(&normal) - radius,
-                    point_m: x,
-                    tip_m: *tip,
-                };
-                m += 1;
-            }
+    /// The active contacts (at most `M` after tracking and detection, in
+    /// tool-point order).
+    fn contact_set(&self) -> ContactSet<T, M> {
+        let mut set = ContactSet::new();
+        for c in self.contacts.iter().flatten() {
+            // Tracking and detection keep at most M: never refused here.
+            let _ = set.push(*c);
         }
-        (set, m)
+        set
     }
 
     fn output(
@@ -297,7 +268,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
 impl<'a, T: Real, const P: usize, const M: usize> PrecomputedLoop<'a, T, P, M> {
     /// The last contact solution (for the deformation field at the physics
     /// rate), `None` before the first tick or after a fault.
-    pub fn solution(&self) -> Option<&crate::ContactSolution<T, M>> {
+    pub fn solution(&self) -> Option<&ContactSolution<T, M>> {
         self.tissue.solution()
     }
 }
@@ -308,24 +279,7 @@ impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
     /// after the tick). On failure the next tick latches a model fault
     /// (zero force) until [`Self::reset`].
     pub fn physics_update(&mut self) -> Result<StepReport<T>, PhysicsError> {
-        let (set, m) = match self.previous_m {
-            Some(tool) => self.targets(&tool, &mut 0),
-            None => ([ContactTarget::placeholder(); M], 0),
-        };
-        self.tissue.update(set.get(..m).unwrap_or(&[]))
+        let set = self.contact_set();
+        self.tissue.update(&set)
     }
-}
-
-/// Removes entry `q` of the first `len` entries of `items` (keeping their
-/// order); returns the new length (`len` when `q` is not among them).
-fn remove_at<E: Copy>(items: &mut [E], len: usize, q: usize) -> usize {
-    if q >= len {
-        return len;
-    }
-    for i in q..len.saturating_sub(1) {
-        if let (Some(next), Some(slot)) = (items.get(i + 1).copied(), items.get_mut(i)) {
-            *slot = next;
-        }
-    }
-    len.saturating_sub(1)
 }

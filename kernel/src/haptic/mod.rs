@@ -1,13 +1,14 @@
-//! Tool contact and the fixed-timestep haptic loop (Cotin 1999 §4;
-//! MODELS.md §6): collision indexes (table-built for the pre-computed
-//! model, re-binned for a deforming one), contact detection and tracking,
-//! the tissue models the loop drives, and the safety supervisor on the
-//! force output.
+//! The fixed-timestep haptic loop and its safety supervisor (Cotin 1999 §4;
+//! MODELS.md §6), the top layer: each tick reads the tool points, detects
+//! and tracks contacts ([`crate::contact`]), has the tissue model
+//! ([`crate::precomputed::PrecomputedTissue`] or
+//! [`crate::tensor_mass::DynamicTissue`]) solve the contact set, and passes
+//! the device force through the [`Supervisor`].
 
-pub mod contact;
-pub mod deforming;
-pub mod dynamic_tissue;
-pub mod haptic_loop;
-pub mod safety;
-pub mod surface;
-pub mod tissue;
+mod haptic_loop;
+mod safety;
+
+pub use haptic_loop::{
+    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, LoopError, PrecomputedLoop, TickCounters,
+};
+pub use safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};

@@ -1,5 +1,6 @@
 //! The pre-computed quasi-static linear elastic model with multiple
-//! simultaneous contacts (Cotin et al., RR-3510 §4; MODELS.md §2).
+//! simultaneous contacts (Cotin et al., RR-3510 §4; MODELS.md §2), and its
+//! tissue adapter for the haptic loop ([`PrecomputedTissue`]).
 //!
 //! Given `m ≤ M` contact points `c_p`, each a touchable vertex or a point on a
 //! surface triangle (barycentric weights `β^p_a` on vertices `v^p_a`), with
@@ -10,11 +11,13 @@
 //! `u_n = Σ_q Σ_b β^q_b C_{n v^q_b} g_q`, is a separate call so the haptic
 //! path can skip it. Superposing elementary deformations instead would
 //! overshoot (the paper's figure); solving the coupled system does not.
+//!
+//! Depends on [`crate::math`], [`crate::table`] and [`crate::contact`].
 
-mod cholesky;
-mod contact;
+mod constraint;
 mod model;
+mod tissue;
 
-pub(crate) use cholesky::cholesky3;
-pub use contact::{Contact, ContactError, ContactPoint};
+pub use constraint::{AsConstraint, Constraint, ContactError, ContactPoint};
 pub use model::{ContactSolution, DisplacementError, PrecomputedModel};
+pub use tissue::PrecomputedTissue;

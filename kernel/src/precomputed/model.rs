@@ -4,9 +4,9 @@ use core::fmt;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::cholesky::solve_blocks;
-use super::contact::{Contact, ContactError, ResolvedPoint, resolve};
-use crate::Real;
+use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
+use crate::math::cholesky::solve_blocks;
+use crate::{MAX_CONTACT_CAPACITY, Real};
 use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
 
@@ -101,9 +101,14 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// is returned unless every check passed and every force is finite.
     pub fn contact_forces<const M: usize>(
         &self,
-        contacts: &[Contact<T>],
+        contacts: &[impl AsConstraint<T>],
     ) -> Result<ContactSolution<T, M>, ContactError> {
-        const { assert!(M >= 1 && M <= 16, "contact capacity M must be in 1..=16") };
+        const {
+            assert!(
+                M >= 1 && M <= MAX_CONTACT_CAPACITY,
+                "contact capacity M must be in 1..=MAX_CONTACT_CAPACITY"
+            )
+        };
         let m = contacts.len();
         if m > M {
             return Err(ContactError::TooManyContacts {
@@ -128,7 +133,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             .enumerate()
         {
             *point = resolve(&self.table, p, contact)?;
-            *d = contact.displacement_m;
+            *d = contact.displacement_m();
         }
         check_duplicates(contacts)?;
         if m == 0 {
@@ -310,11 +315,11 @@ fn add_products<T: Real>(blocks: &[[T; 9]], w: &Vector3<T>, out: &mut [[T; 3]]) 
 }
 
 /// Two vertex contacts on one vertex make the system exactly singular; name them.
-fn check_duplicates<T: Real>(contacts: &[Contact<T>]) -> Result<(), ContactError> {
-    use super::contact::ContactPoint::Vertex;
+fn check_duplicates<T: Real>(contacts: &[impl AsConstraint<T>]) -> Result<(), ContactError> {
+    use ContactPoint::Vertex;
     for (second, b) in contacts.iter().enumerate() {
         for (first, a) in contacts.iter().enumerate().take(second) {
-            if let (Vertex(va), Vertex(vb)) = (a.point, b.point)
+            if let (Vertex(va), Vertex(vb)) = (a.point(), b.point())
                 && va == vb
             {
                 return Err(ContactError::DuplicateContact { first, second });

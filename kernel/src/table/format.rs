@@ -2,8 +2,8 @@
 //! and the kernel reader.
 //!
 //! ```text
-//! offset 0            RawHeader (104 bytes)
-//! offset 104          SectionEntry × section_count (24 bytes each)
+//! offset 0            RawHeader (112 bytes)
+//! offset 112          SectionEntry × section_count (24 bytes each)
 //! …                   sections, each starting at a multiple of SECTION_ALIGN
 //! file_len - 4        CRC-32/ISO-HDLC of bytes [0, file_len - 4), little-endian
 //! ```
@@ -30,7 +30,7 @@
 //! [`RawHeader::mesh_triangle_count`] and the St Venant-Kirchhoff term
 //! sections of tensor-mass tables ([`SectionKind::VertexTerms`] to
 //! [`SectionKind::TetTerms`], Picinbono 2001 §3.1, table 1; the monomial
-//! layouts are documented in [`crate::tensor_mass::stvk_terms`]).
+//! layouts are documented in the tensor-mass model's `stvk_terms` module).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -240,7 +240,7 @@ pub enum SectionKind {
     /// `[scalar; 4]` × N: St Venant-Kirchhoff cubic and quartic terms owned
     /// by each vertex (Picinbono 2001 eq. 13–14, table 1), summed over its
     /// tets: `[c.x, c.y, c.z, d]` (N/m², N/m³); layout in
-    /// [`crate::tensor_mass::stvk_terms`].
+    /// the tensor-mass model's `stvk_terms` module.
     VertexTerms = 25,
     /// `[scalar; 16]` × E: the terms owned by each edge `(i, j)`, `i < j`
     /// (local position 0 is `i`), same order as [`SectionKind::EdgeColumn`].

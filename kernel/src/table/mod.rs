@@ -1,17 +1,24 @@
 //! Offline tables: the byte format ([`format`]), load errors ([`LoadError`]) and
-//! the validated, zero-copy view the step path uses ([`PrecomputedTable`]).
+//! the validated, zero-copy views the step path uses ([`PrecomputedTable`],
+//! [`TensorMassTable`], and the collision index of a surface,
+//! [`SurfaceIndex`]). Depends only on [`crate::math`].
 //!
 //! A table is bytes until [`PrecomputedTable::load`] has checked it once
 //! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
 //! diagonal blocks); afterwards the step path trusts it.
 
+mod collision;
 mod container;
 mod error;
 pub mod format;
+mod index;
 mod precomputed;
 mod tensor_mass;
 
+pub(crate) use collision::BuiltLists;
+pub use collision::{Grid, SurfaceIndex, max_row};
 pub use error::LoadError;
+pub use index::{FreeIndex, VertexSlot};
 pub use precomputed::PrecomputedTable;
 pub use tensor_mass::TensorMassTable;
 

@@ -5,8 +5,10 @@ use nalgebra::Matrix3;
 use super::LoadError;
 use super::container::{Container, check_finite};
 use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TableKind};
+use super::collision::{SurfaceIndex, SurfaceSections};
+use super::index::VertexSlot;
 use crate::Real;
-use crate::haptic::surface::{SurfaceIndex, SurfaceSections};
+use crate::math::cholesky::cholesky3;
 
 /// A pre-computed table that passed every load-time check; the step path
 /// takes only this type.
@@ -114,16 +116,17 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         self.header.poisson
     }
 
-    /// Free index of `vertex`: `Some(Some(i))` free, `Some(None)` fixed,
-    /// `None` out of range.
-    pub fn free_index(&self, vertex: u32) -> Option<Option<u32>> {
-        let slot = *self.vertex_slot.get(vertex as usize)?;
-        Some((slot != FIXED_SLOT).then_some(slot))
+    /// Where `vertex` stands: free (with its free index) or fixed; `None`
+    /// out of range.
+    pub fn slot(&self, vertex: u32) -> Option<VertexSlot> {
+        self.vertex_slot
+            .get(vertex as usize)
+            .map(|&entry| VertexSlot::of_entry(entry))
     }
 
     /// `true` if `vertex` is fixed (zero displacement). Out of range: `false`.
     pub fn is_fixed(&self, vertex: u32) -> bool {
-        matches!(self.free_index(vertex), Some(None))
+        self.slot(vertex).is_some_and(VertexSlot::is_fixed)
     }
 
     /// Vertex of each free index; the first [`Self::touchable_count`] are the
@@ -207,7 +210,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             let asym = (c - c.transpose()).abs().max();
             if asym > sym_tol
                 || !asym.finite()
-                || crate::precomputed::cholesky3(&c, T::zero()).is_none()
+                || cholesky3(&c, T::zero()).is_none()
             {
                 return Err(bad);
             }

@@ -139,7 +139,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
 
     /// Lamé coefficients `(λ, μ)` of the table's material, Pa.
     pub fn lame(&self) -> (T, T) {
-        let (lambda, mu) = crate::element::lame(self.header.young_pa, self.header.poisson);
+        let (lambda, mu) = crate::math::element::lame(self.header.young_pa, self.header.poisson);
         (T::of_f64(lambda), T::of_f64(mu))
     }
 
@@ -205,7 +205,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
 
     /// St Venant-Kirchhoff terms owned by each vertex of the uncut mesh,
     /// `[c.x, c.y, c.z, d]` (N/m², N/m³; Picinbono 2001 eq. 14, table 1;
-    /// layout in [`crate::tensor_mass::stvk_terms`]).
+    /// layout in the tensor-mass model's `stvk_terms` module).
     pub fn vertex_terms(&self) -> &'a [[T; VERTEX_TERMS_LEN]] {
         self.vertex_terms
     }

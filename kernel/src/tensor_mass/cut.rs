@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 use super::model::TensorMassModel;
 use super::stvk_terms::{TetPlace, tet_terms};
 use crate::Real;
-use crate::element::stiffness_block;
+use crate::math::element::stiffness_block;
 use crate::table::format::{NO_NEIGHBOUR, TET_EDGE_PAIRS, tet_face_vertices};
 
 /// Why a tet was not removed.

@@ -11,18 +11,34 @@
 //! per force evaluation (four for RK4); every loop runs over table-declared
 //! counts. Nothing allocates and nothing panics; divergence puts the model in
 //! a [`Fault`] state the caller sees instead of numbers.
+//!
+//! For the haptic loop: [`DeformingSurface`] (the surface at the current
+//! positions, re-binned per physics update) and [`DynamicTissue`] (the
+//! model as a tissue). Depends on [`crate::math`], [`crate::table`] and
+//! [`crate::contact`].
 
 mod cut;
 mod force;
 mod integrator;
 mod law;
+mod limits;
 mod model;
 mod state;
 mod stvk;
 pub mod stvk_terms;
+mod surface;
+mod tissue;
 
 pub use cut::{CutReport, RemoveError, TearThresholds};
 pub use integrator::Integrator;
 pub use law::{ElasticLaw, StvkForm};
-pub use model::{DynamicParams, InputError, Limits, StepError, StepReport, TensorMassModel};
+pub use limits::Limits;
+pub use model::{DynamicParams, InputError, StepError, StepReport, TensorMassModel};
 pub use state::{Fault, StateBuffers, StateError, VertexMode};
+pub use surface::{
+    DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers, SurfaceLengths,
+};
+pub use tissue::{
+    DynamicTissue, DynamicTissueError, Extrapolation, HeldContact, MAX_SUBSTEPS,
+    MIN_MOVABLE_WEIGHT2, PhysicsConfig, PhysicsError, SECANT_MIN_MOTION_M,
+};

@@ -5,24 +5,14 @@ use core::fmt;
 use nalgebra::Vector3;
 
 use super::force::{InternalForces, Stiffness, vec3};
-use super::integrator::{Integrator, Loads, Watch};
+use super::integrator::{Integrator, Loads};
+use super::limits::{Limits, Watch};
 use super::law::{ElasticLaw, StvkForm};
 use super::state::{Fault, StateBuffers, StateError, VertexMode};
 use super::stvk::TetPass;
 use super::stvk_terms::{NonLinearTerms, TermArraysMut};
 use crate::Real;
 use crate::table::TensorMassTable;
-
-/// Divergence bounds checked inside every step (MODELS.md §6: divergence is
-/// detected before it reaches the output). `+∞` switches a bound off;
-/// non-finite state is always a fault.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Limits<T> {
-    /// Largest allowed displacement norm of any vertex, m.
-    pub max_displacement_m: T,
-    /// Largest allowed total kinetic energy, J.
-    pub max_kinetic_energy_j: T,
-}
 
 /// Parameters of the dynamics that are not in the table.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,6 +30,25 @@ pub struct DynamicParams<T> {
     pub gravity_m_s2: Vector3<T>,
     /// Divergence bounds.
     pub limits: Limits<T>,
+}
+
+impl<T: Real> DynamicParams<T> {
+    /// The linear law without the penalty or gravity, with mass-proportional
+    /// damping `damping_per_s` (1/s) and a displacement bound
+    /// `max_displacement_m` (m); the kinetic-energy bound is off. Other
+    /// settings by struct update: `DynamicParams { law, ..DynamicParams::linear(c, d) }`.
+    pub fn linear(damping_per_s: T, max_displacement_m: T) -> Self {
+        Self {
+            law: ElasticLaw::Linear,
+            incompressibility_n: None,
+            damping_per_s,
+            gravity_m_s2: Vector3::zeros(),
+            limits: Limits {
+                max_displacement_m,
+                max_kinetic_energy_j: T::of_f64(f64::INFINITY),
+            },
+        }
+    }
 }
 
 /// What a step did.

@@ -74,20 +74,19 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use cortex_m_rt::entry;
 use nalgebra::Vector3;
-use palpate_kernel::haptic::deforming::SurfaceBuffers;
-use palpate_kernel::haptic::dynamic_tissue::{DynamicTissue, Extrapolation, PhysicsConfig};
-use palpate_kernel::haptic::haptic_loop::{DynamicLoop, ForceOutput, LoopConfig, PrecomputedLoop};
-use palpate_kernel::haptic::safety::{OutputStatus, SafetyLimits};
-use palpate_kernel::haptic::tissue::PrecomputedTissue;
-use palpate_kernel::precomputed::Contact;
+use palpate_kernel::haptic::{
+    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits,
+};
+use palpate_kernel::precomputed::{Constraint, PrecomputedTissue};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, Fault, Integrator, Limits, StateBuffers, StvkForm, TearThresholds,
-    TensorMassModel, VertexMode,
+    DynamicParams, DynamicTissue, ElasticLaw, Extrapolation, Fault, Integrator, Limits,
+    PhysicsConfig, StateBuffers, StvkForm, SurfaceBuffers, TearThresholds, TensorMassModel,
+    VertexMode,
 };
 use palpate_kernel::{MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
@@ -433,7 +432,7 @@ fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
     };
     let model = PrecomputedModel::new(table);
 
-    let mut contacts = [Contact::at_vertex(0, [0.0f32; 3].into()); SLOTS];
+    let mut contacts = [Constraint::at_vertex(0, [0.0f32; 3].into()); SLOTS];
     for (p, contact) in contacts.iter_mut().enumerate() {
         let (Some(&kind), Some(&vertices), Some(&weights), Some(&d)) = (
             inputs.on_triangle.get(p),
@@ -444,9 +443,9 @@ fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
             continue;
         };
         *contact = if kind != 0 {
-            Contact::on_triangle(vertices, weights, d.into())
+            Constraint::on_triangle(vertices, weights, d.into())
         } else {
-            Contact::at_vertex(vertices[0], d.into())
+            Constraint::at_vertex(vertices[0], d.into())
         };
     }
     let set = contacts

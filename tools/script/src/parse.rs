@@ -4,10 +4,10 @@ use core::fmt;
 
 use heapless::Vec;
 use nalgebra::Vector3;
-use palpate_kernel::{Contact, MAX_CONTACTS, Real};
+use palpate_kernel::{Constraint, MAX_CONTACTS, Real};
 
 /// The contacts of one step, at most [`MAX_CONTACTS`].
-pub type StepContacts<T> = Vec<Contact<T>, MAX_CONTACTS>;
+pub type StepContacts<T> = Vec<Constraint<T>, MAX_CONTACTS>;
 
 /// Why a contact or a sequence line could not be parsed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,14 +79,14 @@ pub fn parse_vertex_vector<T: Real>(text: &str) -> Result<(u32, [T; 3]), ParseEr
 ///
 /// Only the syntax is checked here; whether the vertices are touchable and
 /// the weights valid is the kernel's check ([`palpate_kernel::ContactError`]).
-pub fn parse_contact<T: Real>(text: &str) -> Result<Contact<T>, ParseError> {
+pub fn parse_contact<T: Real>(text: &str) -> Result<Constraint<T>, ParseError> {
     let (point, displacement) = text.split_once(':').ok_or(ParseError::MissingColon)?;
     match point.split_once('@') {
         None => {
             let (vertex, d) = parse_vertex_vector(text)?;
-            Ok(Contact::at_vertex(vertex, Vector3::from(d)))
+            Ok(Constraint::at_vertex(vertex, Vector3::from(d)))
         }
-        Some((vertices, weights)) => Ok(Contact::on_triangle(
+        Some((vertices, weights)) => Ok(Constraint::on_triangle(
             three(vertices, "vertices", ParseError::BadVertex)?,
             three(weights, "weights", ParseError::BadNumber)?,
             Vector3::from(three(displacement, "displacement", ParseError::BadNumber)?),

@@ -4,27 +4,20 @@
 //! bucket data structure must be updated" for a deformed mesh; MODELS.md
 //! §6).
 //!
-//! Bounded re-binning: [`DeformingSurface::rebin`] is four passes over the
-//! `N` vertices (positions, bounding box, the two counting-sort passes),
-//! one over the `T` surface triangles and two over the `C` grid cells of
-//! the caller's buffer; the
-//! cell edge is the longest current surface edge (so the 27 cells around a
-//! point hold every vertex of a triangle under it, as in the table-built
-//! index), enlarged by doubling (at most [`MAX_CELL_DOUBLINGS`] times) until
-//! the grid fits the `C` cells.
+//! Bounded re-binning: [`DeformingSurface::rebin`] moves the vertices (one
+//! pass over the `N` vertices) and re-bins them with the crate's one grid
+//! builder ([`crate::contact::grid::bin`], whose sizing rule and bounds are
+//! documented there) into the caller's buffers.
 
 use core::fmt;
 
 use nalgebra::Vector3;
 
-use super::contact::{Supports, SurfaceGeometry};
-use super::surface::{BuiltLists, Grid, SurfaceIndex, max_row};
+use super::TensorMassModel;
 use crate::Real;
-use crate::tensor_mass::TensorMassModel;
-
-/// Largest number of cell-edge doublings of one re-bin; a grid still too
-/// large after them (a non-physical state) becomes a single cell.
-pub const MAX_CELL_DOUBLINGS: u32 = 64;
+use crate::contact::grid::{self, BinBuffers, Binned};
+use crate::contact::{Supports, SurfaceGeometry};
+use crate::table::{BuiltLists, Grid, SurfaceIndex};
 
 /// The caller's buffers of a deforming surface (static arrays on
 /// firmware). Lengths for a table of `N` vertices and `T` surface
@@ -185,8 +178,11 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             max_bucket: 0,
             max_valence: 0,
         };
-        surface.build_vertex_triangles();
-        surface.max_valence = max_row(surface.buffers.vertex_triangle_start);
+        surface.max_valence = grid::vertex_triangles(
+            surface.triangles,
+            surface.buffers.vertex_triangle_start,
+            surface.buffers.vertex_triangle,
+        );
         // The rest state is finite (validated table), so this bins.
         let displacement = model.displacements_m().unwrap_or(&[]);
         surface
@@ -197,35 +193,6 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
                 found: 0,
             })?;
         Ok(surface)
-    }
-
-    /// Each vertex's surface triangles, ascending (a counting sort over the
-    /// triangles, which visits them in order).
-    fn build_vertex_triangles(&mut self) {
-        let start = &mut *self.buffers.vertex_triangle_start;
-        start.fill(0);
-        for tri in self.triangles {
-            for &v in tri {
-                if let Some(s) = start.get_mut(v as usize + 1) {
-                    *s += 1;
-                }
-            }
-        }
-        prefix_sum(start);
-        // `start[v]` is the cursor of vertex v while filling; it ends at the
-        // start of v + 1, then everything shifts back by one.
-        for (t, tri) in self.triangles.iter().enumerate() {
-            for &v in tri {
-                let Some(cursor) = start.get_mut(v as usize) else {
-                    continue;
-                };
-                if let Some(slot) = self.buffers.vertex_triangle.get_mut(*cursor as usize) {
-                    *slot = t as u32;
-                }
-                *cursor += 1;
-            }
-        }
-        shift_back(start);
     }
 
     /// Moves the surface to `rest + displacement_m` (m; one entry per
@@ -247,134 +214,23 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
                 return Err(NonFinitePosition { vertex: v as u32 });
             }
         }
-        let longest_m = self.update_planes();
-        self.grid = self.fitted_grid(longest_m);
-        self.file_vertices();
+        let Binned {
+            grid,
+            cells,
+            filed,
+            max_bucket,
+        } = grid::bin(
+            self.buffers.positions_m,
+            self.triangles,
+            self.buffers.vertex_triangle_start,
+            BinBuffers {
+                planes: self.buffers.planes,
+                cell_start: self.buffers.cell_start,
+                grid_vertex: self.buffers.grid_vertex,
+            },
+        );
+        (self.grid, self.cells, self.filed, self.max_bucket) = (grid, cells, filed, max_bucket);
         Ok(())
-    }
-
-    /// Recomputes every triangle's plane; returns the longest edge, m.
-    fn update_planes(&mut self) -> T {
-        let positions = &*self.buffers.positions_m;
-        let at = |v: u32| {
-            positions
-                .get(v as usize)
-                .map_or(Vector3::zeros(), |p| Vector3::new(p[0], p[1], p[2]))
-        };
-        let mut longest2 = T::zero();
-        for (plane, tri) in self.buffers.planes.iter_mut().zip(self.triangles) {
-            let [a, b, c] = tri.map(at);
-            for e in [b - a, c - b, a - c] {
-                longest2 = longest2.max(e.norm_squared());
-            }
-            let n = (b - a).cross(&(c - a));
-            let length = n.norm();
-            // A collapsed triangle gets a zero normal: never touched.
-            *plane = if length > T::zero() {
-                let n = n / length;
-                [n.x, n.y, n.z, n.dot(&a)]
-            } else {
-                [T::zero(); 4]
-            };
-        }
-        longest2.sqrt()
-    }
-
-    /// The grid over the surface vertices' box with cells of at least
-    /// `longest_m`, within the cell capacity.
-    fn fitted_grid(&self, longest_m: T) -> Grid<T> {
-        let starts = &*self.buffers.vertex_triangle_start;
-        let mut lo = Vector3::repeat(T::of_f64(f64::MAX));
-        let mut hi = -lo;
-        let mut any = false;
-        for (v, p) in self.buffers.positions_m.iter().enumerate() {
-            if has_triangles(starts, v) {
-                let p = Vector3::new(p[0], p[1], p[2]);
-                lo = lo.inf(&p);
-                hi = hi.sup(&p);
-                any = true;
-            }
-        }
-        if !any {
-            lo = Vector3::zeros();
-            hi = Vector3::zeros();
-        }
-        let extent = hi - lo;
-        let capacity = self.buffers.cell_start.len().saturating_sub(1).max(1);
-        let floor_m = T::of_f64(1e-6);
-        let mut cell_m = if longest_m > floor_m {
-            longest_m
-        } else {
-            floor_m
-        };
-        let dims_for =
-            |cell: T| extent.map(|e| ((e / cell).floor().as_f64() as u32).saturating_add(1));
-        let fits = |d: &Vector3<u32>| {
-            d.iter()
-                .try_fold(1usize, |n, &k| n.checked_mul(k as usize))
-                .is_some_and(|n| n <= capacity)
-        };
-        for _ in 0..MAX_CELL_DOUBLINGS {
-            let dims = dims_for(cell_m);
-            if fits(&dims) {
-                return Grid {
-                    origin_m: lo,
-                    cell_m,
-                    dims: [dims.x, dims.y, dims.z],
-                };
-            }
-            cell_m = cell_m + cell_m;
-        }
-        // One cell over the whole box (every query visits it).
-        let whole = extent.max() + floor_m;
-        Grid {
-            origin_m: lo,
-            cell_m: if whole > cell_m { whole } else { cell_m },
-            dims: [1; 3],
-        }
-    }
-
-    /// Files each surface vertex in its cell (a counting sort).
-    fn file_vertices(&mut self) {
-        let [nx, ny, nz] = self.grid.dims.map(|d| d as usize);
-        self.cells = nx * ny * nz;
-        let grid = self.grid;
-        let starts = &*self.buffers.vertex_triangle_start;
-        let cell_start = self
-            .buffers
-            .cell_start
-            .get_mut(..=self.cells)
-            .unwrap_or_default();
-        cell_start.fill(0);
-        let cell_of = |p: &[T; 3]| {
-            let [i, j, k] = grid
-                .cell_of(&Vector3::new(p[0], p[1], p[2]))
-                .map(|c| c as usize);
-            i + nx * (j + ny * k)
-        };
-        for (v, p) in self.buffers.positions_m.iter().enumerate() {
-            if has_triangles(starts, v)
-                && let Some(count) = cell_start.get_mut(cell_of(p) + 1)
-            {
-                *count += 1;
-            }
-        }
-        prefix_sum(cell_start);
-        for (v, p) in self.buffers.positions_m.iter().enumerate() {
-            if !has_triangles(starts, v) {
-                continue;
-            }
-            let Some(cursor) = cell_start.get_mut(cell_of(p)) else {
-                continue;
-            };
-            if let Some(slot) = self.buffers.grid_vertex.get_mut(*cursor as usize) {
-                *slot = v as u32;
-            }
-            *cursor += 1;
-        }
-        shift_back(cell_start);
-        self.filed = cell_start.last().copied().unwrap_or(0) as usize;
-        self.max_bucket = max_row(cell_start);
     }
 
     /// The index over the current lists (constant time).
@@ -407,28 +263,5 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             self.index(),
             supports,
         )
-    }
-}
-
-/// `true` if vertex `v` has a surface triangle.
-fn has_triangles(starts: &[u32], v: usize) -> bool {
-    matches!((starts.get(v), starts.get(v + 1)), (Some(a), Some(b)) if a < b)
-}
-
-/// Counts (entry `i + 1` holds row `i`'s count) to starts, in place.
-fn prefix_sum(starts: &mut [u32]) {
-    let mut total = 0u32;
-    for s in starts.iter_mut() {
-        total = total.saturating_add(*s);
-        *s = total;
-    }
-}
-
-/// After filling with `starts[i]` as row `i`'s cursor (now the start of
-/// row `i + 1`): shifts every entry up by one and restores `starts[0] = 0`.
-fn shift_back(starts: &mut [u32]) {
-    let mut previous = 0u32;
-    for s in starts.iter_mut() {
-        (*s, previous) = (previous, *s);
     }
 }

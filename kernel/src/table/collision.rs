@@ -1,16 +1,18 @@
-//! The collision index of a pre-computed table (Cotin 1999 §4, collision
-//! buckets; MODELS.md §6): the boundary-surface vertices filed in a regular
-//! grid over their bounding box, and the surface triangles around each
-//! vertex. Built offline (`palpate tables build`), validated once by
-//! [`SurfaceIndex::new`] (called from `PrecomputedTable::load`), then
+//! The collision index (Cotin 1999 §4, collision buckets; MODELS.md §6):
+//! the boundary-surface vertices filed in a regular grid over their bounding
+//! box, and the surface triangles around each vertex. The sections of a
+//! pre-computed table are built offline (`palpate tables build`, with
+//! [`crate::contact::grid`]) and validated once by [`SurfaceIndex::new`]
+//! (called from `PrecomputedTable::load`); a deforming surface's index is
+//! assembled from lists the kernel built itself. Both are then
 //! queried in bounded time: a query visits the 27 cells around a point,
 //! each holding at most [`SurfaceIndex::max_bucket`] vertices, each with at
 //! most [`SurfaceIndex::max_valence`] triangles.
 
 use nalgebra::Vector3;
 
+use super::LoadError;
 use crate::Real;
-use crate::table::LoadError;
 
 /// The validated collision index (a view into the table).
 #[derive(Clone, Copy, Debug)]
@@ -42,16 +44,19 @@ pub(crate) struct SurfaceSections<'a, T> {
 /// A regular grid over a box: origin (its lowest corner), cell edge and
 /// cells per axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Grid<T> {
-    pub(crate) origin_m: Vector3<T>,
-    pub(crate) cell_m: T,
-    pub(crate) dims: [u32; 3],
+pub struct Grid<T> {
+    /// The lowest corner, m.
+    pub origin_m: Vector3<T>,
+    /// The cell edge, m.
+    pub cell_m: T,
+    /// Cells per axis.
+    pub dims: [u32; 3],
 }
 
 impl<T: Real> Grid<T> {
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
-    pub(crate) fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
+    pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
         let mut cell = [0u32; 3];
         for ((c, (&x, &o)), &d) in cell
             .iter_mut()
@@ -93,7 +98,7 @@ fn csr_ok(starts: &[u32], total: usize) -> bool {
 }
 
 /// The largest row of a CSR list.
-pub(crate) fn max_row(starts: &[u32]) -> u32 {
+pub fn max_row(starts: &[u32]) -> u32 {
     starts
         .windows(2)
         .map(|w| match w {

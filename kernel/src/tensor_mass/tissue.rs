@@ -48,11 +48,10 @@ use core::fmt;
 
 use nalgebra::Vector3;
 
-use super::contact::{Supports, SurfaceGeometry};
-use super::deforming::{DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers};
-use super::tissue::{ContactTarget, Refusal, Solved, Tissue};
+use super::surface::{DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers};
+use super::{Integrator, StepError, StepReport, TensorMassModel};
 use crate::Real;
-use crate::tensor_mass::{Integrator, StepError, StepReport, TensorMassModel};
+use crate::contact::{Contact, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue};
 
 /// Least `Σ w_i²` over a contact triangle's movable vertices for the
 /// tissue to hold it: below it (a contact point near a fixed vertex) the
@@ -159,21 +158,15 @@ impl core::error::Error for PhysicsError {}
 /// What a tool point's contact held at the last physics update.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeldContact<T> {
-    /// The held triangle's vertices.
-    pub vertices: [u32; 3],
-    /// The contact point's barycentric weights at the update.
-    pub weights: [T; 3],
+    /// The contact at the update, in the rest frame: its `normal` is the
+    /// held triangle's unit normal at rest (the direction of the force and
+    /// of the held displacement), `tip_m` the tool sphere's centre at the
+    /// update (the contact point then touches it), and `force_n` the force
+    /// the tool applies to the tissue after the update, `−Σ s_i f_i` over the
+    /// held vertices' elastic forces, N.
+    pub contact: Contact<T>,
     /// Each vertex's share `s_i` of the contact point's displacement.
     pub shares: [T; 3],
-    /// Unit normal of the held triangle at rest: the direction of the
-    /// force and of the held displacement.
-    pub normal: Vector3<T>,
-    /// The tool sphere's centre at the update, m (the contact point then
-    /// touches it: the gap is zero).
-    pub tip_m: Vector3<T>,
-    /// Force on the hand after the update, `Σ s_i f_i` over the held
-    /// vertices' elastic forces, N.
-    pub force_n: Vector3<T>,
     /// `k = Σ_ij s_i s_j n · K_ij n` of the held vertices along `normal`,
     /// N/m (computed once per update: the tensors change only by cuts).
     pub stiffness_n_per_m: T,
@@ -263,9 +256,9 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     /// minimum-norm solution of `Σ w_i u_i = d`: `s_i = w_i / Σ_k w_k²`
     /// over the movable vertices, 0 for a fixed one; all 0 when
     /// `Σ_k w_k² < MIN_MOVABLE_WEIGHT2` (the solve refuses such a contact).
-    fn shares(&self, t: &ContactTarget<T>) -> [T; 3] {
+    fn shares(&self, t: &Contact<T>) -> [T; 3] {
         let movable = t.vertices.map(|v| self.movable(v));
-        let w = t.contact.weights;
+        let w = t.weights;
         let norm2 = w
             .iter()
             .zip(&movable)
@@ -286,7 +279,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     /// along it (module docs: the rest normal keeps the force direction
     /// and the held translation steady while the dimple under the tool
     /// tilts the deformed triangles).
-    fn in_rest_frame(&self, t: &ContactTarget<T>) -> ContactTarget<T> {
+    fn in_rest_frame(&self, t: &Contact<T>) -> Contact<T> {
         let rest = self.model.table().rest_positions();
         let at = |v: u32| rest.get(v as usize).map(|p| Vector3::new(p[0], p[1], p[2]));
         let [a, b, c] = t.vertices.map(at);
@@ -295,7 +288,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             _ => None,
         }
         .unwrap_or(t.normal);
-        ContactTarget {
+        Contact {
             normal,
             gap_m: t.gap_m + (t.tip_m - t.point_m).dot(&(normal - t.normal)),
             ..*t
@@ -332,14 +325,15 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         k
     }
 
-    /// The force sent for target `t` (in the rest frame) at this tick: its
-    /// direction and its normal component, N, positive pushing the tool out
-    /// (module docs). With a held triangle the gap is the tool's motion
-    /// along the held normal since the update, whatever triangle tracking
-    /// has reached since; a new contact uses its own triangle and gap.
-    fn extrapolate(&self, t: &ContactTarget<T>) -> (Vector3<T>, T) {
+    /// The force sent for contact `t` (in the rest frame, with its vertices'
+    /// `shares`) at this tick: its direction and its normal component, N,
+    /// positive pushing the tool out (module docs). With a held triangle the
+    /// gap is the tool's motion along the held normal since the update,
+    /// whatever triangle tracking has reached since; a new contact uses its
+    /// own triangle and gap.
+    fn extrapolate(&self, t: &Contact<T>, shares: &[T; 3]) -> (Vector3<T>, T) {
         let Some(h) = carried(&self.held, t) else {
-            let k = self.normal_stiffness(&t.vertices, &self.shares(t), &t.normal);
+            let k = self.normal_stiffness(&t.vertices, shares, &t.normal);
             return (t.normal, -k * t.gap_m);
         };
         // 1 − j/period at the j-th tick after the update: zero by the next
@@ -352,33 +346,28 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         } else {
             T::zero()
         };
-        let n = h.normal;
-        let gap = (t.tip_m - h.tip_m).dot(&n);
+        let n = h.contact.normal;
+        let gap = (t.tip_m - h.contact.tip_m).dot(&n);
         (
             n,
-            h.force_n.dot(&n) - h.scale * h.stiffness_n_per_m * gap + blend * h.offset_n,
+            -h.contact.force_n.dot(&n) - h.scale * h.stiffness_n_per_m * gap + blend * h.offset_n,
         )
     }
 
-    /// The extrapolation ratio after an update that changed the force from
-    /// `before`'s to `force_n` while the tool moved from `before.tip_m` to
-    /// `t.tip_m` (a new contact's `before` is zero force at `α = 1`, the
-    /// tool's motion its gap).
-    fn secant_scale(
-        &self,
-        before: &HeldContact<T>,
-        t: &ContactTarget<T>,
-        force_n: &Vector3<T>,
-    ) -> T {
-        let n = before.normal;
-        let motion = (t.tip_m - before.tip_m).dot(&n);
+    /// The extrapolation ratio after an update that changed the force on
+    /// the hand from `before`'s to `force_n` while the tool moved from
+    /// `before`'s tip to `t.tip_m` (a new contact's `before` is zero force at
+    /// `α = 1`, the tool's motion its gap).
+    fn secant_scale(&self, before: &HeldContact<T>, t: &Contact<T>, force_n: &Vector3<T>) -> T {
+        let n = before.contact.normal;
+        let motion = (t.tip_m - before.contact.tip_m).dot(&n);
         if self.physics.extrapolation == Extrapolation::Instantaneous
             || motion.abs() < T::of_f64(SECANT_MIN_MOTION_M)
         {
             return before.scale;
         }
         let predicted = -before.stiffness_n_per_m * motion;
-        let measured = (force_n - before.force_n).dot(&n);
+        let measured = (force_n + before.contact.force_n).dot(&n);
         let ratio = measured / predicted;
         if !ratio.finite() {
             before.scale
@@ -395,7 +384,10 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     /// contacts at the current tool position): release, impose, step
     /// `substeps` times, read the held forces, re-bin. Bounded by the
     /// model's step and the re-bin. On failure the tissue is faulted.
-    pub fn update(&mut self, set: &[ContactTarget<T>]) -> Result<StepReport<T>, PhysicsError> {
+    pub fn update<const M: usize>(
+        &mut self,
+        set: &ContactSet<T, M>,
+    ) -> Result<StepReport<T>, PhysicsError> {
         let result = self.try_update(set);
         if let Err(e) = result {
             self.fault = Some(e);
@@ -404,35 +396,41 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         result
     }
 
-    fn try_update(&mut self, set: &[ContactTarget<T>]) -> Result<StepReport<T>, PhysicsError> {
+    fn try_update<const M: usize>(
+        &mut self,
+        set: &ContactSet<T, M>,
+    ) -> Result<StepReport<T>, PhysicsError> {
         if let Some(fault) = self.fault {
             return Err(fault);
         }
-        let mut rest_frame = [ContactTarget::placeholder(); P];
-        for (r, t) in rest_frame.iter_mut().zip(set) {
-            *r = self.in_rest_frame(t);
+        // Each contact in the rest frame with its shares, computed once.
+        let mut set_now: ContactSet<T, M> = ContactSet::new();
+        let mut shares = [[T::zero(); 3]; M];
+        for (t, s) in set.iter().zip(shares.iter_mut()) {
+            let t = self.in_rest_frame(t);
+            *s = self.shares(&t);
+            let _ = set_now.push(t);
         }
-        let set = rest_frame.get(..set.len()).unwrap_or(&rest_frame);
+        let now = || set_now.iter().zip(&shares);
         let previous = self.held;
-        // What the last tick sent, per target (the corrections' reference).
+        // What the last tick sent, per tool point (the corrections' reference).
         let mut sent = [T::zero(); P];
-        for t in set {
+        for (t, s) in now() {
             if let Some(x) = sent.get_mut(t.tool) {
-                *x = self.extrapolate(t).1;
+                *x = self.extrapolate(t, s).1;
             }
         }
         // Release what no current contact holds (a vertex whose share fell
         // to zero at the contact point's far edge included).
         for held in previous.iter().flatten() {
-            for &v in &held.vertices {
-                let holds = |t: &ContactTarget<T>| {
-                    let shares = self.shares(t);
+            for &v in &held.contact.vertices {
+                let holds = |(t, s): (&Contact<T>, &[T; 3])| {
                     t.vertices
                         .iter()
-                        .zip(&shares)
+                        .zip(s)
                         .any(|(&u, &s)| u == v && s != T::zero())
                 };
-                if !set.iter().any(holds) {
+                if !now().any(holds) {
                     // A fixed vertex was never imposed: nothing to release.
                     let _ = self.model.release(v);
                 }
@@ -441,14 +439,14 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         self.held = [None; P];
         // Impose: move each contact point by gap · n, shared out over its
         // triangle's vertices; a vertex two contacts share gets the sum of
-        // both shifts from where it was (at most 3P entries, 9P² sums).
-        let mut moves = [[(u32::MAX, Vector3::zeros(), Vector3::zeros()); 3]; P];
-        for (t, slots) in set.iter().zip(moves.iter_mut()) {
+        // both shifts from where it was (at most 3M entries, 9M² sums).
+        let mut moves = [[(u32::MAX, Vector3::zeros(), Vector3::zeros()); 3]; M];
+        for ((t, s), slots) in now().zip(moves.iter_mut()) {
             let u = self
                 .model
                 .displacements_m()
                 .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
-            for ((slot, &v), &share) in slots.iter_mut().zip(&t.vertices).zip(&self.shares(t)) {
+            for ((slot, &v), &share) in slots.iter_mut().zip(&t.vertices).zip(s) {
                 if share != T::zero() {
                     let from = u
                         .get(v as usize)
@@ -457,7 +455,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 }
             }
         }
-        for (t, slots) in set.iter().zip(&moves) {
+        for (t, slots) in set_now.iter().zip(&moves) {
             for &(v, from, _) in slots.iter().filter(|(v, _, _)| *v != u32::MAX) {
                 let shift = moves
                     .iter()
@@ -479,9 +477,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         }
         // The force each contact's held vertices resist.
         self.model.elastic_forces_n(self.forces_n);
-        for t in set {
+        for (t, &shares) in now() {
             // The work-conjugate of the contact point's displacement: Σ s_i f_i.
-            let shares = self.shares(t);
             let stiffness_n_per_m = self.normal_stiffness(&t.vertices, &shares, &t.normal);
             let mut force_n = Vector3::zeros();
             for (&v, &share) in t.vertices.iter().zip(&shares) {
@@ -492,12 +489,12 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             // A new contact started touching (gap 0, zero force) at α = 1,
             // the tool then `gap` further along the normal.
             let before = carried(&previous, t).unwrap_or(HeldContact {
-                vertices: t.vertices,
-                weights: t.contact.weights,
+                contact: Contact {
+                    tip_m: t.tip_m - t.normal * t.gap_m,
+                    force_n: Vector3::zeros(),
+                    ..*t
+                },
                 shares,
-                normal: t.normal,
-                tip_m: t.tip_m - t.normal * t.gap_m,
-                force_n: Vector3::zeros(),
                 stiffness_n_per_m,
                 scale: T::one(),
                 offset_n: T::zero(),
@@ -511,12 +508,11 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             };
             if let Some(slot) = self.held.get_mut(t.tool) {
                 *slot = Some(HeldContact {
-                    vertices: t.vertices,
-                    weights: t.contact.weights,
+                    contact: Contact {
+                        force_n: -force_n,
+                        ..*t
+                    },
                     shares,
-                    normal: t.normal,
-                    tip_m: t.tip_m,
-                    force_n,
                     stiffness_n_per_m,
                     scale,
                     offset_n,
@@ -538,12 +534,12 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
 /// still on or next to that triangle (they share a vertex).
 fn carried<T: Real, const P: usize>(
     held: &[Option<HeldContact<T>>; P],
-    t: &ContactTarget<T>,
+    t: &Contact<T>,
 ) -> Option<HeldContact<T>> {
     held.get(t.tool)
         .copied()
         .flatten()
-        .filter(|h| h.vertices.iter().any(|v| t.vertices.contains(v)))
+        .filter(|h| h.contact.vertices.iter().any(|v| t.vertices.contains(v)))
 }
 
 /// `K x`, or `Kᵀ x` when `transposed`, for a row-major 3×3 `K`.
@@ -564,32 +560,27 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
         true
     }
 
-    /// `F_q = (n · F_update − α k · gap + blend · offset) n` per target
-    /// (module docs); the force of
-    /// the last update carries over while the contact stays on or next to
-    /// the triangle it held (they share a vertex).
-    fn solve(&mut self, set: &[ContactTarget<T>]) -> Result<Solved<T, M>, Refusal> {
+    /// `F_q = (n · F_update − α k · gap + blend · offset) n` per contact
+    /// (module docs); the force of the last update carries over while the
+    /// contact stays on or next to the triangle it held (they share a
+    /// vertex).
+    fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal> {
         if self.fault.is_some() || self.model.fault().is_some() {
             return Err(Refusal::Fault);
         }
-        let mut solved = Solved {
-            device_force_n: Vector3::zeros(),
-            tissue_forces_n: [Vector3::zeros(); M],
-        };
-        for (q, (t, g)) in set
-            .iter()
-            .zip(solved.tissue_forces_n.iter_mut())
-            .enumerate()
-        {
-            if self.shares(t) == [T::zero(); 3] {
+        let mut device_force_n = Vector3::zeros();
+        for (q, c) in set.iter_mut().enumerate() {
+            let t = self.in_rest_frame(c);
+            let shares = self.shares(&t);
+            if shares == [T::zero(); 3] {
                 return Err(Refusal::Contact(q));
             }
-            let (normal, force) = self.extrapolate(&self.in_rest_frame(t));
+            let (normal, force) = self.extrapolate(&t, &shares);
             let force_n = normal * force;
-            solved.device_force_n += force_n;
-            *g = -force_n;
+            device_force_n += force_n;
+            c.force_n = -force_n;
         }
-        Ok(solved)
+        Ok(device_force_n)
     }
 
     fn begin_tick(&mut self) {

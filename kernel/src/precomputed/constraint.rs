@@ -1,11 +1,16 @@
-//! Contact points, their validation against a table, and contact errors.
+//! What the pre-computed solve takes (MODELS.md §2): a point of the surface
+//! and the displacement imposed on it ([`AsConstraint`], implemented by a
+//! scripted [`Constraint`] and by the haptic path's
+//! [`crate::contact::Contact`]), its validation against a table, and the
+//! errors of a contact set.
 
 use core::fmt;
 
 use nalgebra::Vector3;
 
 use crate::Real;
-use crate::table::PrecomputedTable;
+use crate::contact::Contact;
+use crate::table::{PrecomputedTable, VertexSlot};
 
 /// Where a contact acts on the surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,16 +32,50 @@ pub enum ContactPoint<T> {
     },
 }
 
-/// One contact: a point and the displacement the tool imposes on it.
+/// A contact as the pre-computed solve sees it: a point of the surface and
+/// the displacement `d_p` the tool imposes on it.
+pub trait AsConstraint<T: Real> {
+    /// Where the tool touches.
+    fn point(&self) -> ContactPoint<T>;
+    /// Imposed displacement `d_p` of the point from rest, m.
+    fn displacement_m(&self) -> Vector3<T>;
+}
+
+/// A scripted constraint: a point and the displacement imposed on it (the
+/// `precomputed solve`/`replay` commands and the firmware's sequences).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Contact<T: Real> {
+pub struct Constraint<T: Real> {
     /// Where the tool touches.
     pub point: ContactPoint<T>,
     /// Imposed displacement `d_p` of the point from rest, m.
     pub displacement_m: Vector3<T>,
 }
 
-impl<T: Real> Contact<T> {
+impl<T: Real> AsConstraint<T> for Constraint<T> {
+    fn point(&self) -> ContactPoint<T> {
+        self.point
+    }
+
+    fn displacement_m(&self) -> Vector3<T> {
+        self.displacement_m
+    }
+}
+
+/// A haptic contact imposes `gap · normal` on its triangle point.
+impl<T: Real> AsConstraint<T> for Contact<T> {
+    fn point(&self) -> ContactPoint<T> {
+        ContactPoint::Triangle {
+            vertices: self.vertices,
+            weights: self.weights,
+        }
+    }
+
+    fn displacement_m(&self) -> Vector3<T> {
+        Contact::displacement_m(self)
+    }
+}
+
+impl<T: Real> Constraint<T> {
     /// A contact at a touchable vertex.
     pub fn at_vertex(vertex: u32, displacement_m: Vector3<T>) -> Self {
         Self {
@@ -179,24 +218,24 @@ impl<T: Real> ResolvedPoint<T> {
 pub(crate) fn resolve<T: Real>(
     table: &PrecomputedTable<'_, T>,
     index: usize,
-    contact: &Contact<T>,
+    contact: &impl AsConstraint<T>,
 ) -> Result<ResolvedPoint<T>, ContactError> {
     let contact_index = index;
-    if !contact.displacement_m.iter().all(|x| x.finite()) {
+    if !contact.displacement_m().iter().all(|x| x.finite()) {
         return Err(ContactError::NonFiniteInput {
             contact: contact_index,
         });
     }
     let touchable = table.touchable_count() as u32;
     let lookup = |vertex: u32| -> Result<Option<u32>, ContactError> {
-        match table.free_index(vertex) {
+        match table.slot(vertex) {
             None => Err(ContactError::VertexOutOfRange {
                 contact: contact_index,
                 vertex,
             }),
-            Some(None) => Ok(None),
-            Some(Some(i)) if i < touchable => Ok(Some(i)),
-            Some(Some(_)) => Err(ContactError::NotOnSurface {
+            Some(VertexSlot::Fixed) => Ok(None),
+            Some(VertexSlot::Free(i)) if i.as_u32() < touchable => Ok(Some(i.as_u32())),
+            Some(VertexSlot::Free(_)) => Err(ContactError::NotOnSurface {
                 contact: contact_index,
                 vertex,
             }),
@@ -207,7 +246,7 @@ pub(crate) fn resolve<T: Real>(
         weights: [T::zero(); 3],
         len: 0,
     };
-    match contact.point {
+    match contact.point() {
         ContactPoint::Vertex(vertex) => {
             let slot = lookup(vertex)?.ok_or(ContactError::FixedVertex {
                 contact: contact_index,

@@ -1,7 +1,7 @@
 //! Contact detection and tracking on a tissue surface (Cotin 1999 §4;
 //! MODELS.md §6): the rest surface of a pre-computed model, or the deformed
 //! surface of a dynamic model at its last physics update
-//! ([`super::deforming::DeformingSurface`]). A tool point is a sphere of radius
+//! ([`crate::tensor_mass::DeformingSurface`]). A tool point is a sphere of radius
 //! `r`; its contact is a point of a surface triangle (barycentric weights),
 //! created when the sphere's motion segment crosses the triangle from
 //! outside, moved with the tool (frictionless sliding: the contact point is
@@ -11,23 +11,13 @@
 
 use nalgebra::Vector3;
 
-use super::surface::SurfaceIndex;
+use super::Contact;
 use crate::Real;
-use crate::table::{PrecomputedTable, TensorMassTable};
+use crate::table::{PrecomputedTable, SurfaceIndex, TensorMassTable};
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
 /// walk; a contact that would slide further stops at the last triangle).
 pub const MAX_WALK_STEPS: u32 = 8;
-
-/// A tool point's contact: a surface triangle (index into the table's
-/// surface triangles) and the barycentric weights of the contact point.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ToolContact<T> {
-    /// Surface triangle index.
-    pub triangle: u32,
-    /// Barycentric weights, each in `[0, 1]`, summing to 1.
-    pub weights: [T; 3],
-}
 
 /// Work done by detection and tracking (per-stage counters for the timing
 /// budget).
@@ -157,17 +147,30 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         })
     }
 
-    /// Vertices and unit outward normal of a surface triangle.
-    pub fn triangle(&self, triangle: u32) -> Option<([u32; 3], Vector3<T>)> {
-        self.face(triangle).map(|f| (f.vertices, f.normal))
-    }
-
-    /// Position of a contact point on this surface, m.
-    pub fn point(&self, contact: &ToolContact<T>) -> Option<Vector3<T>> {
-        let f = self.face(contact.triangle)?;
-        let [a, b, c] = f.corners;
-        let [wa, wb, wc] = contact.weights;
-        Some(a * wa + b * wb + c * wc)
+    /// Tool point `tool`'s contact at `weights` on `triangle`, with the
+    /// sphere (radius `radius_m`) centred at `tip_m` (m); no force yet.
+    fn contact(
+        &self,
+        tool: usize,
+        triangle: u32,
+        face: &Face<T>,
+        weights: [T; 3],
+        tip_m: &Vector3<T>,
+        radius_m: T,
+    ) -> Contact<T> {
+        let [a, b, c] = face.corners;
+        let point_m = a * weights[0] + b * weights[1] + c * weights[2];
+        Contact {
+            tool,
+            triangle,
+            vertices: face.vertices,
+            weights,
+            normal: face.normal,
+            point_m,
+            tip_m: *tip_m,
+            gap_m: (tip_m - point_m).dot(&face.normal) - radius_m,
+            force_n: Vector3::zeros(),
+        }
     }
 
     /// The first surface triangle that a sphere of radius `radius_m` moving
@@ -181,15 +184,16 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// products with the stored plane.
     pub fn detect(
         &self,
+        tool: usize,
         from_m: &Vector3<T>,
         to_m: &Vector3<T>,
         radius_m: T,
         work: &mut ContactWork,
-    ) -> Option<ToolContact<T>> {
+    ) -> Option<Contact<T>> {
         let tolerance = T::WEIGHT_TOLERANCE;
         // A start exactly touching the surface may round to just inside it.
         let slack_m = tolerance * self.index.cell_m();
-        let mut best: Option<(T, ToolContact<T>)> = None;
+        let mut best: Option<(T, u32, [T; 3])> = None;
         let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
         let near_grid = |p: &Vector3<T>| self.index.is_near(p, radius_m);
         let (near_to, near_from) = (near_grid(to_m), !same_cell && near_grid(from_m));
@@ -212,7 +216,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 }
                 let s0 = s0.max(T::zero());
                 let along = s0 / (s0 - s1);
-                if best.as_ref().is_some_and(|(b, _)| *b <= along) {
+                if best.as_ref().is_some_and(|(b, _, _)| *b <= along) {
                     continue;
                 }
                 let Some(f) = self.corners(t) else { continue };
@@ -222,30 +226,28 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 let x = from_m + (to_m - from_m) * along - normal * radius_m;
                 let w = barycentric(&f.corners, &normal, &x);
                 if w.iter().all(|&wi| wi >= -tolerance) {
-                    let contact = ToolContact {
-                        triangle: t,
-                        weights: clamp_weights(w),
-                    };
-                    best = Some((along, contact));
+                    best = Some((along, t, clamp_weights(w)));
                 }
             }
         }
-        best.map(|(_, c)| c)
+        let (_, triangle, weights) = best?;
+        let face = self.face(triangle)?;
+        Some(self.contact(tool, triangle, &face, weights, to_m, radius_m))
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
     /// the sphere's lowest point `tip − r n` onto the surface, walking to
     /// the neighbouring triangle across any edge it falls outside of (at
     /// most [`MAX_WALK_STEPS`]; never straight back, which over a concave
-    /// fold would swing between the two triangles). Returns the new contact and the signed gap
-    /// `(tip − x)·n − r` (m; negative while the sphere penetrates).
+    /// fold would swing between the two triangles). Returns the moved
+    /// contact, with its signed gap (negative while the sphere penetrates).
     pub fn track(
         &self,
-        contact: &ToolContact<T>,
+        contact: &Contact<T>,
         tip_m: &Vector3<T>,
         radius_m: T,
         work: &mut ContactWork,
-    ) -> Option<(ToolContact<T>, T)> {
+    ) -> Option<Contact<T>> {
         let tolerance = T::WEIGHT_TOLERANCE;
         let mut triangle = contact.triangle;
         let mut face = self.face(triangle)?;
@@ -284,9 +286,6 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         }
         let x_plane = tip_m - face.normal * radius_m;
         let weights = clamp_weights(barycentric(&face.corners, &face.normal, &x_plane));
-        let [a, b, c] = face.corners;
-        let x = a * weights[0] + b * weights[1] + c * weights[2];
-        let gap = (tip_m - x).dot(&face.normal) - radius_m;
-        Some((ToolContact { triangle, weights }, gap))
+        Some(self.contact(contact.tool, triangle, &face, weights, tip_m, radius_m))
     }
 }

@@ -1,0 +1,276 @@
+//! The one builder of the collision bucket grid (Cotin 1999 §4, collision
+//! buckets; MODELS.md §6), allocation-free, into the caller's buffers. The
+//! host's table writer calls it once on the rest surface (the sections of a
+//! pre-computed table, validated again at load by
+//! [`crate::table::SurfaceIndex`]); the tensor-mass model's deforming
+//! surface calls it at every physics update on the current positions.
+//!
+//! Sizing rule (one rule for both): the cell edge starts at the longest
+//! surface edge, so that the 27 cells around any point on (or just off) the
+//! surface hold every vertex of the triangle under it, and grows by
+//! [`CELL_GROWTH`] until the grid has at most as many cells as the caller's
+//! `cell_start` buffer holds (at most [`MAX_CELL_GROWTHS`] times; a grid
+//! still too large after them, a non-physical state, becomes one cell).
+//!
+//! Cost: [`vertex_triangles`] is one pass over the `T` triangles and two
+//! over the `N` vertices; [`bin`] one pass over the triangles, three over the
+//! vertices, two over the cells and at most [`MAX_CELL_GROWTHS`] dimension
+//! computations. Every loop runs over slice lengths.
+
+use nalgebra::Vector3;
+
+use crate::Real;
+use crate::table::{Grid, max_row};
+
+/// Factor by which the cell edge grows until the grid fits its capacity.
+pub const CELL_GROWTH: f64 = 1.25;
+
+/// Most growths of the cell edge in one [`bin`]: `1.25^200 ≈ 4·10¹⁹`, more
+/// than any ratio of box to capacity a `u32` cell count can need.
+pub const MAX_CELL_GROWTHS: u32 = 200;
+
+/// Least cell edge, m (a surface of coincident vertices still bins).
+pub const MIN_CELL_M: f64 = 1e-6;
+
+/// The buffers [`bin`] fills.
+pub struct BinBuffers<'b, T> {
+    /// Plane of every surface triangle (unit outward normal, offset `n·p`
+    /// in m; zero for a collapsed triangle, which is never touched): `T`.
+    pub planes: &'b mut [[T; 4]],
+    /// Start of each cell's vertex list: capacity in cells plus one, at
+    /// least 2; the grid uses the first `cells + 1`.
+    pub cell_start: &'b mut [u32],
+    /// Surface vertices filed by cell: `N` (the first `filed` are used).
+    pub grid_vertex: &'b mut [u32],
+}
+
+/// What [`bin`] built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Binned<T> {
+    /// The grid.
+    pub grid: Grid<T>,
+    /// Its cells (`cell_start[..=cells]` is the list).
+    pub cells: usize,
+    /// Surface vertices filed (`grid_vertex[..filed]`).
+    pub filed: usize,
+    /// Most vertices in one cell.
+    pub max_bucket: u32,
+}
+
+/// Each vertex's surface triangles, ascending, as a CSR list: `start` has
+/// `N + 1` entries, `list` `3 T` (a counting sort over the triangles, which
+/// visits them in order). A corner beyond the last vertex (a corrupted
+/// input) is filed under the last vertex, which keeps the list at `3 T` so
+/// that the loader reports the triangle itself. Returns the most triangles
+/// around one vertex.
+pub fn vertex_triangles(triangles: &[[u32; 3]], start: &mut [u32], list: &mut [u32]) -> u32 {
+    start.fill(0);
+    let last = start.len().saturating_sub(2);
+    let row = |v: u32| (v as usize).min(last);
+    for tri in triangles {
+        for &v in tri {
+            if let Some(s) = start.get_mut(row(v) + 1) {
+                *s += 1;
+            }
+        }
+    }
+    prefix_sum(start);
+    // `start[v]` is the cursor of vertex v while filling; it ends at the
+    // start of v + 1, then everything shifts back by one.
+    for (t, tri) in triangles.iter().enumerate() {
+        for &v in tri {
+            let Some(cursor) = start.get_mut(row(v)) else {
+                continue;
+            };
+            if let Some(slot) = list.get_mut(*cursor as usize) {
+                *slot = t as u32;
+            }
+            *cursor += 1;
+        }
+    }
+    shift_back(start);
+    max_row(start)
+}
+
+/// Computes every triangle's plane over `positions_m` and files each
+/// surface vertex (one with a triangle in `vertex_triangle_start`) in a grid
+/// sized by the module's rule. Bounded (module docs).
+pub fn bin<T: Real>(
+    positions_m: &[[T; 3]],
+    triangles: &[[u32; 3]],
+    vertex_triangle_start: &[u32],
+    buffers: BinBuffers<'_, T>,
+) -> Binned<T> {
+    let longest_m = planes(positions_m, triangles, buffers.planes);
+    let capacity = buffers.cell_start.len().saturating_sub(1).max(1);
+    let grid = fitted_grid(positions_m, vertex_triangle_start, longest_m, capacity);
+    let (cells, filed, max_bucket) = file_vertices(
+        &grid,
+        positions_m,
+        vertex_triangle_start,
+        buffers.cell_start,
+        buffers.grid_vertex,
+    );
+    Binned {
+        grid,
+        cells,
+        filed,
+        max_bucket,
+    }
+}
+
+/// Surface vertices (with at least one triangle) of a CSR vertex list.
+pub fn surface_vertex_count(vertex_triangle_start: &[u32]) -> usize {
+    (0..vertex_triangle_start.len().saturating_sub(1))
+        .filter(|&v| has_triangles(vertex_triangle_start, v))
+        .count()
+}
+
+/// Recomputes every triangle's plane; returns the longest edge, m.
+fn planes<T: Real>(positions_m: &[[T; 3]], triangles: &[[u32; 3]], planes: &mut [[T; 4]]) -> T {
+    let at = |v: u32| {
+        positions_m
+            .get(v as usize)
+            .map_or(Vector3::zeros(), |p| Vector3::new(p[0], p[1], p[2]))
+    };
+    let mut longest2 = T::zero();
+    for (plane, tri) in planes.iter_mut().zip(triangles) {
+        let [a, b, c] = tri.map(at);
+        for e in [b - a, c - b, a - c] {
+            longest2 = longest2.max(e.norm_squared());
+        }
+        let n = (b - a).cross(&(c - a));
+        let length = n.norm();
+        // A collapsed triangle gets a zero normal: never touched.
+        *plane = if length > T::zero() {
+            let n = n / length;
+            [n.x, n.y, n.z, n.dot(&a)]
+        } else {
+            [T::zero(); 4]
+        };
+    }
+    longest2.sqrt()
+}
+
+/// The grid over the surface vertices' box with cells of at least
+/// `longest_m`, within `capacity` cells.
+fn fitted_grid<T: Real>(
+    positions_m: &[[T; 3]],
+    starts: &[u32],
+    longest_m: T,
+    capacity: usize,
+) -> Grid<T> {
+    let mut lo = Vector3::repeat(T::of_f64(f64::MAX));
+    let mut hi = -lo;
+    let mut any = false;
+    for (v, p) in positions_m.iter().enumerate() {
+        if has_triangles(starts, v) {
+            let p = Vector3::new(p[0], p[1], p[2]);
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+            any = true;
+        }
+    }
+    if !any {
+        lo = Vector3::zeros();
+        hi = Vector3::zeros();
+    }
+    let extent = hi - lo;
+    let floor_m = T::of_f64(MIN_CELL_M);
+    let mut cell_m = if longest_m > floor_m {
+        longest_m
+    } else {
+        floor_m
+    };
+    let dims_for = |cell: T| extent.map(|e| ((e / cell).floor().as_f64() as u32).saturating_add(1));
+    let fits = |d: &Vector3<u32>| {
+        d.iter()
+            .try_fold(1usize, |n, &k| n.checked_mul(k as usize))
+            .is_some_and(|n| n <= capacity)
+    };
+    for _ in 0..MAX_CELL_GROWTHS {
+        let dims = dims_for(cell_m);
+        if fits(&dims) {
+            return Grid {
+                origin_m: lo,
+                cell_m,
+                dims: [dims.x, dims.y, dims.z],
+            };
+        }
+        cell_m *= T::of_f64(CELL_GROWTH);
+    }
+    // One cell over the whole box (every query visits it).
+    let whole = extent.max() + floor_m;
+    Grid {
+        origin_m: lo,
+        cell_m: if whole > cell_m { whole } else { cell_m },
+        dims: [1; 3],
+    }
+}
+
+/// Files each surface vertex in its cell (a counting sort); returns the
+/// cells, the vertices filed and the largest bucket.
+fn file_vertices<T: Real>(
+    grid: &Grid<T>,
+    positions_m: &[[T; 3]],
+    starts: &[u32],
+    cell_start: &mut [u32],
+    grid_vertex: &mut [u32],
+) -> (usize, usize, u32) {
+    let [nx, ny, nz] = grid.dims.map(|d| d as usize);
+    let cells = nx * ny * nz;
+    let cell_start = cell_start.get_mut(..=cells).unwrap_or_default();
+    cell_start.fill(0);
+    let cell_of = |p: &[T; 3]| {
+        let [i, j, k] = grid
+            .cell_of(&Vector3::new(p[0], p[1], p[2]))
+            .map(|c| c as usize);
+        i + nx * (j + ny * k)
+    };
+    for (v, p) in positions_m.iter().enumerate() {
+        if has_triangles(starts, v)
+            && let Some(count) = cell_start.get_mut(cell_of(p) + 1)
+        {
+            *count += 1;
+        }
+    }
+    prefix_sum(cell_start);
+    for (v, p) in positions_m.iter().enumerate() {
+        if !has_triangles(starts, v) {
+            continue;
+        }
+        let Some(cursor) = cell_start.get_mut(cell_of(p)) else {
+            continue;
+        };
+        if let Some(slot) = grid_vertex.get_mut(*cursor as usize) {
+            *slot = v as u32;
+        }
+        *cursor += 1;
+    }
+    shift_back(cell_start);
+    let filed = cell_start.last().copied().unwrap_or(0) as usize;
+    (cells, filed, max_row(cell_start))
+}
+
+/// `true` if vertex `v` has a surface triangle.
+fn has_triangles(starts: &[u32], v: usize) -> bool {
+    matches!((starts.get(v), starts.get(v + 1)), (Some(a), Some(b)) if a < b)
+}
+
+/// Counts (entry `i + 1` holds row `i`'s count) to starts, in place.
+fn prefix_sum(starts: &mut [u32]) {
+    let mut total = 0u32;
+    for s in starts.iter_mut() {
+        total = total.saturating_add(*s);
+        *s = total;
+    }
+}
+
+/// After filling with `starts[i]` as row `i`'s cursor (now the start of
+/// row `i + 1`): shifts every entry up by one and restores `starts[0] = 0`.
+fn shift_back(starts: &mut [u32]) {
+    let mut previous = 0u32;
+    for s in starts.iter_mut() {
+        (*s, previous) = (previous, *s);
+    }
+}

@@ -1,0 +1,49 @@
+//! The one contact type of the haptic path and its bounded set (MODELS.md
+//! §6): detection and tracking create a [`Contact`] on the tissue's surface,
+//! the loop gathers the active ones in a [`ContactSet`], the tissue's solve
+//! writes each one's force, and the loop sums them for the supervisor.
+
+use nalgebra::Vector3;
+
+use crate::Real;
+
+/// A tool point touching a surface triangle, from detection to force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact<T> {
+    /// The tool point (index into the loop's tool points).
+    pub tool: usize,
+    /// The surface triangle (index into the surface's triangles).
+    pub triangle: u32,
+    /// Its mesh vertices.
+    pub vertices: [u32; 3],
+    /// Barycentric weights of the contact point, each in `[0, 1]`, summing
+    /// to 1.
+    pub weights: [T; 3],
+    /// Unit outward normal of the triangle.
+    pub normal: Vector3<T>,
+    /// The contact point on the surface, m.
+    pub point_m: Vector3<T>,
+    /// The tool sphere's centre, m.
+    pub tip_m: Vector3<T>,
+    /// Signed gap between the tool sphere and the contact point along the
+    /// normal, `(tip − point)·n − r`, m (negative while the sphere
+    /// penetrates): the contact point's imposed displacement is
+    /// `gap · normal`.
+    pub gap_m: T,
+    /// Force the tool applies to the tissue here, N, written by the
+    /// tissue's solve (zero before it; `force · normal > 0` is adhesive:
+    /// the tool would pull).
+    pub force_n: Vector3<T>,
+}
+
+impl<T: Real> Contact<T> {
+    /// The imposed displacement of the contact point, `gap · normal`, m.
+    pub fn displacement_m(&self) -> Vector3<T> {
+        self.normal * self.gap_m
+    }
+}
+
+/// At most `M` contacts, in tool-point order: what flows from detection
+/// through the tissue solve to the force (`heapless::Vec`: capacity a
+/// const generic, pushes beyond it refused, never a panic).
+pub type ContactSet<T, const M: usize> = heapless::Vec<Contact<T>, M>;
