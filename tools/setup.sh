@@ -8,12 +8,15 @@
 #   no-panic diagnostics, under $(rustc --print sysroot)/lib/rustlib/*/bin);
 # - qemu-system-arm (runs the firmware) and valgrind (callgrind instruction
 #   counts of `palpate budget` and its test), from apt-get, with sudo when
-#   not root.
+#   not root;
+# - cargo-deny (licenses, bans, sources, advisories; `deny.toml`), built from
+#   crates.io with `cargo install --locked` (about 3-5 min the first time).
 # Idempotent; a fast no-op when all is present.
 set -euo pipefail
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
-rustup component add llvm-tools
+rustup component add llvm-tools rustfmt clippy
+command -v cargo-deny >/dev/null || cargo install cargo-deny --locked --version 0.20.2
 
 missing=()
 command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
@@ -33,3 +36,4 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 qemu-system-arm --version | head -1
 valgrind --version
+cargo deny --version

@@ -13,7 +13,7 @@ fn palpate(args: &[&str]) -> Output {
 
 fn reference(rel: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/reference")
+        .join("../tests/reference")
         .join(rel)
         .display()
         .to_string()

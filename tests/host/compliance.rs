@@ -1,5 +1,5 @@
 //! Compliance table (`palpate::tables::compliance`) against the independent
-//! scikit-fem reference (`shared/reference/linear/cube_compliance.json`).
+//! scikit-fem reference (`tests/reference/linear/cube_compliance.json`).
 
 // Index loops mirror the tensor notation of MODELS.md.
 #![allow(clippy::needless_range_loop)]

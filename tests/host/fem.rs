@@ -1,5 +1,5 @@
 //! P1 element, global assembly and the direct Dirichlet solve against the
-//! independent scikit-fem reference (`shared/reference/linear/`).
+//! independent scikit-fem reference (`tests/reference/linear/`).
 
 // Index loops mirror the tensor notation of MODELS.md.
 #![allow(clippy::needless_range_loop)]

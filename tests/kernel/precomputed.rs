@@ -1,6 +1,6 @@
 //! The pre-computed multi-contact model (`palpate_kernel::precomputed`) against
 //! independent truth: the scikit-fem reference solutions of
-//! `shared/reference/linear/cube_contact.json`, a direct Dirichlet solve of the
+//! `tests/reference/linear/cube_contact.json`, a direct Dirichlet solve of the
 //! host's own f64 FEM (`fem::static_solve`), and the constraint residual.
 //!
 //! Tolerances (relative to the largest value of the compared field). f64

@@ -1,7 +1,7 @@
 //! The St Venant-Kirchhoff force of the tensor-mass model
 //! (`palpate_kernel::tensor_mass`, `ElasticLaw::StVenantKirchhoff`) against
 //! independent truth: central finite differences of the energy, the JAX
-//! reference forces and energies (`shared/reference/svk/`), rigid motions
+//! reference forces and energies (`tests/reference/svk/`), rigid motions
 //! (zero force), the small-strain limit (the linear model), and the
 //! incompressibility penalty's closed form on one tet.
 

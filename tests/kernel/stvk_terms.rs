@@ -2,7 +2,7 @@
 //! (`palpate_kernel::tensor_mass::stvk_terms`, table sections `vertex-terms`
 //! … `tet-terms`) against independent truth: the Green-strain energy
 //! `Σ V (λ/2 (tr E)² + μ tr E²)` computed here from `F = Ds Dm⁻¹`, its central
-//! finite differences, the JAX reference forces (`shared/reference/svk/`),
+//! finite differences, the JAX reference forces (`tests/reference/svk/`),
 //! frame invariance under a rigid rotation, and the cut invariant (subtracting
 //! a tet's terms equals rebuilding without it).
 

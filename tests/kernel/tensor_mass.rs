@@ -1,6 +1,6 @@
 //! The dynamic tensor-mass model (`palpate_kernel::tensor_mass`) against
 //! independent truth: scikit-fem's global stiffness and lumped masses
-//! (`shared/reference/linear/cube_K.csv`, `masses/cube_lumped_mass.csv`), the
+//! (`tests/reference/linear/cube_K.csv`, `masses/cube_lumped_mass.csv`), the
 //! scikit-fem static contact solution (`linear/cube_contact.json`) as the
 //! damped steady state, integrator steps derived by hand for one tet, energy
 //! conservation of the symplectic schemes, and the fault state.

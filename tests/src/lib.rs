@@ -3,9 +3,10 @@
 
 use std::path::PathBuf;
 
-/// `../shared/reference/` beside the checkout (present in CI too).
+/// The independent reference data committed with the tests
+/// (`tests/reference/`, see its README for how each file was computed).
 pub fn reference_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/reference")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("reference")
 }
 
 /// Small hand-written test files committed with the tests (`tests/data/`).
@@ -162,7 +163,7 @@ pub fn rel_max_diff(a: &[f64], b: &[f64]) -> f64 {
     if scale == 0.0 { diff } else { diff / scale }
 }
 
-/// The reference cube (`shared/reference/meshes/cube.msh`, E = 5000 Pa,
+/// The reference cube (`tests/reference/meshes/cube.msh`, E = 5000 Pa,
 /// ν = 0.45) with its base `z = 0` fixed, built into a table of `precision`
 /// through the same pipeline as `palpate tables build`.
 pub fn reference_cube_table(
@@ -194,7 +195,7 @@ pub fn json_rows(v: &serde_json::Value) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// `shared/reference/linear/cube_K.csv`: the global stiffness of `cube`
+/// `tests/reference/linear/cube_K.csv`: the global stiffness of `cube`
 /// (E = 5000 Pa, ν = 0.45) as `(row, col) → value` (DOF `3·vertex + axis`, N/m).
 pub fn read_reference_stiffness() -> std::collections::HashMap<(usize, usize), f64> {
     let text =
