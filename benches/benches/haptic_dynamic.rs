@@ -18,13 +18,13 @@
 use core::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palpate::dynamic::{OwnedState, OwnedSurface};
-use palpate::tables::load::TableFile;
+use palpate::table::load::TableFile;
+use palpate::tensor_mass::{OwnedState, OwnedSurface};
 use palpate_benches::{haptic_config, haptic_tool, tensor_cube_table};
-use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
 use palpate_kernel::haptic::DynamicLoop;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
 
 fn params() -> DynamicParams<f32> {
     DynamicParams::linear(30.0, 0.2)
@@ -103,8 +103,8 @@ fn dynamic(c: &mut Criterion) {
         let model = TensorMassModel::new(table, state.buffers(), params()).expect("model");
         let mut owned = OwnedSurface::for_model(&model);
         let (buffers, _) = owned.buffers();
-        let mut surface = palpate_kernel::tensor_mass::DeformingSurface::new(&model, buffers)
-            .expect("surface");
+        let mut surface =
+            palpate_kernel::tensor_mass::DeformingSurface::new(&model, buffers).expect("surface");
         let u = vec![[0.0f32, 0.0, 0.001]; table.vertex_count()];
         group.bench_function(BenchmarkId::new("rebin", format!("{cells}cells")), |b| {
             b.iter(|| black_box(surface.rebin(black_box(&u))))

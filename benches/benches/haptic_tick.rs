@@ -13,7 +13,7 @@
 use core::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palpate::tables::load::TableFile;
+use palpate::table::load::TableFile;
 use palpate_benches::{TOOL_RADIUS_M, cube_table, haptic_config as config, haptic_tool as tool};
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::contact::{ContactWork, SurfaceGeometry};

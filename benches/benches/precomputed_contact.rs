@@ -26,7 +26,7 @@ use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use palpate::tables::load::{AnyModel, TableFile};
+use palpate::table::load::{AnyModel, TableFile};
 use palpate_benches::{cube_table, top_vertices};
 use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel};
 

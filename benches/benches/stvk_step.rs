@@ -19,13 +19,13 @@ use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use palpate::dynamic::OwnedState;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::{ORGAN_CUBE_M, box_mesh, cylinder_mesh, organ_mesh};
 use palpate::mesh::{MeshReport, TetMesh};
-use palpate::tables::file::Precision;
-use palpate::tables::load::TableFile;
-use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+use palpate::table::build::{BuildOptions, build};
+use palpate::table::file::Precision;
+use palpate::table::load::TableFile;
+use palpate::tensor_mass::OwnedState;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
     DynamicParams, ElasticLaw, Integrator, StvkForm, TensorMassModel,
@@ -65,22 +65,20 @@ fn table(mesh: &TetMesh) -> TableFile {
         .iter()
         .map(|p| p[2])
         .fold(f64::INFINITY, f64::min);
-    let options = TensorMassOptions {
-        material: Material::new(5000.0, 0.4).expect("material"),
-        density_kg_m3: 1000.0,
-        fix: vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")],
-        precision: Precision::F32,
-    };
-    let bytes = build_tensor_mass_table(mesh, &MeshReport::default(), &options).expect("table");
-    TableFile::from_bytes(&bytes)
+    let options = BuildOptions::tensor_mass(
+        Material::new(5000.0, 0.4).expect("material"),
+        1000.0,
+        vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")],
+        Precision::F32,
+    );
+    let built = build(mesh, &MeshReport::default(), &options).expect("table");
+    TableFile::from_bytes(&built.bytes)
 }
 
 fn params(law: ElasticLaw, incompressibility_n: Option<f32>) -> DynamicParams<f32> {
-    DynamicParams {
-        law,
-        incompressibility_n,
-        ..DynamicParams::linear(5.0, 10.0)
-    }
+    DynamicParams::linear(5.0, 10.0)
+        .with_law(law)
+        .with_incompressibility(incompressibility_n)
 }
 
 fn step(c: &mut Criterion) {

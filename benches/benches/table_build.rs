@@ -1,4 +1,4 @@
-//! Table build time (`host-harness/src/tables`): sparse Cholesky (faer, AMD
+//! Table build time (`host-harness/src/table`): sparse Cholesky (faer, AMD
 //! ordering) vs the paper's conjugate-gradient baseline, on tissue cubes of
 //! 6³, 12³ and 20³ cells (343, 2197 and 9261 vertices).
 //!
@@ -12,8 +12,8 @@
 use core::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palpate::tables::build::build_table;
-use palpate::tables::compliance::Solver;
+use palpate::table::build::{TableKindOptions, build};
+use palpate::table::compliance::Solver;
 use palpate_benches::tissue_cube;
 
 fn table_build(c: &mut Criterion) {
@@ -28,11 +28,11 @@ fn table_build(c: &mut Criterion) {
     ] {
         let (mesh, report, mut options) = tissue_cube(cells);
         for &solver in solvers {
-            options.solver = solver;
+            options.kind = TableKindOptions::Precomputed { solver };
             let name = format!("{solver:?}").to_lowercase();
             let id = BenchmarkId::new(name, format!("{}v", mesh.positions.len()));
             group.bench_with_input(id, &options, |b, options| {
-                b.iter(|| build_table(&mesh, &report, options).expect("table"))
+                b.iter(|| build(&mesh, &report, options).expect("table"))
             });
         }
     }

@@ -22,33 +22,18 @@ use core::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use palpate::dynamic::OwnedState;
-use palpate::fem::material::Material;
-use palpate::mesh::MeshReport;
-use palpate::mesh::generate::box_mesh;
-use palpate::tables::file::Precision;
-use palpate::tables::load::TableFile;
-use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+use palpate::table::load::TableFile;
+use palpate::tensor_mass::OwnedState;
+use palpate_benches::tensor_cube_table;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
 
 fn table(cells: usize) -> TableFile {
-    let mesh = box_mesh([cells; 3], [0.1; 3]);
-    let options = TensorMassOptions {
-        material: Material::new(3000.0, 0.45).expect("material"),
-        density_kg_m3: 1000.0,
-        fix: vec!["z<1e-6".parse().expect("predicate")],
-        precision: Precision::F32,
-    };
-    let bytes = build_tensor_mass_table(&mesh, &MeshReport::default(), &options).expect("table");
-    TableFile::from_bytes(&bytes)
+    TableFile::from_bytes(&tensor_cube_table(cells))
 }
 
 fn params() -> DynamicParams<f32> {
-    DynamicParams {
-        gravity_m_s2: Vector3::new(0.0, 0.0, -9.81),
-        ..DynamicParams::linear(5.0, 1.0)
-    }
+    DynamicParams::linear(5.0, 1.0).with_gravity(Vector3::new(0.0, 0.0, -9.81))
 }
 
 fn step(c: &mut Criterion) {

@@ -6,31 +6,30 @@ use nalgebra::Vector3;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
-use palpate::tables::build::{BuildOptions, BuiltTable, build_table};
-use palpate::tables::compliance::Solver;
-use palpate::tables::file::Precision;
-use palpate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+use palpate::table::build::{BuildOptions, BuiltTable, TableKindOptions, build};
+use palpate::table::compliance::Solver;
+use palpate::table::file::Precision;
 use palpate_kernel::haptic::LoopConfig;
 use palpate_kernel::haptic::SafetyLimits;
 
 /// A cube of `cells³` Kuhn cells, 0.1 m wide, soft tissue (E = 3000 Pa,
-/// ν = 0.45), its base `z = 0` fixed.
+/// ν = 0.45), its base `z = 0` fixed, with the options of its f32
+/// pre-computed table (sparse Cholesky).
 pub fn tissue_cube(cells: usize) -> (TetMesh, MeshReport, BuildOptions) {
     let mesh = box_mesh([cells; 3], [0.1; 3]);
-    let options = BuildOptions {
-        material: Material::new(3000.0, 0.45).expect("material"),
-        fix: vec!["z<1e-6".parse().expect("predicate")],
-        solver: Solver::Cholesky,
-        precision: Precision::F32,
-        progress: false,
-    };
+    let options = BuildOptions::precomputed(
+        Material::new(3000.0, 0.45).expect("material"),
+        vec!["z<1e-6".parse().expect("predicate")],
+        Solver::Cholesky,
+        Precision::F32,
+    );
     (mesh, MeshReport::default(), options)
 }
 
 /// The f32 table of [`tissue_cube`]`(cells)`.
 pub fn cube_table(cells: usize) -> BuiltTable {
     let (mesh, report, options) = tissue_cube(cells);
-    build_table(&mesh, &report, &options).expect("table")
+    build(&mesh, &report, &options).expect("table")
 }
 
 /// Touchable top-surface vertices of the `cells³` cube spread over the top
@@ -45,13 +44,15 @@ pub fn top_vertices(cells: usize) -> [u32; 4] {
 /// The f32 tensor-mass table of [`tissue_cube`]`(cells)`, density 1000 kg/m³.
 pub fn tensor_cube_table(cells: usize) -> Vec<u8> {
     let (mesh, report, options) = tissue_cube(cells);
-    let options = TensorMassOptions {
-        material: options.material,
-        density_kg_m3: 1000.0,
-        fix: options.fix,
-        precision: Precision::F32,
+    let options = BuildOptions {
+        kind: TableKindOptions::TensorMass {
+            density_kg_m3: 1000.0,
+        },
+        ..options
     };
-    build_tensor_mass_table(&mesh, &report, &options).expect("tensor-mass table")
+    build(&mesh, &report, &options)
+        .expect("tensor-mass table")
+        .bytes
 }
 
 /// Tool sphere radius of the haptic benches, m.

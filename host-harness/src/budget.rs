@@ -36,15 +36,16 @@ use std::process::Command;
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::contact::MAX_WALK_STEPS;
+use palpate_kernel::contact::{MAX_WALK_STEPS, Tissue};
 use palpate_kernel::haptic::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters};
-use palpate_kernel::contact::Tissue;
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 
 use crate::mesh::{MeshReport, TetMesh};
-use crate::session::run::{DynamicSetup, loop_config, precomputed_table, tensor_mass_table, ticks};
+use crate::session::run::{DynamicSetup, loop_config, scene_table, ticks};
+use crate::session::tool_points::{ForToolPoints, with_tool_points};
 use crate::session::{ModelSpec, Scene, Trajectory};
+use crate::table::load::TableFile;
 
 /// Instructions of a tick outside detection, tracking and solves.
 pub const BASE_IR: u64 = 600;
@@ -96,24 +97,20 @@ pub fn budget_table(
     report: &MeshReport,
 ) -> anyhow::Result<(Vec<u8>, u64)> {
     let points = scene.tool.points as u64;
-    Ok(match scene.model {
+    let bytes = scene_table(scene, mesh, report)?;
+    let file = TableFile::from_bytes(&bytes);
+    let load = |e| anyhow::anyhow!("table: {e}");
+    let bound = match scene.model {
         ModelSpec::Precomputed => {
-            let bytes = precomputed_table(scene, mesh, report)?;
-            let file = crate::tables::load::TableFile::from_bytes(&bytes);
-            let table = PrecomputedTable::<f32>::load(file.bytes())
-                .map_err(|e| anyhow::anyhow!("table: {e}"))?;
-            let bound = tick_bound(&table, points, points);
-            (bytes, bound)
+            let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
+            tick_bound(&table, points, points)
         }
         ModelSpec::Dynamic(_) => {
-            let bytes = tensor_mass_table(scene, mesh, report)?;
-            let file = crate::tables::load::TableFile::from_bytes(&bytes);
-            let table = TensorMassTable::<f32>::load(file.bytes())
-                .map_err(|e| anyhow::anyhow!("table: {e}"))?;
-            let bound = dynamic_tick_bound(&table, points, points);
-            (bytes, bound)
+            let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
+            dynamic_tick_bound(&table, points, points)
         }
-    })
+    };
+    Ok((bytes, bound))
 }
 
 /// One tick, kept out of line so callgrind can collect exactly its cost
@@ -132,12 +129,14 @@ pub fn budget_tick<B: Tissue<f32, P>, const P: usize>(
 /// the wall time spent in the ticks. A dynamic scene's physics updates run
 /// every `physics_every` ticks, after the tick and outside [`budget_tick`].
 pub fn probe(table: &[u8], scene: &Scene, trajectory: &Trajectory) -> anyhow::Result<Probe> {
-    match scene.tool.points {
-        1 => probe_with::<1>(table, scene, trajectory),
-        2 => probe_with::<2>(table, scene, trajectory),
-        3 => probe_with::<3>(table, scene, trajectory),
-        _ => probe_with::<4>(table, scene, trajectory),
-    }
+    with_tool_points(
+        scene.tool.points,
+        ProbeRun {
+            bytes: table,
+            scene,
+            trajectory,
+        },
+    )
 }
 
 /// What [`probe`] saw.
@@ -146,6 +145,21 @@ pub struct Probe {
     pub counters: Vec<TickCounters>,
     /// Wall time inside the ticks, s (physics updates excluded).
     pub ticks_s: f64,
+}
+
+/// [`probe`]'s arguments, run with the scene's tool points.
+struct ProbeRun<'a> {
+    bytes: &'a [u8],
+    scene: &'a Scene,
+    trajectory: &'a Trajectory,
+}
+
+impl ForToolPoints for ProbeRun<'_> {
+    type Output = anyhow::Result<Probe>;
+
+    fn call<const P: usize>(self) -> anyhow::Result<Probe> {
+        probe_with::<P>(self.bytes, self.scene, self.trajectory)
+    }
 }
 
 fn probe_with<const P: usize>(

@@ -16,10 +16,10 @@ use nalgebra::Vector3;
 use palpate_kernel::{Constraint, MAX_CONTACTS};
 
 use crate::output::vtk;
-use crate::session::run::precomputed_options;
+use crate::session::run::table_options;
 use crate::session::{MeshSource, Scene};
-use crate::tables::build::build_table;
-use crate::tables::load::{AnyModel, TableFile};
+use crate::table::build::build;
+use crate::table::load::{AnyModel, TableFile};
 
 /// Steps of each phase of the scripted press-and-release.
 const PHASES: [(&str, usize); 3] = [("press", 40), ("hold", 20), ("release", 40)];
@@ -37,7 +37,7 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
     };
     let (mesh, mut report) = scene.load_mesh()?;
     report.source = "built-in block".into();
-    let options = precomputed_options(&scene)?;
+    let options = table_options(&scene)?;
     println!(
         "scene: {:.0}x{:.0}x{:.0} cm block, {} vertices, {} tets, E = {} Pa, nu = {}, base fixed",
         size_m[0] * 100.0,
@@ -49,7 +49,7 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
         options.material.poisson
     );
     let started = Instant::now();
-    let built = build_table(&mesh, &report, &options)?;
+    let built = build(&mesh, &report, &options)?;
     println!(
         "table: {} free, {} touchable vertices, {:.1} MB (f32), built in {:.3} s",
         built.free_count,

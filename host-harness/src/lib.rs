@@ -1,12 +1,14 @@
 //! Palpate host harness: mesh input, offline tables, scripted runs, reports.
 //!
 //! Data flow: [`mesh`] (read and validate a tetrahedral mesh) → [`fem`]
-//! (P1 stiffness) → [`tables`] (compliance, table file) → the kernel
-//! (`palpate_kernel`) → [`precomputed`] / [`demo`] / [`replay`] (runs and reports).
+//! (P1 stiffness) → [`table`] (one build pipeline for both kinds of table:
+//! compliance or tensor-mass arrays, the table file) → the kernel
+//! (`palpate_kernel`) → [`precomputed`] / [`tensor_mass`] / [`session`] /
+//! [`demo`] / [`replay`] (runs and reports). The host modules are named after
+//! the kernel's (`palpate_kernel::table`, `palpate_kernel::tensor_mass`).
 
 pub mod budget;
 pub mod demo;
-pub mod dynamic;
 pub mod experiment;
 pub mod fem;
 pub mod fix;
@@ -15,4 +17,5 @@ pub mod output;
 pub mod precomputed;
 pub mod replay;
 pub mod session;
-pub mod tables;
+pub mod table;
+pub mod tensor_mass;

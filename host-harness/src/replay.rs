@@ -4,7 +4,7 @@
 
 use anyhow::{Context, bail};
 
-use crate::tables::load::{AnyModel, TableFile};
+use crate::table::load::{AnyModel, TableFile};
 
 /// Replays `sequence` on an f32 table and returns the output lines (format:
 /// `palpate_script` crate docs).

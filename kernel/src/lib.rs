@@ -27,15 +27,10 @@
 //! Guarantees of the step path (everything after `load`): no allocation, no
 //! panic path (proven at link time by `tools/nopanic-check`), and every loop
 //! bounded by a compile-time capacity or a count validated at load.
+//!
+//! Lints (`forbid(unsafe_code)`, `deny(missing_docs)`, and the clippy
+//! lints against panics) are set in the `[lints]` tables of `Cargo.toml`.
 #![no_std]
-#![forbid(unsafe_code)]
-#![deny(missing_docs)]
-#![warn(
-    clippy::panic,
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::indexing_slicing
-)]
 
 pub mod contact;
 pub mod haptic;

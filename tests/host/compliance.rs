@@ -1,4 +1,4 @@
-//! Compliance table (`palpate::tables::compliance`) against the independent
+//! Compliance table (`palpate::table::compliance`) against the independent
 //! scikit-fem reference (`tests/reference/linear/cube_compliance.json`).
 
 // Index loops mirror the tensor notation of MODELS.md.
@@ -7,7 +7,7 @@
 use palpate::fem::assembly::FreeOrdering;
 use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
-use palpate::tables::compliance::{Compliance, Solver, compute_compliance};
+use palpate::table::compliance::{Compliance, Solver, compute_compliance};
 use palpate_kernel::table::format::surface_block_index;
 use palpate_tests::{
     boundary_vertices, kuhn_box, read_reference_json, read_reference_tetgen, rel_max_diff,
@@ -74,10 +74,10 @@ fn check_against_reference(solver: Solver, tol: f64) {
     let mut theirs = Vec::new();
     for (key, col) in blocks {
         let kv: usize = key.parse().unwrap();
-        let k = o.vertex_slot[kv] as usize;
+        let k = o.vertex_slot[kv].expect("a free vertex") as usize;
         assert!(k < o.touchable_count, "vertex {kv} is touchable");
         for (n_ref, rows) in col.as_array().unwrap().iter().enumerate() {
-            let n = o.vertex_slot[free[n_ref] as usize] as usize;
+            let n = o.vertex_slot[free[n_ref] as usize].expect("a free vertex") as usize;
             let b = block(&c, &o, n, k);
             for a in 0..3 {
                 for bb in 0..3 {

@@ -327,6 +327,9 @@ fn free_ordering_layout() {
     let o = FreeOrdering::new(6, &fixed, &[5, 1, 2, 4, 2]);
     assert_eq!(o.touchable_count, 3);
     assert_eq!(o.free_vertex, vec![2, 4, 5, 3]);
-    assert_eq!(o.vertex_slot, vec![u32::MAX, u32::MAX, 0, 3, 1, 2]);
+    assert_eq!(
+        o.vertex_slot,
+        vec![None, None, Some(0), Some(3), Some(1), Some(2)]
+    );
     assert_eq!(o.free_count(), 4);
 }

@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use palpate::session::generate::MAX_GENERATED_SAMPLES;
 use palpate::session::{
     DynamicSpec, GenerateError, Generator, Keyframe, MaterialSpec, MeshSource, ModelSpec, Pinch,
-    Poke, Press, PressHold, Rates, SafetyLimits, Sample, Scene, Slide, Strike, ToolSpec,
-    Trajectory, TrajectoryError, sample_keyframes,
+    Poke, Press, PressHold, Rates, Sample, Scene, Slide, Strike, ToolSpec, Trajectory,
+    TrajectoryError, sample_keyframes,
 };
+use palpate_kernel::haptic::SafetyLimits;
 use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use palpate_tests::reference_dir;

@@ -1,4 +1,4 @@
-//! `palpate dynamic critical-dt` (`host-harness/src/dynamic/stability.rs`)
+//! `palpate dynamic critical-dt` (`host-harness/src/tensor_mass/stability.rs`)
 //! against theory: `ω_max` from power iteration against a dense symmetric
 //! eigensolver of `M^{-1/2} K M^{-1/2}` (nalgebra), and the measured critical
 //! steps against the known limits of each scheme on `ü = −ω² u`: symplectic
@@ -6,26 +6,26 @@
 //! region on the imaginary axis).
 
 use nalgebra::{DMatrix, SymmetricEigen};
-use palpate::dynamic::OwnedState;
-use palpate::dynamic::run::{f64_table, host_params};
-use palpate::dynamic::stability::{critical_dt, omega_max};
 use palpate::fem::material::Material;
 use palpate::mesh::MeshReport;
 use palpate::mesh::generate::box_mesh;
-use palpate::tables::file::Precision;
-use palpate::tables::tensor_mass::TensorMassOptions;
+use palpate::table::build::BuildOptions;
+use palpate::table::file::Precision;
+use palpate::tensor_mass::OwnedState;
+use palpate::tensor_mass::run::{f64_table, host_params};
+use palpate::tensor_mass::stability::{critical_dt, omega_max};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{Integrator, TensorMassModel, VertexMode};
 
 #[test]
 fn critical_steps_match_the_stability_limits() {
     let mesh = box_mesh([3, 3, 3], [0.03; 3]);
-    let options = TensorMassOptions {
-        material: Material::new(3000.0, 0.45).unwrap(),
-        density_kg_m3: 1000.0,
-        fix: vec!["z<1e-6".parse().unwrap()],
-        precision: Precision::F64,
-    };
+    let options = BuildOptions::tensor_mass(
+        Material::new(3000.0, 0.45).unwrap(),
+        1000.0,
+        vec!["z<1e-6".parse().unwrap()],
+        Precision::F64,
+    );
     let file = f64_table(&mesh, &MeshReport::default(), &options).unwrap();
     let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
     let mut state = OwnedState::for_table(&table);

@@ -4,11 +4,12 @@
 //! contact solve; continuity, determinism, and robustness to any input.
 
 use nalgebra::Vector3;
-use palpate::tables::file::Precision;
+use palpate::table::file::Precision;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{LoopConfig, PrecomputedLoop};
 use palpate_kernel::haptic::{OutputStatus, SafetyFault, SafetyLimits, Supervisor};
 use palpate_kernel::precomputed::PrecomputedTissue;
+use palpate_kernel::table::TriangleIndex;
 use palpate_kernel::{Constraint, PrecomputedModel};
 use palpate_tests::reference_cube_table;
 use proptest::prelude::*;
@@ -87,7 +88,11 @@ fn probe_press_matches_the_direct_solve_and_releases() {
             assert!((normal.z - 1.0).abs() < 1e-12, "a top-face triangle");
             let depth = z - 0.01 - 1.0;
             let direct = model
-                .contact_forces::<1>(&[Constraint::on_triangle(vertices, c.weights, normal * depth)])
+                .contact_forces::<1>(&[Constraint::on_triangle(
+                    vertices,
+                    c.weights,
+                    normal * depth,
+                )])
                 .expect("solve")
                 .device_force_n();
             let diff = (out.force_n - direct).norm();
@@ -114,8 +119,11 @@ fn probe_press_matches_the_direct_solve_and_releases() {
     assert_eq!(out.force_n, Vector3::zeros());
 }
 
-fn haptic_triangle(table: &PrecomputedTable<'_, f64>, t: u32) -> ([u32; 3], Vector3<f64>) {
-    let tri = table.surface_triangles()[t as usize];
+fn haptic_triangle(
+    table: &PrecomputedTable<'_, f64>,
+    t: TriangleIndex,
+) -> ([u32; 3], Vector3<f64>) {
+    let tri = table.surface_triangles()[t.get()];
     let p = |v: u32| Vector3::from(table.rest_positions()[v as usize]);
     let n = (p(tri[1]) - p(tri[0]))
         .cross(&(p(tri[2]) - p(tri[0])))

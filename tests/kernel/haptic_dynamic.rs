@@ -6,23 +6,22 @@
 //! divergence fault, and robustness to any tool input (proptest).
 
 use nalgebra::Vector3;
-use palpate::dynamic::run::f64_table;
-use palpate::dynamic::{OwnedState, OwnedSurface};
 use palpate::fem::material::Material;
 use palpate::mesh::MeshReport;
 use palpate::mesh::generate::box_mesh;
-use palpate::tables::build::{BuildOptions, build_table};
-use palpate::tables::compliance::Solver;
-use palpate::tables::file::Precision;
-use palpate::tables::load::TableFile;
-use palpate::tables::tensor_mass::TensorMassOptions;
+use palpate::table::build::{BuildOptions, build};
+use palpate::table::compliance::Solver;
+use palpate::table::file::Precision;
+use palpate::table::load::TableFile;
+use palpate::tensor_mass::run::f64_table;
+use palpate::tensor_mass::{OwnedState, OwnedSurface};
 use palpate_kernel::contact::{ContactWork, Supports};
-use palpate_kernel::tensor_mass::DeformingSurface;
-use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
 use palpate_kernel::haptic::{DynamicLoop, LoopConfig};
 use palpate_kernel::haptic::{OutputStatus, SafetyFault, SafetyLimits};
 use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::DeformingSurface;
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
 use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable};
 use proptest::prelude::*;
 
@@ -34,12 +33,12 @@ const TICK_S: f64 = 1e-3;
 
 fn block_table() -> TableFile {
     let mesh = box_mesh([6, 6, 3], SIZE_M);
-    let options = TensorMassOptions {
-        material: Material::new(3000.0, 0.45).expect("material"),
-        density_kg_m3: 1000.0,
-        fix: vec!["z<0.001".parse().expect("predicate")],
-        precision: Precision::F64,
-    };
+    let options = BuildOptions::tensor_mass(
+        Material::new(3000.0, 0.45).expect("material"),
+        1000.0,
+        vec!["z<0.001".parse().expect("predicate")],
+        Precision::F64,
+    );
     f64_table(&mesh, &MeshReport::default(), &options).expect("table")
 }
 
@@ -188,20 +187,18 @@ fn extrapolated_force_equals_the_model_force_between_updates() {
         assert!(gap < -2e-4, "pressed further: gap {gap}");
         let mut u = model.displacements_m().expect("finite").to_vec();
         for (&v, &share) in held.contact.vertices.iter().zip(&held.shares) {
-            for (a, d) in u[v as usize]
-                .iter_mut()
-                .zip((normal * (gap * share)).iter())
-            {
+            for (a, d) in u[v.get()].iter_mut().zip((normal * (gap * share)).iter()) {
                 *a += d;
             }
         }
         let mut f = vec![[0.0; 3]; u.len()];
         model.elastic_forces_of(&u, &mut f);
         let total: Vector3<f64> = held
-            .contact.vertices
+            .contact
+            .vertices
             .iter()
             .zip(&held.shares)
-            .map(|(&v, &share)| Vector3::from(f[v as usize]) * share)
+            .map(|(&v, &share)| Vector3::from(f[v.get()]) * share)
             .sum();
         let truth = normal * total.dot(&normal);
         let error = (out.force_n - truth).norm() / truth.norm();
@@ -238,22 +235,26 @@ fn held_force_at_rest_matches_the_static_solve() {
         let u = haptic.tissue().model().displacements_m().expect("finite");
         // The vertices with a share are the held ones.
         let (contacts, shares): (Vec<Constraint<f64>>, Vec<f64>) = held
-            .contact.vertices
+            .contact
+            .vertices
             .iter()
             .zip(&held.shares)
             .filter(|(_, s)| **s != 0.0)
-            .map(|(&v, &s)| (Constraint::at_vertex(v, Vector3::from(u[v as usize])), s))
+            .map(|(&v, &s)| {
+                (
+                    Constraint::at_vertex(v.as_u32(), Vector3::from(u[v.get()])),
+                    s,
+                )
+            })
             .unzip();
         let mesh = box_mesh([6, 6, 3], SIZE_M);
-        let options = BuildOptions {
-            material: Material::new(3000.0, 0.45).expect("material"),
-            fix: vec!["z<0.001".parse().expect("predicate")],
-            solver: Solver::Cholesky,
-            precision: Precision::F64,
-            progress: false,
-        };
-        let built =
-            build_table(&mesh, &MeshReport::default(), &options).expect("pre-computed table");
+        let options = BuildOptions::precomputed(
+            Material::new(3000.0, 0.45).expect("material"),
+            vec!["z<0.001".parse().expect("predicate")],
+            Solver::Cholesky,
+            Precision::F64,
+        );
+        let built = build(&mesh, &MeshReport::default(), &options).expect("pre-computed table");
         let bytes = TableFile::from_bytes(&built.bytes);
         let static_table = PrecomputedTable::<f64>::load(bytes.bytes()).expect("load");
         let solution = PrecomputedModel::new(static_table)
@@ -410,14 +411,13 @@ proptest! {
         )
     ) {
         let mesh = box_mesh([6, 6, 3], SIZE_M);
-        let options = TensorMassOptions {
-            material: Material::new(3000.0, 0.45).expect("material"),
-            density_kg_m3: 1000.0,
-            fix: vec!["z<0.001".parse().expect("predicate")],
-            precision: Precision::F32,
-        };
-        let bytes = palpate::tables::tensor_mass::build_tensor_mass_table(&mesh, &MeshReport::default(), &options)
-            .expect("table");
+        let options = BuildOptions::tensor_mass(
+            Material::new(3000.0, 0.45).expect("material"),
+            1000.0,
+            vec!["z<0.001".parse().expect("predicate")],
+            Precision::F32,
+        );
+        let bytes = build(&mesh, &MeshReport::default(), &options).expect("table").bytes;
         let file = TableFile::from_bytes(&bytes);
         let table = TensorMassTable::<f32>::load(file.bytes()).expect("table");
         let mut state = OwnedState::for_table(&table).without_split_terms();

@@ -16,8 +16,8 @@
 use nalgebra::Vector3;
 use palpate::fem::material::Material;
 use palpate::fem::static_solve::solve_prescribed;
-use palpate::tables::file::Precision;
-use palpate::tables::load::{AnyModel, TableFile};
+use palpate::table::file::Precision;
+use palpate::table::load::{AnyModel, TableFile};
 use palpate_kernel::{Constraint, ContactError, MAX_CONTACTS, PrecomputedModel, Real};
 use palpate_tests::{json_rows, read_reference_json, reference_cube_table, rel_max_diff};
 use proptest::prelude::*;

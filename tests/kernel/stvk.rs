@@ -6,9 +6,9 @@
 //! incompressibility penalty's closed form on one tet.
 
 use nalgebra::{Rotation3, Vector3};
-use palpate::dynamic::evaluate::forces_and_energy;
 use palpate::fem::material::Material;
 use palpate::mesh::{MeshReport, TetMesh, read_mesh};
+use palpate::tensor_mass::evaluate::forces_and_energy;
 use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use palpate_tests::{json_rows, read_reference_json, reference_dir};
 
@@ -267,20 +267,15 @@ fn incompressibility_penalty_has_the_papers_magnitude_and_direction() {
 /// removed tets' terms equal the rebuilt ones to rounding; measured ~1e-15).
 #[test]
 fn cutting_equals_rebuilding_without_the_tets() {
-    use palpate::dynamic::OwnedState;
-    use palpate::dynamic::run::{f64_table, host_params};
-    use palpate::tables::file::Precision;
-    use palpate::tables::tensor_mass::TensorMassOptions;
+    use palpate::table::build::BuildOptions;
+    use palpate::table::file::Precision;
+    use palpate::tensor_mass::OwnedState;
+    use palpate::tensor_mass::run::{f64_table, host_params};
     use palpate_kernel::table::TensorMassTable;
-    use palpate_kernel::tensor_mass::{DynamicParams, TensorMassModel};
+    use palpate_kernel::tensor_mass::TensorMassModel;
 
     let (mesh, report) = cube();
-    let options = TensorMassOptions {
-        material: material(),
-        density_kg_m3: 1000.0,
-        fix: Vec::new(),
-        precision: Precision::F64,
-    };
+    let options = BuildOptions::tensor_mass(material(), 1000.0, Vec::new(), Precision::F64);
     let x = jiggled(&mesh, 0.04, 3);
     let u: Vec<[f64; 3]> = x
         .iter()
@@ -288,10 +283,7 @@ fn cutting_equals_rebuilding_without_the_tets() {
         .map(|(x, p)| [x[0] - p[0], x[1] - p[1], x[2] - p[2]])
         .collect();
     for form in FORMS {
-        let params = DynamicParams {
-            law: stvk(form),
-            ..host_params(&mesh.positions, 0.0)
-        };
+        let params = host_params(&mesh.positions, 0.0).with_law(stvk(form));
         let file = f64_table(&mesh, &report, &options).expect("table");
         let table = TensorMassTable::<f64>::load(file.bytes()).expect("load");
         let mut state = OwnedState::for_table(&table);

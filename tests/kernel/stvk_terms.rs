@@ -12,12 +12,11 @@ use std::collections::HashMap;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use palpate::fem::material::Material;
 use palpate::mesh::generate::box_mesh;
-use palpate::mesh::{MeshReport, TetMesh, read_mesh};
-use palpate::tables::file::Precision;
-use palpate::tables::load::TableFile;
-use palpate::tables::tensor_mass::{
-    TensorMassArrays, TensorMassOptions, build_tensor_mass_table, write_tensor_mass_table,
-};
+use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
+use palpate::table::build::{BuildOptions, build};
+use palpate::table::file::Precision;
+use palpate::table::load::TableFile;
+use palpate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 use palpate_kernel::LoadError;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::SectionKind;
@@ -27,13 +26,13 @@ use palpate_tests::{json_rows, read_reference_json, reference_dir};
 const YOUNG_PA: f64 = 5000.0;
 const POISSON: f64 = 0.45;
 
-fn options() -> TensorMassOptions {
-    TensorMassOptions {
-        material: Material::new(YOUNG_PA, POISSON).expect("material"),
-        density_kg_m3: 1000.0,
-        fix: Vec::new(),
-        precision: Precision::F64,
-    }
+fn options() -> BuildOptions {
+    BuildOptions::tensor_mass(
+        Material::new(YOUNG_PA, POISSON).expect("material"),
+        1000.0,
+        Vec::new(),
+        Precision::F64,
+    )
 }
 
 fn cube() -> TetMesh {
@@ -48,7 +47,9 @@ fn small_box() -> TetMesh {
 }
 
 fn table_file(mesh: &TetMesh) -> TableFile {
-    let bytes = build_tensor_mass_table(mesh, &MeshReport::default(), &options()).expect("build");
+    let bytes = build(mesh, &MeshReport::default(), &options())
+        .expect("build")
+        .bytes;
     TableFile::from_bytes(&bytes)
 }
 
@@ -539,15 +540,16 @@ fn subtracting_tet_terms_equals_rebuild_without_the_tets() {
 #[test]
 fn f32_table_loads() {
     let mesh = small_box();
-    let bytes = build_tensor_mass_table(
+    let bytes = build(
         &mesh,
         &MeshReport::default(),
-        &TensorMassOptions {
+        &BuildOptions {
             precision: Precision::F32,
             ..options()
         },
     )
-    .unwrap();
+    .unwrap()
+    .bytes;
     let file = TableFile::from_bytes(&bytes);
     let t32 = TensorMassTable::<f32>::load(file.bytes()).expect("valid f32 table");
     let f64_file = table_file(&mesh);
@@ -576,11 +578,13 @@ fn broken_triangle_sections_are_refused() {
     let arrays = TensorMassArrays::new(
         &mesh,
         &opts.material,
-        opts.density_kg_m3,
+        1000.0,
         vec![false; mesh.positions.len()],
     );
+    let triangles = boundary_surface(&mesh).triangles;
     let load = |arrays: &TensorMassArrays| {
-        let file = TableFile::from_bytes(&write_tensor_mass_table(&mesh, &opts, arrays));
+        let bytes = write_tensor_mass_table(&mesh, &triangles, arrays, opts.precision);
+        let file = TableFile::from_bytes(&bytes);
         TensorMassTable::<f64>::load(file.bytes()).map(|_| ())
     };
     assert_eq!(load(&arrays), Ok(()));

@@ -1,8 +1,8 @@
 //! Table loading (`palpate_kernel::table`): round trip, corruption detection,
 //! and every structural error a well-formed checksum cannot hide.
 
-use palpate::tables::file::{Precision, TableContents, write_table};
-use palpate::tables::load::TableFile;
+use palpate::table::file::{Precision, TableContents, write_table};
+use palpate::table::load::TableFile;
 use palpate_kernel::table::format::{HEADER_LEN, SECTION_ENTRY_LEN, SectionKind};
 use palpate_kernel::{LoadError, PrecomputedTable};
 use palpate_tests::reference_cube_table;

@@ -6,19 +6,16 @@
 //! conservation of the symplectic schemes, and the fault state.
 
 use nalgebra::{Matrix2, Vector2, Vector3};
-use palpate::dynamic::OwnedState;
 use palpate::fem::material::Material;
-use palpate::mesh::{MeshReport, TetMesh, read_mesh};
-use palpate::tables::file::Precision;
-use palpate::tables::load::TableFile;
-use palpate::tables::tensor_mass::{
-    TensorMassArrays, TensorMassOptions, build_tensor_mass_table, write_tensor_mass_table,
-};
+use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
+use palpate::table::build::{BuildOptions, build};
+use palpate::table::file::Precision;
+use palpate::table::load::TableFile;
+use palpate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+use palpate::tensor_mass::OwnedState;
 use palpate_kernel::LoadError;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{
-    DynamicParams, Fault, Integrator, StepError, TensorMassModel,
-};
+use palpate_kernel::tensor_mass::{DynamicParams, Fault, Integrator, StepError, TensorMassModel};
 use palpate_tests::{
     json_rows, max_entry_difference, read_reference_json, read_reference_stiffness, reference_dir,
 };
@@ -29,18 +26,20 @@ fn cube() -> (TetMesh, MeshReport) {
     read_mesh(&reference_dir().join("meshes/cube.msh")).expect("cube.msh")
 }
 
-fn options(fix: &[&str], young_pa: f64, poisson: f64) -> TensorMassOptions {
-    TensorMassOptions {
-        material: Material::new(young_pa, poisson).expect("material"),
-        density_kg_m3: DENSITY,
-        fix: fix.iter().map(|f| f.parse().expect("predicate")).collect(),
-        precision: Precision::F64,
-    }
+fn options(fix: &[&str], young_pa: f64, poisson: f64) -> BuildOptions {
+    BuildOptions::tensor_mass(
+        Material::new(young_pa, poisson).expect("material"),
+        DENSITY,
+        fix.iter().map(|f| f.parse().expect("predicate")).collect(),
+        Precision::F64,
+    )
 }
 
 fn cube_table(fix: &[&str]) -> TableFile {
     let (mesh, report) = cube();
-    let bytes = build_tensor_mass_table(&mesh, &report, &options(fix, 5000.0, 0.45)).unwrap();
+    let bytes = build(&mesh, &report, &options(fix, 5000.0, 0.45))
+        .unwrap()
+        .bytes;
     TableFile::from_bytes(&bytes)
 }
 
@@ -166,7 +165,7 @@ fn one_tet_steps_match_hand_derivation() {
         tets: vec![[0, 1, 2, 3]],
     };
     let opts = options(&["z<0.5"], 1000.0, 0.25);
-    let bytes = build_tensor_mass_table(&mesh, &MeshReport::default(), &opts).unwrap();
+    let bytes = build(&mesh, &MeshReport::default(), &opts).unwrap().bytes;
     let file = TableFile::from_bytes(&bytes);
     let (lambda, mu) = (400.0, 400.0);
     let volume = 1.0 / 6.0;
@@ -392,7 +391,9 @@ fn broken_edge_and_tet_references_are_refused() {
     let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 0.001).collect();
     let arrays = TensorMassArrays::new(&mesh, &opts.material, DENSITY, fixed);
     let load = |arrays: &TensorMassArrays| {
-        let file = TableFile::from_bytes(&write_tensor_mass_table(&mesh, &opts, arrays));
+        let triangles = boundary_surface(&mesh).triangles;
+        let bytes = write_tensor_mass_table(&mesh, &triangles, arrays, opts.precision);
+        let file = TableFile::from_bytes(&bytes);
         TensorMassTable::<f64>::load(file.bytes()).map(|_| ())
     };
     assert_eq!(load(&arrays), Ok(()));
@@ -421,7 +422,7 @@ fn broken_edge_and_tet_references_are_refused() {
 fn removal_equals_rebuild_and_keeps_the_mesh_conformal() {
     let (mesh, _) = cube();
     let opts = options(&["z<0.001"], 5000.0, 0.45);
-    let bytes = build_tensor_mass_table(&mesh, &MeshReport::default(), &opts).unwrap();
+    let bytes = build(&mesh, &MeshReport::default(), &opts).unwrap().bytes;
     let file = TableFile::from_bytes(&bytes);
     let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
     let mut state = OwnedState::for_table(&table);
@@ -541,7 +542,7 @@ fn a_rotated_free_body_swells_by_theta_squared() {
             model.step(Integrator::SymplecticEuler, dt).unwrap();
         }
         let u = model.displacements_m().unwrap();
-        let gain = palpate::dynamic::run::volume_change(&mesh, u, model.tet_alive());
+        let gain = palpate::tensor_mass::run::volume_change(&mesh, u, model.tet_alive());
         println!(
             "{degrees:>6.0} deg   {:>12.2} %   {:>12.2} %",
             100.0 * gain,

@@ -167,20 +167,19 @@ pub fn rel_max_diff(a: &[f64], b: &[f64]) -> f64 {
 /// ν = 0.45) with its base `z = 0` fixed, built into a table of `precision`
 /// through the same pipeline as `palpate tables build`.
 pub fn reference_cube_table(
-    precision: palpate::tables::file::Precision,
-) -> palpate::tables::load::TableFile {
-    use palpate::tables::build::{BuildOptions, build_table};
+    precision: palpate::table::file::Precision,
+) -> palpate::table::load::TableFile {
+    use palpate::table::build::{BuildOptions, build};
     let (mesh, report) =
         palpate::mesh::read_mesh(&reference_dir().join("meshes/cube.msh")).expect("cube.msh");
-    let options = BuildOptions {
-        material: palpate::fem::material::Material::new(5000.0, 0.45).expect("material"),
-        fix: vec!["z<0.001".parse().expect("predicate")],
-        solver: palpate::tables::compliance::Solver::Cholesky,
+    let options = BuildOptions::precomputed(
+        palpate::fem::material::Material::new(5000.0, 0.45).expect("material"),
+        vec!["z<0.001".parse().expect("predicate")],
+        palpate::table::compliance::Solver::Cholesky,
         precision,
-        progress: false,
-    };
-    let built = build_table(&mesh, &report, &options).expect("build table");
-    palpate::tables::load::TableFile::from_bytes(&built.bytes)
+    );
+    let built = build(&mesh, &report, &options).expect("build table");
+    palpate::table::load::TableFile::from_bytes(&built.bytes)
 }
 
 /// A JSON array of `[x, y, z]` rows as `f64` triples.

@@ -8,8 +8,8 @@
 //! force component; measured there ≤ 7.9e-8).
 
 use nalgebra::Vector3;
-use palpate::tables::file::Precision;
-use palpate::tables::load::AnyModel;
+use palpate::table::file::Precision;
+use palpate::table::load::AnyModel;
 use palpate_kernel::{Constraint, PrecomputedModel};
 use palpate_script::{ParseError, ReplayError, parse_contact, parse_step, replay, steps};
 use palpate_tests::{json_rows, read_reference_json, reference_cube_table};

@@ -17,18 +17,18 @@
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, StvkForm, TensorMassModel};
 use serde::Serialize;
 
 use super::relax::{Relaxation, relax};
-use crate::dynamic::OwnedState;
-use crate::dynamic::run::{host_params, volume_change};
-use crate::dynamic::stability::omega_max;
 use crate::fem::material::Material;
-use crate::mesh::TetMesh;
-use crate::tables::file::Precision;
-use crate::tables::load::TableFile;
-use crate::tables::tensor_mass::{TensorMassArrays, TensorMassOptions, write_tensor_mass_table};
+use crate::mesh::{TetMesh, boundary_surface};
+use crate::table::file::Precision;
+use crate::table::load::TableFile;
+use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+use crate::tensor_mass::OwnedState;
+use crate::tensor_mass::run::{diagonal, volume_change};
+use crate::tensor_mass::stability::omega_max;
 
 /// What a stage's target is measured on: a scalar of the deformed body.
 pub type Measure = Box<dyn Fn(&TetMesh, &[[f64; 3]]) -> f64>;
@@ -213,14 +213,15 @@ pub fn run_scene(
     controls: &Controls,
     mut progress: impl FnMut(&str),
 ) -> anyhow::Result<SceneResult> {
-    let options = TensorMassOptions {
-        material: scene.material,
-        density_kg_m3: 1000.0,
-        fix: Vec::new(),
-        precision: Precision::F64,
-    };
+    // The fixed flags are the scene's own (no predicates): the arrays and
+    // the writer of the table build, without its predicate stage.
     let arrays = TensorMassArrays::new(&scene.mesh, &scene.material, 1000.0, scene.fixed.clone());
-    let file = TableFile::from_bytes(&write_tensor_mass_table(&scene.mesh, &options, &arrays));
+    let file = TableFile::from_bytes(&write_tensor_mass_table(
+        &scene.mesh,
+        &boundary_surface(&scene.mesh).triangles,
+        &arrays,
+        Precision::F64,
+    ));
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let n = scene.mesh.positions.len();
 
@@ -237,15 +238,12 @@ pub fn run_scene(
     let mut bodies = Vec::new();
     let mut dt_s = 0.0;
     for ((law, gamma), state) in laws.into_iter().zip(states.iter_mut()) {
-        let mut params = palpate_kernel::tensor_mass::DynamicParams {
-            law,
-            incompressibility_n: gamma,
-            ..host_params(&scene.mesh.positions, 0.0)
-        };
         // The linear model's equilibria at the later stages lie several body
         // sizes away (its large-rotation error is the point of the
         // experiment): only a displacement of 100 body sizes is divergence.
-        params.limits.max_displacement_m *= 100.0;
+        let params = DynamicParams::linear(0.0, 100.0 * diagonal(&scene.mesh.positions))
+            .with_law(law)
+            .with_incompressibility(gamma);
         let mut model = TensorMassModel::new(table, state.buffers(), params)?;
         if dt_s == 0.0 {
             // A quarter of the linear stability limit 2/ω_max: zeroing the

@@ -2,12 +2,10 @@
 //! shared with the kernel's compliance table (`MODELS.md` §1–2).
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use palpate_kernel::table::format::FIXED_SLOT;
 
 use super::element::element_stiffness;
 use super::material::Material;
-
-/// Marker for "this vertex has no slot" in slot maps ([`FreeOrdering::vertex_slot`]).
-pub const NO_SLOT: u32 = u32::MAX;
 
 /// Full global stiffness `K` (N/m), `3N × 3N` for `N = positions.len()`, with
 /// DOF `3 * vertex + component` (component 0 = x, 1 = y, 2 = z).
@@ -26,48 +24,40 @@ pub fn assemble_stiffness(
     m: &Material,
 ) -> SparseColMat<usize, f64> {
     let n = u32::try_from(positions.len()).expect("vertex count fits in u32");
-    let slot: Vec<u32> = (0..n).collect();
+    let slot: Vec<Option<u32>> = (0..n).map(Some).collect();
     assemble_restricted(positions, tets, m, &slot, positions.len())
 }
 
 /// Stiffness restricted to a subset of vertices, renumbered (N/m).
 ///
 /// `slot[v]` is the new index of mesh vertex `v` in `0..slot_count`, or
-/// [`NO_SLOT`] to drop the vertex (its rows and columns are removed, i.e. the
+/// `None` to drop the vertex (its rows and columns are removed, i.e. the
 /// vertex is fixed or handled elsewhere). The result is `3·slot_count`
 /// square with DOF `3 * slot + component`: with `slot = vertex_slot` of a
 /// [`FreeOrdering`] it is the matrix `A` of `MODELS.md` §2 (Cotin RR-3510 §4),
 /// the stiffness restricted to the free DOFs. Both triangles are stored.
 ///
 /// # Panics
-/// If `slot.len() != positions.len()`, a slot is `>= slot_count` (and not
-/// [`NO_SLOT`]), or a tet references a vertex `>= positions.len()`.
+/// If `slot.len() != positions.len()`, a slot is `>= slot_count`, or a tet
+/// references a vertex `>= positions.len()`.
 pub fn assemble_restricted(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
     m: &Material,
-    slot: &[u32],
+    slot: &[Option<u32>],
     slot_count: usize,
 ) -> SparseColMat<usize, f64> {
     assert_eq!(slot.len(), positions.len(), "one slot per vertex");
     assert!(
-        slot.iter()
-            .all(|&s| s == NO_SLOT || (s as usize) < slot_count),
+        slot.iter().flatten().all(|&s| (s as usize) < slot_count),
         "slot out of range"
     );
     // Block pattern: sorted neighbour slots (self included) of every slot.
     let mut nbr: Vec<Vec<u32>> = vec![Vec::new(); slot_count];
     for t in tets {
         let s = t.map(|v| slot[v as usize]);
-        for &sj in &s {
-            if sj == NO_SLOT {
-                continue;
-            }
-            for &sk in &s {
-                if sk != NO_SLOT {
-                    nbr[sj as usize].push(sk);
-                }
-            }
+        for sj in s.iter().flatten() {
+            nbr[*sj as usize].extend(s.iter().flatten());
         }
     }
     for l in &mut nbr {
@@ -90,21 +80,17 @@ pub fn assemble_restricted(
     let mut val = vec![0.0f64; row_idx.len()];
     for t in tets {
         let s = t.map(|v| slot[v as usize]);
-        if s.iter().all(|&x| x == NO_SLOT) {
+        if s.iter().all(Option::is_none) {
             continue;
         }
         let p = t.map(|v| positions[v as usize]);
         let ke = element_stiffness(&p, m);
         // Block (row j, column k) goes to column slot s[k], neighbour s[j].
-        for (k, &sk) in s.iter().enumerate() {
-            if sk == NO_SLOT {
-                continue;
-            }
+        for (k, sk) in s.iter().enumerate() {
+            let Some(sk) = *sk else { continue };
             let l = &nbr[sk as usize];
-            for (j, &sj) in s.iter().enumerate() {
-                if sj == NO_SLOT {
-                    continue;
-                }
+            for (j, sj) in s.iter().enumerate() {
+                let Some(sj) = *sj else { continue };
                 let pos = l.binary_search(&sj).expect("pattern holds every block");
                 for b in 0..3 {
                     let base = col_ptr[3 * sk as usize + b] + 3 * pos;
@@ -130,8 +116,8 @@ pub fn assemble_restricted(
 pub struct FreeOrdering {
     /// Free index → mesh vertex.
     pub free_vertex: Vec<u32>,
-    /// Mesh vertex → free index, `u32::MAX` ([`NO_SLOT`]) if fixed.
-    pub vertex_slot: Vec<u32>,
+    /// Mesh vertex → free index, `None` if fixed.
+    pub vertex_slot: Vec<Option<u32>>,
     /// Number of touchable (free surface) vertices, the first entries of
     /// `free_vertex`.
     pub touchable_count: usize,
@@ -168,9 +154,9 @@ impl FreeOrdering {
                 .filter(|&v| !on_surface[v] && !fixed[v])
                 .map(|v| v as u32),
         );
-        let mut vertex_slot = vec![NO_SLOT; vertex_count];
+        let mut vertex_slot = vec![None; vertex_count];
         for (i, &v) in free_vertex.iter().enumerate() {
-            vertex_slot[v as usize] = i as u32;
+            vertex_slot[v as usize] = Some(i as u32);
         }
         Self {
             free_vertex,
@@ -182,5 +168,14 @@ impl FreeOrdering {
     /// Number of free (not fixed) vertices `F`; the free DOF count is `3F`.
     pub fn free_count(&self) -> usize {
         self.free_vertex.len()
+    }
+
+    /// The vertex-slot section as a table file stores it (N entries): the
+    /// free index, or the format's [`FIXED_SLOT`] for a fixed vertex.
+    pub fn slot_entries(&self) -> Vec<u32> {
+        self.vertex_slot
+            .iter()
+            .map(|slot| slot.unwrap_or(FIXED_SLOT))
+            .collect()
     }
 }

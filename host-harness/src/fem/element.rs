@@ -5,22 +5,6 @@ use palpate_kernel::math::element::stiffness_block;
 
 use super::material::Material;
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// Shape-function gradients and signed volume of the tetrahedron `p` (m).
 ///
 /// Returns `(a, V)` with `a[j] = ∇Λ_j` (1/m), constant over the element, and
@@ -32,23 +16,14 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// A degenerate tet (`V == 0`) gives non-finite gradients; meshes are
 /// validated before they get here.
 pub fn shape_gradients(p: &[[f64; 3]; 4]) -> ([[f64; 3]; 4], f64) {
-    let c1 = sub(p[1], p[0]);
-    let c2 = sub(p[2], p[0]);
-    let c3 = sub(p[3], p[0]);
-    let r1 = cross(c2, c3);
-    let r2 = cross(c3, c1);
-    let r3 = cross(c1, c2);
-    let det = dot(c1, r1);
+    let [p0, p1, p2, p3] = p.map(Vector3::from);
+    let (c1, c2, c3) = (p1 - p0, p2 - p0, p3 - p0);
+    let (r1, r2, r3) = (c2.cross(&c3), c3.cross(&c1), c1.cross(&c2));
+    let det = c1.dot(&r1);
     let inv = 1.0 / det;
-    let a1 = r1.map(|x| x * inv);
-    let a2 = r2.map(|x| x * inv);
-    let a3 = r3.map(|x| x * inv);
-    let a0 = [
-        -(a1[0] + a2[0] + a3[0]),
-        -(a1[1] + a2[1] + a3[1]),
-        -(a1[2] + a2[2] + a3[2]),
-    ];
-    ([a0, a1, a2, a3], det / 6.0)
+    let (a1, a2, a3) = (r1 * inv, r2 * inv, r3 * inv);
+    let a0 = -(a1 + a2 + a3);
+    ([a0, a1, a2, a3].map(Into::into), det / 6.0)
 }
 
 /// Element stiffness of the tetrahedron `p` (m) for material `m`, as 4×4

@@ -3,7 +3,7 @@
 use anyhow::{Context, bail, ensure};
 use faer::Mat;
 
-use super::assembly::{NO_SLOT, assemble_restricted, assemble_stiffness};
+use super::assembly::{assemble_restricted, assemble_stiffness};
 use super::llt::SparseLlt;
 use super::material::Material;
 
@@ -63,11 +63,11 @@ pub fn solve_prescribed(
     }
     let k = assemble_stiffness(positions, tets, m);
     // r = K u with the known part of u only.
-    let mut slot = vec![NO_SLOT; n];
+    let mut slot = vec![None; n];
     let mut unknown = Vec::new();
     for v in 0..n {
         if !known[v] {
-            slot[v] = unknown.len() as u32;
+            slot[v] = Some(unknown.len() as u32);
             unknown.push(v);
         }
     }

@@ -4,11 +4,13 @@
 //! Data flow: a scene file (TOML) → [`Scene`] (mesh, fixed vertices, material, model, tool,
 //! rates, safety limits) → the table build and the kernel's haptic loop; a trajectory file (CSV)
 //! or a [`generate::Generator`] → [`Trajectory`] → every tool point's position at each tick
-//! ([`Trajectory::positions_at`]).
+//! ([`Trajectory::positions_at`]). [`tool_points`] turns a scene's tool-point count into the
+//! kernel's const generic.
 
 pub mod generate;
 pub mod run;
 pub mod scene;
+pub mod tool_points;
 pub mod trajectory;
 
 pub use generate::{
@@ -16,7 +18,7 @@ pub use generate::{
     sample_keyframes,
 };
 pub use scene::{
-    DynamicSpec, MAX_TOOL_POINTS, MaterialSpec, MeshSource, ModelSpec, Rates, SafetyLimits, Scene,
-    SceneError, ToolSpec,
+    DynamicSpec, MAX_TOOL_POINTS, MaterialSpec, MeshSource, ModelSpec, Rates, Scene, SceneError,
+    ToolSpec,
 };
 pub use trajectory::{FileProblem, LineProblem, Sample, Trajectory, TrajectoryError};

@@ -17,64 +17,49 @@ use std::path::Path;
 use anyhow::Context;
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::tensor_mass::{DynamicTissue, PhysicsConfig};
-use palpate_kernel::haptic::{DynamicLoop, ForceOutput, LoopConfig, PrecomputedLoop};
-use palpate_kernel::haptic::{OutputStatus, SafetyLimits};
+use palpate_kernel::haptic::{
+    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits,
+};
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, StvkForm, TensorMassModel};
+use palpate_kernel::tensor_mass::{
+    DynamicParams, DynamicTissue, ElasticLaw, PhysicsConfig, StvkForm, TensorMassModel,
+};
 
+use super::tool_points::{ForToolPoints, with_tool_points};
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
-use crate::dynamic::run::diagonal;
-use crate::dynamic::{OwnedState, OwnedSurface};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::vtk;
-use crate::tables::build::{BuildOptions, build_table};
-use crate::tables::compliance::Solver;
-use crate::tables::file::Precision;
-use crate::tables::load::TableFile;
-use crate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+use crate::table::build::{BuildOptions, build};
+use crate::table::compliance::Solver;
+use crate::table::file::Precision;
+use crate::table::load::TableFile;
+use crate::tensor_mass::run::diagonal;
+use crate::tensor_mass::{OwnedState, OwnedSurface};
 
-/// The build options of `scene`'s pre-computed table: its material and
-/// supports, sparse Cholesky, f32 (the firmware precision), quiet.
-pub fn precomputed_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
-    Ok(BuildOptions {
-        material: scene.elastic_material()?,
-        fix: scene.fix.clone(),
-        solver: Solver::Cholesky,
-        precision: Precision::F32,
-        progress: false,
+/// The build options of `scene`'s table, by its model: its material and
+/// supports, f32 (the firmware precision), quiet; a pre-computed table
+/// solved by sparse Cholesky, a tensor-mass table of the scene's density.
+pub fn table_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
+    let material = scene.elastic_material()?;
+    let fix = scene.fix.clone();
+    Ok(match scene.model {
+        ModelSpec::Precomputed => {
+            BuildOptions::precomputed(material, fix, Solver::Cholesky, Precision::F32)
+        }
+        ModelSpec::Dynamic(_) => {
+            BuildOptions::tensor_mass(material, scene.material.density_kg_m3, fix, Precision::F32)
+        }
     })
 }
 
-/// The f32 pre-computed table of `scene`, built in memory with the same
-/// pipeline as `palpate tables build`.
-pub fn precomputed_table(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<Vec<u8>> {
-    let options = precomputed_options(scene)?;
-    Ok(build_table(mesh, report, &options)
+/// The f32 table of `scene` (pre-computed or tensor-mass, by its model),
+/// built in memory with the same pipeline as `palpate tables build`.
+pub fn scene_table(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Vec<u8>> {
+    let options = table_options(scene)?;
+    Ok(build(mesh, report, &options)
         .with_context(|| scene.source.clone())?
         .bytes)
-}
-
-/// The f32 tensor-mass table of `scene` (the firmware precision), built in
-/// memory with the same pipeline as `palpate tables build --kind
-/// tensor-mass`.
-pub fn tensor_mass_table(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<Vec<u8>> {
-    let options = TensorMassOptions {
-        material: scene.elastic_material()?,
-        density_kg_m3: scene.material.density_kg_m3,
-        fix: scene.fix.clone(),
-        precision: Precision::F32,
-    };
-    build_tensor_mass_table(mesh, report, &options).with_context(|| scene.source.clone())
 }
 
 /// The haptic loop configuration of `scene` (f32).
@@ -151,36 +136,58 @@ pub fn run_session(
         frames: Vec::new(),
     };
     writeln!(session.out, "t,fx,fy,fz,contacts,status")?;
-    let config = loop_config(scene);
     let ticks = Ticks {
         trajectory,
         tick_s: scene.tick_s(),
         every: scene.rates.physics_every.max(1) as usize,
     };
-    match scene.model {
-        ModelSpec::Precomputed => {
-            let file = TableFile::from_bytes(&precomputed_table(scene, &mesh, &report)?);
-            let table = PrecomputedTable::<f32>::load(file.bytes()).context("session table")?;
-            match scene.tool.points {
-                1 => ticks.precomputed::<1>(&table, config, &mut session),
-                2 => ticks.precomputed::<2>(&table, config, &mut session),
-                3 => ticks.precomputed::<3>(&table, config, &mut session),
-                _ => ticks.precomputed::<4>(&table, config, &mut session),
-            }?;
-        }
+    let file = TableFile::from_bytes(&scene_table(scene, &mesh, &report)?);
+    let tissue = match scene.model {
+        ModelSpec::Precomputed => SessionTissue::Precomputed(
+            PrecomputedTable::<f32>::load(file.bytes()).context("session table")?,
+            loop_config(scene),
+        ),
         ModelSpec::Dynamic(spec) => {
-            let file = TableFile::from_bytes(&tensor_mass_table(scene, &mesh, &report)?);
             let table = TensorMassTable::<f32>::load(file.bytes()).context("session table")?;
-            let dynamic = DynamicSetup::of(scene, &spec, table)?;
-            match scene.tool.points {
-                1 => ticks.dynamic::<1>(&dynamic, &mut session),
-                2 => ticks.dynamic::<2>(&dynamic, &mut session),
-                3 => ticks.dynamic::<3>(&dynamic, &mut session),
-                _ => ticks.dynamic::<4>(&dynamic, &mut session),
-            }?;
+            SessionTissue::Dynamic(DynamicSetup::of(scene, &spec, table)?)
+        }
+    };
+    with_tool_points(
+        scene.tool.points,
+        SessionTicks {
+            ticks: &ticks,
+            tissue: &tissue,
+            session: &mut session,
+        },
+    )?;
+    session.finish()
+}
+
+/// The tissue a session runs on: a pre-computed table and the loop
+/// settings, or a dynamic scene's setup.
+enum SessionTissue<'t> {
+    Precomputed(PrecomputedTable<'t, f32>, LoopConfig<f32>),
+    Dynamic(DynamicSetup<'t>),
+}
+
+/// A session's ticks on its tissue, run with the scene's tool points.
+struct SessionTicks<'a, 't, 'o> {
+    ticks: &'a Ticks<'a>,
+    tissue: &'a SessionTissue<'t>,
+    session: &'a mut Session<'o>,
+}
+
+impl ForToolPoints for SessionTicks<'_, '_, '_> {
+    type Output = anyhow::Result<()>;
+
+    fn call<const P: usize>(self) -> anyhow::Result<()> {
+        match self.tissue {
+            SessionTissue::Precomputed(table, config) => {
+                self.ticks.precomputed::<P>(table, *config, self.session)
+            }
+            SessionTissue::Dynamic(setup) => self.ticks.dynamic::<P>(setup, self.session),
         }
     }
-    session.finish()
 }
 
 /// A dynamic scene's table and settings: everything to build its loop.
@@ -208,11 +215,9 @@ impl<'t> DynamicSetup<'t> {
             .collect();
         Ok(Self {
             table,
-            params: DynamicParams {
-                law: spec.law,
-                incompressibility_n: spec.incompressibility_n.map(|g| g as f32),
-                ..DynamicParams::linear(spec.damping_per_s as f32, diagonal(&rest) as f32)
-            },
+            params: DynamicParams::linear(spec.damping_per_s as f32, diagonal(&rest) as f32)
+                .with_law(spec.law)
+                .with_incompressibility(spec.incompressibility_n.map(|g| g as f32)),
             physics: PhysicsConfig {
                 extrapolation: spec.extrapolation,
                 integrator: spec.integrator,

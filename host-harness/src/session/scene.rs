@@ -43,6 +43,7 @@
 use std::path::{Path, PathBuf};
 
 use palpate_kernel::MAX_CONTACTS;
+use palpate_kernel::haptic::SafetyLimits;
 use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
@@ -180,15 +181,6 @@ pub struct Rates {
     pub physics_every: u32,
 }
 
-/// Limits of the safety supervisor on the device force.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SafetyLimits {
-    /// Magnitude clamp of the device force, N, finite and > 0.
-    pub max_force_n: f64,
-    /// Largest change of the device force per second (slew limit), N/s, finite and > 0.
-    pub max_slew_n_per_s: f64,
-}
-
 /// A validated scene.
 ///
 /// Invariants (checked by [`Scene::validate`], which every constructor runs): the ranges stated
@@ -212,8 +204,9 @@ pub struct Scene {
     pub tool: ToolSpec,
     /// Loop rates.
     pub rates: Rates,
-    /// Safety limits.
-    pub safety: SafetyLimits,
+    /// Limits of the safety supervisor on the device force (N, N/s), each finite and > 0;
+    /// the loop takes them in f32 ([`crate::session::run::loop_config`]).
+    pub safety: SafetyLimits<f64>,
 }
 
 // ---- The file as written (serde), before validation. ----

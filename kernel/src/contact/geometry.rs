@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 
 use super::Contact;
 use crate::Real;
-use crate::table::{PrecomputedTable, SurfaceIndex, TensorMassTable};
+use crate::table::{PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex};
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
 /// walk; a contact that would slide further stops at the last triangle).
@@ -40,33 +40,32 @@ pub enum Supports<'a, T: Real> {
 }
 
 impl<T: Real> Supports<'_, T> {
-    fn is_fixed(&self, vertex: u32) -> bool {
+    fn is_fixed(&self, vertex: VertexIndex) -> bool {
         match self {
-            Self::Precomputed(t) => t.is_fixed(vertex),
-            Self::TensorMass(t) => t.is_fixed(vertex),
+            Self::Precomputed(t) => t.is_fixed_vertex(vertex),
+            Self::TensorMass(t) => t.is_fixed_vertex(vertex),
         }
     }
 }
 
-/// A surface to touch: vertex positions (m), surface triangles, their
-/// collision index (whose planes match the positions) and the supports.
+/// A surface to touch: vertex positions (m), the collision index over its
+/// triangles (whose planes match the positions) and the supports.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceGeometry<'a, T: Real> {
     positions: &'a [[T; 3]],
-    triangles: &'a [[u32; 3]],
     index: SurfaceIndex<'a, T>,
     supports: Supports<'a, T>,
 }
 
 /// Vertices and corners of a triangle.
 struct Corners<T: Real> {
-    vertices: [u32; 3],
+    vertices: [VertexIndex; 3],
     corners: [Vector3<T>; 3],
 }
 
 /// Corners and unit outward normal of a triangle.
 struct Face<T: Real> {
-    vertices: [u32; 3],
+    vertices: [VertexIndex; 3],
     corners: [Vector3<T>; 3],
     normal: Vector3<T>,
 }
@@ -99,23 +98,20 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     pub fn new(table: &'a PrecomputedTable<'a, T>) -> Self {
         Self::of_parts(
             table.rest_positions(),
-            table.surface_triangles(),
             *table.surface_index(),
             Supports::Precomputed(table),
         )
     }
 
     /// A surface from its parts; `index` must have been built over
-    /// `positions` and `triangles`.
+    /// `positions` (its vertices index them).
     pub(crate) fn of_parts(
         positions: &'a [[T; 3]],
-        triangles: &'a [[u32; 3]],
         index: SurfaceIndex<'a, T>,
         supports: Supports<'a, T>,
     ) -> Self {
         Self {
             positions,
-            triangles,
             index,
             supports,
         }
@@ -127,17 +123,17 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     }
 
     /// Vertices and rest corners of a surface triangle.
-    fn corners(&self, triangle: u32) -> Option<Corners<T>> {
-        let vertices = *self.triangles.get(triangle as usize)?;
+    fn corners(&self, triangle: TriangleIndex) -> Option<Corners<T>> {
+        let vertices = self.index.triangle(triangle)?;
         let mut corners = [Vector3::zeros(); 3];
         for (c, &v) in corners.iter_mut().zip(&vertices) {
-            let p = self.positions.get(v as usize)?;
+            let p = self.positions.get(v.get())?;
             *c = Vector3::new(p[0], p[1], p[2]);
         }
         Some(Corners { vertices, corners })
     }
 
-    fn face(&self, triangle: u32) -> Option<Face<T>> {
+    fn face(&self, triangle: TriangleIndex) -> Option<Face<T>> {
         let Corners { vertices, corners } = self.corners(triangle)?;
         let (normal, _) = self.index.plane(triangle)?;
         Some(Face {
@@ -152,7 +148,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     fn contact(
         &self,
         tool: usize,
-        triangle: u32,
+        triangle: TriangleIndex,
         face: &Face<T>,
         weights: [T; 3],
         tip_m: &Vector3<T>,
@@ -193,7 +189,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let tolerance = T::WEIGHT_TOLERANCE;
         // A start exactly touching the surface may round to just inside it.
         let slack_m = tolerance * self.index.cell_m();
-        let mut best: Option<(T, u32, [T; 3])> = None;
+        let mut best: Option<(T, TriangleIndex, [T; 3])> = None;
         let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
         let near_grid = |p: &Vector3<T>| self.index.is_near(p, radius_m);
         let (near_to, near_from) = (near_grid(to_m), !same_cell && near_grid(from_m));
@@ -203,7 +199,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             .take_while(|_| near_to)
             .chain(self.index.vertices_near(from_m).take_while(|_| near_from));
         for v in candidates {
-            for &t in self.index.triangles_of(v) {
+            for t in self.index.triangles_of(v) {
                 work.triangles_tested = work.triangles_tested.saturating_add(1);
                 // The stored plane first: two dot products reject almost all.
                 let Some((normal, offset)) = self.index.plane(t) else {
@@ -268,16 +264,13 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             ) else {
                 break;
             };
-            let shared =
-                self.index.triangles_of(j).iter().find(|&&t| {
-                    t != triangle && self.index.triangles_of(k).binary_search(&t).is_ok()
-                });
+            let shared = self.index.across(triangle, j, k);
             // Back where it came from: the point lies over a concave fold
             // between the two (a dimple's valley); stay, clamped to the edge.
-            if shared.copied() == came_from {
+            if shared == came_from {
                 break;
             }
-            let Some(next) = shared.and_then(|&t| self.face(t).map(|f| (t, f))) else {
+            let Some(next) = shared.and_then(|t| self.face(t).map(|f| (t, f))) else {
                 break;
             };
             work.walk_steps = work.walk_steps.saturating_add(1);

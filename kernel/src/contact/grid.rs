@@ -16,6 +16,11 @@
 //! over the `N` vertices; [`bin`] one pass over the triangles, three over the
 //! vertices, two over the cells and at most [`MAX_CELL_GROWTHS`] dimension
 //! computations. Every loop runs over slice lengths.
+//!
+//! The builder reads raw `u32` lists (the host's mesh at table build, the
+//! table's validated triangles at run time) and writes `u32` sections, so it
+//! widens their entries itself; the checked index types of [`crate::table`]
+//! are handed out by the [`crate::table::SurfaceIndex`] over its lists.
 
 use nalgebra::Vector3;
 
@@ -79,13 +84,9 @@ pub fn vertex_triangles(triangles: &[[u32; 3]], start: &mut [u32], list: &mut [u
     // start of v + 1, then everything shifts back by one.
     for (t, tri) in triangles.iter().enumerate() {
         for &v in tri {
-            let Some(cursor) = start.get_mut(row(v)) else {
-                continue;
-            };
-            if let Some(slot) = list.get_mut(*cursor as usize) {
-                *slot = t as u32;
+            if let Some(cursor) = start.get_mut(row(v)) {
+                place(list, cursor, t as u32);
             }
-            *cursor += 1;
         }
     }
     shift_back(start);
@@ -183,19 +184,15 @@ fn fitted_grid<T: Real>(
         floor_m
     };
     let dims_for = |cell: T| extent.map(|e| ((e / cell).floor().as_f64() as u32).saturating_add(1));
-    let fits = |d: &Vector3<u32>| {
-        d.iter()
-            .try_fold(1usize, |n, &k| n.checked_mul(k as usize))
-            .is_some_and(|n| n <= capacity)
-    };
     for _ in 0..MAX_CELL_GROWTHS {
         let dims = dims_for(cell_m);
-        if fits(&dims) {
-            return Grid {
-                origin_m: lo,
-                cell_m,
-                dims: [dims.x, dims.y, dims.z],
-            };
+        let grid = Grid {
+            origin_m: lo,
+            cell_m,
+            dims: [dims.x, dims.y, dims.z],
+        };
+        if grid.cell_count().is_some_and(|n| n <= capacity) {
+            return grid;
         }
         cell_m *= T::of_f64(CELL_GROWTH);
     }
@@ -217,16 +214,11 @@ fn file_vertices<T: Real>(
     cell_start: &mut [u32],
     grid_vertex: &mut [u32],
 ) -> (usize, usize, u32) {
-    let [nx, ny, nz] = grid.dims.map(|d| d as usize);
-    let cells = nx * ny * nz;
+    // A fitted grid's cells fit the buffer (module docs).
+    let cells = grid.cell_count().unwrap_or(0);
     let cell_start = cell_start.get_mut(..=cells).unwrap_or_default();
     cell_start.fill(0);
-    let cell_of = |p: &[T; 3]| {
-        let [i, j, k] = grid
-            .cell_of(&Vector3::new(p[0], p[1], p[2]))
-            .map(|c| c as usize);
-        i + nx * (j + ny * k)
-    };
+    let cell_of = |p: &[T; 3]| grid.linear(grid.cell_of(&Vector3::new(p[0], p[1], p[2])));
     for (v, p) in positions_m.iter().enumerate() {
         if has_triangles(starts, v)
             && let Some(count) = cell_start.get_mut(cell_of(p) + 1)
@@ -239,13 +231,9 @@ fn file_vertices<T: Real>(
         if !has_triangles(starts, v) {
             continue;
         }
-        let Some(cursor) = cell_start.get_mut(cell_of(p)) else {
-            continue;
-        };
-        if let Some(slot) = grid_vertex.get_mut(*cursor as usize) {
-            *slot = v as u32;
+        if let Some(cursor) = cell_start.get_mut(cell_of(p)) {
+            place(grid_vertex, cursor, v as u32);
         }
-        *cursor += 1;
     }
     shift_back(cell_start);
     let filed = cell_start.last().copied().unwrap_or(0) as usize;
@@ -255,6 +243,15 @@ fn file_vertices<T: Real>(
 /// `true` if vertex `v` has a surface triangle.
 fn has_triangles(starts: &[u32], v: usize) -> bool {
     matches!((starts.get(v), starts.get(v + 1)), (Some(a), Some(b)) if a < b)
+}
+
+/// The fill step of a counting sort: `list[cursor] = value`, then the
+/// cursor (a row's next free entry) moves on.
+fn place(list: &mut [u32], cursor: &mut u32, value: u32) {
+    if let Some(slot) = list.get_mut(*cursor as usize) {
+        *slot = value;
+    }
+    *cursor += 1;
 }
 
 /// Counts (entry `i + 1` holds row `i`'s count) to starts, in place.

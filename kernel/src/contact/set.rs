@@ -6,16 +6,17 @@
 use nalgebra::Vector3;
 
 use crate::Real;
+use crate::table::{TriangleIndex, VertexIndex};
 
 /// A tool point touching a surface triangle, from detection to force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact<T> {
     /// The tool point (index into the loop's tool points).
     pub tool: usize,
-    /// The surface triangle (index into the surface's triangles).
-    pub triangle: u32,
-    /// Its mesh vertices.
-    pub vertices: [u32; 3],
+    /// The surface triangle (checked index into the surface's triangles).
+    pub triangle: TriangleIndex,
+    /// Its mesh vertices (checked indices of the surface's vertices).
+    pub vertices: [VertexIndex; 3],
     /// Barycentric weights of the contact point, each in `[0, 1]`, summing
     /// to 1.
     pub weights: [T; 3],

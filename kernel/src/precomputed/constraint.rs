@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 
 use crate::Real;
 use crate::contact::Contact;
-use crate::table::{PrecomputedTable, VertexSlot};
+use crate::table::{FreeIndex, PrecomputedTable, VertexIndex, VertexSlot};
 
 /// Where a contact acts on the surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,7 +65,7 @@ impl<T: Real> AsConstraint<T> for Constraint<T> {
 impl<T: Real> AsConstraint<T> for Contact<T> {
     fn point(&self) -> ContactPoint<T> {
         ContactPoint::Triangle {
-            vertices: self.vertices,
+            vertices: self.vertices.map(VertexIndex::as_u32),
             weights: self.weights,
         }
     }
@@ -198,14 +198,24 @@ impl core::error::Error for ContactError {}
 /// indices with weights. Fixed vertices (zero compliance) are dropped.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ResolvedPoint<T> {
-    pub(crate) touchable: [u32; 3],
+    pub(crate) touchable: [FreeIndex; 3],
     pub(crate) weights: [T; 3],
     pub(crate) len: usize,
 }
 
 impl<T: Real> ResolvedPoint<T> {
+    /// A point with no term.
+    pub(crate) fn empty() -> Self {
+        Self {
+            // Placeholders, never read: `terms` stops at `len`.
+            touchable: [FreeIndex::checked(0); 3],
+            weights: [T::zero(); 3],
+            len: 0,
+        }
+    }
+
     /// The `(touchable index, weight)` pairs, at most three.
-    pub(crate) fn terms(&self) -> impl Iterator<Item = (u32, T)> + '_ {
+    pub(crate) fn terms(&self) -> impl Iterator<Item = (FreeIndex, T)> + '_ {
         self.touchable
             .iter()
             .copied()
@@ -226,26 +236,22 @@ pub(crate) fn resolve<T: Real>(
             contact: contact_index,
         });
     }
-    let touchable = table.touchable_count() as u32;
-    let lookup = |vertex: u32| -> Result<Option<u32>, ContactError> {
+    let touchable = table.touchable_count();
+    let lookup = |vertex: u32| -> Result<Option<FreeIndex>, ContactError> {
         match table.slot(vertex) {
             None => Err(ContactError::VertexOutOfRange {
                 contact: contact_index,
                 vertex,
             }),
             Some(VertexSlot::Fixed) => Ok(None),
-            Some(VertexSlot::Free(i)) if i.as_u32() < touchable => Ok(Some(i.as_u32())),
+            Some(VertexSlot::Free(i)) if i.get() < touchable => Ok(Some(i)),
             Some(VertexSlot::Free(_)) => Err(ContactError::NotOnSurface {
                 contact: contact_index,
                 vertex,
             }),
         }
     };
-    let mut point = ResolvedPoint {
-        touchable: [0; 3],
-        weights: [T::zero(); 3],
-        len: 0,
-    };
+    let mut point = ResolvedPoint::empty();
     match contact.point() {
         ContactPoint::Vertex(vertex) => {
             let slot = lookup(vertex)?.ok_or(ContactError::FixedVertex {

@@ -6,9 +6,9 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
 use crate::math::cholesky::solve_blocks;
-use crate::{MAX_CONTACT_CAPACITY, Real};
 use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
+use crate::{MAX_CONTACT_CAPACITY, Real};
 
 /// The pre-computed model over a validated table (RR-3510 §4, MODELS.md §2).
 /// Holds no mutable state: every query is a pure function of the table and
@@ -116,13 +116,8 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 capacity: M,
             });
         }
-        let empty = ResolvedPoint {
-            touchable: [0; 3],
-            weights: [T::zero(); 3],
-            len: 0,
-        };
         let mut solution = ContactSolution {
-            points: [empty; M],
+            points: [ResolvedPoint::empty(); M],
             forces_n: [Vector3::zeros(); M],
             len: m,
         };
@@ -177,7 +172,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         let mut c = Matrix3::zeros();
         for (a, beta_a) in p.terms() {
             for (b, beta_b) in q.terms() {
-                if let Some(block) = self.table.touchable_block(a, b) {
+                if let Some(block) = self.table.touchable_block_of(a, b) {
                     c += block * (beta_a * beta_b);
                 }
             }
@@ -244,7 +239,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     ) {
         for (point, g) in solution.resolved() {
             for (k, beta) in point.terms() {
-                self.add_column_rows(k as usize, &(g * beta), first, out);
+                self.add_column_rows(k.get(), &(g * beta), first, out);
             }
         }
     }

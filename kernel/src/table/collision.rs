@@ -12,14 +12,21 @@
 use nalgebra::Vector3;
 
 use super::LoadError;
+use super::index::{TriangleIndex, VertexIndex, csr_row, span};
 use crate::Real;
 
-/// The validated collision index (a view into the table).
+/// The validated collision index (a view into the table), with the surface
+/// triangles it was built over.
+///
+/// Invariants (checked by [`super::PrecomputedTable::load`], by
+/// construction for an index the kernel assembled): every filed vertex and every triangle
+/// corner is a vertex of the surface's positions, and every triangle in a
+/// vertex's list is a surface triangle containing it, so the indices it
+/// hands out ([`VertexIndex`], [`TriangleIndex`]) are in range.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceIndex<'a, T> {
-    origin_m: Vector3<T>,
-    cell_m: T,
-    dims: [u32; 3],
+    grid: Grid<T>,
+    triangles: &'a [[u32; 3]],
     cell_start: &'a [u32],
     grid_vertex: &'a [u32],
     vertex_triangle_start: &'a [u32],
@@ -53,6 +60,37 @@ pub struct Grid<T> {
     pub dims: [u32; 3],
 }
 
+/// Cell coordinates or counts per axis, widened for indexing.
+fn widen(c: [u32; 3]) -> [usize; 3] {
+    c.map(|x| x as usize)
+}
+
+impl<T> Grid<T> {
+    /// Cells of the grid (`nx · ny · nz`), `None` if that overflows.
+    pub(crate) fn cell_count(&self) -> Option<usize> {
+        widen(self.dims)
+            .iter()
+            .try_fold(1usize, |n, &d| n.checked_mul(d))
+    }
+
+    /// The linear index `i + nx (j + ny k)` of cell `c = [i, j, k]`.
+    pub(crate) fn linear(&self, c: [u32; 3]) -> usize {
+        let ([i, j, k], [nx, ny, _]) = (widen(c), widen(self.dims));
+        i + nx * (j + ny * k)
+    }
+
+    /// The cell `[i, j, k]` of linear index `cell` (its inverse).
+    fn coordinates(&self, cell: usize) -> [u32; 3] {
+        let [nx, ny, _] = widen(self.dims);
+        let (x, rest) = (cell.checked_rem(nx), cell.checked_div(nx));
+        let (y, z) = (
+            rest.and_then(|r| r.checked_rem(ny)),
+            rest.and_then(|r| r.checked_div(ny)),
+        );
+        [x, y, z].map(|c| c.unwrap_or(0) as u32)
+    }
+}
+
 impl<T: Real> Grid<T> {
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
@@ -80,6 +118,8 @@ impl<T: Real> Grid<T> {
 /// The lists of an index the kernel built itself (re-binning a deforming
 /// surface), consistent by construction.
 pub(crate) struct BuiltLists<'a, T> {
+    /// The surface triangles (vertices of the surface's positions).
+    pub(crate) triangles: &'a [[u32; 3]],
     pub(crate) cell_start: &'a [u32],
     pub(crate) grid_vertex: &'a [u32],
     pub(crate) vertex_triangle_start: &'a [u32],
@@ -115,29 +155,28 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     pub(crate) fn new(
         s: &SurfaceSections<'a, T>,
         positions: &[[T; 3]],
-        triangles: &[[u32; 3]],
+        triangles: &'a [[u32; 3]],
     ) -> Result<Self, LoadError> {
-        let grid_error = |index: usize| LoadError::BadSurfaceGrid {
-            index: index as u32,
-        };
+        let grid_error = |index: u32| LoadError::BadSurfaceGrid { index };
         let (Some(&[x, y, z, cell_m]), Some(&dims)) = (s.grid.first(), s.dims.first()) else {
             return Err(grid_error(0));
         };
-        let cells = dims
-            .iter()
-            .try_fold(1usize, |n, &d| n.checked_mul(d as usize));
+        let grid = Grid {
+            origin_m: Vector3::new(x, y, z),
+            cell_m,
+            dims,
+        };
         let geometry_ok = [x, y, z, cell_m].iter().all(|v| v.finite()) && cell_m > T::zero();
         if !geometry_ok
             || dims.contains(&0)
-            || cells.and_then(|c| c.checked_add(1)) != Some(s.cell_start.len())
+            || grid.cell_count().and_then(|c| c.checked_add(1)) != Some(s.cell_start.len())
             || !csr_ok(s.cell_start, s.grid_vertex.len())
         {
             return Err(grid_error(0));
         }
         let index = Self {
-            origin_m: Vector3::new(x, y, z),
-            cell_m,
-            dims,
+            grid,
+            triangles,
             cell_start: s.cell_start,
             grid_vertex: s.grid_vertex,
             vertex_triangle_start: s.vertex_triangle_start,
@@ -150,16 +189,15 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         // Every filed vertex exists and lies within one cell of its own.
         for (cell, bucket) in s.cell_start.windows(2).enumerate() {
             let [start, end] = bucket else { continue };
-            let vertices = s
-                .grid_vertex
-                .get(*start as usize..*end as usize)
-                .unwrap_or(&[]);
+            let vertices = s.grid_vertex.get(span(*start, *end)).unwrap_or(&[]);
             for &v in vertices {
-                let p = positions.get(v as usize).ok_or(grid_error(v as usize))?;
-                let home = index.cell_of(&Vector3::new(p[0], p[1], p[2]));
-                let filed = index.coordinates(cell);
+                let p = VertexIndex::new(v, positions.len())
+                    .and_then(|v| positions.get(v.get()))
+                    .ok_or(grid_error(v))?;
+                let home = grid.cell_of(&Vector3::new(p[0], p[1], p[2]));
+                let filed = grid.coordinates(cell);
                 if home.iter().zip(filed).any(|(&a, b)| a.abs_diff(b) > 1) {
-                    return Err(grid_error(v as usize));
+                    return Err(grid_error(v));
                 }
             }
         }
@@ -173,15 +211,14 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         for (v, row) in s.vertex_triangle_start.windows(2).enumerate() {
             let bad = LoadError::BadVertexTriangles { vertex: v as u32 };
             let [start, end] = row else { continue };
-            let list = s
-                .vertex_triangle
-                .get(*start as usize..*end as usize)
-                .ok_or(bad)?;
+            let list = s.vertex_triangle.get(span(*start, *end)).ok_or(bad)?;
             if !list.windows(2).all(|w| w.first() < w.get(1)) {
                 return Err(bad);
             }
             for &t in list {
-                let tri = triangles.get(t as usize).ok_or(bad)?;
+                let tri = TriangleIndex::new(t, triangles.len())
+                    .and_then(|t| triangles.get(t.get()))
+                    .ok_or(bad)?;
                 if !tri.contains(&(v as u32)) {
                     return Err(bad);
                 }
@@ -196,7 +233,9 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             let n = Vector3::new(nx, ny, nz);
             let mut corners = [Vector3::zeros(); 3];
             for (c, &v) in corners.iter_mut().zip(tri) {
-                let p = positions.get(v as usize).ok_or(bad)?;
+                let p = VertexIndex::new(v, positions.len())
+                    .and_then(|v| positions.get(v.get()))
+                    .ok_or(bad)?;
                 *c = Vector3::new(p[0], p[1], p[2]);
             }
             let [a, b, c] = corners;
@@ -250,9 +289,8 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             .saturating_mul(max_valence)
             .min(lists.vertex_triangle.len() as u32);
         Self {
-            origin_m: grid.origin_m,
-            cell_m: grid.cell_m,
-            dims: grid.dims,
+            grid,
+            triangles: lists.triangles,
             cell_start: lists.cell_start,
             grid_vertex: lists.grid_vertex,
             vertex_triangle_start: lists.vertex_triangle_start,
@@ -268,9 +306,9 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     fn cell_centre(&self, c: [u32; 3]) -> Vector3<T> {
         let half = T::of_f64(0.5);
         let at = |axis: usize| {
-            let o = self.origin_m.get(axis).copied().unwrap_or(T::zero());
+            let o = self.grid.origin_m.get(axis).copied().unwrap_or(T::zero());
             let i = c.get(axis).copied().unwrap_or(0);
-            o + (T::of_f64(f64::from(i)) + half) * self.cell_m
+            o + (T::of_f64(f64::from(i)) + half) * self.grid.cell_m
         };
         Vector3::new(at(0), at(1), at(2))
     }
@@ -285,17 +323,17 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
 
     /// Grid origin, m.
     pub fn origin_m(&self) -> Vector3<T> {
-        self.origin_m
+        self.grid.origin_m
     }
 
     /// Grid cell edge, m.
     pub fn cell_m(&self) -> T {
-        self.cell_m
+        self.grid.cell_m
     }
 
     /// Cells per axis.
     pub fn dims(&self) -> [u32; 3] {
-        self.dims
+        self.grid.dims
     }
 
     /// Most vertices in one cell (a table-declared loop bound).
@@ -311,72 +349,91 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
     pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
-        Grid {
-            origin_m: self.origin_m,
-            cell_m: self.cell_m,
-            dims: self.dims,
-        }
-        .cell_of(p)
+        self.grid.cell_of(p)
     }
 
     /// `true` if `p` (m) lies within one cell edge plus `margin_m` of the
     /// grid's box (a point farther out has no surface vertex within a cell).
     pub fn is_near(&self, p: &Vector3<T>, margin_m: T) -> bool {
-        let reach = self.cell_m + margin_m;
+        let Grid {
+            origin_m,
+            cell_m,
+            dims,
+        } = &self.grid;
+        let reach = *cell_m + margin_m;
         p.iter()
-            .zip(self.origin_m.iter())
-            .zip(&self.dims)
+            .zip(origin_m.iter())
+            .zip(dims)
             .all(|((&x, &o), &d)| {
-                let extent = self.cell_m * T::of_f64(f64::from(d));
+                let extent = *cell_m * T::of_f64(f64::from(d));
                 x >= o - reach && x <= o + extent + reach
             })
     }
 
-    fn coordinates(&self, cell: usize) -> [u32; 3] {
-        let [nx, ny, _] = self.dims.map(|d| d as usize);
-        let (x, rest) = (cell.checked_rem(nx), cell.checked_div(nx));
-        let (y, z) = (
-            rest.and_then(|r| r.checked_rem(ny)),
-            rest.and_then(|r| r.checked_div(ny)),
-        );
-        [x, y, z].map(|c| c.unwrap_or(0) as u32)
-    }
-
     /// The surface vertices filed in the 27 cells around the cell of `p`
     /// (m). Bounded by `27 × max_bucket`.
-    pub fn vertices_near(&self, p: &Vector3<T>) -> impl Iterator<Item = u32> + '_ {
+    pub fn vertices_near(&self, p: &Vector3<T>) -> impl Iterator<Item = VertexIndex> + '_ {
         let [cx, cy, cz] = self.cell_of(p);
-        let [nx, ny, nz] = self.dims;
+        let [nx, ny, nz] = self.grid.dims;
         let range = |c: u32, n: u32| c.saturating_sub(1)..=(c + 1).min(n.saturating_sub(1));
         range(cz, nz).flat_map(move |k| {
             range(cy, ny).flat_map(move |j| {
                 range(cx, nx).flat_map(move |i| {
-                    let cell = i as usize + nx as usize * (j as usize + ny as usize * k as usize);
-                    let start = self.cell_start.get(cell).copied().unwrap_or(0) as usize;
-                    let end = self.cell_start.get(cell + 1).copied().unwrap_or(0) as usize;
-                    self.grid_vertex
-                        .get(start..end)
-                        .unwrap_or(&[])
-                        .iter()
-                        .copied()
+                    let bucket = csr_row(self.cell_start, self.grid.linear([i, j, k]))
+                        .and_then(|row| self.grid_vertex.get(row))
+                        .unwrap_or(&[]);
+                    // Filed vertices are vertices of the surface (invariant).
+                    bucket.iter().map(|&v| VertexIndex::checked(v))
                 })
             })
         })
     }
 
+    /// The vertices of surface triangle `t`; `None` for an index of
+    /// another surface beyond this one's triangles.
+    pub fn triangle(&self, t: TriangleIndex) -> Option<[VertexIndex; 3]> {
+        // Triangle corners are vertices of the surface (invariant).
+        Some(self.triangles.get(t.get())?.map(VertexIndex::checked))
+    }
+
     /// The stored plane of surface triangle `t`: unit outward normal and
     /// offset `n·p` (m).
-    pub fn plane(&self, t: u32) -> Option<(Vector3<T>, T)> {
-        let [x, y, z, d] = *self.planes.get(t as usize)?;
+    pub fn plane(&self, t: TriangleIndex) -> Option<(Vector3<T>, T)> {
+        let [x, y, z, d] = *self.planes.get(t.get())?;
         Some((Vector3::new(x, y, z), d))
     }
 
-    /// The surface triangles around `vertex` (indices into the table's
-    /// surface triangles), ascending. Bounded by `max_valence`.
-    pub fn triangles_of(&self, vertex: u32) -> &'a [u32] {
-        let v = vertex as usize;
-        let start = self.vertex_triangle_start.get(v).copied().unwrap_or(0) as usize;
-        let end = self.vertex_triangle_start.get(v + 1).copied().unwrap_or(0) as usize;
-        self.vertex_triangle.get(start..end).unwrap_or(&[])
+    /// The surface triangles around `vertex`, ascending. Bounded by
+    /// `max_valence`.
+    pub fn triangles_of(
+        &self,
+        vertex: VertexIndex,
+    ) -> impl ExactSizeIterator<Item = TriangleIndex> + Clone + use<'a, T> {
+        // Listed triangles are surface triangles (invariant).
+        self.triangle_row(vertex)
+            .iter()
+            .map(|&t| TriangleIndex::checked(t))
+    }
+
+    /// The surface triangle other than `not` around both `a` and `b` (the
+    /// neighbour of `not` across its edge `ab`), the first in ascending
+    /// order if several. Bounded by `max_valence` binary searches.
+    pub fn across(
+        &self,
+        not: TriangleIndex,
+        a: VertexIndex,
+        b: VertexIndex,
+    ) -> Option<TriangleIndex> {
+        let around_b = self.triangle_row(b);
+        self.triangles_of(a)
+            .find(|&t| t != not && around_b.binary_search(&t.as_u32()).is_ok())
+    }
+
+    /// The row of `vertex` in the vertex-to-triangle list (empty out of
+    /// range).
+    fn triangle_row(&self, vertex: VertexIndex) -> &'a [u32] {
+        csr_row(self.vertex_triangle_start, vertex.get())
+            .and_then(|row| self.vertex_triangle.get(row))
+            .unwrap_or(&[])
     }
 }

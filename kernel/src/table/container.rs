@@ -114,7 +114,7 @@ fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result
     let directory_len = (h.section_count as usize).checked_mul(SECTION_ENTRY_LEN);
     let header_len = directory_len.and_then(|d| d.checked_add(HEADER_LEN));
     if header_len != Some(h.header_len as usize)
-        || h.header_len as usize > body_len
+        || header_len.is_some_and(|len| len > body_len)
         || h.free_count > h.vertex_count
         || h.touchable_count > h.free_count
         || h.reserved != 0

@@ -30,7 +30,10 @@
 //! [`RawHeader::mesh_triangle_count`] and the St Venant-Kirchhoff term
 //! sections of tensor-mass tables ([`SectionKind::VertexTerms`] to
 //! [`SectionKind::TetTerms`], Picinbono 2001 §3.1, table 1; the monomial
-//! layouts are documented in the tensor-mass model's `stvk_terms` module).
+//! layouts are documented in the tensor-mass model's `stvk_terms` module),
+//! a 104-byte header at first, then [`RawHeader::grid_cell_count`] and
+//! [`RawHeader::surface_vertex_count`] with the collision-index sections of
+//! pre-computed tables: the 112-byte header of today ([`HEADER_LEN`]).
 
 use bytemuck::{Pod, Zeroable};
 

@@ -5,7 +5,10 @@
 //!
 //! A table is bytes until [`PrecomputedTable::load`] has checked it once
 //! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
-//! diagonal blocks); afterwards the step path trusts it.
+//! diagonal blocks); afterwards the step path trusts it, and indexes it with
+//! the checked indices the views hand out ([`VertexIndex`],
+//! [`TriangleIndex`], [`TetIndex`], [`EdgeIndex`], [`FreeIndex`]) instead of
+//! raw `u32`s: the format's sentinels stay inside this module.
 
 mod collision;
 mod container;
@@ -18,7 +21,8 @@ mod tensor_mass;
 pub(crate) use collision::BuiltLists;
 pub use collision::{Grid, SurfaceIndex, max_row};
 pub use error::LoadError;
-pub use index::{FreeIndex, VertexSlot};
+pub(crate) use index::span;
+pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};
 pub use precomputed::PrecomputedTable;
 pub use tensor_mass::TensorMassTable;
 

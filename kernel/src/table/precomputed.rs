@@ -3,10 +3,10 @@
 use nalgebra::Matrix3;
 
 use super::LoadError;
+use super::collision::{SurfaceIndex, SurfaceSections};
 use super::container::{Container, check_finite};
 use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TableKind};
-use super::collision::{SurfaceIndex, SurfaceSections};
-use super::index::VertexSlot;
+use super::index::{FreeIndex, VertexIndex, VertexSlot};
 use crate::Real;
 use crate::math::cholesky::cholesky3;
 
@@ -116,17 +116,36 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         self.header.poisson
     }
 
+    /// `vertex` as a checked index of this table's vertices; `None` out of
+    /// range.
+    pub fn vertex(&self, vertex: u32) -> Option<VertexIndex> {
+        VertexIndex::new(vertex, self.vertex_count())
+    }
+
     /// Where `vertex` stands: free (with its free index) or fixed; `None`
     /// out of range.
     pub fn slot(&self, vertex: u32) -> Option<VertexSlot> {
+        self.vertex_slot_of(self.vertex(vertex)?)
+    }
+
+    /// Where the checked `vertex` stands ([`Self::slot`] without the range
+    /// check; `None` only for an index of a larger table).
+    pub fn vertex_slot_of(&self, vertex: VertexIndex) -> Option<VertexSlot> {
         self.vertex_slot
-            .get(vertex as usize)
+            .get(vertex.get())
             .map(|&entry| VertexSlot::of_entry(entry))
     }
 
     /// `true` if `vertex` is fixed (zero displacement). Out of range: `false`.
     pub fn is_fixed(&self, vertex: u32) -> bool {
         self.slot(vertex).is_some_and(VertexSlot::is_fixed)
+    }
+
+    /// `true` if the checked `vertex` is fixed ([`Self::is_fixed`] without
+    /// the range check).
+    pub fn is_fixed_vertex(&self, vertex: VertexIndex) -> bool {
+        self.vertex_slot_of(vertex)
+            .is_some_and(VertexSlot::is_fixed)
     }
 
     /// Vertex of each free index; the first [`Self::touchable_count`] are the
@@ -158,13 +177,20 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// `C_nk` for two touchable free indices `n`, `k` (either order; the
     /// transpose is taken for `n > k`), m/N. `None` if either is not touchable.
     pub fn touchable_block(&self, n: u32, k: u32) -> Option<Matrix3<T>> {
+        let s = self.touchable_count();
+        self.touchable_block_of(FreeIndex::new(n, s)?, FreeIndex::new(k, s)?)
+    }
+
+    /// `C_nk` for two free indices `n`, `k` ([`Self::touchable_block`] on
+    /// checked indices), m/N. `None` if either is not touchable.
+    pub fn touchable_block_of(&self, n: FreeIndex, k: FreeIndex) -> Option<Matrix3<T>> {
         let (lo, hi) = if n <= k { (n, k) } else { (k, n) };
-        if hi as usize >= self.touchable_count() {
+        if hi.get() >= self.touchable_count() {
             return None;
         }
         let raw = self
             .surface
-            .get(format::surface_block_index(lo as usize, hi as usize))?;
+            .get(format::surface_block_index(lo.get(), hi.get()))?;
         let block = Matrix3::from_row_slice(raw);
         Some(if n <= k { block } else { block.transpose() })
     }
@@ -208,10 +234,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             let scale = c.abs().max();
             let sym_tol = T::of_f64(1e-4) * scale;
             let asym = (c - c.transpose()).abs().max();
-            if asym > sym_tol
-                || !asym.finite()
-                || cholesky3(&c, T::zero()).is_none()
-            {
+            if asym > sym_tol || !asym.finite() || cholesky3(&c, T::zero()).is_none() {
                 return Err(bad);
             }
         }
@@ -222,7 +245,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
 /// Every surface triangle's vertices are `< n`.
 fn check_triangles(triangles: &[[u32; 3]], n: usize) -> Result<(), LoadError> {
     for (t, tri) in triangles.iter().enumerate() {
-        if tri.iter().any(|&v| v as usize >= n) {
+        if tri.iter().any(|&v| VertexIndex::new(v, n).is_none()) {
             return Err(LoadError::BadTriangle { triangle: t as u32 });
         }
     }

@@ -8,6 +8,7 @@ use super::format::{
     EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_SHAPE_LEN, TET_TERMS_LEN,
     TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN, tet_edge_vertices, tet_face_vertices,
 };
+use super::index::{EdgeIndex, TetIndex, VertexIndex, csr_row, span};
 use crate::Real;
 
 /// A tensor-mass table that passed every load-time check.
@@ -103,7 +104,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         if let Some(t) = table
             .triangles
             .iter()
-            .position(|tri| tri.iter().any(|&v| v as usize >= table.vertex_count()))
+            .position(|tri| tri.iter().any(|&v| table.vertex(v).is_none()))
         {
             return Err(LoadError::BadTriangle { triangle: t as u32 });
         }
@@ -148,9 +149,53 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         self.header.density_kg_m3
     }
 
+    /// `vertex` as a checked index of this table's vertices; `None` out of
+    /// range.
+    pub fn vertex(&self, vertex: u32) -> Option<VertexIndex> {
+        VertexIndex::new(vertex, self.vertex_count())
+    }
+
+    /// `tet` as a checked index of this table's tets; `None` out of range.
+    pub fn tet(&self, tet: u32) -> Option<TetIndex> {
+        TetIndex::new(tet, self.tet_count())
+    }
+
     /// `true` if `vertex` is fixed by the table (out of range: `false`).
     pub fn is_fixed(&self, vertex: u32) -> bool {
-        self.vertex_slot.get(vertex as usize) == Some(&FIXED_SLOT)
+        self.vertex(vertex).is_some_and(|v| self.is_fixed_vertex(v))
+    }
+
+    /// `true` if the checked `vertex` is fixed ([`Self::is_fixed`] without
+    /// the range check).
+    pub fn is_fixed_vertex(&self, vertex: VertexIndex) -> bool {
+        self.vertex_slot.get(vertex.get()) == Some(&FIXED_SLOT)
+    }
+
+    /// Every tet index, ascending.
+    pub fn tet_indices(&self) -> impl ExactSizeIterator<Item = TetIndex> + use<T> {
+        let count = u32::try_from(self.tet_count()).unwrap_or(u32::MAX);
+        (0..count).map(TetIndex::checked)
+    }
+
+    /// The vertices of `tet` (checked at load: `< N`).
+    pub fn tet_vertices(&self, tet: TetIndex) -> Option<[VertexIndex; 4]> {
+        Some(self.tets.get(tet.get())?.map(VertexIndex::checked))
+    }
+
+    /// The edges of `tet` in [`tet_edge_vertices`] order (checked at load:
+    /// `< E`).
+    pub fn tet_edge_indices(&self, tet: TetIndex) -> Option<[EdgeIndex; 6]> {
+        Some(self.tet_edges.get(tet.get())?.map(EdgeIndex::checked))
+    }
+
+    /// The neighbour of `tet` across the face opposite each local vertex,
+    /// `None` where the face is on the boundary ([`NO_NEIGHBOUR`] in the
+    /// section) or `tet` is out of range.
+    pub fn neighbours_of(&self, tet: TetIndex) -> [Option<TetIndex>; 4] {
+        let row = self.neighbours.get(tet.get()).copied();
+        // Checked at load: `< tet_count` or the sentinel.
+        row.unwrap_or([NO_NEIGHBOUR; 4])
+            .map(|o| (o != NO_NEIGHBOUR).then_some(TetIndex::checked(o)))
     }
 
     /// Rest positions, m.
@@ -261,11 +306,19 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
     /// The edge `(i, j)` (either order) if it exists: its index. Bounded by
     /// the row length of `min(i, j)`.
     pub fn edge_index(&self, i: u32, j: u32) -> Option<u32> {
+        let (i, j) = (self.vertex(i)?, self.vertex(j)?);
+        self.edge_between(i, j).map(EdgeIndex::as_u32)
+    }
+
+    /// The edge between the checked vertices `i` and `j` (either order), if
+    /// any ([`Self::edge_index`] on checked indices).
+    pub fn edge_between(&self, i: VertexIndex, j: VertexIndex) -> Option<EdgeIndex> {
         let (lo, hi) = if i < j { (i, j) } else { (j, i) };
-        let start = *self.row_start.get(lo as usize)?;
-        let end = *self.row_start.get(lo as usize + 1)?;
-        let row = self.column.get(start as usize..end as usize)?;
-        row.binary_search(&hi).ok().map(|k| start + k as u32)
+        let row = csr_row(self.row_start, lo.get())?;
+        let start = row.start;
+        let k = self.column.get(row)?.binary_search(&hi.as_u32()).ok()?;
+        // An edge of the validated CSR list: `< E`.
+        Some(EdgeIndex::checked(u32::try_from(start + k).ok()?))
     }
 
     fn check_vertices(&self) -> Result<(), LoadError> {
@@ -297,10 +350,10 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
             let [start, end] = *pair else {
                 return Err(bad);
             };
-            let row = self.column.get(start as usize..end as usize).ok_or(bad)?;
+            let row = self.column.get(span(start, end)).ok_or(bad)?;
             let mut previous = i as u32;
             for &j in row {
-                if j <= previous || j as usize >= n {
+                if j <= previous || VertexIndex::new(j, n).is_none() {
                     return Err(bad);
                 }
                 previous = j;

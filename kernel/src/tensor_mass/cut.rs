@@ -13,7 +13,8 @@ use super::model::TensorMassModel;
 use super::stvk_terms::{TetPlace, tet_terms};
 use crate::Real;
 use crate::math::element::stiffness_block;
-use crate::table::format::{NO_NEIGHBOUR, TET_EDGE_PAIRS, tet_face_vertices};
+use crate::table::format::{TET_EDGE_PAIRS, tet_face_vertices};
+use crate::table::{EdgeIndex, TetIndex, VertexIndex};
 
 /// Why a tet was not removed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,57 +50,69 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
     /// Bounded: a hanging tet has no live face neighbour, so removing it
     /// cannot leave another tet hanging; at most 4 follow the first.
     pub fn remove_tet(&mut self, tet: u32) -> Result<u32, RemoveError> {
-        let t = tet as usize;
-        match self.state.tet_alive.get(t) {
+        let t = self
+            .table
+            .tet(tet)
+            .ok_or(RemoveError::TetOutOfRange { tet })?;
+        self.remove(t)
+    }
+
+    /// [`Self::remove_tet`] of a checked tet.
+    fn remove(&mut self, t: TetIndex) -> Result<u32, RemoveError> {
+        let tet = t.as_u32();
+        match self.state.tet_alive.get(t.get()) {
             None => return Err(RemoveError::TetOutOfRange { tet }),
             Some(false) => return Err(RemoveError::AlreadyRemoved { tet }),
             Some(true) => {}
         }
         self.subtract(t);
         let mut removed = 1;
-        let neighbours = self.table.tet_neighbours().get(t).copied();
-        for other in neighbours.unwrap_or([NO_NEIGHBOUR; 4]) {
+        for other in self.table.neighbours_of(t).into_iter().flatten() {
             if self.is_alive(other) && self.live_face_neighbours(other) == 0 {
-                self.subtract(other as usize);
+                self.subtract(other);
                 removed += 1;
             }
         }
         Ok(removed)
     }
 
-    fn is_alive(&self, tet: u32) -> bool {
-        self.state.tet_alive.get(tet as usize) == Some(&true)
+    fn is_alive(&self, tet: TetIndex) -> bool {
+        self.state.tet_alive.get(tet.get()) == Some(&true)
     }
 
-    fn live_face_neighbours(&self, tet: u32) -> usize {
-        let neighbours = self.table.tet_neighbours().get(tet as usize);
-        neighbours.map_or(0, |n| n.iter().filter(|&&o| self.is_alive(o)).count())
+    fn live_face_neighbours(&self, tet: TetIndex) -> usize {
+        let neighbours = self.table.neighbours_of(tet).into_iter().flatten();
+        neighbours.filter(|&o| self.is_alive(o)).count()
     }
 
     /// The current boundary surface: every face of a live tet whose
     /// neighbour across it is absent or removed, outward right-hand normal.
     /// Bounded by `4 × tet_count`.
     pub fn surface_triangles(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
-        let tets = self.table.tets().iter().zip(self.table.tet_neighbours());
-        tets.zip(self.state.tet_alive.iter())
-            .filter(|(_, alive)| **alive)
-            .flat_map(move |((tet, neighbours), _)| {
-                tet_face_vertices(*tet)
-                    .into_iter()
-                    .zip(*neighbours)
-                    .filter(move |(_, other)| !self.is_alive(*other))
-                    .map(|(face, _)| face)
-            })
+        let live = self.table.tet_indices().filter(move |&t| self.is_alive(t));
+        live.flat_map(move |t| {
+            let faces = self
+                .table
+                .tets()
+                .get(t.get())
+                .map(|&tet| tet_face_vertices(tet));
+            faces
+                .into_iter()
+                .flatten()
+                .zip(self.table.neighbours_of(t))
+                .filter(move |(_, other)| !other.is_some_and(|o| self.is_alive(o)))
+                .map(|(face, _)| face)
+        })
     }
 
     /// Subtracts tet `t`'s blocks and mass shares and marks it removed. A
     /// vertex left without live tets is detached: mass, vertex tensor and
     /// velocity set to exactly zero (it keeps still).
-    fn subtract(&mut self, t: usize) {
-        let (Some(&tet), Some(edges), Some((a, volume))) = (
-            self.table.tets().get(t),
-            self.table.tet_edges().get(t),
-            self.table.tet_shape(t),
+    fn subtract(&mut self, t: TetIndex) {
+        let (Some(tet), Some(edges), Some((a, volume))) = (
+            self.table.tet_vertices(t),
+            self.table.tet_edge_indices(t),
+            self.table.tet_shape(t.get()),
         ) else {
             return;
         };
@@ -107,7 +120,7 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         let share = T::of_f64(self.table.density_kg_m3()) * volume / T::of_f64(4.0);
         let s = &mut self.state;
         for (&v, aj) in tet.iter().zip(&a) {
-            let v = v as usize;
+            let v = v.get();
             let block = stiffness_block(aj, aj, volume, lambda, mu);
             let (Some(k), Some(m), Some(count), Some(vel)) = (
                 s.vertex_tensors.get_mut(v),
@@ -127,28 +140,30 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
                 *m -= share;
             }
         }
-        for ([j, l], &e) in TET_EDGE_PAIRS.into_iter().zip(edges) {
+        for ([j, l], &e) in TET_EDGE_PAIRS.into_iter().zip(&edges) {
             // The stored edge tensor couples its lower vertex (row) to its higher.
             let (Some(&vj), Some(&vl)) = (tet.get(j), tet.get(l)) else {
                 continue;
             };
             let (row, col) = if vj < vl { (j, l) } else { (l, j) };
             if let (Some(ar), Some(ac), Some(k)) =
-                (a.get(row), a.get(col), s.edge_tensors.get_mut(e as usize))
+                (a.get(row), a.get(col), s.edge_tensors.get_mut(e.get()))
             {
                 subtract_block(k, &stiffness_block(ar, ac, volume, lambda, mu));
             }
         }
-        if let (true, Some(&triangles)) = (s.has_stvk_terms(), self.table.tet_triangles().get(t)) {
+        let triangles = self.table.tet_triangles().get(t.get());
+        if let (true, Some(&triangles)) = (s.has_stvk_terms(), triangles) {
             let place = TetPlace {
-                tet: t as u32,
-                vertices: tet,
-                edges: *edges,
+                tet: t.as_u32(),
+                vertices: tet.map(VertexIndex::as_u32),
+                edges: edges.map(EdgeIndex::as_u32),
                 triangles,
             };
-            tet_terms(tet, &a, volume, lambda, mu).subtract_from(&place, &mut s.stvk_terms);
+            let terms = tet_terms(place.vertices, &a, volume, lambda, mu);
+            terms.subtract_from(&place, &mut s.stvk_terms);
         }
-        if let Some(alive) = s.tet_alive.get_mut(t) {
+        if let Some(alive) = s.tet_alive.get_mut(t.get()) {
             *alive = false;
         }
     }
@@ -186,9 +201,9 @@ pub struct TearThresholds<T> {
 
 impl<T: Real> TensorMassModel<'_, '_, T> {
     /// Current position of `vertex`, m (rest + displacement).
-    fn position(&self, vertex: u32) -> Option<Vector3<T>> {
-        let p = self.table.rest_positions().get(vertex as usize)?;
-        let u = self.state.displacement_m.get(vertex as usize)?;
+    fn position(&self, vertex: VertexIndex) -> Option<Vector3<T>> {
+        let p = self.table.rest_positions().get(vertex.get())?;
+        let u = self.state.displacement_m.get(vertex.get())?;
         Some(Vector3::new(p[0] + u[0], p[1] + u[1], p[2] + u[2]))
     }
 
@@ -233,12 +248,12 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
     }
 
     /// Current and rest corner positions of `tet`, m.
-    fn corners(&self, tet: [u32; 4]) -> Option<(Corners<T>, Corners<T>)> {
+    fn corners(&self, tet: [VertexIndex; 4]) -> Option<(Corners<T>, Corners<T>)> {
         let mut now = [Vector3::zeros(); 4];
         let mut rest = [Vector3::zeros(); 4];
         for ((n, r), &v) in now.iter_mut().zip(rest.iter_mut()).zip(&tet) {
             *n = self.position(v)?;
-            let p = self.table.rest_positions().get(v as usize)?;
+            let p = self.table.rest_positions().get(v.get())?;
             *r = Vector3::new(p[0], p[1], p[2]);
         }
         Some((now, rest))
@@ -249,21 +264,21 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
     fn remove_where(
         &mut self,
         capacity: u32,
-        qualifies: impl Fn(&Self, [u32; 4]) -> bool,
+        qualifies: impl Fn(&Self, [VertexIndex; 4]) -> bool,
     ) -> CutReport {
         let mut report = CutReport::default();
-        for t in 0..self.table.tet_count() {
-            let Some(&tet) = self.table.tets().get(t) else {
+        for t in self.table.tet_indices() {
+            let Some(tet) = self.table.tet_vertices(t) else {
                 break;
             };
-            if !self.is_alive(t as u32) || !qualifies(self, tet) {
+            if !self.is_alive(t) || !qualifies(self, tet) {
                 continue;
             }
             if report.removed >= capacity {
                 report.pending = true;
                 break;
             }
-            report.removed += self.remove_tet(t as u32).unwrap_or(0);
+            report.removed += self.remove(t).unwrap_or(0);
         }
         report
     }

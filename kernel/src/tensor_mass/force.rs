@@ -8,6 +8,7 @@ use super::law::{ElasticLaw, StvkForm};
 use super::stvk::TetPass;
 use super::stvk_terms::NonLinearTerms;
 use crate::Real;
+use crate::table::span;
 
 /// Everything the internal-force pass of a step reads, for the configured
 /// [`ElasticLaw`] and optional incompressibility penalty.
@@ -119,7 +120,7 @@ impl<T: Real> Stiffness<'_, T> {
             let (Some(&[start, end]), Some(ui)) = (pair.first_chunk::<2>(), u.get(i)) else {
                 continue;
             };
-            let range = start as usize..end as usize;
+            let range = span(start, end);
             let (Some(columns), Some(tensors)) =
                 (self.column.get(range.clone()), self.edge_tensors.get(range))
             else {

@@ -6,8 +6,8 @@ use nalgebra::Vector3;
 
 use super::force::{InternalForces, Stiffness, vec3};
 use super::integrator::{Integrator, Loads};
-use super::limits::{Limits, Watch};
 use super::law::{ElasticLaw, StvkForm};
+use super::limits::{Limits, Watch};
 use super::state::{Fault, StateBuffers, StateError, VertexMode};
 use super::stvk::TetPass;
 use super::stvk_terms::{NonLinearTerms, TermArraysMut};
@@ -36,7 +36,8 @@ impl<T: Real> DynamicParams<T> {
     /// The linear law without the penalty or gravity, with mass-proportional
     /// damping `damping_per_s` (1/s) and a displacement bound
     /// `max_displacement_m` (m); the kinetic-energy bound is off. Other
-    /// settings by struct update: `DynamicParams { law, ..DynamicParams::linear(c, d) }`.
+    /// settings by the `with_*` methods:
+    /// `DynamicParams::linear(c, d).with_law(law).with_gravity(g)`.
     pub fn linear(damping_per_s: T, max_displacement_m: T) -> Self {
         Self {
             law: ElasticLaw::Linear,
@@ -47,6 +48,43 @@ impl<T: Real> DynamicParams<T> {
                 max_displacement_m,
                 max_kinetic_energy_j: T::of_f64(f64::INFINITY),
             },
+        }
+    }
+
+    /// The same with the elastic force `law`.
+    #[must_use]
+    pub fn with_law(self, law: ElasticLaw) -> Self {
+        Self { law, ..self }
+    }
+
+    /// The same with the incompressibility penalty `γ` (N), `None` for off.
+    #[must_use]
+    pub fn with_incompressibility(self, incompressibility_n: Option<T>) -> Self {
+        Self {
+            incompressibility_n,
+            ..self
+        }
+    }
+
+    /// The same with gravity `gravity_m_s2` (m/s²) on every free vertex.
+    #[must_use]
+    pub fn with_gravity(self, gravity_m_s2: Vector3<T>) -> Self {
+        Self {
+            gravity_m_s2,
+            ..self
+        }
+    }
+
+    /// The same with the kinetic-energy bound `max_kinetic_energy_j` (J;
+    /// `+∞` is off).
+    #[must_use]
+    pub fn with_max_kinetic_energy(self, max_kinetic_energy_j: T) -> Self {
+        Self {
+            limits: Limits {
+                max_kinetic_energy_j,
+                ..self.limits
+            },
+            ..self
         }
     }
 }
@@ -198,9 +236,9 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         terms.tet.copy_from_slice_checked(self.table.tet_terms());
         s.tet_alive.fill(true);
         s.live_tets.fill(0);
-        for tet in self.table.tets() {
-            for &v in tet {
-                if let Some(count) = s.live_tets.get_mut(v as usize) {
+        for t in self.table.tet_indices() {
+            for v in self.table.tet_vertices(t).into_iter().flatten() {
+                if let Some(count) = s.live_tets.get_mut(v.get()) {
                     *count += 1;
                 }
             }
@@ -275,14 +313,14 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     }
 
     fn vertex_index(&self, vertex: u32) -> Result<usize, InputError> {
-        let v = vertex as usize;
-        if v >= self.state.modes.len() {
-            return Err(InputError::VertexOutOfRange { vertex });
-        }
-        if self.state.modes.get(v) == Some(&VertexMode::Fixed) {
+        let v = self
+            .table
+            .vertex(vertex)
+            .ok_or(InputError::VertexOutOfRange { vertex })?;
+        if self.state.modes.get(v.get()) == Some(&VertexMode::Fixed) {
             return Err(InputError::FixedVertex { vertex });
         }
-        Ok(v)
+        Ok(v.get())
     }
 
     /// The index of a free or imposed `vertex` taking the finite input `value`.

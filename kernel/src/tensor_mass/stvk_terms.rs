@@ -50,10 +50,10 @@
 use nalgebra::Vector3;
 
 use crate::Real;
-use crate::table::TensorMassTable;
 use crate::table::format::{
     EDGE_TERMS_LEN, TET_EDGE_PAIRS, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
 };
+use crate::table::{TensorMassTable, span};
 
 /// Cubic monomials owned by a vertex: `(u_0·c)(u_0·u_0)`.
 pub const VERTEX_CUBIC: [[usize; 3]; 1] = [[0, 0, 0]];
@@ -159,6 +159,8 @@ impl<T: Real> TetTerms<T> {
         self.scatter(place, arrays, -T::one());
     }
 
+    // `TetPlace` is plain `u32` data (the host's assembly builds it from its
+    // mesh): its entries are widened here, one bounds-checked `get_mut` each.
     fn scatter(&self, place: &TetPlace, arrays: &mut TermArraysMut<'_, T>, sign: T) {
         for (&v, terms) in place.vertices.iter().zip(&self.vertex) {
             axpy(arrays.vertex.get_mut(v as usize), terms, sign);
@@ -409,7 +411,7 @@ impl<'t, T: Real> NonLinearTerms<'t, T> {
             let &[start, end] = row else {
                 continue;
             };
-            let range = start as usize..end as usize;
+            let range = span(start, end);
             let (Some(columns), Some(terms)) = (
                 self.edge_column.get(range.clone()),
                 self.edge_terms.get(range),
@@ -549,6 +551,12 @@ fn monomials<T: Real, const V: usize, const NC: usize, const NQ: usize, const L:
 }
 
 #[cfg(test)]
+#[allow(
+    clippy::indexing_slicing,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic
+)]
 mod tests {
     use super::*;
 

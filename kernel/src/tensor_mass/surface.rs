@@ -238,6 +238,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
         SurfaceIndex::assembled(
             self.grid,
             BuiltLists {
+                triangles: self.triangles,
                 cell_start: self.buffers.cell_start.get(..=self.cells).unwrap_or(&[]),
                 grid_vertex: self.buffers.grid_vertex.get(..self.filed).unwrap_or(&[]),
                 vertex_triangle_start: self.buffers.vertex_triangle_start,
@@ -257,11 +258,6 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
     /// The surface at the last re-bin, for detection and tracking;
     /// `supports` names the table's fixed vertices.
     pub fn geometry<'g>(&'g self, supports: Supports<'g, T>) -> SurfaceGeometry<'g, T> {
-        SurfaceGeometry::of_parts(
-            self.buffers.positions_m,
-            self.triangles,
-            self.index(),
-            supports,
-        )
+        SurfaceGeometry::of_parts(self.buffers.positions_m, self.index(), supports)
     }
 }

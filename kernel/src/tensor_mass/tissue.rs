@@ -52,6 +52,7 @@ use super::surface::{DeformingSurface, NonFinitePosition, SurfaceBufferError, Su
 use super::{Integrator, StepError, StepReport, TensorMassModel};
 use crate::Real;
 use crate::contact::{Contact, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue};
+use crate::table::VertexIndex;
 
 /// Least `Σ w_i²` over a contact triangle's movable vertices for the
 /// tissue to hold it: below it (a contact point near a fixed vertex) the
@@ -248,8 +249,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     }
 
     /// `true` for a vertex the tool can move (not fixed by the table).
-    fn movable(&self, v: u32) -> bool {
-        !self.model.table().is_fixed(v)
+    fn movable(&self, v: VertexIndex) -> bool {
+        !self.model.table().is_fixed_vertex(v)
     }
 
     /// Each vertex's share of the contact point's displacement, the
@@ -281,7 +282,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     /// tilts the deformed triangles).
     fn in_rest_frame(&self, t: &Contact<T>) -> Contact<T> {
         let rest = self.model.table().rest_positions();
-        let at = |v: u32| rest.get(v as usize).map(|p| Vector3::new(p[0], p[1], p[2]));
+        let at = |v: VertexIndex| rest.get(v.get()).map(|p| Vector3::new(p[0], p[1], p[2]));
         let [a, b, c] = t.vertices.map(at);
         let normal = match (a, b, c) {
             (Some(a), Some(b), Some(c)) => (b - a).cross(&(c - a)).try_normalize(T::zero()),
@@ -299,7 +300,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     /// on the hand per metre of normal displacement of the contact point,
     /// shared out as `s` over `vertices` (module docs). Cost: 9 tensor
     /// products and 6 edge look-ups.
-    fn normal_stiffness(&self, vertices: &[u32; 3], shares: &[T; 3], n: &Vector3<T>) -> T {
+    fn normal_stiffness(&self, vertices: &[VertexIndex; 3], shares: &[T; 3], n: &Vector3<T>) -> T {
         let table = self.model.table();
         let mut k = T::zero();
         for (&i, &si) in vertices.iter().zip(shares) {
@@ -310,13 +311,13 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 let nkn = if i == j {
                     self.model
                         .vertex_tensors()
-                        .get(i as usize)
+                        .get(i.get())
                         .map_or(T::zero(), |kij| n.dot(&product(kij, n, false)))
                 } else {
                     // The stored edge tensor is K_{lo,hi}; K_{hi,lo} is its transpose.
                     table
-                        .edge_index(i, j)
-                        .and_then(|e| self.model.edge_tensors().get(e as usize))
+                        .edge_between(i, j)
+                        .and_then(|e| self.model.edge_tensors().get(e.get()))
                         .map_or(T::zero(), |kij| n.dot(&product(kij, n, i > j)))
                 };
                 k += si * sj * nkn;
@@ -432,7 +433,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 };
                 if !now().any(holds) {
                     // A fixed vertex was never imposed: nothing to release.
-                    let _ = self.model.release(v);
+                    let _ = self.model.release(v.as_u32());
                 }
             }
         }
@@ -440,7 +441,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         // Impose: move each contact point by gap · n, shared out over its
         // triangle's vertices; a vertex two contacts share gets the sum of
         // both shifts from where it was (at most 3M entries, 9M² sums).
-        let mut moves = [[(u32::MAX, Vector3::zeros(), Vector3::zeros()); 3]; M];
+        let mut moves = [[(None, Vector3::zeros(), Vector3::zeros()); 3]; M];
         for ((t, s), slots) in now().zip(moves.iter_mut()) {
             let u = self
                 .model
@@ -449,21 +450,22 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             for ((slot, &v), &share) in slots.iter_mut().zip(&t.vertices).zip(s) {
                 if share != T::zero() {
                     let from = u
-                        .get(v as usize)
+                        .get(v.get())
                         .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]));
-                    *slot = (v, from, t.normal * (t.gap_m * share));
+                    *slot = (Some(v), from, t.normal * (t.gap_m * share));
                 }
             }
         }
         for (t, slots) in set_now.iter().zip(&moves) {
-            for &(v, from, _) in slots.iter().filter(|(v, _, _)| *v != u32::MAX) {
+            for &(v, from, _) in slots {
+                let Some(v) = v else { continue };
                 let shift = moves
                     .iter()
                     .flatten()
-                    .filter(|(w, _, _)| *w == v)
+                    .filter(|(w, _, _)| *w == Some(v))
                     .fold(Vector3::zeros(), |a, (_, _, s)| a + s);
                 self.model
-                    .impose(v, from + shift)
+                    .impose(v.as_u32(), from + shift)
                     .map_err(|_| PhysicsError::NonFiniteContact { tool: t.tool })?;
             }
         }
@@ -482,7 +484,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             let stiffness_n_per_m = self.normal_stiffness(&t.vertices, &shares, &t.normal);
             let mut force_n = Vector3::zeros();
             for (&v, &share) in t.vertices.iter().zip(&shares) {
-                if let Some(f) = self.forces_n.get(v as usize) {
+                if let Some(f) = self.forces_n.get(v.get()) {
                     force_n += Vector3::new(f[0], f[1], f[2]) * share;
                 }
             }

@@ -84,9 +84,8 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, ElasticLaw, Extrapolation, Fault, Integrator, Limits,
-    PhysicsConfig, StateBuffers, StvkForm, SurfaceBuffers, TearThresholds, TensorMassModel,
-    VertexMode,
+    DynamicParams, DynamicTissue, ElasticLaw, Extrapolation, Fault, Integrator, PhysicsConfig,
+    StateBuffers, StvkForm, SurfaceBuffers, TearThresholds, TensorMassModel, VertexMode,
 };
 use palpate_kernel::{MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
@@ -809,16 +808,14 @@ fn params(inputs: &TensorInputs) -> DynamicParams<f32> {
         1 => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
         _ => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
     };
-    DynamicParams {
-        law,
-        incompressibility_n: option(inputs.incompressibility_on, inputs.incompressibility_n),
-        damping_per_s: inputs.damping_per_s,
-        gravity_m_s2: inputs.gravity_m_s2.into(),
-        limits: Limits {
-            max_displacement_m: inputs.max_displacement_m,
-            max_kinetic_energy_j: inputs.max_kinetic_energy_j,
-        },
-    }
+    DynamicParams::linear(inputs.damping_per_s, inputs.max_displacement_m)
+        .with_law(law)
+        .with_incompressibility(option(
+            inputs.incompressibility_on,
+            inputs.incompressibility_n,
+        ))
+        .with_gravity(inputs.gravity_m_s2.into())
+        .with_max_kinetic_energy(inputs.max_kinetic_energy_j)
 }
 
 /// One tick of the tensor-mass model: load and model on `inputs`, then

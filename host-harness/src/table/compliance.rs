@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use palpate_kernel::table::format::surface_block_index;
 
 use super::cg::JacobiCg;
-use crate::fem::assembly::{FreeOrdering, NO_SLOT, assemble_restricted};
+use crate::fem::assembly::{FreeOrdering, assemble_restricted};
 use crate::fem::llt::SparseLlt;
 use crate::fem::material::Material;
 
@@ -83,17 +83,12 @@ pub fn compute_compliance(
     ensure!(s <= f, "touchable_count {s} exceeds free count {f}");
     for (i, &v) in ordering.free_vertex.iter().enumerate() {
         ensure!(
-            (v as usize) < nv && ordering.vertex_slot[v as usize] as usize == i,
+            (v as usize) < nv && ordering.vertex_slot[v as usize] == Some(i as u32),
             "ordering is inconsistent at free index {i}"
         );
     }
     ensure!(
-        ordering
-            .vertex_slot
-            .iter()
-            .filter(|&&x| x != NO_SLOT)
-            .count()
-            == f,
+        ordering.vertex_slot.iter().flatten().count() == f,
         "ordering is inconsistent: vertex_slot and free_vertex disagree"
     );
     for (t, tet) in tets.iter().enumerate() {

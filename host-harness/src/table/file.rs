@@ -28,7 +28,10 @@ pub struct TableContents<'a> {
     pub poisson: f64,
     /// CRC-64 of the source mesh (`TetMesh::content_hash`).
     pub mesh_hash: u64,
-    /// Mesh vertex → free index, `u32::MAX` for fixed (N entries).
+    /// Mesh vertex → free index, or the format's `FIXED_SLOT` for a fixed
+    /// vertex (N entries, as stored: [`FreeOrdering::slot_entries`]).
+    ///
+    /// [`FreeOrdering::slot_entries`]: crate::fem::assembly::FreeOrdering::slot_entries
     pub vertex_slot: &'a [u32],
     /// Free index → mesh vertex; the first `touchable_count` are touchable.
     pub free_vertex: &'a [u32],

@@ -8,26 +8,30 @@
 
 use std::collections::HashMap;
 
-use anyhow::bail;
 use bytemuck::Zeroable;
 use nalgebra::Vector3;
 use palpate_kernel::math::element::stiffness_block;
 use palpate_kernel::table::format::{
-    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS,
-    TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN,
-    tet_edge_vertices, tet_face_vertices,
+    EDGE_TERMS_LEN, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS, TET_SHAPE_LEN,
+    TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN, tet_edge_vertices,
+    tet_face_vertices,
 };
 use palpate_kernel::tensor_mass::stvk_terms::{TermArraysMut, TetPlace, tet_terms};
 
 use super::file::{Precision, Section, write_container};
+use crate::fem::assembly::FreeOrdering;
 use crate::fem::element::shape_gradients;
 use crate::fem::material::Material;
-use crate::fix::{FixPredicate, fixed_vertices};
-use crate::mesh::{MeshReport, TetMesh, boundary_surface};
+use crate::mesh::TetMesh;
 
 /// The arrays of a tensor-mass table, in f64 before rounding.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TensorMassArrays {
+    /// Young's modulus and Poisson ratio the tensors and terms were
+    /// assembled with (the header's).
+    pub material: Material,
+    /// Mass density the masses were lumped with, kg/m³ (the header's).
+    pub density_kg_m3: f64,
     /// `true` for fixed vertices (N).
     pub fixed: Vec<bool>,
     /// Lumped masses `ρ Σ V/4`, kg (N).
@@ -91,6 +95,8 @@ impl TensorMassArrays {
             })
             .collect();
         let mut arrays = Self {
+            material: *material,
+            density_kg_m3,
             fixed,
             masses_kg: vec![0.0; n],
             vertex_tensors: vec![[0.0; 9]; n],
@@ -212,75 +218,38 @@ fn face_neighbours(tets: &[[u32; 4]]) -> Vec<[u32; 4]> {
     neighbours
 }
 
-/// Everything `dynamic` commands need to build a tensor-mass table.
-#[derive(Clone, Debug)]
-pub struct TensorMassOptions {
-    /// Young's modulus and Poisson ratio.
-    pub material: Material,
-    /// Mass density, kg/m³.
-    pub density_kg_m3: f64,
-    /// A vertex matching any predicate is fixed (none is allowed: a free body).
-    pub fix: Vec<FixPredicate>,
-    /// Stored float width.
-    pub precision: Precision,
-}
-
-/// Builds the tensor-mass table file of `mesh`. Unreferenced vertices are
-/// kept (numbering is the file's) and fixed (they have no mass).
-pub fn build_tensor_mass_table(
-    mesh: &TetMesh,
-    report: &MeshReport,
-    options: &TensorMassOptions,
-) -> anyhow::Result<Vec<u8>> {
-    if !(options.density_kg_m3.is_finite() && options.density_kg_m3 > 0.0) {
-        bail!(
-            "density must be finite and > 0 kg/m3, got {}",
-            options.density_kg_m3
-        );
-    }
-    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
-    let arrays = TensorMassArrays::new(mesh, &options.material, options.density_kg_m3, fixed);
-    Ok(write_tensor_mass_table(mesh, options, &arrays))
-}
-
-/// Serializes `arrays` of `mesh` (`TableKind::TensorMass`).
+/// Serializes `arrays` of `mesh` with its boundary `triangles` (outward,
+/// [`boundary_surface`](crate::mesh::boundary_surface)) as a tensor-mass
+/// table (`TableKind::TensorMass`) with floats of `precision`. The free
+/// vertices are numbered in vertex order (no touchable split: the model
+/// finds its contacts on the deforming surface), the fixed ones stored as
+/// the format's `FIXED_SLOT`.
 pub fn write_tensor_mass_table(
     mesh: &TetMesh,
-    options: &TensorMassOptions,
+    triangles: &[[u32; 3]],
     arrays: &TensorMassArrays,
+    precision: Precision,
 ) -> Vec<u8> {
-    let vertex_slot: Vec<u32> = arrays
-        .fixed
-        .iter()
-        .scan(0u32, |free, &fixed| {
-            Some(if fixed {
-                FIXED_SLOT
-            } else {
-                *free += 1;
-                *free - 1
-            })
-        })
-        .collect();
-    let surface = boundary_surface(mesh);
+    let ordering = FreeOrdering::new(mesh.positions.len(), &arrays.fixed, &[]);
     let header = RawHeader {
         table_kind: TableKind::TensorMass as u32,
         vertex_count: mesh.positions.len() as u32,
         tet_count: mesh.tets.len() as u32,
-        free_count: arrays.fixed.iter().filter(|&&f| !f).count() as u32,
-        triangle_count: surface.triangles.len() as u32,
+        free_count: ordering.free_count() as u32,
+        triangle_count: triangles.len() as u32,
         edge_count: arrays.column.len() as u32,
-        young_pa: options.material.young_pa,
-        poisson: options.material.poisson,
-        density_kg_m3: options.density_kg_m3,
+        young_pa: arrays.material.young_pa,
+        poisson: arrays.material.poisson,
+        density_kg_m3: arrays.density_kg_m3,
         mesh_hash: mesh.content_hash(),
         mesh_triangle_count: arrays.mesh_triangles.len() as u64,
         ..RawHeader::zeroed()
     };
-    let p = options.precision;
+    let p = precision;
     let sections = [
-        Section::ints(SectionKind::VertexSlot, &vertex_slot),
+        Section::ints(SectionKind::VertexSlot, &ordering.slot_entries()),
         Section::floats(SectionKind::RestPositions, &mesh.positions, p),
-        Section::ints(SectionKind::SurfaceTriangles, &surface.triangles),
+        Section::ints(SectionKind::SurfaceTriangles, triangles),
         Section::floats(SectionKind::LumpedMass, &arrays.masses_kg, p),
         Section::floats(SectionKind::VertexTensor, &arrays.vertex_tensors, p),
         Section::ints(SectionKind::EdgeRowStart, &arrays.row_start),

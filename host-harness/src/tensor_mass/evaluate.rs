@@ -3,14 +3,14 @@
 
 use anyhow::Context;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, TensorMassModel};
+use palpate_kernel::tensor_mass::{ElasticLaw, TensorMassModel};
 
 use super::OwnedState;
 use super::run::{f64_table, host_params};
 use crate::fem::material::Material;
 use crate::mesh::{MeshReport, TetMesh};
-use crate::tables::file::Precision;
-use crate::tables::tensor_mass::TensorMassOptions;
+use crate::table::build::BuildOptions;
+use crate::table::file::Precision;
 
 /// Internal forces (N, one per vertex: the elastic force on each vertex,
 /// `−∂W/∂x`, plus the incompressibility penalty when `incompressibility_n` is
@@ -30,21 +30,14 @@ pub fn forces_and_energy(
         deformed_m.len(),
         mesh.positions.len()
     );
-    let options = TensorMassOptions {
-        material,
-        // Mass plays no part in the forces; any positive density builds.
-        density_kg_m3: 1000.0,
-        fix: Vec::new(),
-        precision: Precision::F64,
-    };
+    // Mass plays no part in the forces; any positive density builds.
+    let options = BuildOptions::tensor_mass(material, 1000.0, Vec::new(), Precision::F64);
     let file = f64_table(mesh, report, &options)?;
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
-    let params = DynamicParams {
-        law,
-        incompressibility_n,
-        ..host_params(&mesh.positions, 0.0)
-    };
+    let params = host_params(&mesh.positions, 0.0)
+        .with_law(law)
+        .with_incompressibility(incompressibility_n);
     let model = TensorMassModel::new(table, state.buffers(), params)?;
     let u: Vec<[f64; 3]> = deformed_m
         .iter()

@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::OwnedState;
 use super::run::{diagonal, f64_table, host_params};
 use crate::mesh::{MeshReport, TetMesh};
-use crate::tables::tensor_mass::TensorMassOptions;
+use crate::table::build::BuildOptions;
 
 /// Steps of the loading scenario per trial.
 pub const TRIAL_STEPS: usize = 2000;
@@ -188,13 +188,13 @@ pub fn critical_dt(
     }
 }
 
-/// `dynamic critical-dt`: builds the f64 model of `mesh` (damping
-/// `damping_per_s`, 1/s) and measures `integrator`'s critical step, with a
+/// `dynamic critical-dt`: builds the f64 model of `mesh` (the tensor-mass
+/// table `options`, damping `damping_per_s`, 1/s) and measures `integrator`'s critical step, with a
 /// perturbation of 1e-3 of the bounding-box diagonal.
 pub fn critical_dt_of_mesh(
     mesh: &TetMesh,
     report: &MeshReport,
-    options: &TensorMassOptions,
+    options: &BuildOptions,
     damping_per_s: f64,
     integrator: Integrator,
 ) -> anyhow::Result<CriticalDt> {

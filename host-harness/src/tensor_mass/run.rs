@@ -13,14 +13,16 @@ use serde::Serialize;
 use super::OwnedState;
 use crate::fem::element::shape_gradients;
 use crate::mesh::{MeshReport, TetMesh};
-use crate::tables::load::TableFile;
-use crate::tables::tensor_mass::{TensorMassOptions, build_tensor_mass_table};
+use crate::table::build::{BuildOptions, build};
+use crate::table::file::Precision;
+use crate::table::load::TableFile;
 
 /// A scripted dynamic run.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
-    /// Material, density, fixed vertices (the precision is forced to f64).
-    pub table: TensorMassOptions,
+    /// The tensor-mass table: material, density, fixed vertices (the
+    /// precision is forced to f64).
+    pub table: BuildOptions,
     /// Mass-proportional damping, 1/s.
     pub damping_per_s: f64,
     /// The elastic force.
@@ -63,12 +65,10 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     let file = f64_table(mesh, report, &options.table)?;
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
-    let params = DynamicParams {
-        law: options.law,
-        incompressibility_n: options.incompressibility_n,
-        gravity_m_s2: Vector3::from(options.gravity_m_s2),
-        ..host_params(&mesh.positions, options.damping_per_s)
-    };
+    let params = host_params(&mesh.positions, options.damping_per_s)
+        .with_law(options.law)
+        .with_incompressibility(options.incompressibility_n)
+        .with_gravity(Vector3::from(options.gravity_m_s2));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     for &tet in &options.cut_tets {
         model
@@ -111,17 +111,18 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     })
 }
 
-/// The f64 tensor-mass table of `mesh` (host runs verify in f64).
+/// The table of `mesh` that `options` describe (a tensor-mass kind) in f64:
+/// host runs verify in f64.
 pub fn f64_table(
     mesh: &TetMesh,
     report: &MeshReport,
-    options: &TensorMassOptions,
+    options: &BuildOptions,
 ) -> anyhow::Result<TableFile> {
-    let mut options = options.clone();
-    options.precision = crate::tables::file::Precision::F64;
-    Ok(TableFile::from_bytes(&build_tensor_mass_table(
-        mesh, report, &options,
-    )?))
+    let options = BuildOptions {
+        precision: Precision::F64,
+        ..options.clone()
+    };
+    Ok(TableFile::from_bytes(&build(mesh, report, &options)?.bytes))
 }
 
 /// The host commands' parameters: the linear law without penalty, damping

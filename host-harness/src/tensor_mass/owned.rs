@@ -2,11 +2,11 @@
 //! table.
 
 use palpate_kernel::Real;
-use palpate_kernel::tensor_mass::SurfaceBuffers;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
 };
+use palpate_kernel::tensor_mass::SurfaceBuffers;
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{StateBuffers, TensorMassModel, VertexMode};
 

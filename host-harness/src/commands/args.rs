@@ -1,0 +1,86 @@
+//! Argument groups several commands share, each flattened into a command
+//! with `#[command(flatten)]`: the material (`--young`, `--poisson`), the
+//! fixed-vertex predicates (`--fix`) and the JSON-only output switch
+//! (`--json`); and the values of `--form`, which two commands take.
+
+use anyhow::bail;
+use palpate::fem::material::Material;
+use palpate::fix::FixPredicate;
+use palpate_kernel::tensor_mass::StvkForm;
+
+/// `--young` and `--poisson`: an isotropic linear elastic material.
+#[derive(clap::Args)]
+pub struct MaterialArgs {
+    /// Young's modulus, Pa.
+    #[arg(long)]
+    pub young: f64,
+    /// Poisson ratio, in [0, 0.5).
+    #[arg(long)]
+    pub poisson: f64,
+}
+
+impl MaterialArgs {
+    /// The validated material.
+    pub fn material(&self) -> anyhow::Result<Material> {
+        Ok(Material::new(self.young, self.poisson)?)
+    }
+}
+
+/// `--fix` (repeatable): the fixed-vertex predicates, required. A model
+/// that admits a free body makes them optional with
+/// `#[command(mut_arg("fix", optional_fix))]` (an override that keeps the
+/// required arguments of the usage line in their order).
+#[derive(clap::Args)]
+pub struct FixArgs {
+    /// Fixed vertices: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
+    #[arg(long = "fix", required = true, value_parser = parse_fix, allow_hyphen_values = true)]
+    pub fix: Vec<FixPredicate>,
+}
+
+/// `--fix` made optional: none fixes nothing (a free body).
+pub fn optional_fix(fix: clap::Arg) -> clap::Arg {
+    fix.required(false).help(
+        "Fixed vertices: x|y|z then <, <=, > or >= then a number (repeatable; none = free body)",
+    )
+}
+
+fn parse_fix(s: &str) -> Result<FixPredicate, String> {
+    s.parse()
+}
+
+/// `--json` of a command whose only output format is one JSON object.
+#[derive(clap::Args)]
+pub struct JsonArgs {
+    /// Print one JSON object (the only output format).
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl JsonArgs {
+    /// Refuses to run `command` without `--json`: the format is named on the
+    /// command line, so another can be added later.
+    pub fn require(&self, command: &str) -> anyhow::Result<()> {
+        if !self.json {
+            bail!("{command} prints JSON only: pass --json");
+        }
+        Ok(())
+    }
+}
+
+/// `--form`: the two St Venant-Kirchhoff implementations.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum FormArg {
+    /// Per tet from the deformation gradient.
+    PerTet,
+    /// Picinbono's split terms on vertices, edges, triangles and tets.
+    Tensors,
+}
+
+impl From<FormArg> for StvkForm {
+    fn from(form: FormArg) -> Self {
+        match form {
+            FormArg::PerTet => StvkForm::PerTet,
+            FormArg::Tensors => StvkForm::Tensors,
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! `palpate budget`: per-tick instruction counts (callgrind) of every
+//! generated trajectory on a scene's mesh, against the static bound of
+//! [`palpate::budget`]; `--probe` is the child process callgrind measures.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use palpate::budget::{BudgetRow, M4F_IPS, budget_table, measure, probe, trajectories};
+use palpate::session::{MeshSource, Scene, Trajectory};
+use palpate::table::load::TableFile;
+
+/// `palpate budget`'s arguments.
+#[derive(clap::Args)]
+pub struct BudgetArgs {
+    /// Scene file (TOML), `built-in` or `built-in-dynamic`.
+    scene: String,
+    /// Working folder for tables, trajectories and callgrind dumps.
+    #[arg(long, default_value = "budget-out")]
+    work_dir: PathBuf,
+    /// Print one JSON array instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Measure only this generated trajectory (repeatable; default: every
+    /// one the scene's tool can run).
+    #[arg(long = "trajectory", value_name = "NAME")]
+    only: Vec<String>,
+    /// Internal: run the ticks of this trajectory on this table (the
+    /// process callgrind measures).
+    #[arg(long, hide = true, num_args = 2, value_names = ["TABLE", "TRAJECTORY"])]
+    probe: Option<Vec<PathBuf>>,
+}
+
+/// `palpate budget`: measure every generated trajectory on the scene's mesh
+/// (and, for a generated box, at half its resolution) under callgrind.
+pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
+    let BudgetArgs {
+        scene: scene_arg,
+        work_dir,
+        json,
+        only,
+        probe: probe_paths,
+    } = args;
+    let mut scene = Scene::named(scene_arg)?;
+    if let Some([table_path, trajectory_path]) = probe_paths.as_deref() {
+        let bytes = TableFile::read(table_path)?;
+        let trajectory = Trajectory::read(trajectory_path, scene.tool.points)?;
+        let counters = probe(bytes.bytes(), &scene, &trajectory)
+            .with_context(|| table_path.display().to_string())?
+            .counters;
+        let lines: Vec<String> = counters
+            .iter()
+            .map(|c| {
+                format!(
+                    "{},{},{}",
+                    c.contact.triangles_tested, c.contact.walk_steps, c.solves
+                )
+            })
+            .collect();
+        std::fs::write(trajectory_path.with_extension("work"), lines.join("\n"))?;
+        return Ok(());
+    }
+    std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
+    let exe = std::env::current_exe()?;
+    let mut sizes = vec![scene.mesh.clone()];
+    if let MeshSource::GeneratedBox { size_m, cells } = &scene.mesh {
+        let coarse = cells.map(|c| (c / 2).max(1));
+        sizes.insert(
+            0,
+            MeshSource::GeneratedBox {
+                size_m: *size_m,
+                cells: coarse,
+            },
+        );
+    }
+    let points = scene.tool.points;
+    let mut chosen = trajectories(points)?;
+    if let Some(unknown) = only
+        .iter()
+        .find(|name| !chosen.iter().any(|(known, _)| known == name))
+    {
+        let known: Vec<&str> = chosen.iter().map(|(name, _)| *name).collect();
+        bail!(
+            "--trajectory {unknown}: not a generated trajectory of this scene (one of: {})",
+            known.join(", ")
+        );
+    }
+    if !only.is_empty() {
+        chosen.retain(|(name, _)| only.iter().any(|o| o == name));
+    }
+    let mut rows: Vec<BudgetRow> = Vec::new();
+    for (s, source) in sizes.into_iter().enumerate() {
+        scene.mesh = source;
+        let (mesh, report) = scene.load_mesh()?;
+        let (bytes, bound) = budget_table(&scene, &mesh, &report)?;
+        let table_path = work_dir.join(format!("table-{s}.bin"));
+        std::fs::write(&table_path, &bytes)?;
+        let file = TableFile::from_bytes(&bytes);
+        for (name, trajectory) in &chosen {
+            let csv = work_dir.join(format!("{name}-{s}.csv"));
+            trajectory.write_csv_file(&csv)?;
+            let probe_args: Vec<String> = vec![
+                "budget".into(),
+                scene_arg.into(),
+                "--probe".into(),
+                table_path.display().to_string(),
+                csv.display().to_string(),
+            ];
+            let irs = measure(&exe, &probe_args, &work_dir.join(format!("cg-{name}-{s}")))?;
+            let work = std::fs::read_to_string(csv.with_extension("work"))?;
+            let mut max_work = [0u32; 3];
+            for line in work.lines() {
+                for (m, v) in max_work.iter_mut().zip(line.split(',')) {
+                    *m = (*m).max(v.parse().unwrap_or(0));
+                }
+            }
+            let max_ir = irs.iter().copied().max().unwrap_or(0);
+            let total_ir = irs.iter().sum::<u64>();
+            let mean_ir = total_ir as f64 / irs.len().max(1) as f64;
+            // The host's time per instruction in the ticks, run natively.
+            let native = probe(file.bytes(), &scene, trajectory)?;
+            let host_ns_per_ir = native.ticks_s * 1e9 / total_ir.max(1) as f64;
+            rows.push(BudgetRow {
+                mesh: format!(
+                    "{} vertices, {} tets",
+                    mesh.positions.len(),
+                    mesh.tets.len()
+                ),
+                trajectory: name,
+                ticks: irs.len(),
+                max_ir,
+                mean_ir,
+                bound_ir: bound,
+                bound_host_us: bound as f64 * host_ns_per_ir / 1e3,
+                max_work,
+            });
+        }
+    }
+    if *json {
+        println!("{}", serde_json::to_string(&rows)?);
+        return Ok(());
+    }
+    println!(
+        "{:<26} {:<11} {:>6} {:>9} {:>9} {:>9} {:>6} {:>11} {:>11} {:>12}",
+        "mesh",
+        "trajectory",
+        "ticks",
+        "mean Ir",
+        "max Ir",
+        "bound Ir",
+        "max/b",
+        "bound@168M",
+        "bound@host",
+        "tests/walk/solves"
+    );
+    for r in &rows {
+        println!(
+            "{:<26} {:<11} {:>6} {:>9.0} {:>9} {:>9} {:>6.3} {:>8.1} µs {:>8.2} µs {:>5}/{}/{}",
+            r.mesh,
+            r.trajectory,
+            r.ticks,
+            r.mean_ir,
+            r.max_ir,
+            r.bound_ir,
+            r.max_ir as f64 / r.bound_ir as f64,
+            r.bound_ir as f64 / M4F_IPS * 1e6,
+            r.bound_host_us,
+            r.max_work[0],
+            r.max_work[1],
+            r.max_work[2]
+        );
+    }
+    if let Some(r) = rows.iter().find(|r| r.max_ir > r.bound_ir) {
+        bail!(
+            "{} on {}: {} instructions exceed the bound {}",
+            r.trajectory,
+            r.mesh,
+            r.max_ir,
+            r.bound_ir
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,206 @@
+//! `palpate dynamic`: the tensor-mass model (RR-3510 §5) stepped through the
+//! kernel: a scripted run (`run`) and the critical time step of an
+//! integrator (`critical-dt`).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use clap::Subcommand;
+use palpate::mesh::{MeshReport, TetMesh, read_mesh};
+use palpate::table::build::BuildOptions;
+use palpate::table::file::Precision;
+use palpate::tensor_mass::run::RunOptions;
+use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
+
+use super::args::{FixArgs, FormArg, JsonArgs, MaterialArgs, optional_fix};
+
+#[derive(Subcommand)]
+pub enum DynamicCommand {
+    /// Step the model under constant loads and print the final state as JSON.
+    Run {
+        #[command(flatten)]
+        model: DynamicModelArgs,
+        /// Constant external force <V>:<fx>,<fy>,<fz> (N, repeatable).
+        #[arg(long = "load", value_parser = parse_load, allow_hyphen_values = true)]
+        load: Vec<(u32, [f64; 3])>,
+        /// Gravity <gx>,<gy>,<gz> (m/s2).
+        #[arg(long, value_parser = parse_gravity, allow_hyphen_values = true, default_value = "0,0,0")]
+        gravity: [f64; 3],
+        /// Time step, s.
+        #[arg(long)]
+        dt: f64,
+        /// Number of steps.
+        #[arg(long)]
+        steps: usize,
+        /// Tets to remove before the first step: <i>,<j>,...
+        #[arg(long = "cut-tets", value_delimiter = ',')]
+        cut_tets: Vec<u32>,
+        /// Elastic law: linear tensor-mass, St Venant-Kirchhoff, or St
+        /// Venant-Kirchhoff with the incompressibility penalty.
+        #[arg(long = "model", value_enum, default_value = "linear")]
+        law: ModelArg,
+        /// How the St Venant-Kirchhoff force is evaluated.
+        #[arg(long, value_enum, default_value = "per-tet")]
+        form: FormArg,
+        /// Incompressibility penalty γ, N (required by, and only for,
+        /// --model stvk-incompressible).
+        #[arg(long)]
+        incompressibility: Option<f64>,
+    },
+    /// Largest stable time step of an integrator (bisection) next to 2/ω_max.
+    CriticalDt {
+        #[command(flatten)]
+        model: DynamicModelArgs,
+    },
+}
+
+/// What both `dynamic` commands take: the mesh, its material and supports,
+/// the damping and the integrator.
+#[derive(clap::Args)]
+#[command(mut_arg("fix", optional_fix))]
+pub struct DynamicModelArgs {
+    /// Input mesh (.msh, .node/.ele, .vtk), metres.
+    mesh: PathBuf,
+    #[command(flatten)]
+    material: MaterialArgs,
+    /// Mass density, kg/m3.
+    #[arg(long)]
+    density: f64,
+    /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
+    #[arg(long)]
+    damping: f64,
+    #[command(flatten)]
+    fix: FixArgs,
+    /// Time integrator.
+    #[arg(long, value_enum)]
+    integrator: IntegratorArg,
+    #[command(flatten)]
+    json: JsonArgs,
+}
+
+impl DynamicModelArgs {
+    /// Checks `--json`, reads the mesh and gathers the (f64) table options.
+    fn read(&self, command: &str) -> anyhow::Result<(TetMesh, MeshReport, BuildOptions)> {
+        self.json.require(&format!("dynamic {command}"))?;
+        let (mesh, report) = read_mesh(&self.mesh)?;
+        let options = BuildOptions::tensor_mass(
+            self.material.material()?,
+            self.density,
+            self.fix.fix.clone(),
+            Precision::F64,
+        );
+        Ok((mesh, report, options))
+    }
+}
+
+/// `--model` of `dynamic run`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    Linear,
+    Stvk,
+    StvkIncompressible,
+}
+
+impl ModelArg {
+    /// The law and penalty of `--model`, `--form` and `--incompressibility`.
+    fn law(
+        self,
+        form: FormArg,
+        incompressibility: Option<f64>,
+    ) -> anyhow::Result<(ElasticLaw, Option<f64>)> {
+        let stvk = ElasticLaw::StVenantKirchhoff(form.into());
+        match (self, incompressibility) {
+            (ModelArg::Linear, None) => Ok((ElasticLaw::Linear, None)),
+            (ModelArg::Stvk, None) => Ok((stvk, None)),
+            (ModelArg::StvkIncompressible, Some(gamma)) if gamma.is_finite() && gamma >= 0.0 => {
+                Ok((stvk, Some(gamma)))
+            }
+            (ModelArg::StvkIncompressible, Some(gamma)) => {
+                bail!("--incompressibility must be finite and >= 0 N, got {gamma}")
+            }
+            (ModelArg::StvkIncompressible, None) => {
+                bail!("--model stvk-incompressible needs --incompressibility <gamma> (N)")
+            }
+            (_, Some(_)) => {
+                bail!("--incompressibility applies to --model stvk-incompressible only")
+            }
+        }
+    }
+}
+
+/// `--integrator`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum IntegratorArg {
+    Euler,
+    Symplectic,
+    Rk4,
+    Central,
+}
+
+impl From<IntegratorArg> for Integrator {
+    fn from(arg: IntegratorArg) -> Self {
+        match arg {
+            IntegratorArg::Euler => Integrator::ExplicitEuler,
+            IntegratorArg::Symplectic => Integrator::SymplecticEuler,
+            IntegratorArg::Rk4 => Integrator::Rk4,
+            IntegratorArg::Central => Integrator::CentralDifference,
+        }
+    }
+}
+
+fn parse_load(s: &str) -> Result<(u32, [f64; 3]), String> {
+    palpate_script::parse_vertex_vector(s).map_err(|e| e.to_string())
+}
+
+fn parse_gravity(s: &str) -> Result<[f64; 3], String> {
+    palpate_script::parse_vector(s).map_err(|e| e.to_string())
+}
+
+/// Runs a `dynamic` command: prints its JSON object.
+pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
+    match command {
+        DynamicCommand::Run {
+            model,
+            load,
+            gravity,
+            dt,
+            steps,
+            cut_tets,
+            law,
+            form,
+            incompressibility,
+        } => {
+            let (mesh, report, table) = model.read("run")?;
+            let (law, incompressibility_n) = law.law(form, incompressibility)?;
+            let options = RunOptions {
+                table,
+                damping_per_s: model.damping,
+                law,
+                incompressibility_n,
+                loads: load,
+                gravity_m_s2: gravity,
+                integrator: model.integrator.into(),
+                dt_s: dt,
+                steps,
+                cut_tets,
+            };
+            let output = palpate::tensor_mass::run::run(&mesh, &report, &options)
+                .with_context(|| model.mesh.display().to_string())?;
+            println!("{}", serde_json::to_string(&output)?);
+            Ok(())
+        }
+        DynamicCommand::CriticalDt { model } => {
+            let (mesh, report, table) = model.read("critical-dt")?;
+            let result = palpate::tensor_mass::stability::critical_dt_of_mesh(
+                &mesh,
+                &report,
+                &table,
+                model.damping,
+                model.integrator.into(),
+            )
+            .with_context(|| model.mesh.display().to_string())?;
+            println!("{}", serde_json::to_string(&result)?);
+            Ok(())
+        }
+    }
+}

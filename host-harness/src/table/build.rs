@@ -1,0 +1,232 @@
+//! The one table build (`palpate tables build`, and every table the harness
+//! builds in memory): mesh + material + fixed predicates → table bytes, for
+//! either kind of table.
+//!
+//! Stages: the shared preparation (fixed vertices, boundary surface) → the
+//! kind's arrays (the compliance blocks over the free/touchable ordering, or
+//! the tensor-mass arrays) → the writer (for a pre-computed table with its
+//! collision index, built from the same surface) → a [`BuiltTable`] summary.
+
+use core::time::Duration;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+
+use super::compliance::{Solver, compute_compliance};
+use super::file::{Precision, TableContents, write_table};
+use super::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+use crate::fem::assembly::FreeOrdering;
+use crate::fem::material::Material;
+use crate::fix::{FixPredicate, fixed_vertices};
+use crate::mesh::{MeshReport, Surface, TetMesh, boundary_surface};
+
+/// Everything a table build needs besides the mesh.
+#[derive(Clone, Debug)]
+pub struct BuildOptions {
+    /// Which table, with the options only that kind takes.
+    pub kind: TableKindOptions,
+    /// Young's modulus and Poisson ratio.
+    pub material: Material,
+    /// A vertex matching any predicate is fixed.
+    pub fix: Vec<FixPredicate>,
+    /// Stored float width.
+    pub precision: Precision,
+    /// Show a progress bar over the compliance solves (a tensor-mass table
+    /// has none).
+    pub progress: bool,
+}
+
+/// The kind of table to build, and what only that kind needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TableKindOptions {
+    /// The pre-computed compliance table (RR-3510 §4), solved with `solver`
+    /// (sparse Cholesky or the paper's CG baseline). Some vertex must match
+    /// a predicate (a free body has a singular stiffness) and some must stay
+    /// free.
+    Precomputed {
+        /// How the compliance columns are solved.
+        solver: Solver,
+    },
+    /// The dynamic tensor-mass table (RR-3510 §5). Any predicates, none
+    /// included (a free body).
+    TensorMass {
+        /// Mass density, kg/m³, finite and > 0.
+        density_kg_m3: f64,
+    },
+}
+
+impl BuildOptions {
+    /// A pre-computed table of `material` with the `fix` predicates, solved
+    /// with `solver`, stored in `precision`, without a progress bar.
+    pub fn precomputed(
+        material: Material,
+        fix: Vec<FixPredicate>,
+        solver: Solver,
+        precision: Precision,
+    ) -> Self {
+        Self {
+            kind: TableKindOptions::Precomputed { solver },
+            material,
+            fix,
+            precision,
+            progress: false,
+        }
+    }
+
+    /// A tensor-mass table of `material` and density `density_kg_m3`
+    /// (kg/m³) with the `fix` predicates, stored in `precision`.
+    pub fn tensor_mass(
+        material: Material,
+        density_kg_m3: f64,
+        fix: Vec<FixPredicate>,
+        precision: Precision,
+    ) -> Self {
+        Self {
+            kind: TableKindOptions::TensorMass { density_kg_m3 },
+            material,
+            fix,
+            precision,
+            progress: false,
+        }
+    }
+}
+
+/// A built table and what went into it.
+#[derive(Clone, Debug)]
+pub struct BuiltTable {
+    /// The table file bytes.
+    pub bytes: Vec<u8>,
+    /// Vertices fixed by a predicate.
+    pub fixed_by_predicate: usize,
+    /// Unreferenced vertices, kept in the numbering and fixed.
+    pub fixed_unreferenced: usize,
+    /// Free vertices (`F`).
+    pub free_count: usize,
+    /// Touchable vertices (`S`) of a pre-computed table; 0 for a
+    /// tensor-mass table (its contacts are found on the deforming surface).
+    pub touchable_count: usize,
+    /// Edges (`E`, each once) of a tensor-mass table; 0 for a pre-computed
+    /// table.
+    pub edge_count: usize,
+    /// Wall time of the kind's arrays: the compliance computation
+    /// (assembly, factorization, solves) or the tensor-mass assembly.
+    pub arrays_time: Duration,
+}
+
+/// Builds the table of `mesh` that `options` describe. Fixed vertices are
+/// those matching a predicate plus the unreferenced ones (kept so numbering
+/// is the file's, fixed because no tet gives them stiffness or mass). In a
+/// pre-computed table the touchable vertices are the free vertices of the
+/// boundary surface.
+pub fn build(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+) -> anyhow::Result<BuiltTable> {
+    if let TableKindOptions::TensorMass { density_kg_m3 } = options.kind
+        && !(density_kg_m3.is_finite() && density_kg_m3 > 0.0)
+    {
+        bail!("density must be finite and > 0 kg/m3, got {density_kg_m3}");
+    }
+    let (fixed, fixed_by_predicate) =
+        fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
+    if let TableKindOptions::Precomputed { .. } = options.kind {
+        if fixed_by_predicate == 0 {
+            bail!(
+                "{}: no vertex matches the --fix predicates ({}); a free body has a singular stiffness",
+                report.source,
+                describe(&options.fix)
+            );
+        }
+        if fixed.iter().all(|&f| f) {
+            bail!(
+                "{}: every vertex is fixed by the --fix predicates ({}); nothing can move",
+                report.source,
+                describe(&options.fix)
+            );
+        }
+    }
+    let surface = boundary_surface(mesh);
+    let summary = BuiltTable {
+        bytes: Vec::new(),
+        fixed_by_predicate,
+        fixed_unreferenced: report.unreferenced_vertices.len(),
+        free_count: fixed.iter().filter(|&&f| !f).count(),
+        touchable_count: 0,
+        edge_count: 0,
+        arrays_time: Duration::ZERO,
+    };
+    match options.kind {
+        TableKindOptions::Precomputed { solver } => {
+            precomputed(mesh, report, options, solver, &fixed, &surface, summary)
+        }
+        TableKindOptions::TensorMass { density_kg_m3 } => {
+            let start = Instant::now();
+            let arrays = TensorMassArrays::new(mesh, &options.material, density_kg_m3, fixed);
+            let arrays_time = start.elapsed();
+            Ok(BuiltTable {
+                bytes: write_tensor_mass_table(
+                    mesh,
+                    &surface.triangles,
+                    &arrays,
+                    options.precision,
+                ),
+                edge_count: arrays.column.len(),
+                arrays_time,
+                ..summary
+            })
+        }
+    }
+}
+
+/// The pre-computed stages: the free/touchable ordering, the compliance,
+/// the writer (with the collision index of `surface`).
+fn precomputed(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    solver: Solver,
+    fixed: &[bool],
+    surface: &Surface,
+    summary: BuiltTable,
+) -> anyhow::Result<BuiltTable> {
+    let ordering = FreeOrdering::new(mesh.positions.len(), fixed, &surface.vertices);
+    let start = Instant::now();
+    let compliance = compute_compliance(
+        &mesh.positions,
+        &mesh.tets,
+        &options.material,
+        &ordering,
+        solver,
+        options.progress,
+    )
+    .with_context(|| format!("{}: computing the compliance table", report.source))?;
+    let arrays_time = start.elapsed();
+    let bytes = write_table(
+        &TableContents {
+            tet_count: mesh.tets.len(),
+            young_pa: options.material.young_pa,
+            poisson: options.material.poisson,
+            mesh_hash: mesh.content_hash(),
+            vertex_slot: &ordering.slot_entries(),
+            free_vertex: &ordering.free_vertex,
+            touchable_count: ordering.touchable_count,
+            positions: &mesh.positions,
+            triangles: &surface.triangles,
+            surface: &compliance.surface,
+            interior: &compliance.interior,
+        },
+        options.precision,
+    );
+    Ok(BuiltTable {
+        bytes,
+        touchable_count: ordering.touchable_count,
+        arrays_time,
+        ..summary
+    })
+}
+
+fn describe(fix: &[FixPredicate]) -> String {
+    let all: Vec<String> = fix.iter().map(ToString::to_string).collect();
+    all.join(", ")
+}

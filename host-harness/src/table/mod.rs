@@ -1,0 +1,13 @@
+//! Offline tables (the host side of `palpate_kernel::table`): the one build
+//! pipeline for both kinds ([`build`]), the compliance computation of the
+//! pre-computed model (Cotin RR-3510 §4; [`compliance`], [`cg`]), the
+//! tensor-mass arrays (RR-3510 §5; [`tensor_mass`]), the collision index
+//! ([`collision`]), the table file writer ([`file`]) and reader ([`load`]).
+
+pub mod build;
+pub mod cg;
+pub mod collision;
+pub mod compliance;
+pub mod file;
+pub mod load;
+pub mod tensor_mass;

@@ -1,0 +1,30 @@
+//! Every workspace integration test, in one binary whose modules mirror the
+//! source tree: `kernel::…` (the `no_std` kernel), `host::…` (the harness),
+//! `tools::…` (the shared script crate). Each module states the independent
+//! truth it checks against; the shared readers of the reference data are in
+//! `src/lib.rs`.
+
+mod host {
+    mod compliance;
+    mod experiment;
+    mod fem;
+    mod mesh;
+    mod session;
+    mod session_run;
+    mod stability;
+}
+
+mod kernel {
+    mod haptic;
+    mod haptic_dynamic;
+    mod layers;
+    mod precomputed;
+    mod stvk;
+    mod stvk_terms;
+    mod table;
+    mod tensor_mass;
+}
+
+mod tools {
+    mod script;
+}
