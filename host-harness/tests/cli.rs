@@ -223,33 +223,21 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
     assert_one_line_error(&out, "failed validation");
     let table = build_cube_table("cube-err.tbl", &[]);
     let table_str = table.display().to_string();
-    let out = palpate(&[
-        "precomputed",
-        "solve",
-        &table_str,
-        "--contact",
-        "0:0,0,-0.01",
-        "--json",
-    ]);
-    assert_one_line_error(&out, "vertex 0 is fixed");
-    let out = palpate(&[
-        "precomputed",
-        "solve",
-        &table_str,
-        "--contact",
-        "194:0,0",
-        "--json",
-    ]);
-    assert_one_line_error(&out, "--contact '194:0,0'");
-    let out = palpate(&[
-        "precomputed",
-        "solve",
-        &table_str,
-        "--contact",
-        "194,195,200@1,0,0:0,0,0",
-        "--json",
-    ]);
-    assert_one_line_error(&out, "wrong form");
+    for (contact, error) in [
+        ("0:0,0,-0.01", "vertex 0 is fixed"),
+        ("194:0,0", "--contact '194:0,0'"),
+        ("194,195,200@1,0,0:0,0,0", "wrong form"),
+    ] {
+        let out = palpate(&[
+            "precomputed",
+            "solve",
+            &table_str,
+            "--contact",
+            contact,
+            "--json",
+        ]);
+        assert_one_line_error(&out, error);
+    }
     let out = palpate(&["precomputed", "nonsense"]);
     assert_eq!(out.status.code(), Some(2));
 }
@@ -470,11 +458,12 @@ fn stvk_forces_prints_forces_and_energy() {
 /// for both models, on both mesh sizes, every tick's callgrind instruction
 /// count at or below the static bound from the table sizes and capacities
 /// (needs valgrind: `tools/setup.sh` installs it). Instruction counts are
-/// deterministic, so this is not a timed test. One trajectory per model, the
-/// one that works the contact path hardest (`strike`: an oblique fast entry
-/// that walks across triangles; `slide`: tracking across the deforming
-/// surface); `.ci/run` runs the exhaustive `palpate budget` on every
-/// trajectory.
+/// deterministic, so this is not a timed test. One trajectory per model:
+/// `strike` (a fast oblique entry: the highest mean count per tick on the
+/// pre-computed model, every trajectory sharing its largest tick, the first
+/// detection) and `slide` (tracking across the deforming surface: the
+/// largest tick and the most triangles tested on the dynamic model);
+/// `.ci/run` runs the exhaustive `palpate budget` on every trajectory.
 #[test]
 fn budget_ticks_stay_within_the_static_bound() {
     for (scene, trajectory) in [("built-in", "strike"), ("built-in-dynamic", "slide")] {

@@ -1,6 +1,7 @@
 //! Table loading (`palpate_kernel::table`): round trip, corruption detection,
 //! and every structural error a well-formed checksum cannot hide.
 
+use palpate::table::collision::collision_index;
 use palpate::table::file::{Precision, TableContents, write_table};
 use palpate::table::load::TableFile;
 use palpate_kernel::table::format::{HEADER_LEN, SECTION_ENTRY_LEN, SectionKind};
@@ -133,6 +134,7 @@ impl Tiny {
                 triangles: &self.triangles,
                 surface: &self.surface,
                 interior: &self.interior,
+                collision: &collision_index(&self.positions, &self.triangles),
             },
             Precision::F32,
         )

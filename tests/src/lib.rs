@@ -18,18 +18,28 @@ pub fn data_dir() -> PathBuf {
 /// reference data (0-based indices): vertex positions and tets.
 pub fn read_reference_tetgen(name: &str) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     let dir = reference_dir().join("meshes");
-    let node = std::fs::read_to_string(dir.join(format!("{name}.node"))).expect("read .node");
-    let ele = std::fs::read_to_string(dir.join(format!("{name}.ele"))).expect("read .ele");
-    let rows = |text: &str| -> Vec<Vec<String>> {
-        text.lines()
-            .map(|l| l.split('#').next().unwrap_or("").trim())
-            .filter(|l| !l.is_empty())
-            .map(|l| l.split_whitespace().map(str::to_owned).collect())
-            .collect()
+    let read = |ext: &str| {
+        std::fs::read_to_string(dir.join(format!("{name}.{ext}")))
+            .unwrap_or_else(|e| panic!("read {name}.{ext}: {e}"))
     };
-    let node_rows = rows(&node);
-    let n: usize = node_rows[0][0].parse().expect("vertex count");
-    let positions: Vec<[f64; 3]> = node_rows[1..=n]
+    (
+        tetgen_rows(&read("node"), "coordinate"),
+        tetgen_rows(&read("ele"), "vertex index"),
+    )
+}
+
+/// The `K` values after the index of each row of a TetGen `.node`/`.ele`
+/// text: the first line gives the row count, indices are 0-based and in
+/// order, `#` starts a comment.
+fn tetgen_rows<T: core::str::FromStr, const K: usize>(text: &str, what: &str) -> Vec<[T; K]> {
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or("").trim())
+        .filter(|l| !l.is_empty())
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    let count: usize = rows[0][0].parse().expect("row count");
+    rows[1..=count]
         .iter()
         .enumerate()
         .map(|(i, r)| {
@@ -38,24 +48,13 @@ pub fn read_reference_tetgen(name: &str) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
                 i,
                 "0-based, in order"
             );
-            [1, 2, 3].map(|c| r[c].parse().expect("coordinate"))
+            core::array::from_fn(|c| {
+                r[c + 1]
+                    .parse()
+                    .unwrap_or_else(|_| panic!("{what} in row {i}"))
+            })
         })
-        .collect();
-    let ele_rows = rows(&ele);
-    let m: usize = ele_rows[0][0].parse().expect("tet count");
-    let tets: Vec<[u32; 4]> = ele_rows[1..=m]
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            assert_eq!(
-                r[0].parse::<usize>().expect("index"),
-                i,
-                "0-based, in order"
-            );
-            [1, 2, 3, 4].map(|c| r[c].parse().expect("vertex index"))
-        })
-        .collect();
-    (positions, tets)
+        .collect()
 }
 
 /// Unit box `[0,1]³` split into `cells` hexahedral cells, 6 Kuhn tets each,

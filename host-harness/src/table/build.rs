@@ -4,14 +4,16 @@
 //!
 //! Stages: the shared preparation (fixed vertices, boundary surface) → the
 //! kind's arrays (the compliance blocks over the free/touchable ordering, or
-//! the tensor-mass arrays) → the writer (for a pre-computed table with its
-//! collision index, built from the same surface) → a [`BuiltTable`] summary.
+//! the tensor-mass arrays) → for a pre-computed table, the collision index of
+//! the same surface (the kernel's grid builder) → the writer → a
+//! [`BuiltTable`] summary.
 
 use core::time::Duration;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 
+use super::collision::collision_index;
 use super::compliance::{Solver, compute_compliance};
 use super::file::{Precision, TableContents, write_table};
 use super::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
@@ -180,7 +182,7 @@ pub fn build(
 }
 
 /// The pre-computed stages: the free/touchable ordering, the compliance,
-/// the writer (with the collision index of `surface`).
+/// the collision index of `surface`, the writer.
 fn precomputed(
     mesh: &TetMesh,
     report: &MeshReport,
@@ -202,6 +204,7 @@ fn precomputed(
     )
     .with_context(|| format!("{}: computing the compliance table", report.source))?;
     let arrays_time = start.elapsed();
+    let collision = collision_index(&mesh.positions, &surface.triangles);
     let bytes = write_table(
         &TableContents {
             tet_count: mesh.tets.len(),
@@ -215,6 +218,7 @@ fn precomputed(
             triangles: &surface.triangles,
             surface: &compliance.surface,
             interior: &compliance.interior,
+            collision: &collision,
         },
         options.precision,
     );

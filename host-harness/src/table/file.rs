@@ -2,7 +2,7 @@
 
 use bytemuck::Zeroable;
 
-use super::collision::collision_index;
+use super::collision::CollisionIndex;
 use palpate_kernel::table::format::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
     SectionEntry, SectionKind, TableKind,
@@ -45,12 +45,15 @@ pub struct TableContents<'a> {
     pub surface: &'a [[f64; 9]],
     /// Interior compliance blocks, m/N.
     pub interior: &'a [[f64; 9]],
+    /// The collision index of `triangles` over `positions`
+    /// ([`super::collision::collision_index`]).
+    pub collision: &'a CollisionIndex,
 }
 
 /// Serializes a pre-computed table (`TableKind::Precomputed`) with floats
 /// of `precision`.
 pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
-    let index = collision_index(c.positions, c.triangles);
+    let index = c.collision;
     let header = RawHeader {
         table_kind: TableKind::Precomputed as u32,
         grid_cell_count: (index.cell_start.len() - 1) as u32,

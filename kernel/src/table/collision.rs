@@ -61,6 +61,7 @@ pub struct Grid<T> {
 }
 
 /// Cell coordinates or counts per axis, widened for indexing.
+#[inline(always)]
 fn widen(c: [u32; 3]) -> [usize; 3] {
     c.map(|x| x as usize)
 }
@@ -74,6 +75,7 @@ impl<T> Grid<T> {
     }
 
     /// The linear index `i + nx (j + ny k)` of cell `c = [i, j, k]`.
+    #[inline(always)]
     pub(crate) fn linear(&self, c: [u32; 3]) -> usize {
         let ([i, j, k], [nx, ny, _]) = (widen(c), widen(self.dims));
         i + nx * (j + ny * k)
@@ -431,6 +433,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
 
     /// The row of `vertex` in the vertex-to-triangle list (empty out of
     /// range).
+    #[inline]
     fn triangle_row(&self, vertex: VertexIndex) -> &'a [u32] {
         csr_row(self.vertex_triangle_start, vertex.get())
             .and_then(|row| self.vertex_triangle.get(row))
