@@ -125,7 +125,10 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// Where `vertex` stands: free (with its free index) or fixed; `None`
     /// out of range.
     pub fn slot(&self, vertex: u32) -> Option<VertexSlot> {
-        self.vertex_slot_of(self.vertex(vertex)?)
+        // The section's own bound is the range check (one comparison on the
+        // force path, not two).
+        let entry = self.vertex_slot.get(usize::try_from(vertex).ok()?)?;
+        Some(VertexSlot::of_entry(*entry))
     }
 
     /// Where the checked `vertex` stands ([`Self::slot`] without the range
