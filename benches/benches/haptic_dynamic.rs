@@ -98,6 +98,8 @@ fn dynamic(c: &mut Criterion) {
                 BenchmarkId::new("physics_update", format!("{cells}cells")),
                 |b| b.iter(|| black_box(haptic.physics_update())),
             );
+            // Every measured update was a real step, not an early refusal.
+            assert!(haptic.physics_update().is_ok(), "physics update faulted");
         });
         let mut state = OwnedState::for_table(&table).without_split_terms();
         let model = TensorMassModel::new(table, state.buffers(), params()).expect("model");

@@ -440,7 +440,15 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         self.held = [None; P];
         // Impose: move each contact point by gap · n, shared out over its
         // triangle's vertices; a vertex two contacts share gets the sum of
-        // both shifts from where it was (at most 3M entries, 9M² sums).
+        // both shifts from where it was (at most 3M entries, 9M² sums). A
+        // gap is a tick's measurement: with no tick since the last update
+        // it has been imposed already, so a back-to-back update (a late
+        // physics thread catching up) holds the contacts where they are.
+        let measured = if self.ticks_since_update > 0 {
+            T::one()
+        } else {
+            T::zero()
+        };
         let mut moves = [[(None, Vector3::zeros(), Vector3::zeros()); 3]; M];
         for ((t, s), slots) in now().zip(moves.iter_mut()) {
             let u = self
@@ -452,7 +460,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                     let from = u
                         .get(v.get())
                         .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]));
-                    *slot = (Some(v), from, t.normal * (t.gap_m * share));
+                    *slot = (Some(v), from, t.normal * (t.gap_m * share * measured));
                 }
             }
         }
