@@ -9,6 +9,7 @@ mod host {
     mod experiment;
     mod fem;
     mod mesh;
+    mod robustness;
     mod session;
     mod session_run;
     mod stability;

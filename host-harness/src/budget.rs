@@ -176,15 +176,15 @@ fn probe_with<const P: usize>(
                 loop_config(scene),
             )
             .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
-            Ok(probe_ticks(&mut haptic, scene, trajectory, |_| {}))
+            probe_ticks(&mut haptic, scene, trajectory, |_| {})
         }
         ModelSpec::Dynamic(spec) => {
             let table = TensorMassTable::<f32>::load(bytes).map_err(load)?;
             DynamicSetup::of(scene, &spec, table)?.with_loop::<P, _>(|haptic| {
                 // A failed update faults the following ticks: measured too.
-                Ok(probe_ticks(haptic, scene, trajectory, |h| {
+                probe_ticks(haptic, scene, trajectory, |h| {
                     let _ = h.physics_update();
-                }))
+                })
             })
         }
     }
@@ -195,11 +195,11 @@ fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
     scene: &Scene,
     trajectory: &Trajectory,
     mut physics: impl FnMut(&mut HapticLoop<f32, B, P, P>),
-) -> Probe {
+) -> anyhow::Result<Probe> {
     let every = scene.rates.physics_every.max(1) as usize;
     let mut counters = Vec::new();
     let mut ticks_s = 0.0;
-    for (k, (_, tool)) in ticks::<P>(trajectory, scene.tick_s()).enumerate() {
+    for (k, (_, tool)) in ticks::<P>(trajectory, scene.tick_s())?.enumerate() {
         let started = std::time::Instant::now();
         core::hint::black_box(budget_tick(haptic, &tool));
         ticks_s += started.elapsed().as_secs_f64();
@@ -208,7 +208,7 @@ fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
             physics(haptic);
         }
     }
-    Probe { counters, ticks_s }
+    Ok(Probe { counters, ticks_s })
 }
 
 /// Per-tick instruction counts of `args` (a `palpate budget --probe …`

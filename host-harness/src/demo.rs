@@ -8,6 +8,7 @@
 //! every step runs the kernel's force path and displacement update.
 
 use core::time::Duration;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -15,6 +16,7 @@ use anyhow::Context;
 use nalgebra::Vector3;
 use palpate_kernel::{Constraint, MAX_CONTACTS};
 
+use crate::output::atomic::SeriesDir;
 use crate::output::vtk;
 use crate::session::run::table_options;
 use crate::session::{MeshSource, Scene};
@@ -28,9 +30,12 @@ const STEP_S: f64 = 0.01;
 /// A VTK frame every this many steps.
 const FRAME_EVERY: usize = 4;
 
-/// Runs the demo, printing forces per phase and timings, and writing the VTK
-/// series into `out_dir`.
-pub fn run(out_dir: &Path) -> anyhow::Result<()> {
+/// Runs the demo, printing forces per phase and timings to `out`, and
+/// writing the VTK series into the folder `out_dir`, whole or not at all
+/// ([`SeriesDir`]: a fresh folder, or one a previous run wrote, replaced
+/// when the series is complete; anything else is refused before the run).
+pub fn run(out_dir: &Path, out: &mut dyn Write) -> anyhow::Result<()> {
+    let series = SeriesDir::create(out_dir)?;
     let scene = Scene::built_in();
     let MeshSource::GeneratedBox { size_m, .. } = scene.mesh else {
         anyhow::bail!("the built-in scene is a generated block");
@@ -38,7 +43,8 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
     let (mesh, mut report) = scene.load_mesh()?;
     report.source = "built-in block".into();
     let options = table_options(&scene)?;
-    println!(
+    writeln!(
+        out,
         "scene: {:.0}x{:.0}x{:.0} cm block, {} vertices, {} tets, E = {} Pa, nu = {}, base fixed",
         size_m[0] * 100.0,
         size_m[1] * 100.0,
@@ -47,16 +53,17 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
         mesh.tets.len(),
         options.material.young_pa,
         options.material.poisson
-    );
+    )?;
     let started = Instant::now();
     let built = build(&mesh, &report, &options)?;
-    println!(
+    writeln!(
+        out,
         "table: {} free, {} touchable vertices, {:.1} MB (f32), built in {:.3} s",
         built.free_count,
         built.touchable_count,
         built.bytes.len() as f64 / 1e6,
         started.elapsed().as_secs_f64()
-    );
+    )?;
     let file = TableFile::from_bytes(&built.bytes);
     let AnyModel::F32(model) = file.model().context("built-in table")? else {
         anyhow::bail!("built-in table is not f32");
@@ -80,24 +87,24 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
         Vector3::new(0.0f32, 0.0, -0.006),
         Vector3::new(0.002f32, 0.0, -0.004),
     ];
-    println!(
+    writeln!(
+        out,
         "probes: vertex {} pressed to {:?} m, vertex {} pressed to {:?} m",
         probes[0],
         full_press_m[0].as_slice(),
         probes[1],
         full_press_m[1].as_slice()
-    );
+    )?;
 
-    std::fs::create_dir_all(out_dir)
-        .with_context(|| format!("{}: cannot create", out_dir.display()))?;
     let mut displacement = vec![[0.0f32; 3]; mesh.positions.len()];
     let mut frames: Vec<(f64, PathBuf)> = Vec::new();
     let mut force_time = Vec::new();
     let mut update_time = Vec::new();
     let mut step = 0usize;
-    println!(
+    writeln!(
+        out,
         "phase    steps  device force at end (N)          |F| peak (N)  contact forces at end (N)"
-    );
+    )?;
     for (phase, steps) in PHASES {
         let mut peak = 0.0f32;
         let mut last = None;
@@ -122,7 +129,7 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
             peak = peak.max(solution.device_force_n().norm());
             step += 1;
             if step.is_multiple_of(FRAME_EVERY) {
-                let path = out_dir.join(format!("frame_{step:04}.vtk"));
+                let path = series.dir().join(format!("frame_{step:04}.vtk"));
                 let u: Vec<[f64; 3]> = displacement.iter().map(|u| u.map(f64::from)).collect();
                 vtk::write_frame(&path, &mesh.positions, &mesh.tets, &u)?;
                 frames.push((step as f64 * STEP_S, path));
@@ -136,28 +143,33 @@ pub fn run(out_dir: &Path) -> anyhow::Result<()> {
                 .iter()
                 .map(|g| format!("({:+.4}, {:+.4}, {:+.4})", g.x, g.y, g.z))
                 .collect();
-            println!(
+            writeln!(
+                out,
                 "{phase:<8} {steps:>5}  ({:+.4}, {:+.4}, {:+.4})  {peak:>11.4}  {}",
                 f.x,
                 f.y,
                 f.z,
                 g.join(" ")
-            );
+            )?;
         }
     }
+    // The collection last, then the whole folder into place.
+    vtk::write_collection(&series.dir().join("demo.pvd"), &frames)?;
+    series.commit()?;
     let collection = out_dir.join("demo.pvd");
-    vtk::write_collection(&collection, &frames)?;
     let (force_mean, force_max) = stats(&force_time);
     let (update_mean, update_max) = stats(&update_time);
-    println!(
+    writeln!(
+        out,
         "timing over {step} steps: force path (2 contacts) mean {force_mean:.2} us, max {force_max:.2} us; \
          displacement update mean {update_mean:.1} us, max {update_max:.1} us"
-    );
-    println!(
+    )?;
+    writeln!(
+        out,
         "wrote {} VTK frames and {} (open in ParaView)",
         frames.len(),
         collection.display()
-    );
+    )?;
     Ok(())
 }
 

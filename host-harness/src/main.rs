@@ -1,7 +1,8 @@
 //! The `palpate` command line (contract in README.md): tables, solves,
 //! sessions, experiments, demo. This file parses, dispatches to the command
 //! groups of [`commands`] and applies the error policy: any error is one
-//! line `error: …` on stderr and exit status 2.
+//! line `error: …` on stderr and exit status 2, except a closed standard
+//! output (a broken pipe), which ends the run normally (exit 0).
 
 use std::process::ExitCode;
 
@@ -57,6 +58,8 @@ fn main() -> ExitCode {
         .and_then(|cli| run(cli, &matches));
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of standard output went away (`… | head -1`): a normal end.
+        Err(e) if commands::stdout::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

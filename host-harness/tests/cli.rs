@@ -104,7 +104,7 @@ fn contacts_come_out_in_argument_order() {
         "solve",
         &table_str,
         "--contact-bary",
-        "194,195,200@0.2,0.5,0.3:0,0,-0.004",
+        "194,195,201@0.2,0.5,0.3:0,0,-0.004",
         "--contact",
         "205:0,0,-0.002",
         "--json",

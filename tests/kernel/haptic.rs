@@ -209,3 +209,48 @@ proptest! {
         }
     }
 }
+
+/// Issue 12: a tool sample far away (1e10 m on every axis, then a return to
+/// 5 mm inside the top face) is detected again on the way back. The swept
+/// segment from 1e10 m is clipped to the grid's reach before the
+/// intersection, so in f32 the part near the surface keeps its precision
+/// (before the clip every digit was lost and the tool, once inside, was never
+/// detected: zero force for as long as it stayed in). Also from straight
+/// above and from 1e6 m, which worked before.
+#[test]
+fn a_far_sample_then_a_return_inside_is_detected() {
+    let file = reference_cube_table(Precision::F32);
+    let table = PrecomputedTable::<f32>::load(file.bytes()).expect("table");
+    let limits = SafetyLimits {
+        max_force_n: 20.0f32,
+        max_slew_n_per_s: 10_000.0,
+    };
+    let config = LoopConfig {
+        radius_m: 0.01f32,
+        dt_s: 1e-3,
+        limits,
+    };
+    // 5 mm inside: the sphere's centre 5 mm below the top face plus r; far
+    // enough from the corner (0, 0, 1) that its cells do not hold it (the
+    // unclipped f32 sweep from 1e10 m projected onto that corner).
+    let inside = Vector3::new(0.9f32, 0.9, 1.0 + 0.01 - 0.005);
+    for far in [
+        Vector3::new(1e10f32, 1e10, 1e10),
+        Vector3::new(0.9f32, 0.9, 1e10),
+        Vector3::new(1e6f32, 1e6, 1e6),
+    ] {
+        let mut haptic = PrecomputedLoop::<f32, 1, 1>::new(PrecomputedTissue::new(&table), config)
+            .expect("loop");
+        let above = haptic.tick(&[Vector3::new(0.9, 0.9, 1.05)]);
+        assert_eq!(above.contacts, 0);
+        let away = haptic.tick(&[far]);
+        assert_eq!((away.contacts, away.force_n), (0, Vector3::zeros()));
+        for tick in 0..5 {
+            let out = haptic.tick(&[inside]);
+            assert_eq!(out.contacts, 1, "from {far:?}, tick {tick} back inside");
+            assert!(out.force_n.z > 0.0, "from {far:?}: {:?}", out.force_n);
+            let c = haptic.contacts()[0].expect("contact");
+            assert!((c.gap_m + 0.005).abs() < 1e-4, "{c:?}");
+        }
+    }
+}

@@ -320,7 +320,10 @@ fn back_to_back_physics_updates_hold_the_contact() {
             let held = haptic.tissue().held()[0].expect("held");
             let u = haptic.tissue().model().displacements_m().expect("finite");
             let imposed = held.contact.vertices.iter().zip(&held.shares);
-            imposed.filter(|(_, s)| **s != 0.0).map(|(v, _)| u[v.get()]).collect()
+            imposed
+                .filter(|(_, s)| **s != 0.0)
+                .map(|(v, _)| u[v.get()])
+                .collect()
         };
         let first = held_at(haptic);
         assert!(!first.is_empty(), "the contact holds a vertex");
@@ -331,7 +334,10 @@ fn back_to_back_physics_updates_hold_the_contact() {
         let last = held_at(haptic);
         for (a, b) in first.iter().zip(&last) {
             let moved = (Vector3::from(*a) - Vector3::from(*b)).norm();
-            assert!(moved < 1e-12, "a held vertex moved {moved} m: {a:?} -> {b:?}");
+            assert!(
+                moved < 1e-12,
+                "a held vertex moved {moved} m: {a:?} -> {b:?}"
+            );
         }
         let out = haptic.tick(&tool_at(3e-3));
         println!("force at the next tick {:.4} N", out.force_n.z);

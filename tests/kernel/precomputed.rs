@@ -213,11 +213,13 @@ fn barycentric_contact_at_a_vertex_is_a_vertex_contact() {
     let vertex = m
         .contact_forces::<4>(&[Constraint::at_vertex(194, d)])
         .unwrap();
-    // Triangle 194-195-200 on the top face, all weight on 194, in each slot.
+    // Surface triangle 194-195-201 on the top face, all weight on 194, in
+    // each slot (the corners rotated so that 194 is there).
     for weights in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
-        let mut tri = [195, 200, 201];
+        let mut tri = [194, 195, 201];
         let slot = weights.iter().position(|&w| w == 1.0).unwrap();
-        tri[slot] = 194;
+        tri.rotate_right(slot);
+        assert_eq!(tri[slot], 194);
         let bary = m
             .contact_forces::<4>(&[Constraint::on_triangle(tri, weights, d)])
             .unwrap();
@@ -231,7 +233,7 @@ fn barycentric_point_moves_by_the_imposed_displacement() {
     let AnyModel::F64(m) = file.model().unwrap() else {
         unreachable!()
     };
-    let tri = [194u32, 195, 200];
+    let tri = [194u32, 195, 201];
     let weights = [0.2, 0.5, 0.3];
     let d = Vector3::new(0.001, 0.0, -0.005);
     let s = m
@@ -268,7 +270,7 @@ fn free_displacements_are_the_vertex_displacements_by_free_index() {
     let s = m
         .contact_forces::<4>(&[
             Constraint::on_triangle(
-                [194, 195, 200],
+                [194, 195, 201],
                 [0.2, 0.5, 0.3],
                 Vector3::new(0.0, 0.001, -0.004),
             ),
@@ -352,13 +354,33 @@ fn contact_errors_are_typed() {
     assert_eq!(err(&[bad]), ContactError::BadWeights { contact: 0 });
     let negative = Constraint::on_triangle([194, 195, 200], [1.2, -0.2, 0.0], d);
     assert_eq!(err(&[negative]), ContactError::BadWeights { contact: 0 });
-    // The same point twice through different triangles: singular system.
-    let p1 = Constraint::on_triangle([194, 195, 200], [0.5, 0.5, 0.0], d);
+    // The same point twice through the two surface triangles sharing the
+    // edge 194-195: singular system.
+    let p1 = Constraint::on_triangle([194, 195, 188], [0.5, 0.5, 0.0], d);
     let p2 = Constraint::on_triangle([195, 194, 201], [0.5, 0.5, 0.0], d);
     assert_eq!(err(&[p1, p2]), ContactError::IllConditioned { contact: 1 });
-    // All weight on fixed base vertices (0, 1, 6 are on z = 0): zero compliance.
-    let on_base = Constraint::on_triangle([0, 1, 6], [0.3, 0.3, 0.4], d);
+    // All weight on fixed base vertices (surface triangle 0, 1, 7 on z = 0):
+    // zero compliance.
+    let on_base = Constraint::on_triangle([0, 1, 7], [0.3, 0.3, 0.4], d);
     assert_eq!(err(&[on_base]), ContactError::IllConditioned { contact: 0 });
+    // Three surface vertices that are not a surface triangle (194, 195 and
+    // 200 span the other diagonal of a top square), and a repeated vertex.
+    let across = Constraint::on_triangle([194, 195, 200], [0.2, 0.3, 0.5], d);
+    assert_eq!(
+        err(&[across]),
+        ContactError::NotSurfaceTriangle {
+            contact: 0,
+            vertices: [194, 195, 200]
+        }
+    );
+    let twice = Constraint::on_triangle([194, 194, 201], [0.2, 0.3, 0.5], d);
+    assert_eq!(
+        err(&[Constraint::at_vertex(205, d), twice]),
+        ContactError::RepeatedVertex {
+            contact: 1,
+            vertex: 194
+        }
+    );
     // An empty set is a well-defined zero force.
     let none = m.contact_forces::<4>(&[] as &[Constraint<f32>]).unwrap();
     assert_eq!(none.device_force_n(), Vector3::zeros());
@@ -397,12 +419,17 @@ proptest! {
         FILE.with(|file| {
             let AnyModel::F32(m) = file.model().unwrap() else { unreachable!() };
             let touchable = touchable_vertices(&m);
-            let contacts: Vec<Constraint<f32>> = picks.iter().zip(&ds).map(|(&(a, b, c, wa, wb, bary), d)| {
+            let surface = m.table().surface_triangles();
+            let contacts: Vec<Constraint<f32>> = picks.iter().zip(&ds).map(|(&(a, b, _, wa, wb, bary), d)| {
                 let v = |i: usize| touchable[i % touchable.len()];
                 let d = Vector3::from(*d);
                 if bary {
+                    // A surface triangle (three other vertices are refused),
+                    // its corners rotated by `b`.
                     let (wa, wb) = (wa * 0.5, wb * 0.5);
-                    Constraint::on_triangle([v(a), v(b), v(c)], [wa, wb, 1.0 - wa - wb], d)
+                    let mut tri = surface[a % surface.len()];
+                    tri.rotate_left(b % 3);
+                    Constraint::on_triangle(tri, [wa, wb, 1.0 - wa - wb], d)
                 } else {
                     Constraint::at_vertex(v(a), d)
                 }

@@ -8,14 +8,16 @@ use palpate::fem::material::Material;
 use palpate::fix::FixPredicate;
 use palpate_kernel::tensor_mass::StvkForm;
 
-/// `--young` and `--poisson`: an isotropic linear elastic material.
+/// `--young` and `--poisson`: an isotropic linear elastic material. Negative
+/// numbers parse (`--young -3000`), so that [`Self::material`] refuses them
+/// with the physics reason instead of clap's usage error.
 #[derive(clap::Args)]
 pub struct MaterialArgs {
     /// Young's modulus, Pa.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub young: f64,
     /// Poisson ratio, in [0, 0.5).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub poisson: f64,
 }
 

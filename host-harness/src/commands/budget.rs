@@ -2,12 +2,16 @@
 //! generated trajectory on a scene's mesh, against the static bound of
 //! [`palpate::budget`]; `--probe` is the child process callgrind measures.
 
+use core::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use palpate::budget::{BudgetRow, M4F_IPS, budget_table, measure, probe, trajectories};
+use palpate::session::run::check_scene_table;
 use palpate::session::{MeshSource, Scene, Trajectory};
 use palpate::table::load::TableFile;
+
+use super::stdout;
 
 /// `palpate budget`'s arguments.
 #[derive(clap::Args)]
@@ -87,6 +91,14 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     if !only.is_empty() {
         chosen.retain(|(name, _)| only.iter().any(|o| o == name));
     }
+    // Every size's table is checked against the build limits before the
+    // first is built (the coarse one can take a while).
+    for source in &sizes {
+        let mut sized = scene.clone();
+        sized.mesh = source.clone();
+        let (mesh, report) = sized.load_mesh()?;
+        check_scene_table(&sized, &mesh, &report)?;
+    }
     let mut rows: Vec<BudgetRow> = Vec::new();
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
@@ -136,10 +148,10 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         }
     }
     if *json {
-        println!("{}", serde_json::to_string(&rows)?);
+        stdout::println(&serde_json::to_string(&rows)?)?;
         return Ok(());
     }
-    println!(
+    let mut text = format!(
         "{:<26} {:<11} {:>6} {:>9} {:>9} {:>9} {:>6} {:>11} {:>11} {:>12}",
         "mesh",
         "trajectory",
@@ -152,8 +164,10 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         "bound@host",
         "tests/walk/solves"
     );
+    text.push('\n');
     for r in &rows {
-        println!(
+        let _ = writeln!(
+            text,
             "{:<26} {:<11} {:>6} {:>9.0} {:>9} {:>9} {:>6.3} {:>8.1} µs {:>8.2} µs {:>5}/{}/{}",
             r.mesh,
             r.trajectory,
@@ -169,6 +183,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             r.max_work[2]
         );
     }
+    stdout::print(&text)?;
     if let Some(r) = rows.iter().find(|r| r.max_ir > r.bound_ir) {
         bail!(
             "{} on {}: {} instructions exceed the bound {}",

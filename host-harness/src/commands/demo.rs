@@ -1,17 +1,24 @@
 //! `palpate demo`: the built-in scene (two probes pressed and released),
 //! run by [`palpate::demo`].
 
+use std::io::Write as _;
 use std::path::PathBuf;
+
+use super::stdout::Stdout;
 
 /// `palpate demo`'s arguments.
 #[derive(clap::Args)]
 pub struct DemoArgs {
-    /// Folder for the VTK series (created if absent).
+    /// Folder for the VTK series: created, or replaced if a previous run
+    /// wrote it (anything else is refused).
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
 }
 
 /// Runs the demo: forces and timings on stdout, the VTK series in `--out`.
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
-    palpate::demo::run(&args.out)
+    let mut out = Stdout;
+    palpate::demo::run(&args.out, &mut out)?;
+    out.flush()?;
+    Ok(())
 }

@@ -13,6 +13,7 @@ use palpate::tensor_mass::run::RunOptions;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
 
 use super::args::{FixArgs, FormArg, JsonArgs, MaterialArgs, optional_fix};
+use super::stdout;
 
 #[derive(Subcommand)]
 pub enum DynamicCommand {
@@ -186,7 +187,7 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             };
             let output = palpate::tensor_mass::run::run(&mesh, &report, &options)
                 .with_context(|| model.mesh.display().to_string())?;
-            println!("{}", serde_json::to_string(&output)?);
+            stdout::println(&serde_json::to_string(&output)?)?;
             Ok(())
         }
         DynamicCommand::CriticalDt { model } => {
@@ -199,7 +200,7 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
                 model.integrator.into(),
             )
             .with_context(|| model.mesh.display().to_string())?;
-            println!("{}", serde_json::to_string(&result)?);
+            stdout::println(&serde_json::to_string(&result)?)?;
             Ok(())
         }
     }

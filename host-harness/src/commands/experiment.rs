@@ -4,6 +4,8 @@
 use clap::Subcommand;
 use palpate::experiment::{scenes, volume_bend};
 
+use super::stdout;
+
 #[derive(Subcommand)]
 pub enum ExperimentCommand {
     /// Picinbono 2001 table 2: volume change of a bent cylinder (three stages)
@@ -41,9 +43,9 @@ pub fn run(command: ExperimentCommand) -> anyhow::Result<()> {
                     })
                     .collect();
                 let output = serde_json::json!({ "scenes": results, "paper_percent": paper });
-                println!("{output}");
+                stdout::println(&output.to_string())?;
             } else {
-                print!("{}", volume_bend::table(&results));
+                stdout::print(&volume_bend::table(&results))?;
             }
             Ok(())
         }

@@ -6,10 +6,12 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::{ArgMatches, Subcommand};
+use palpate::limits::{MAX_SEQUENCE_FILE_BYTES, read_bounded};
 use palpate::table::load::{AnyModel, TableFile};
 use palpate_kernel::{Constraint, Real};
 
 use super::args::JsonArgs;
+use super::stdout;
 
 #[derive(Subcommand)]
 pub enum PrecomputedCommand {
@@ -57,14 +59,25 @@ pub fn run(command: PrecomputedCommand, matches: &ArgMatches) -> anyhow::Result<
                     serde_json::to_string(&palpate::precomputed::solve(&m, &contacts(solve)?)?)?
                 }
             };
-            println!("{text}");
+            stdout::println(&text)?;
             Ok(())
         }
         PrecomputedCommand::Replay { table, sequence } => {
             let file = TableFile::read(&table)?;
-            let text = std::fs::read_to_string(&sequence)
-                .with_context(|| format!("{}: cannot read", sequence.display()))?;
-            print!("{}", palpate::replay::replay(&file, &text)?);
+            let text = read_bounded(
+                &sequence,
+                MAX_SEQUENCE_FILE_BYTES,
+                "a sequence file (MAX_SEQUENCE_FILE_BYTES)",
+            )
+            .and_then(|bytes| {
+                String::from_utf8(bytes)
+                    .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+            })
+            .with_context(|| format!("{}: cannot read", sequence.display()))?;
+            let (table_name, sequence_name) =
+                (table.display().to_string(), sequence.display().to_string());
+            let lines = palpate::replay::replay(&file, &table_name, &text, &sequence_name)?;
+            stdout::print(&lines)?;
             Ok(())
         }
     }

@@ -1,12 +1,16 @@
 //! `palpate session`: haptic sessions, the kernel's fixed-timestep loop
 //! driven by a trajectory (`run`), and generated trajectories (`generate`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use clap::Subcommand;
-use palpate::session::run::run_session;
-use palpate::session::{Generator, Pinch, Poke, PressHold, Scene, Slide, Strike, Trajectory};
+use palpate::output::atomic::{self, AtomicFile};
+use palpate::session::run::run_session_to_files;
+use palpate::session::{
+    Generator, MeshSource, Pinch, Poke, PressHold, Scene, Slide, Strike, Trajectory,
+};
+
+use super::mesh_files;
 
 #[derive(Subcommand)]
 pub enum SessionCommand {
@@ -18,10 +22,11 @@ pub enum SessionCommand {
         /// Trajectory file: CSV `t,tool,x,y,z` (s, tool point, m) with a header.
         #[arg(long)]
         trajectory: PathBuf,
-        /// Output CSV, one line per tick.
+        /// Output CSV, one line per tick (replaced only when the run succeeds).
         #[arg(long)]
         out: PathBuf,
-        /// Folder for a VTK frame per physics update and `session.pvd`.
+        /// Folder for a VTK frame per physics update and `session.pvd`: created,
+        /// or replaced if a previous run wrote it (anything else is refused).
         #[arg(long)]
         vtk: Option<PathBuf>,
         /// Keep non-finite values and backward times (reported on stderr) and
@@ -60,7 +65,22 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             vtk,
             lenient,
         } => {
+            // The outputs: never an input, nor inside the VTK folder they
+            // replace; checked before anything is read (and again with the
+            // scene's mesh once the scene names it).
+            let scene_file = Path::new(&scene);
+            let mut inputs: Vec<(&str, PathBuf)> = vec![("--trajectory", trajectory.clone())];
+            if !matches!(scene.as_str(), "built-in" | "built-in-dynamic") {
+                inputs.push(("the scene", scene_file.to_path_buf()));
+            }
+            refuse_inputs(&out, vtk.as_deref(), &inputs)?;
             let scene = Scene::named(&scene)?;
+            if let MeshSource::File(mesh) = &scene.mesh {
+                for file in mesh_files(mesh) {
+                    inputs.push(("the scene's mesh", file));
+                }
+                refuse_inputs(&out, vtk.as_deref(), &inputs)?;
+            }
             let points = scene.tool.points;
             let trajectory = if lenient {
                 let (t, findings) = Trajectory::read_unchecked(&trajectory, points)?;
@@ -71,13 +91,7 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             } else {
                 Trajectory::read(&trajectory, points)?
             };
-            if let Some(dir) = &vtk {
-                std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-            }
-            let file = std::fs::File::create(&out).with_context(|| out.display().to_string())?;
-            let mut writer = std::io::BufWriter::new(file);
-            let summary = run_session(&scene, &trajectory, &mut writer, vtk.as_deref())?;
-            std::io::Write::flush(&mut writer)?;
+            let summary = run_session_to_files(&scene, &trajectory, &out, vtk.as_deref())?;
             eprintln!(
                 "{} ticks ({} in contact, {} clamped, {} faulted); max force {:.3} N, max jump {:.4} N per tick; {} VTK frames",
                 summary.ticks,
@@ -102,8 +116,23 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                 TrajectoryKind::Strike => Strike::default().trajectory(),
             }
             .map_err(|e| anyhow::anyhow!("{e}"))?;
-            trajectory.write_csv_file(&output)?;
+            let mut file = AtomicFile::create(&output)?;
+            trajectory.write_csv(&mut file)?;
+            file.commit()?;
             Ok(())
         }
     }
+}
+
+/// Refuses `session run` outputs that would overwrite an input: `--out` one
+/// of `inputs`, or `--out` or an input inside the `--vtk` folder.
+fn refuse_inputs(out: &Path, vtk: Option<&Path>, inputs: &[(&str, PathBuf)]) -> anyhow::Result<()> {
+    let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(l, p)| (*l, p.as_path())).collect();
+    atomic::refuse_input(("--out", out), &inputs)?;
+    if let Some(dir) = vtk {
+        let mut inside = inputs.clone();
+        inside.push(("--out", out));
+        atomic::refuse_inside(("--vtk", dir), &inside)?;
+    }
+    Ok(())
 }

@@ -3,13 +3,13 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Subcommand;
 use palpate::mesh::read_mesh;
-use palpate::tensor_mass::evaluate::{forces_and_energy, read_positions_csv};
+use palpate::tensor_mass::evaluate::{NonFiniteResult, forces_and_energy, read_positions_csv};
 use palpate_kernel::tensor_mass::ElasticLaw;
 
 use super::args::{FormArg, JsonArgs, MaterialArgs};
+use super::stdout;
 
 #[derive(Subcommand)]
 pub enum StvkCommand {
@@ -43,6 +43,15 @@ pub fn run(command: StvkCommand) -> anyhow::Result<()> {
             json.require("stvk forces")?;
             let (mesh, report) = read_mesh(&path)?;
             let deformed_m = read_positions_csv(&deformed)?;
+            anyhow::ensure!(
+                deformed_m.len() == mesh.positions.len(),
+                "{}: {} lines of deformed positions, expected one x,y,z line per vertex of {} ({} vertices)",
+                deformed.display(),
+                deformed_m.len(),
+                path.display(),
+                mesh.positions.len()
+            );
+            // A non-finite result comes from the deformed positions: name them.
             let (forces, energy) = forces_and_energy(
                 &mesh,
                 &report,
@@ -51,9 +60,16 @@ pub fn run(command: StvkCommand) -> anyhow::Result<()> {
                 None,
                 &deformed_m,
             )
-            .with_context(|| path.display().to_string())?;
+            .map_err(|e| {
+                let source = if e.downcast_ref::<NonFiniteResult>().is_some() {
+                    &deformed
+                } else {
+                    &path
+                };
+                e.context(source.display().to_string())
+            })?;
             let output = serde_json::json!({ "forces": forces, "energy": energy });
-            println!("{output}");
+            stdout::println(&output.to_string())?;
             Ok(())
         }
     }

@@ -1,18 +1,22 @@
 //! `palpate tables`: build a table of either kind (`build`), print a table's
 //! report (`info`).
 
-use std::path::PathBuf;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Subcommand};
 use palpate::mesh::read_mesh;
-use palpate::table::build::{BuildOptions, TableKindOptions, build};
+use palpate::output::atomic::{self, AtomicFile};
+use palpate::table::build::{BuildOptions, TableKindOptions, build_with_limits};
 use palpate::table::compliance::Solver;
+use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 
 use super::args::{FixArgs, MaterialArgs};
+use super::{mesh_files, stdout};
 
 #[derive(Subcommand)]
 pub enum TablesCommand {
@@ -44,6 +48,11 @@ pub enum TablesCommand {
         /// Mass density, kg/m3 (required with, and only with, --kind tensor-mass).
         #[arg(long)]
         density: Option<f64>,
+        /// Refuse, before building, a table estimated above this many bytes
+        /// (the estimate is printed; 4294967296, MAX_TABLE_FILE_BYTES, and the
+        /// memory available apply in any case).
+        #[arg(long, value_name = "BYTES")]
+        max_table_bytes: Option<u64>,
     },
     /// Print a table's counts, sizes, material and checksum status.
     Info {
@@ -89,6 +98,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             output,
             kind,
             density,
+            max_table_bytes,
         } => {
             let solver_given = matches
                 .subcommand_matches("build")
@@ -113,6 +123,13 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                     solver: solver.into(),
                 },
             };
+            // The output: never one of the inputs, and written whole or not at
+            // all (opened before the build, so an unwritable path fails fast).
+            let inputs = mesh_files(&mesh);
+            let inputs: Vec<(&str, &Path)> =
+                inputs.iter().map(|p| ("the mesh", p.as_path())).collect();
+            atomic::refuse_input(("-o", output.as_path()), &inputs)?;
+            let mut file = AtomicFile::create(&output)?;
             let (mesh_data, report) = read_mesh(&mesh)?;
             for w in &report.warnings {
                 eprintln!("warning: {w}");
@@ -124,9 +141,15 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 precision,
                 progress: !quiet,
             };
-            let built = build(&mesh_data, &report, &options)?;
-            std::fs::write(&output, &built.bytes)
-                .with_context(|| format!("{}: cannot write", output.display()))?;
+            // The size estimate is checked (and printed) before the build.
+            let limits = SizeLimits {
+                max_table_bytes,
+                print_estimate: true,
+                ..SizeLimits::system()
+            };
+            let built = build_with_limits(&mesh_data, &report, &options, &limits)?;
+            file.write_all(&built.bytes)?;
+            file.commit()?;
             // The summary line on stderr: the mesh, then the kind's counts.
             let vertices = format!(
                 "{} vertices ({} fixed by --fix, {} unreferenced kept fixed), {} tets",
@@ -157,14 +180,15 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             Ok(())
         }
         TablesCommand::Info { table } => {
-            let file = TableFile::read(&table)?;
+            // Read whole when small enough, so a damaged table is reported.
+            let file = TableFile::read_for_report(&table)?;
             match file.info(&table.display().to_string()) {
                 Ok(report) => {
-                    print!("{report}");
+                    stdout::print(&report)?;
                     Ok(())
                 }
                 Err(report) => {
-                    print!("{report}");
+                    stdout::print(&report)?;
                     bail!("{}: table failed validation", table.display())
                 }
             }

@@ -8,6 +8,8 @@
 
 use std::path::Path;
 
+use crate::limits::{MAX_MESH_FILE_BYTES, read_bounded};
+
 mod cursor;
 mod error;
 pub mod generate;
@@ -128,7 +130,9 @@ impl TetMesh {
 
 /// Read a mesh file, choosing the reader by extension: `.msh` (Gmsh 2.x / 4.1, ASCII or binary,
 /// sniffed), `.node` (reads the sibling `.ele`) or `.ele` (reads the sibling `.node`), `.vtk`.
-/// Messages name the file as `path` displays.
+/// Messages name the file as `path` displays. Each file is read whole, at most
+/// [`MAX_MESH_FILE_BYTES`] (checked from a regular file's size before reading; anything else,
+/// a pipe or a device, is read through a bounded reader: [`read_bounded`]).
 pub fn read_mesh(path: &Path) -> Result<(TetMesh, MeshReport), MeshError> {
     let name = path.display().to_string();
     let ext = path
@@ -136,10 +140,14 @@ pub fn read_mesh(path: &Path) -> Result<(TetMesh, MeshReport), MeshError> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
+    // Bounded: a mesh larger than the limit, or `/dev/zero` named `.msh`, is refused with a
+    // message instead of filling the memory.
     let read = |p: &Path| {
-        std::fs::read(p).map_err(|err| MeshError::Io {
-            file: p.display().to_string(),
-            err,
+        read_bounded(p, MAX_MESH_FILE_BYTES, "a mesh file (MAX_MESH_FILE_BYTES)").map_err(|err| {
+            MeshError::Io {
+                file: p.display().to_string(),
+                err,
+            }
         })
     };
     match ext.as_str() {

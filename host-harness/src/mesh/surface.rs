@@ -25,27 +25,45 @@ fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-/// How many tets use each face.
-fn face_counts(mesh: &TetMesh) -> HashMap<[u32; 3], u32> {
-    let mut counts: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.tets.len() * 3);
-    for &t in &mesh.tets {
-        for f in faces(t) {
-            *counts.entry(sorted3(f)).or_insert(0) += 1;
+/// Every face of every tet (vertex ids ascending) with its slot `4·tet + j` (the face opposite
+/// local vertex `j`), sorted by face: the tets sharing a face are one run. A sort rather than a
+/// hash map: 10 times faster on large meshes (a 40³-cell box's 1.5 million faces in about 0.1 s),
+/// which is what lets a table build refuse an oversized mesh at once (`table::estimate`).
+fn sorted_faces(mesh: &TetMesh) -> Vec<([u32; 3], usize)> {
+    let mut all: Vec<([u32; 3], usize)> = Vec::with_capacity(4 * mesh.tets.len());
+    for (t, &tet) in mesh.tets.iter().enumerate() {
+        for (j, f) in faces(tet).into_iter().enumerate() {
+            all.push((sorted3(f), 4 * t + j));
         }
     }
-    counts
+    all.sort_unstable_by_key(|&(f, _)| f);
+    all
+}
+
+/// The runs of equal faces of [`sorted_faces`].
+fn face_runs(sorted: &[([u32; 3], usize)]) -> impl Iterator<Item = &[([u32; 3], usize)]> {
+    sorted.chunk_by(|a, b| a.0 == b.0)
 }
 
 /// Extract the outward-oriented boundary surface (faces used by exactly one tet).
 pub fn boundary_surface(mesh: &TetMesh) -> Surface {
-    boundary_from(mesh, &face_counts(mesh))
+    boundary_from(mesh, &sorted_faces(mesh))
 }
 
-fn boundary_from(mesh: &TetMesh, counts: &HashMap<[u32; 3], u32>) -> Surface {
+fn boundary_from(mesh: &TetMesh, sorted: &[([u32; 3], usize)]) -> Surface {
+    // Which tet faces are on the boundary, then the triangles in tet order, then face order.
+    let mut on_boundary = vec![false; 4 * mesh.tets.len()];
+    for run in face_runs(sorted) {
+        if let [(_, slot)] = run
+            && let Some(b) = on_boundary.get_mut(*slot)
+        {
+            *b = true;
+        }
+    }
     let mut triangles = Vec::new();
-    for &t in &mesh.tets {
-        for f in faces(t) {
-            if counts.get(&sorted3(f)) == Some(&1) {
+    for (t, &tet) in mesh.tets.iter().enumerate() {
+        for (j, f) in faces(tet).into_iter().enumerate() {
+            if on_boundary.get(4 * t + j) == Some(&true) {
                 triangles.push(f);
             }
         }
@@ -63,21 +81,20 @@ fn boundary_from(mesh: &TetMesh, counts: &HashMap<[u32; 3], u32>) -> Surface {
 /// exactly two boundary triangles (open or non-manifold surface).
 pub(crate) fn check(mesh: &TetMesh) -> Vec<String> {
     let mut warnings = Vec::new();
-    let counts = face_counts(mesh);
-    let mut over: Vec<[u32; 3]> = counts
-        .iter()
-        .filter(|(_, c)| **c > 2)
-        .map(|(f, _)| *f)
+    let sorted = sorted_faces(mesh);
+    // Ascending: the runs come in face order.
+    let over: Vec<[u32; 3]> = face_runs(&sorted)
+        .filter(|run| run.len() > 2)
+        .map(|run| run[0].0)
         .collect();
     if !over.is_empty() {
-        over.sort_unstable();
         warnings.push(format!(
             "non-manifold: {} faces shared by more than 2 tets (first: {:?})",
             over.len(),
             over.first().copied().unwrap_or_default()
         ));
     }
-    let surf = boundary_from(mesh, &counts);
+    let surf = boundary_from(mesh, &sorted);
     let mut edges: HashMap<[u32; 2], u32> = HashMap::with_capacity(surf.triangles.len() * 2);
     for tri in &surf.triangles {
         for k in 0..3 {

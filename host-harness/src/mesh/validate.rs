@@ -113,6 +113,17 @@ pub(crate) fn validate(
                     let idx = i128::from(r) - i128::from(*base);
                     match u32::try_from(idx) {
                         Ok(i) if (i as usize) < n => i,
+                        // Below the file's first id (an MSH node id of 0):
+                        // name the id as written, not a negative index.
+                        Err(_) if node_ids.is_some() => {
+                            return Err(MeshError::UnknownNode {
+                                file: tet_file.to_string(),
+                                tet: t,
+                                elem_id: eid(t),
+                                node_id: r,
+                                n_vertices: n,
+                            });
+                        }
                         _ => {
                             return Err(MeshError::IndexOutOfRange {
                                 file: tet_file.to_string(),

@@ -14,7 +14,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{
@@ -28,10 +28,14 @@ use palpate_kernel::tensor_mass::{
 
 use super::tool_points::{ForToolPoints, with_tool_points};
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
-use crate::mesh::{MeshReport, TetMesh};
+use crate::fix::fixed_vertices;
+use crate::limits::{MAX_HAPTIC_HZ, MAX_SESSION_TICKS, MAX_TRAJECTORY_SPAN_S};
+use crate::mesh::{MeshReport, TetMesh, boundary_surface};
+use crate::output::atomic::{self, AtomicFile, SeriesDir};
 use crate::output::vtk;
 use crate::table::build::{BuildOptions, build};
 use crate::table::compliance::Solver;
+use crate::table::estimate::{SizeLimits, TableEstimate};
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
 use crate::tensor_mass::run::diagonal;
@@ -62,6 +66,24 @@ pub fn scene_table(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow
         .bytes)
 }
 
+/// Checks that `scene`'s table on `mesh` fits the limits every build
+/// applies ([`SizeLimits::system`]: the largest table file, the memory
+/// available), from the estimate of its size, without building it (linear
+/// in the mesh): for a command that builds several tables, before the
+/// first. Returns the estimate.
+pub fn check_scene_table(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<TableEstimate> {
+    let options = table_options(scene)?;
+    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
+    let surface = boundary_surface(mesh);
+    let estimate = TableEstimate::of_build(mesh, report, &options, &fixed, &surface);
+    SizeLimits::system().check(&estimate, &report.source)?;
+    Ok(estimate)
+}
+
 /// The haptic loop configuration of `scene` (f32).
 pub fn loop_config(scene: &Scene) -> LoopConfig<f32> {
     LoopConfig {
@@ -74,17 +96,41 @@ pub fn loop_config(scene: &Scene) -> LoopConfig<f32> {
     }
 }
 
+/// The number of ticks of `trajectory` at period `tick_s` (s): one at its
+/// start, then one every `tick_s` up to its end,
+/// `⌊(end − start)/tick_s + 10⁻⁹⌋ + 1`. Checked: a period that is not finite
+/// and > 0, or a count above [`MAX_SESSION_TICKS`] (one hour at 10 kHz), is
+/// an error, never a count that wraps or saturates. A validated scene and a
+/// trajectory read by the readers never exceed it (their own limits,
+/// [`crate::limits`]).
+pub fn tick_count(trajectory: &Trajectory, tick_s: f64) -> anyhow::Result<usize> {
+    if !(tick_s.is_finite() && tick_s > 0.0) {
+        bail!("tick period {tick_s} s: must be finite and > 0 s");
+    }
+    let span_s = trajectory.end_s() - trajectory.start_s();
+    let periods = (span_s / tick_s + 1e-9).floor();
+    // NaN and infinities fail the comparison.
+    if !(periods >= 0.0 && periods < MAX_SESSION_TICKS as f64) {
+        bail!(
+            "the trajectory spans {span_s} s: {periods:e} ticks of {tick_s} s, above the limit of {MAX_SESSION_TICKS} ticks (MAX_SESSION_TICKS: {MAX_TRAJECTORY_SPAN_S} s at {MAX_HAPTIC_HZ} Hz)"
+        );
+    }
+    // A whole number in 0..MAX_SESSION_TICKS: exact as an integer.
+    Ok(periods as usize + 1)
+}
+
 /// The ticks of `trajectory` at period `tick_s`: `(t_s, tool positions)`
-/// for `t = start + k·tick_s` up to the end; a tool point the trajectory
-/// lacks is NaN (the loop faults on it).
+/// for `t = start + k·tick_s` up to the end, [`tick_count`] of them (its
+/// error if the count is out of range); a tool point the trajectory lacks is
+/// NaN (the loop faults on it).
 pub fn ticks<const P: usize>(
     trajectory: &Trajectory,
     tick_s: f64,
-) -> impl Iterator<Item = (f64, [Vector3<f32>; P])> + '_ {
+) -> anyhow::Result<impl Iterator<Item = (f64, [Vector3<f32>; P])> + '_> {
     let start = trajectory.start_s();
-    let count = ((trajectory.end_s() - start) / tick_s + 1e-9).floor() as usize + 1;
+    let count = tick_count(trajectory, tick_s)?;
     let mut positions = vec![[0.0; 3]; trajectory.tool_count()];
-    (0..count).map(move |k| {
+    Ok((0..count).map(move |k| {
         let t = start + k as f64 * tick_s;
         trajectory.positions_at_into(t, &mut positions);
         let tool = core::array::from_fn(|p| {
@@ -92,7 +138,7 @@ pub fn ticks<const P: usize>(
             Vector3::new(x[0] as f32, x[1] as f32, x[2] as f32)
         });
         (t, tool)
-    })
+    }))
 }
 
 /// What a session did.
@@ -117,14 +163,49 @@ pub struct SessionSummary {
     pub physics_error: Option<String>,
 }
 
+/// [`run_session`] into files, as `palpate session run` does: the CSV to the
+/// file `out` and, with `vtk`, the VTK series to that folder, each written
+/// whole or not at all ([`AtomicFile`], [`SeriesDir`]): nothing at `out` or
+/// `vtk` changes until the run has succeeded, and on any error both keep
+/// their previous contents. A `vtk` folder that exists must be one a
+/// previous run wrote (or empty), and `out` must not lie inside it; both
+/// are checked before the mesh is read.
+pub fn run_session_to_files(
+    scene: &Scene,
+    trajectory: &Trajectory,
+    out: &Path,
+    vtk: Option<&Path>,
+) -> anyhow::Result<SessionSummary> {
+    if let Some(dir) = vtk {
+        atomic::refuse_inside(("--vtk", dir), &[("--out", out)])?;
+    }
+    let mut csv = AtomicFile::create(out)?;
+    let series = vtk.map(SeriesDir::create).transpose()?;
+    let summary = run_session(
+        scene,
+        trajectory,
+        &mut csv,
+        series.as_ref().map(SeriesDir::dir),
+    )?;
+    if let Some(series) = series {
+        series.commit()?;
+    }
+    csv.commit()?;
+    Ok(summary)
+}
+
 /// Runs `trajectory` through the haptic loop of `scene`, writing the CSV to
-/// `out` and, with `vtk_dir`, a VTK frame per physics update and a `.pvd`.
+/// `out` and, with `vtk_dir`, a VTK frame per physics update and a `.pvd`
+/// (last) into that folder, which should be a fresh one ([`SeriesDir::dir`]:
+/// frames of an earlier run would stay beside the new ones).
 pub fn run_session(
     scene: &Scene,
     trajectory: &Trajectory,
     out: &mut dyn Write,
     vtk_dir: Option<&Path>,
 ) -> anyhow::Result<SessionSummary> {
+    // Bounded before any work: the table build can take minutes.
+    tick_count(trajectory, scene.tick_s()).with_context(|| scene.source.clone())?;
     let (mesh, report) = scene.load_mesh()?;
     let mut session = Session {
         out,
@@ -273,7 +354,7 @@ impl Ticks<'_> {
             .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
         let model = *haptic.tissue().model();
         let mut field = vec![[0.0f32; 3]; session.rest.len()];
-        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s).enumerate() {
+        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s)?.enumerate() {
             session.record(t, &haptic.tick(&tool))?;
             if session.dir.is_some() && k % self.every == 0 {
                 match haptic.solution() {
@@ -301,7 +382,7 @@ impl Ticks<'_> {
         haptic: &mut DynamicLoop<'_, '_, f32, P, P>,
         session: &mut Session<'_>,
     ) -> anyhow::Result<()> {
-        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s).enumerate() {
+        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s)?.enumerate() {
             session.record(t, &haptic.tick(&tool))?;
             if (k + 1) % self.every != 0 {
                 continue;

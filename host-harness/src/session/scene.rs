@@ -28,7 +28,7 @@
 //! radius_m = 0.002             # default 0.002
 //!
 //! [rates]
-//! haptic_hz = 1000.0           # default 1000
+//! haptic_hz = 1000.0           # default 1000, at most 10000 (crate::limits::MAX_HAPTIC_HZ)
 //! physics_every = 1            # default 1: a physics update every this many ticks
 //!
 //! [safety]
@@ -50,6 +50,7 @@ use serde::Deserialize;
 
 use crate::fem::material::{Material, MaterialError};
 use crate::fix::FixPredicate;
+use crate::limits::{MAX_HAPTIC_HZ, MAX_SCENE_FILE_BYTES, read_bounded};
 use crate::mesh::generate::box_mesh;
 use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh};
 
@@ -175,7 +176,7 @@ pub struct ToolSpec {
 /// Loop rates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rates {
-    /// Haptic (tick) rate, Hz, finite and > 0.
+    /// Haptic (tick) rate, Hz, finite, > 0 and at most [`MAX_HAPTIC_HZ`].
     pub haptic_hz: f64,
     /// A physics update every this many ticks, ≥ 1 (force extrapolated in between).
     pub physics_every: u32,
@@ -457,11 +458,21 @@ impl Scene {
         }
     }
 
-    /// Read and validate a scene file. A relative `mesh` path is resolved against the file's
-    /// folder. Messages name the file as `path` displays.
+    /// Read and validate a scene file (at most [`MAX_SCENE_FILE_BYTES`], UTF-8). A relative
+    /// `mesh` path is resolved against the file's folder. Messages name the file as `path`
+    /// displays.
     pub fn read(path: &Path) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|err| SceneError::Io {
+        let text = read_bounded(
+            path,
+            MAX_SCENE_FILE_BYTES,
+            "a scene file (MAX_SCENE_FILE_BYTES)",
+        )
+        .and_then(|bytes| {
+            String::from_utf8(bytes)
+                .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+        })
+        .map_err(|err| SceneError::Io {
             file: file.clone(),
             err,
         })?;
@@ -642,6 +653,14 @@ impl Scene {
                 "must be finite and > 0 Hz",
             );
         }
+        if self.rates.haptic_hz > MAX_HAPTIC_HZ {
+            return invalid(
+                format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
+                &format!(
+                    "above {MAX_HAPTIC_HZ} Hz (MAX_HAPTIC_HZ): haptic devices servo at 1 to 10 kHz"
+                ),
+            );
+        }
         if self.rates.physics_every == 0 {
             return invalid(
                 "[rates] physics_every = 0".into(),
@@ -667,6 +686,35 @@ impl Scene {
                     self.safety.max_slew_n_per_s
                 ),
                 "must be finite and > 0 N/s",
+            );
+        }
+        // The loop runs in f32 (`session::run::loop_config`): a value beyond
+        // its range would reach the kernel as infinity or zero.
+        let in_f32 = |x: f64| {
+            let y = x as f32;
+            y.is_finite() && y > 0.0
+        };
+        let f32_range = format!("between {:e} and {:e}", f32::MIN_POSITIVE, f32::MAX);
+        for (key, value, unit) in [
+            ("[safety] max_force_n", self.safety.max_force_n, "N"),
+            (
+                "[safety] max_slew_n_per_s",
+                self.safety.max_slew_n_per_s,
+                "N/s",
+            ),
+            ("[tool] radius_m", self.tool.radius_m, "m"),
+        ] {
+            if !in_f32(value) {
+                return invalid(
+                    format!("{key} = {value:e}"),
+                    &format!("out of range of the loop's f32: must lie {f32_range} {unit}"),
+                );
+            }
+        }
+        if !in_f32(self.tick_s()) {
+            return invalid(
+                format!("[rates] haptic_hz = {:e}", self.rates.haptic_hz),
+                &format!("out of range of the loop's f32: 1/haptic_hz must lie {f32_range} s"),
             );
         }
         if let ModelSpec::Dynamic(d) = &self.model {

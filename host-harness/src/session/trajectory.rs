@@ -19,6 +19,10 @@
 //! - time never decreases from one line to the next, whatever the tool point: the file is one
 //!   time-ordered stream, as a device log is. Samples of different tool points may share a time,
 //!   and so may two samples of the same point: that is a jump (see [`Trajectory::positions_at`]);
+//! - every time is within ±[`MAX_TRAJECTORY_TIME_S`] (2³² s) and the samples span at most
+//!   [`MAX_TRAJECTORY_SPAN_S`] (one hour) from the earliest to the latest, so that a session's
+//!   tick count is bounded (`crate::limits` says why); the error names the line that goes beyond
+//!   and the line it is too far from;
 //! - the tool index is below the scene's tool point count, and every tool point has at least one
 //!   sample;
 //! - exactly 5 fields per line, numbers that parse, the header first; one record per line (a
@@ -26,12 +30,18 @@
 //!
 //! [`Trajectory::read_unchecked`] is the lenient reader for robustness tests: it keeps non-finite
 //! values and backward times (reporting each such line as a finding) so that they can be fed to
-//! the kernel, which must fault and output zero force.
+//! the kernel, which must fault and output zero force; a finite time out of range or beyond the
+//! span is an error there too (it would only make the run unbounded).
+//!
+//! A file is read whole, at most [`MAX_TRAJECTORY_FILE_BYTES`] (`crate::limits::read_bounded`).
 
 use std::io;
 use std::path::Path;
 
 use super::scene::MAX_TOOL_POINTS;
+use crate::limits::{
+    MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S, read_bounded,
+};
 
 /// The header line's fields, in order.
 pub const HEADER: [&str; 5] = ["t", "tool", "x", "y", "z"];
@@ -110,6 +120,28 @@ pub enum LineProblem {
     /// The CSV reader could not read the line (e.g. invalid UTF-8).
     #[error("unreadable: {0}")]
     Unreadable(String),
+    /// A finite time beyond ±[`MAX_TRAJECTORY_TIME_S`].
+    #[error(
+        "time {t_s:e} s is out of range: a trajectory time is within ±{MAX_TRAJECTORY_TIME_S} s (MAX_TRAJECTORY_TIME_S)"
+    )]
+    TimeOutOfRange {
+        /// This line's time, s.
+        t_s: f64,
+    },
+    /// A time further than [`MAX_TRAJECTORY_SPAN_S`] from the earliest or latest so far.
+    #[error(
+        "time {t_s} s is {span_s} s from line {other_line} at {other_s} s: a trajectory spans at most {MAX_TRAJECTORY_SPAN_S} s (MAX_TRAJECTORY_SPAN_S); split a longer one"
+    )]
+    SpanTooLong {
+        /// This line's time, s.
+        t_s: f64,
+        /// The span this line would give, s.
+        span_s: f64,
+        /// The line of the earliest (or latest) sample it is too far from.
+        other_line: usize,
+        /// That sample's time, s.
+        other_s: f64,
+    },
 }
 
 /// What is wrong with the file as a whole.
@@ -178,6 +210,9 @@ struct Builder<'a> {
     tracks: Vec<Vec<(f64, [f64; 3])>>,
     /// Line and time of the last sample with a non-NaN time.
     previous: Option<(usize, f64)>,
+    /// Line and time of the earliest and of the latest finite time so far.
+    earliest: Option<(usize, f64)>,
+    latest: Option<(usize, f64)>,
     findings: Vec<TrajectoryError>,
 }
 
@@ -195,6 +230,8 @@ impl<'a> Builder<'a> {
             samples: Vec::new(),
             tracks: vec![Vec::new(); tool_count],
             previous: None,
+            earliest: None,
+            latest: None,
             findings: Vec::new(),
         })
     }
@@ -245,6 +282,9 @@ impl<'a> Builder<'a> {
         if !sample.t_s.is_nan() {
             self.previous = Some((line, sample.t_s));
         }
+        if sample.t_s.is_finite() {
+            self.check_span(line, sample.t_s)?;
+        }
         let Some(track) = self.tracks.get_mut(sample.tool) else {
             return Err(self.line_error(
                 line,
@@ -256,6 +296,41 @@ impl<'a> Builder<'a> {
         };
         track.push((sample.t_s, sample.position_m));
         self.samples.push(sample);
+        Ok(())
+    }
+
+    /// The time range and span rules, in both modes: an error for `t_s` (finite) on `line`.
+    fn check_span(&mut self, line: usize, t_s: f64) -> Result<(), TrajectoryError> {
+        if t_s.abs() > MAX_TRAJECTORY_TIME_S {
+            return Err(self.line_error(line, LineProblem::TimeOutOfRange { t_s }));
+        }
+        let earliest = *self.earliest.get_or_insert((line, t_s));
+        let latest = *self.latest.get_or_insert((line, t_s));
+        // The span with this time is its distance to the farther of the two extremes (both
+        // within ±2³² s: the differences are exact enough and finite).
+        let (other_line, other_s) = if t_s - earliest.1 >= latest.1 - t_s {
+            earliest
+        } else {
+            latest
+        };
+        let span_s = (t_s - other_s).abs();
+        if span_s > MAX_TRAJECTORY_SPAN_S {
+            return Err(self.line_error(
+                line,
+                LineProblem::SpanTooLong {
+                    t_s,
+                    span_s,
+                    other_line,
+                    other_s,
+                },
+            ));
+        }
+        if t_s < earliest.1 {
+            self.earliest = Some((line, t_s));
+        }
+        if t_s > latest.1 {
+            self.latest = Some((line, t_s));
+        }
         Ok(())
     }
 
@@ -391,7 +466,12 @@ fn read_file(
     mode: Mode,
 ) -> Result<(Trajectory, Vec<TrajectoryError>), TrajectoryError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|err| TrajectoryError::Io {
+    let bytes = read_bounded(
+        path,
+        MAX_TRAJECTORY_FILE_BYTES,
+        "a trajectory file (MAX_TRAJECTORY_FILE_BYTES)",
+    )
+    .map_err(|err| TrajectoryError::Io {
         file: file.clone(),
         action: "read",
         err,
@@ -420,7 +500,8 @@ impl Trajectory {
     /// [`Trajectory::read`] refuses with; a line can give two: a non-finite coordinate and a
     /// backward time). A missing header, a wrong field count, a field that is
     /// not a number, an unknown tool point or a tool point without a sample are still errors: there
-    /// is no value to keep.
+    /// is no value to keep; so are a finite time out of range and a span beyond the limit (module
+    /// doc).
     pub fn read_unchecked(
         path: &Path,
         tool_count: usize,

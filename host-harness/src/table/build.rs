@@ -11,11 +11,15 @@
 use core::time::Duration;
 use std::time::Instant;
 
-use anyhow::{Context, bail};
+use anyhow::{Context, anyhow, bail};
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::{LoadError, PrecomputedTable};
 
 use super::collision::collision_index;
 use super::compliance::{Solver, compute_compliance};
+use super::estimate::{SizeLimits, TableEstimate};
 use super::file::{Precision, TableContents, write_table};
+use super::load::TableFile;
 use super::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::material::Material;
@@ -120,10 +124,97 @@ pub struct BuiltTable {
 /// is the file's, fixed because no tet gives them stiffness or mass). In a
 /// pre-computed table the touchable vertices are the free vertices of the
 /// boundary surface.
+///
+/// The table is loaded with the kernel's own loader before it is returned
+/// ([`check_loads`]): a table every consumer would refuse (values beyond
+/// the stored precision) is an error here, naming the cause.
+///
+/// Before any array is computed, the table's size and the build's memory
+/// are estimated from the mesh's counts and checked against
+/// [`SizeLimits::system`] (the largest table file, the memory available):
+/// see [`build_with_limits`].
 pub fn build(
     mesh: &TetMesh,
     report: &MeshReport,
     options: &BuildOptions,
+) -> anyhow::Result<BuiltTable> {
+    build_with_limits(mesh, report, options, &SizeLimits::system())
+}
+
+/// [`build`] with the size `limits` given: the estimate
+/// ([`TableEstimate::of_build`], after the fixed vertices and the surface,
+/// before the compliance or the tensor-mass arrays) is refused above them
+/// with one line naming it and the alternatives, in a time linear in the
+/// mesh and without allocating the table.
+pub fn build_with_limits(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    limits: &SizeLimits,
+) -> anyhow::Result<BuiltTable> {
+    let built = build_unchecked(mesh, report, options, limits)?;
+    check_loads(&built.bytes, options, &report.source)?;
+    Ok(built)
+}
+
+/// Loads `bytes`, a table built with `options`, with the kernel's loader of
+/// its kind and precision, as the firmware and every command will. A refusal
+/// is an error naming `source` (the mesh), the loader's reason and, when a
+/// value is out of the scalar's range (an overflow or underflow of the
+/// compliance, stiffness or geometry), what to change.
+pub fn check_loads(bytes: &[u8], options: &BuildOptions, source: &str) -> anyhow::Result<()> {
+    let file = TableFile::from_bytes(bytes);
+    let bytes = file.bytes();
+    let precomputed = matches!(options.kind, TableKindOptions::Precomputed { .. });
+    let loaded = match (precomputed, options.precision) {
+        (true, Precision::F32) => PrecomputedTable::<f32>::load(bytes).map(drop),
+        (true, Precision::F64) => PrecomputedTable::<f64>::load(bytes).map(drop),
+        (false, Precision::F32) => TensorMassTable::<f32>::load(bytes).map(drop),
+        (false, Precision::F64) => TensorMassTable::<f64>::load(bytes).map(drop),
+    };
+    let Err(error) = loaded else {
+        return Ok(());
+    };
+    let young_pa = options.material.young_pa;
+    let out_of_range = matches!(
+        error,
+        LoadError::NonFinite { .. }
+            | LoadError::NotPositiveDefinite { .. }
+            | LoadError::BadVertexData { .. }
+            | LoadError::BadTet { .. }
+            | LoadError::BadSurfacePlane { .. }
+            | LoadError::BadSurfaceGrid { .. }
+            | LoadError::BadMaterial
+    );
+    let hint = match (out_of_range, options.precision) {
+        (true, Precision::F32) => format!(
+            "its values overflow or underflow f32 with E = {young_pa:e} Pa on this mesh; \
+             give E in Pa and the mesh in metres (SI units), or store f64 (--precision f64)"
+        ),
+        (true, Precision::F64) => format!(
+            "its values overflow or underflow f64 with E = {young_pa:e} Pa on this mesh; \
+             give E in Pa and the mesh in metres (SI units)"
+        ),
+        (false, _) => {
+            "the table writer produced a table the kernel refuses (a bug: please report it)".into()
+        }
+    };
+    let source = if source.is_empty() {
+        String::new()
+    } else {
+        format!("{source}: ")
+    };
+    Err(anyhow!(
+        "{source}the built table fails Palpate's own load check ({error}): {hint}"
+    ))
+}
+
+/// [`build`] without the final load check.
+fn build_unchecked(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    limits: &SizeLimits,
 ) -> anyhow::Result<BuiltTable> {
     if let TableKindOptions::TensorMass { density_kg_m3 } = options.kind
         && !(density_kg_m3.is_finite() && density_kg_m3 > 0.0)
@@ -149,6 +240,8 @@ pub fn build(
         }
     }
     let surface = boundary_surface(mesh);
+    let estimate = TableEstimate::of_build(mesh, report, options, &fixed, &surface);
+    limits.check(&estimate, &report.source)?;
     let summary = BuiltTable {
         bytes: Vec::new(),
         fixed_by_predicate,
@@ -166,6 +259,25 @@ pub fn build(
             let start = Instant::now();
             let arrays = TensorMassArrays::new(mesh, &options.material, density_kg_m3, fixed);
             let arrays_time = start.elapsed();
+            if options.precision == Precision::F32 {
+                // All zero once stored: the loader accepts it, the model
+                // would have no stiffness (or mass). Overflows the loader
+                // refuses ([`check_loads`]).
+                for (what, largest) in [
+                    ("stiffness", largest(arrays.vertex_tensors.iter().flatten())),
+                    ("mass", largest(&arrays.masses_kg)),
+                ] {
+                    if largest > 0.0 && largest < f64::from(f32::MIN_POSITIVE) {
+                        bail!(
+                            "{}: the {what} values underflow f32 (largest {largest:e}) with E = {:e} Pa \
+                             and {density_kg_m3} kg/m3 on this mesh; give them in SI units (Pa, \
+                             kg/m3, mesh in metres), or store f64 (--precision f64)",
+                            report.source,
+                            options.material.young_pa
+                        );
+                    }
+                }
+            }
             Ok(BuiltTable {
                 bytes: write_tensor_mass_table(
                     mesh,
@@ -228,6 +340,11 @@ fn precomputed(
         arrays_time,
         ..summary
     })
+}
+
+/// The largest magnitude of `values` (0 for none).
+fn largest<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 fn describe(fix: &[FixPredicate]) -> String {

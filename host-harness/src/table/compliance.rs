@@ -48,7 +48,7 @@ pub struct Compliance {
 }
 
 /// Touchable vertices per batch of right-hand sides (3 columns each).
-const BATCH_VERTICES: usize = 64;
+pub const BATCH_VERTICES: usize = 64;
 /// CG relative residual target.
 const CG_REL_TOL: f64 = 1e-10;
 

@@ -1,11 +1,32 @@
 //! Reading table files on the host: aligned buffers, scalar dispatch, `tables info`.
 
 use core::fmt::Write as _;
+use std::fs::File;
 use std::path::Path;
 
-use anyhow::Context;
-use palpate_kernel::table::format::{CRC_LEN, CRC32, HEADER_LEN, RawHeader, TableKind};
+use anyhow::{Context, bail};
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::table::format::{
+    CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, TableKind,
+};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
+
+use crate::limits::{MAX_TABLE_FILE_BYTES, read_bounded};
+
+/// Fills `buf` from `reader` as far as it goes; the bytes read (fewer only
+/// at the end of the input).
+fn read_up_to(reader: &mut impl std::io::Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match reader.read(&mut buf[filled..]) {
+            Ok(0) => break,
+            Ok(n) => filled += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(filled)
+}
 
 /// Table bytes in a 16-byte-aligned buffer, as the kernel's zero-copy view
 /// requires (a `Vec<u8>` has no alignment guarantee).
@@ -23,10 +44,97 @@ pub enum AnyModel<'a> {
 }
 
 impl TableFile {
-    /// Reads a table file.
+    /// Reads a table file, its fixed-size header first: the magic, the
+    /// format version and the file length the header declares are checked
+    /// (that length against the file's real size and against
+    /// [`MAX_TABLE_FILE_BYTES`]) before anything else is read or allocated,
+    /// so `/dev/zero` or a large file of garbage is refused at once. A pipe
+    /// or a device is read up to the declared length and refused if it has
+    /// more. The rest is read straight into the aligned buffer (one copy).
+    /// Everything else (sections, CRC, values) is the kernel loader's.
     pub fn read(path: &Path) -> anyhow::Result<Self> {
-        let bytes =
-            std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let name = path.display();
+        let mut file = File::open(path).with_context(|| format!("{name}: cannot read"))?;
+        let meta = file
+            .metadata()
+            .with_context(|| format!("{name}: cannot read"))?;
+        let real_len = meta.is_file().then_some(meta.len());
+        let mut head = [0u8; HEADER_LEN];
+        let got =
+            read_up_to(&mut file, &mut head).with_context(|| format!("{name}: cannot read"))?;
+        if got < HEADER_LEN {
+            bail!(
+                "{name}: not a Palpate table: {got} bytes, shorter than the {HEADER_LEN}-byte table header"
+            );
+        }
+        let h: RawHeader = bytemuck::pod_read_unaligned(&head);
+        if h.magic != MAGIC {
+            bail!("{name}: not a Palpate table (its first 8 bytes are not the magic PALPTBL)");
+        }
+        if h.format_version != FORMAT_VERSION {
+            bail!(
+                "{name}: table format version {}, this build reads version {FORMAT_VERSION} (rebuild the table with tables build)",
+                h.format_version
+            );
+        }
+        let declared = h.file_len;
+        if declared > MAX_TABLE_FILE_BYTES {
+            bail!(
+                "{name}: the header declares {declared} bytes, above the largest table file, {MAX_TABLE_FILE_BYTES} bytes (MAX_TABLE_FILE_BYTES)"
+            );
+        }
+        if declared < (HEADER_LEN + CRC_LEN) as u64 {
+            bail!("{name}: the header declares {declared} bytes, shorter than a table");
+        }
+        if let Some(real) = real_len
+            && real != declared
+        {
+            bail!(
+                "{name}: the file is {real} bytes but its header declares {declared}: truncated or padded"
+            );
+        }
+        // At most MAX_TABLE_FILE_BYTES: fits usize on the 64-bit hosts the
+        // harness runs on; a failed allocation is an error, not an abort.
+        let len = usize::try_from(declared)
+            .with_context(|| format!("{name}: {declared} bytes do not fit this host's memory"))?;
+        let mut words: Vec<u128> = Vec::new();
+        words
+            .try_reserve_exact(len.div_ceil(16))
+            .map_err(|e| anyhow::anyhow!("{name}: cannot allocate {declared} bytes: {e}"))?;
+        words.resize(len.div_ceil(16), 0);
+        let buf = &mut bytemuck::cast_slice_mut::<u128, u8>(&mut words)[..len];
+        buf[..HEADER_LEN].copy_from_slice(&head);
+        let rest = read_up_to(&mut file, &mut buf[HEADER_LEN..])
+            .with_context(|| format!("{name}: cannot read"))?;
+        if HEADER_LEN + rest < len {
+            bail!(
+                "{name}: {} bytes, shorter than the {declared} its header declares: truncated",
+                HEADER_LEN + rest
+            );
+        }
+        if real_len.is_none() && read_up_to(&mut file, &mut [0u8; 1]).unwrap_or(0) > 0 {
+            bail!("{name}: longer than the {declared} bytes its header declares");
+        }
+        Ok(Self { words, len })
+    }
+
+    /// Reads a table for a report (`tables info`), which shows what is wrong
+    /// with a damaged table: a regular file of at most
+    /// [`MAX_TABLE_FILE_BYTES`] is read whole whatever its header says;
+    /// anything else goes through [`TableFile::read`] (refused unless its
+    /// header is right).
+    pub fn read_for_report(path: &Path) -> anyhow::Result<Self> {
+        let small_file = std::fs::metadata(path)
+            .is_ok_and(|meta| meta.is_file() && meta.len() <= MAX_TABLE_FILE_BYTES);
+        if !small_file {
+            return Self::read(path);
+        }
+        let bytes = read_bounded(
+            path,
+            MAX_TABLE_FILE_BYTES,
+            "a table file (MAX_TABLE_FILE_BYTES)",
+        )
+        .with_context(|| format!("{}: cannot read", path.display()))?;
         Ok(Self::from_bytes(&bytes))
     }
 
@@ -64,8 +172,31 @@ impl TableFile {
         }
     }
 
+    /// The table kind the header declares, if it is one this kernel knows.
+    pub fn kind(&self) -> Option<TableKind> {
+        match self.raw_header()?.table_kind {
+            k if k == TableKind::Precomputed as u32 => Some(TableKind::Precomputed),
+            k if k == TableKind::TensorMass as u32 => Some(TableKind::TensorMass),
+            _ => None,
+        }
+    }
+
+    /// Validates the table with the kernel's loader of the kind and
+    /// precision the header declares (an unknown kind goes to the
+    /// pre-computed loader, which names it).
+    pub fn validate(&self) -> Result<(), palpate_kernel::LoadError> {
+        let bytes = self.bytes();
+        let f64_table = self.raw_header().map(|h| h.scalar_bytes) == Some(8);
+        match (self.kind(), f64_table) {
+            (Some(TableKind::TensorMass), true) => TensorMassTable::<f64>::load(bytes).map(drop),
+            (Some(TableKind::TensorMass), false) => TensorMassTable::<f32>::load(bytes).map(drop),
+            _ => self.model().map(drop),
+        }
+    }
+
     /// The `tables info` report: counts, sizes, material, checksum and
-    /// validation status. `Err` carries the same report when the table is bad.
+    /// validation status, for either kind of table. `Err` carries the same
+    /// report when the table is bad.
     pub fn info(&self, name: &str) -> Result<String, String> {
         let mut out = String::new();
         let bytes = self.bytes();
@@ -76,11 +207,13 @@ impl TableFile {
             return Err(out);
         };
         let _ = writeln!(out, "format version: {}", h.format_version);
-        let kind = match h.table_kind {
-            k if k == TableKind::Precomputed as u32 => "pre-computed (compliance)",
-            _ => "unknown",
+        let kind = self.kind();
+        let kind_name = match kind {
+            Some(TableKind::Precomputed) => "pre-computed (compliance)",
+            Some(TableKind::TensorMass) => "tensor-mass (dynamic)",
+            None => "unknown",
         };
-        let _ = writeln!(out, "table kind: {kind}");
+        let _ = writeln!(out, "table kind: {kind_name}");
         let precision = match h.scalar_bytes {
             4 => "f32",
             8 => "f64",
@@ -95,19 +228,24 @@ impl TableFile {
             h.vertex_count.saturating_sub(h.free_count)
         );
         let _ = writeln!(out, "free vertices: {}", h.free_count);
-        let _ = writeln!(
-            out,
-            "touchable (free surface) vertices: {}",
-            h.touchable_count
-        );
+        if kind == Some(TableKind::TensorMass) {
+            let _ = writeln!(out, "edges: {}", h.edge_count);
+            let _ = writeln!(out, "mesh triangles: {}", h.mesh_triangle_count);
+        } else {
+            let _ = writeln!(
+                out,
+                "touchable (free surface) vertices: {}",
+                h.touchable_count
+            );
+        }
         let _ = writeln!(out, "surface triangles: {}", h.triangle_count);
         let _ = writeln!(out, "young modulus: {} Pa", h.young_pa);
         let _ = writeln!(out, "poisson ratio: {}", h.poisson);
+        if kind == Some(TableKind::TensorMass) {
+            let _ = writeln!(out, "density: {} kg/m3", h.density_kg_m3);
+        }
         let _ = writeln!(out, "mesh hash: {:016x}", h.mesh_hash);
-        let sections = match h.table_kind {
-            k if k == TableKind::Precomputed as u32 => TableKind::Precomputed.sections(),
-            _ => &[],
-        };
+        let sections = kind.map_or(&[][..], TableKind::sections);
         for &kind in sections {
             if let Some(count) = kind.expected_count(&h) {
                 let size = count * u64::from(kind.elem_bytes(h.scalar_bytes));
@@ -129,8 +267,8 @@ impl TableFile {
             "checksum: {}",
             if checksum_ok { "ok" } else { "MISMATCH" }
         );
-        match self.model() {
-            Ok(_) => {
+        match self.validate() {
+            Ok(()) => {
                 let _ = writeln!(out, "validation: ok");
                 Ok(out)
             }

@@ -2,12 +2,14 @@
 //! pipeline for both kinds ([`build`]), the compliance computation of the
 //! pre-computed model (Cotin RR-3510 §4; [`compliance`], [`cg`]), the
 //! tensor-mass arrays (RR-3510 §5; [`tensor_mass`]), the collision index
-//! ([`collision`]), the table file writer ([`file`]) and reader ([`load`]).
+//! ([`collision`]), the table file writer ([`file`]) and reader ([`load`]),
+//! the size and memory estimate checked before a build ([`estimate`]).
 
 pub mod build;
 pub mod cg;
 pub mod collision;
 pub mod compliance;
+pub mod estimate;
 pub mod file;
 pub mod load;
 pub mod tensor_mass;

@@ -12,10 +12,26 @@ use crate::mesh::{MeshReport, TetMesh};
 use crate::table::build::BuildOptions;
 use crate::table::file::Precision;
 
+/// The force pass gave a non-finite force or energy: the deformed
+/// configuration is too far from rest for f64 (coordinates of 1e200 m). The
+/// caller names the positions' source ([`forces_and_energy`] returns it
+/// inside its `anyhow::Error`; find it with `downcast_ref`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the deformed positions give a non-finite {what} (f64 overflow): they must be in metres, \
+     within a few times the mesh's size of its rest positions"
+)]
+pub struct NonFiniteResult {
+    /// `"force"` or `"energy"`.
+    pub what: &'static str,
+}
+
 /// Internal forces (N, one per vertex: the elastic force on each vertex,
 /// `−∂W/∂x`, plus the incompressibility penalty when `incompressibility_n` is
 /// given) and elastic energy `W` (J) of `mesh` deformed to `deformed_m`
-/// (positions, m, one per vertex), free body (no fixed vertices).
+/// (positions, m, one per vertex), free body (no fixed vertices). A
+/// non-finite force or energy is an error ([`NonFiniteResult`]), never a
+/// result.
 pub fn forces_and_energy(
     mesh: &TetMesh,
     report: &MeshReport,
@@ -48,6 +64,12 @@ pub fn forces_and_energy(
     model.elastic_forces_of(&u, &mut forces);
     let mut scratch = vec![[0.0; 3]; u.len()];
     let energy = model.elastic_energy_of(&u, &mut scratch);
+    if !forces.iter().flatten().all(|f| f.is_finite()) {
+        return Err(NonFiniteResult { what: "force" }.into());
+    }
+    if !energy.is_finite() {
+        return Err(NonFiniteResult { what: "energy" }.into());
+    }
     Ok((forces, energy))
 }
 

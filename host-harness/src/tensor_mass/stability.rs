@@ -1,6 +1,7 @@
 //! `palpate dynamic critical-dt`: the largest stable step of an integrator,
 //! measured by bisection, next to the estimate `2/ω_max` (MODELS.md §3).
 
+use anyhow::bail;
 use nalgebra::Vector3;
 use palpate_kernel::tensor_mass::{Integrator, TensorMassModel, VertexMode};
 use serde::Serialize;
@@ -203,6 +204,37 @@ pub fn critical_dt_of_mesh(
     let mut state = OwnedState::for_table(&table);
     let params = host_params(&mesh.positions, damping_per_s);
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    let moving = (0..model.modes().len())
+        .filter(|&v| model.modes()[v] == VertexMode::Free && model.masses_kg()[v] > 0.0)
+        .count();
+    if moving == 0 {
+        bail!(
+            "every vertex is fixed (by --fix, or unreferenced by any tet): nothing moves, \
+             so no step is unstable and there is no critical step"
+        );
+    }
+    let young_pa = options.material.young_pa;
+    // Checked before the bisection, which would run its every trial on a
+    // bracket of NaN or zero.
+    let omega = omega_max(&mut model);
+    if !(omega.is_finite() && omega > 0.0) {
+        bail!(
+            "the largest eigenfrequency of M^-1 K is {omega} rad/s (f64 overflow or underflow \
+             with E = {young_pa:e} Pa and this mesh and density): give E in Pa, the density in \
+             kg/m3 and the mesh in metres (SI units)"
+        );
+    }
     let amplitude = 1e-3 * diagonal(&mesh.positions);
-    Ok(critical_dt(&mut model, integrator, amplitude))
+    let result = critical_dt(&mut model, integrator, amplitude);
+    if !(result.critical_dt.is_finite() && result.critical_dt > 0.0) {
+        bail!(
+            "no stable step found: {} is unstable even at {:e} s (2/omega_max = {:e} s): the \
+             energies overflow f64 with E = {young_pa:e} Pa on this mesh; give E in Pa, the \
+             density in kg/m3 and the mesh in metres (SI units)",
+            result.integrator,
+            8.0 / omega / f64::from(1u32 << BISECTIONS),
+            result.estimate_2_over_omega_max
+        );
+    }
+    Ok(result)
 }

@@ -93,6 +93,40 @@ fn clamp_weights<T: Real>(w: [T; 3]) -> [T; 3] {
     }
 }
 
+/// The point where the segment from `inside` (within the box `reach`,
+/// lowest and highest corners) to `outside` leaves the box, computed from
+/// `inside`: `inside + (outside − inside)·s` with `s ∈ [0, 1]` the smallest
+/// exit parameter over the axes, so its error is relative to the box, not to
+/// `outside` (which may be 1e10 m away). Constant time; a non-finite
+/// `outside` compares false on every axis and is returned as it is.
+fn clip_towards<T: Real>(
+    inside: &Vector3<T>,
+    outside: &Vector3<T>,
+    reach: &[Vector3<T>; 2],
+) -> Vector3<T> {
+    let [lo, hi] = reach;
+    let mut s = T::one();
+    for (((&a, &b), &l), &h) in inside
+        .iter()
+        .zip(outside.iter())
+        .zip(lo.iter())
+        .zip(hi.iter())
+    {
+        // `a` lies in [l, h], so `b − a` is not zero where `b` is outside.
+        let exit = if b > h {
+            (h - a) / (b - a)
+        } else if b < l {
+            (l - a) / (b - a)
+        } else {
+            continue;
+        };
+        if exit < s {
+            s = exit;
+        }
+    }
+    inside + (outside - inside) * s
+}
+
 impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// The rest surface of a pre-computed `table`.
     pub fn new(table: &'a PrecomputedTable<'a, T>) -> Self {
@@ -178,6 +212,12 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// point more than a cell plus the radius outside the grid). Bounded by
     /// `2 × max_query_triangles` triangle tests, most rejected by two dot
     /// products with the stored plane.
+    ///
+    /// An end outside that reach is first moved along the segment to where
+    /// the segment leaves it ([`clip_towards`], computed from the end inside):
+    /// no triangle can be hit beyond it, and a far end (a tool sample at
+    /// 1e10 m) would otherwise swamp the intersection's arithmetic, in f32
+    /// every digit of the part near the surface.
     pub fn detect(
         &self,
         tool: usize,
@@ -192,7 +232,16 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let mut best: Option<(T, TriangleIndex, [T; 3])> = None;
         let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
         let near_grid = |p: &Vector3<T>| self.index.is_near(p, radius_m);
-        let (near_to, near_from) = (near_grid(to_m), !same_cell && near_grid(from_m));
+        let (to_in, from_in) = (near_grid(to_m), near_grid(from_m));
+        let (near_to, near_from) = (to_in, !same_cell && from_in);
+        // The swept segment, clipped to the reach of the grid when exactly
+        // one end lies outside it (both outside: no candidate is tested).
+        let reach = self.reach(radius_m);
+        let (start_m, end_m) = match (from_in, to_in) {
+            (false, true) => (clip_towards(to_m, from_m, &reach), *to_m),
+            (true, false) => (*from_m, clip_towards(from_m, to_m, &reach)),
+            _ => (*from_m, *to_m),
+        };
         let candidates = self
             .index
             .vertices_near(to_m)
@@ -205,8 +254,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 let Some((normal, offset)) = self.index.plane(t) else {
                     continue;
                 };
-                let s0 = normal.dot(from_m) - offset - radius_m;
-                let s1 = normal.dot(to_m) - offset - radius_m;
+                let s0 = normal.dot(&start_m) - offset - radius_m;
+                let s1 = normal.dot(&end_m) - offset - radius_m;
                 if !(s0 >= -slack_m && s1 < T::zero()) {
                     continue;
                 }
@@ -219,7 +268,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 if f.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
                     continue;
                 }
-                let x = from_m + (to_m - from_m) * along - normal * radius_m;
+                let x = start_m + (end_m - start_m) * along - normal * radius_m;
                 let w = barycentric(&f.corners, &normal, &x);
                 if w.iter().all(|&wi| wi >= -tolerance) {
                     best = Some((along, t, clamp_weights(w)));
@@ -229,6 +278,20 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let (_, triangle, weights) = best?;
         let face = self.face(triangle)?;
         Some(self.contact(tool, triangle, &face, weights, to_m, radius_m))
+    }
+
+    /// The box a sphere of radius `radius_m` must reach into to be near
+    /// the grid ([`SurfaceIndex::is_near`]): its lowest and highest corners,
+    /// m.
+    fn reach(&self, radius_m: T) -> [Vector3<T>; 2] {
+        let (origin, cell) = (self.index.origin_m(), self.index.cell_m());
+        let margin = cell + radius_m;
+        let [nx, ny, nz] = self.index.dims().map(|d| T::of_f64(f64::from(d)) * cell);
+        let margin3 = Vector3::new(margin, margin, margin);
+        [
+            origin - margin3,
+            origin + Vector3::new(nx, ny, nz) + margin3,
+        ]
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of

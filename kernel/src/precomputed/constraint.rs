@@ -21,9 +21,10 @@ pub enum ContactPoint<T> {
     /// weights (each in `[0, 1]`, summing to 1, within
     /// [`Real::WEIGHT_TOLERANCE`]). A fixed vertex of the triangle contributes
     /// zero compliance (its displacement is zero), which is the exact
-    /// constraint `Σ_a β_a u_a = d`. The kernel does not check that the three
-    /// vertices form a triangle of the table: any convex combination of
-    /// touchable vertices is a valid point constraint.
+    /// constraint `Σ_a β_a u_a = d`. The three vertices must be distinct and
+    /// form a triangle of the table's boundary surface, in any order
+    /// ([`ContactError::RepeatedVertex`], [`ContactError::NotSurfaceTriangle`]):
+    /// a point elsewhere is not on the surface a tool can touch.
     Triangle {
         /// Mesh vertex indices.
         vertices: [u32; 3],
@@ -39,6 +40,13 @@ pub trait AsConstraint<T: Real> {
     fn point(&self) -> ContactPoint<T>;
     /// Imposed displacement `d_p` of the point from rest, m.
     fn displacement_m(&self) -> Vector3<T>;
+    /// `true` when a triangle point names a triangle of this table's
+    /// surface by construction (found by detection or tracking on it), so
+    /// the solve skips the surface look-up of [`ContactError::NotSurfaceTriangle`]
+    /// on the haptic path. Scripted input keeps the default, `false`.
+    fn on_surface_triangle(&self) -> bool {
+        false
+    }
 }
 
 /// A scripted constraint: a point and the displacement imposed on it (the
@@ -72,6 +80,12 @@ impl<T: Real> AsConstraint<T> for Contact<T> {
 
     fn displacement_m(&self) -> Vector3<T> {
         Contact::displacement_m(self)
+    }
+
+    /// A contact is made by detection or tracking on the tissue's surface:
+    /// its triangle is one of the surface's.
+    fn on_surface_triangle(&self) -> bool {
+        true
     }
 }
 
@@ -125,6 +139,23 @@ pub enum ContactError {
         /// The vertex.
         vertex: u32,
     },
+    /// A triangle contact names the same vertex twice (no triangle has a
+    /// repeated corner).
+    RepeatedVertex {
+        /// Contact index.
+        contact: usize,
+        /// The repeated vertex.
+        vertex: u32,
+    },
+    /// A triangle contact's three vertices are not a triangle of the
+    /// table's boundary surface (checked through the collision index: at
+    /// most the valence of the first vertex in triangle look-ups).
+    NotSurfaceTriangle {
+        /// Contact index.
+        contact: usize,
+        /// The three vertices, as given.
+        vertices: [u32; 3],
+    },
     /// Barycentric weights outside `[0, 1]` or not summing to one.
     BadWeights {
         /// Contact index.
@@ -170,6 +201,17 @@ impl fmt::Display for ContactError {
             ContactError::NotOnSurface { contact, vertex } => write!(
                 f,
                 "contact {contact}: vertex {vertex} is not on the boundary surface"
+            ),
+            ContactError::RepeatedVertex { contact, vertex } => write!(
+                f,
+                "contact {contact}: vertex {vertex} appears twice; a triangle contact needs three distinct vertices"
+            ),
+            ContactError::NotSurfaceTriangle {
+                contact,
+                vertices: [a, b, c],
+            } => write!(
+                f,
+                "contact {contact}: vertices {a},{b},{c} are not a triangle of the table's boundary surface"
             ),
             ContactError::BadWeights { contact } => write!(
                 f,
@@ -276,6 +318,12 @@ pub(crate) fn resolve<T: Real>(
                     contact: contact_index,
                 });
             }
+            if let Some(vertex) = repeated(vertices) {
+                return Err(ContactError::RepeatedVertex {
+                    contact: contact_index,
+                    vertex,
+                });
+            }
             for (&vertex, &w) in vertices.iter().zip(weights.iter()) {
                 if let Some(slot) = lookup(vertex)?
                     && let (Some(t), Some(b)) = (
@@ -288,7 +336,33 @@ pub(crate) fn resolve<T: Real>(
                     point.len += 1;
                 }
             }
+            // Every vertex is in range here (`lookup` refused the others).
+            let on_surface = contact.on_surface_triangle()
+                || match vertices.map(|v| table.vertex(v)) {
+                    [Some(a), Some(b), Some(c)] => {
+                        table.surface_index().find_triangle([a, b, c]).is_some()
+                    }
+                    _ => false,
+                };
+            if !on_surface {
+                return Err(ContactError::NotSurfaceTriangle {
+                    contact: contact_index,
+                    vertices,
+                });
+            }
         }
     }
     Ok(point)
+}
+
+/// The first vertex that occurs twice in `vertices`, if any.
+fn repeated(vertices: [u32; 3]) -> Option<u32> {
+    let [a, b, c] = vertices;
+    if a == b || a == c {
+        Some(a)
+    } else if b == c {
+        Some(b)
+    } else {
+        None
+    }
 }

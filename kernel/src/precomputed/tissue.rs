@@ -80,6 +80,8 @@ fn contact_index(e: &ContactError) -> Option<usize> {
         ContactError::VertexOutOfRange { contact, .. }
         | ContactError::FixedVertex { contact, .. }
         | ContactError::NotOnSurface { contact, .. }
+        | ContactError::RepeatedVertex { contact, .. }
+        | ContactError::NotSurfaceTriangle { contact, .. }
         | ContactError::BadWeights { contact }
         | ContactError::NonFiniteInput { contact }
         | ContactError::IllConditioned { contact } => Some(contact),

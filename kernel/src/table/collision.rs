@@ -417,6 +417,22 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             .map(|&t| TriangleIndex::checked(t))
     }
 
+    /// The surface triangle whose corners are the three distinct
+    /// `vertices`, in any order; `None` if they are not a surface triangle.
+    /// Bounded by the valence of the first vertex ([`Self::max_valence`]).
+    pub fn find_triangle(&self, vertices: [VertexIndex; 3]) -> Option<TriangleIndex> {
+        let [a, b, c] = vertices;
+        if a == b || b == c || a == c {
+            return None;
+        }
+        // Every listed triangle contains `a` (invariant), so with distinct
+        // vertices containing `b` and `c` makes it exactly `{a, b, c}`.
+        self.triangles_of(a).find(|&t| {
+            self.triangle(t)
+                .is_some_and(|corners| corners.contains(&b) && corners.contains(&c))
+        })
+    }
+
     /// The surface triangle other than `not` around both `a` and `b` (the
     /// neighbour of `not` across its edge `ab`), the first in ascending
     /// order if several. Bounded by `max_valence` binary searches.

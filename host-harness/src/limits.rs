@@ -1,0 +1,176 @@
+//! The harness's bounds on its inputs and runs (issue 12), each in one place: every one is
+//! checked before the work it bounds starts, so that a typo or a hostile file gives a one-line
+//! error instead of filling the disk or the memory. README.md lists them ("Limits").
+//!
+//! - Sessions: [`MAX_HAPTIC_HZ`], [`MAX_TRAJECTORY_SPAN_S`], [`MAX_TRAJECTORY_TIME_S`] and the
+//!   tick count they imply, [`MAX_SESSION_TICKS`] (checked by the scene, the trajectory readers
+//!   and `session::run::tick_count`).
+//! - Files: [`MAX_MESH_FILE_BYTES`], [`MAX_TABLE_FILE_BYTES`], [`MAX_TRAJECTORY_FILE_BYTES`],
+//!   [`MAX_SCENE_FILE_BYTES`], [`MAX_SEQUENCE_FILE_BYTES`], read through [`read_bounded`] (a
+//!   table through its header first: `table::load::TableFile::read`).
+//! - Table builds: the estimate of `table::estimate` against [`MAX_TABLE_FILE_BYTES`], an optional
+//!   `--max-table-bytes` and the memory available ([`mem_available_bytes`]).
+
+use std::fs::File;
+use std::io::{self, Read};
+use std::path::Path;
+
+/// Largest haptic rate a scene accepts (`[rates] haptic_hz`), Hz.
+///
+/// Haptic devices servo at 1 kHz (the default, and what the kernel's budget is measured at);
+/// the fastest desktop devices and research rigs run at 4–10 kHz. Above that the tick (100 µs)
+/// leaves no room for the loop's work on a Cortex-M4F (the budget's static bound is 600–5200 µs
+/// at 168 MHz), and a typo such as `1e7` would multiply a session's ticks and output by 10⁴.
+pub const MAX_HAPTIC_HZ: f64 = 10_000.0;
+
+/// Longest trajectory, s: from its earliest to its latest sample time, one hour.
+///
+/// A surgical training session or a recorded device log lasts minutes, an hour at most; a
+/// session runs one tick per haptic period over the whole span and writes a CSV line per tick,
+/// so without a bound one sample at `t = 1e9` meant 10¹² ticks (a disk filled in minutes). An
+/// hour at [`MAX_HAPTIC_HZ`] is [`MAX_SESSION_TICKS`] ticks, about 2 GB of CSV; at the default
+/// 1 kHz, about 200 MB. Split a longer log into several trajectories.
+pub const MAX_TRAJECTORY_SPAN_S: f64 = 3600.0;
+
+/// Largest magnitude of a trajectory time, s: 2³² s (136 years, so Unix timestamps from a
+/// device log fit).
+///
+/// Up to there, consecutive `f64` times are at most 0.95 µs apart, under a hundredth of the
+/// shortest tick (100 µs at [`MAX_HAPTIC_HZ`]): tick times stay distinct and in order. At
+/// `t = 1e300` adding a tick leaves the time unchanged.
+pub const MAX_TRAJECTORY_TIME_S: f64 = 4_294_967_296.0;
+
+/// Most ticks of one session: a trajectory of [`MAX_TRAJECTORY_SPAN_S`] at [`MAX_HAPTIC_HZ`],
+/// plus its first tick (36 000 001). A validated scene and trajectory never exceed it; the tick
+/// count is computed with checked arithmetic against it all the same (a lenient trajectory, a
+/// scene changed in code).
+pub const MAX_SESSION_TICKS: usize = (MAX_TRAJECTORY_SPAN_S * MAX_HAPTIC_HZ) as usize + 1;
+
+/// Largest mesh file (each of a TetGen pair), bytes: 2 GiB.
+///
+/// An ASCII mesh takes about 290 bytes per vertex with its ~6 tets, so 2 GiB is about 7 million
+/// vertices, the order of a scene's generated-mesh cap (10 million vertices) and far beyond what
+/// either model runs at haptic rates. The parsed mesh costs about as much memory again.
+pub const MAX_MESH_FILE_BYTES: u64 = 2 << 30;
+
+/// Largest table file, bytes: 4 GiB; `tables build` refuses to write a larger table and every
+/// reader refuses a larger file (its header's declared length) before reading past the header.
+///
+/// A firmware table must fit the controller's flash (a few MB); a host f32 table of 4 GiB already
+/// holds the compliance of about 8 000 touchable vertices against 10 000 interior ones, whose
+/// build needs about 4 times that in memory (see `table::estimate`). Reading `/dev/zero` or a
+/// 1 GB file of garbage as a table once cost its whole size twice before the magic was checked.
+pub const MAX_TABLE_FILE_BYTES: u64 = 4 << 30;
+
+/// Largest trajectory file, bytes: 1 GiB.
+///
+/// A one-hour log of 4 tool points sampled at 1 kHz is about 0.7 GB of CSV; the samples cost
+/// about 1.5 times the file again in memory.
+pub const MAX_TRAJECTORY_FILE_BYTES: u64 = 1 << 30;
+
+/// Largest contact-sequence file (`precomputed replay`), bytes: 256 MiB. A step of four
+/// contacts is a line of about 160 bytes: a million steps fit.
+pub const MAX_SEQUENCE_FILE_BYTES: u64 = 256 << 20;
+
+/// Largest scene file, bytes: 1 MiB. A scene is a few dozen lines of TOML written by hand (the
+/// mesh is a separate file).
+pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 20;
+
+/// Reads the file at `path` whole, refusing more than `max_bytes` bytes; `kind` names the
+/// limit in the message (`a mesh file`).
+///
+/// A regular file larger than `max_bytes` is refused from its size, before anything is read.
+/// Anything else (a pipe, `/dev/zero`, a character device) is read through `take(max_bytes + 1)`
+/// and refused once it yields more than `max_bytes`: its memory is bounded whatever it streams.
+/// The error is an [`io::Error`] of kind [`io::ErrorKind::InvalidData`] saying so; the callers
+/// put the file name in front, as for any read error.
+pub fn read_bounded(path: &Path, max_bytes: u64, kind: &str) -> io::Result<Vec<u8>> {
+    let file = File::open(path)?;
+    let meta = file.metadata()?;
+    let mut bytes = Vec::new();
+    if meta.is_file() {
+        if meta.len() > max_bytes {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "{} bytes, more than {max_bytes} bytes, the limit for {kind}",
+                    meta.len()
+                ),
+            ));
+        }
+        // The size is known and bounded: one allocation (the file may still change meanwhile).
+        bytes
+            .try_reserve_exact(usize::try_from(meta.len()).unwrap_or(usize::MAX))
+            .map_err(|e| io::Error::new(io::ErrorKind::OutOfMemory, e.to_string()))?;
+    }
+    file.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max_bytes {
+        let what = if meta.is_file() {
+            "a file that grew while read"
+        } else {
+            "not a regular file"
+        };
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "{what}, and more than {max_bytes} bytes, the limit for {kind}: read stopped there"
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// The memory available to a new allocation without swapping, bytes: `MemAvailable` of
+/// `/proc/meminfo` (Linux 3.14 and later), or less if the process's cgroup (v2) has a memory
+/// limit closer (`memory.max − memory.current`); `None` where neither is known (then the table
+/// build checks only the size limits).
+pub fn mem_available_bytes() -> Option<u64> {
+    let system = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| parse_mem_available(&text));
+    match (system, cgroup_headroom_bytes()) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// `memory.max − memory.current` of this process's cgroup v2, if it has a limit.
+fn cgroup_headroom_bytes() -> Option<u64> {
+    let cgroup = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let path = cgroup.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let dir = Path::new("/sys/fs/cgroup").join(path.trim().trim_start_matches('/'));
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).ok();
+    let max: u64 = read("memory.max")?.trim().parse().ok()?;
+    let current: u64 = read("memory.current")?.trim().parse().ok()?;
+    Some(max.saturating_sub(current))
+}
+
+/// The `MemAvailable:  <n> kB` line of a `/proc/meminfo` text, in bytes.
+pub fn parse_mem_available(meminfo: &str) -> Option<u64> {
+    let line = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?;
+    let mut fields = line.split_whitespace();
+    let value: u64 = fields.next()?.parse().ok()?;
+    match fields.next() {
+        Some("kB") => value.checked_mul(1024),
+        None => Some(value),
+        Some(_) => None,
+    }
+}
+
+/// `bytes` for people: `1.5 GB (1500000000 bytes)`, decimal units.
+pub fn human_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    let short = if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else if b >= 1e6 {
+        format!("{:.1} MB", b / 1e6)
+    } else if b >= 1e3 {
+        format!("{:.1} kB", b / 1e3)
+    } else {
+        return format!("{bytes} bytes");
+    };
+    format!("{short} ({bytes} bytes)")
+}

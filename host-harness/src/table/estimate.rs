@@ -1,0 +1,341 @@
+//! A table's size and its build's peak memory, estimated from the mesh's counts before any
+//! array is computed (issue 12), and the limits a build checks them against.
+//!
+//! A pre-computed table stores `B = S(S+1)/2 + (F−S)·S` compliance blocks of 3×3 scalars
+//! (`F` free, `S` touchable vertices; `kernel/src/table/format.rs`): quadratic in the mesh. A
+//! 40³-cell box with its base fixed (68 921 vertices, 7 921 touchable) has 5.0·10⁸ blocks, an
+//! 18 GB f32 table whose build once aborted the process on a 33.8 GB allocation. [`TableEstimate::table_bytes`] is the
+//! file's layout (the format's own section counts, [`SectionKind::expected_count`]) from these
+//! counts, so it is exact but for the collision grid, whose cell count is known only once it
+//! is built: the estimate takes its bound ([`CELLS_PER_SURFACE_VERTEX`] cells per surface
+//! vertex) and is above the real size by less than `32·Vs + 16` bytes (`Vs` surface vertices),
+//! never below. A tensor-mass table is linear in the mesh; its edge and mesh-triangle counts
+//! come from Euler's formula for a solid without holes (`E = V + F_all − T − 1`,
+//! `F_all = (4T + F_boundary)/2`), exact for such a mesh, off by a few edges otherwise.
+//!
+//! Peak working memory of the build (bytes), from the same counts:
+//! - pre-computed: the compliance in f64 while it is written (`72·B`), the table's sections and
+//!   the file (`2 × table`), a batch of 64 right-hand sides (`3F × 192` f64) and
+//!   [`BUILD_BYTES_PER_VERTEX`] per vertex; the sparse Cholesky factor's fill is not included
+//!   (known only once factorized; far smaller than the blocks when `S` is large);
+//! - tensor-mass: the arrays in f64 (the table's size at 8-byte scalars), the sections and the
+//!   file (`2 × table`) and [`BUILD_BYTES_PER_VERTEX`] per vertex.
+//!
+//! [`SizeLimits::check`] refuses a table above [`MAX_TABLE_FILE_BYTES`] (no reader would load
+//! it) or above the caller's `--max-table-bytes`, and a build whose peak exceeds the memory
+//! available ([`mem_available_bytes`]): one line naming the estimate and the alternatives.
+//!
+//! [`SectionKind::expected_count`]: palpate_kernel::table::format::SectionKind::expected_count
+
+use bytemuck::Zeroable;
+use palpate_kernel::table::format::{
+    CRC_LEN, HEADER_LEN, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN, TableKind,
+};
+
+use super::build::{BuildOptions, TableKindOptions};
+use super::collision::CELLS_PER_SURFACE_VERTEX;
+use super::file::Precision;
+use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
+use crate::mesh::{MeshReport, Surface, TetMesh};
+
+/// Working memory of a build per mesh vertex besides its arrays, bytes: the mesh (24 bytes of
+/// position, ~6 tets of 16), the stiffness matrix's pattern and values (~15 blocks of 9 values
+/// and row indices per free vertex, 2.2 kB), the orderings, the surface and the collision index.
+/// A generous round figure: it matters only for meshes whose table is small.
+pub const BUILD_BYTES_PER_VERTEX: u64 = 4096;
+
+/// Bytes of one f64 3×3 block: the compliance as computed, before it is rounded for the file.
+const F64_BLOCK_BYTES: u64 = 72;
+
+/// Touchable vertices per batch of the Cholesky solves (3 right-hand sides each, f64).
+const BATCH_VERTICES: u64 = super::compliance::BATCH_VERTICES as u64;
+
+/// The counts a table's size follows from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TableCounts {
+    /// Mesh vertices (`N`).
+    pub vertices: u64,
+    /// Vertices some tet uses.
+    pub referenced_vertices: u64,
+    /// Tets.
+    pub tets: u64,
+    /// Free vertices (`F`).
+    pub free: u64,
+    /// Touchable vertices (`S`): free vertices of the boundary surface.
+    pub touchable: u64,
+    /// Boundary surface triangles.
+    pub surface_triangles: u64,
+    /// Distinct vertices of the boundary surface triangles (`Vs`).
+    pub surface_vertices: u64,
+}
+
+impl TableCounts {
+    /// The counts of `mesh` (its reader's `report`) with the vertices `fixed` (one flag per
+    /// vertex) and boundary `surface`: what a build knows before computing any array.
+    pub fn of(mesh: &TetMesh, report: &MeshReport, fixed: &[bool], surface: &Surface) -> Self {
+        let count = |n: usize| n as u64;
+        let free_surface = surface
+            .vertices
+            .iter()
+            .filter(|&&v| fixed.get(v as usize) == Some(&false))
+            .count();
+        Self {
+            vertices: count(mesh.positions.len()),
+            referenced_vertices: count(
+                mesh.positions
+                    .len()
+                    .saturating_sub(report.unreferenced_vertices.len()),
+            ),
+            tets: count(mesh.tets.len()),
+            free: count(fixed.iter().filter(|&&f| !f).count()),
+            touchable: count(free_surface),
+            surface_triangles: count(surface.triangles.len()),
+            surface_vertices: count(surface.vertices.len()),
+        }
+    }
+}
+
+/// A table's estimated size and its build's peak memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TableEstimate {
+    /// Which table.
+    pub kind: TableKind,
+    /// Its stored float width.
+    pub precision: Precision,
+    /// The counts it is estimated from.
+    pub counts: TableCounts,
+    /// Compliance blocks `S(S+1)/2 + (F−S)·S` (pre-computed; 0 for tensor-mass), saturating.
+    pub blocks: u64,
+    /// The table file's size, bytes (module doc: exact but for the grid), saturating at
+    /// `u64::MAX` (a count beyond the format's `u32`).
+    pub table_bytes: u64,
+    /// The build's peak working memory, bytes (module doc), saturating.
+    pub peak_bytes: u64,
+}
+
+impl TableEstimate {
+    /// The estimate of the table `options` describe, for `mesh` with `fixed` vertices and
+    /// boundary `surface` ([`TableCounts::of`]).
+    pub fn of_build(
+        mesh: &TetMesh,
+        report: &MeshReport,
+        options: &BuildOptions,
+        fixed: &[bool],
+        surface: &Surface,
+    ) -> Self {
+        let kind = match options.kind {
+            TableKindOptions::Precomputed { .. } => TableKind::Precomputed,
+            TableKindOptions::TensorMass { .. } => TableKind::TensorMass,
+        };
+        let counts = TableCounts::of(mesh, report, fixed, surface);
+        Self::new(kind, options.precision, counts)
+    }
+
+    /// The estimate of a table of `kind` stored in `precision` for `counts`.
+    pub fn new(kind: TableKind, precision: Precision, counts: TableCounts) -> Self {
+        let c = counts;
+        let surface_blocks = c.touchable.saturating_mul(c.touchable.saturating_add(1)) / 2;
+        let interior_blocks = c
+            .free
+            .saturating_sub(c.touchable)
+            .saturating_mul(c.touchable);
+        let blocks = surface_blocks.saturating_add(interior_blocks);
+        let per_vertex = c.vertices.saturating_mul(BUILD_BYTES_PER_VERTEX);
+        let (table_bytes, peak_bytes) = match kind {
+            TableKind::Precomputed => {
+                let table = file_bytes(kind, precision, &c);
+                // 3F rows of f64 times 3 columns per vertex of the batch.
+                let batch = c
+                    .free
+                    .saturating_mul(3 * 3 * 8)
+                    .saturating_mul(c.touchable.min(BATCH_VERTICES));
+                let peak = blocks
+                    .saturating_mul(F64_BLOCK_BYTES)
+                    .saturating_add(table.saturating_mul(2))
+                    .saturating_add(batch)
+                    .saturating_add(per_vertex);
+                (table, peak)
+            }
+            TableKind::TensorMass => {
+                let table = file_bytes(kind, precision, &c);
+                let arrays = file_bytes(kind, Precision::F64, &c);
+                let peak = arrays
+                    .saturating_add(table.saturating_mul(2))
+                    .saturating_add(per_vertex);
+                (table, peak)
+            }
+        };
+        Self {
+            kind,
+            precision,
+            counts,
+            blocks: if kind == TableKind::Precomputed {
+                blocks
+            } else {
+                0
+            },
+            table_bytes,
+            peak_bytes,
+        }
+    }
+
+    /// One line for people: the table's size and the build's peak memory.
+    pub fn describe(&self) -> String {
+        let c = &self.counts;
+        let what = match self.kind {
+            TableKind::Precomputed => format!(
+                "the pre-computed table ({} compliance blocks: {} free x {} touchable vertices, {})",
+                self.blocks,
+                c.free,
+                c.touchable,
+                precision_name(self.precision)
+            ),
+            TableKind::TensorMass => format!(
+                "the tensor-mass table ({} vertices, {} tets, {})",
+                c.vertices,
+                c.tets,
+                precision_name(self.precision)
+            ),
+        };
+        format!(
+            "{what} would be {}, and its build needs about {} of memory",
+            human_bytes(self.table_bytes),
+            human_bytes(self.peak_bytes)
+        )
+    }
+}
+
+fn precision_name(p: Precision) -> &'static str {
+    match p {
+        Precision::F32 => "f32",
+        Precision::F64 => "f64",
+    }
+}
+
+/// The file size of a table of `kind` in `precision` for counts `c`: the writer's layout
+/// (`table::file::write_container`: header, directory, sections aligned to 16 bytes, CRC) with
+/// the format's section counts. The grid's cell count is its bound. `u64::MAX` when a count
+/// does not fit the header's `u32` or the sum overflows.
+fn file_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> u64 {
+    layout_bytes(kind, precision, c).unwrap_or(u64::MAX)
+}
+
+fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Option<u64> {
+    let u32_of = |x: u64| u32::try_from(x).ok();
+    let scalar_bytes: u32 = match precision {
+        Precision::F32 => 4,
+        Precision::F64 => 8,
+    };
+    let mut header = RawHeader {
+        vertex_count: u32_of(c.vertices)?,
+        tet_count: u32_of(c.tets)?,
+        triangle_count: u32_of(c.surface_triangles)?,
+        ..RawHeader::zeroed()
+    };
+    match kind {
+        TableKind::Precomputed => {
+            header.free_count = u32_of(c.free)?;
+            header.touchable_count = u32_of(c.touchable)?;
+            header.surface_vertex_count = u32_of(c.surface_vertices)?;
+            header.grid_cell_count = u32_of(
+                c.surface_vertices
+                    .max(1)
+                    .checked_mul(CELLS_PER_SURFACE_VERTEX as u64)?,
+            )?;
+        }
+        TableKind::TensorMass => {
+            // Every face once: each interior face is shared by two tets.
+            let mesh_triangles = c.tets.checked_mul(4)?.checked_add(c.surface_triangles)? / 2;
+            // Euler's formula of a solid without holes: V − E + F − T = 1.
+            let edges = c
+                .referenced_vertices
+                .checked_add(mesh_triangles)?
+                .saturating_sub(c.tets.checked_add(1)?);
+            header.edge_count = u32_of(edges)?;
+            header.mesh_triangle_count = mesh_triangles;
+        }
+    }
+    let sections = kind.sections();
+    let align = SECTION_ALIGN as u64;
+    let directory = (HEADER_LEN + sections.len() * SECTION_ENTRY_LEN) as u64;
+    let mut offset = directory.checked_next_multiple_of(align)?;
+    for &section in sections {
+        let bytes = section
+            .expected_count(&header)?
+            .checked_mul(u64::from(section.elem_bytes(scalar_bytes)))?;
+        offset = offset.checked_add(bytes)?.checked_next_multiple_of(align)?;
+    }
+    offset.checked_add(CRC_LEN as u64)
+}
+
+/// What a table build may produce and use, checked by [`SizeLimits::check`] before the arrays
+/// are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SizeLimits {
+    /// Largest table, bytes (`tables build --max-table-bytes`); [`MAX_TABLE_FILE_BYTES`] applies
+    /// in any case.
+    pub max_table_bytes: Option<u64>,
+    /// Memory the build may use, bytes; `None`: not checked.
+    pub available_bytes: Option<u64>,
+    /// Print the estimate on stderr (one line) when the build goes ahead.
+    pub print_estimate: bool,
+}
+
+impl SizeLimits {
+    /// The limits of every build: [`MAX_TABLE_FILE_BYTES`] and the memory available now
+    /// ([`mem_available_bytes`]), nothing printed.
+    pub fn system() -> Self {
+        Self {
+            max_table_bytes: None,
+            available_bytes: mem_available_bytes(),
+            print_estimate: false,
+        }
+    }
+
+    /// Refuses `estimate` above a limit, with one line starting with `source` (the mesh) that
+    /// gives the estimate, the limit and what to do instead; otherwise prints the estimate if
+    /// asked.
+    pub fn check(&self, estimate: &TableEstimate, source: &str) -> anyhow::Result<()> {
+        let table = estimate.table_bytes;
+        let over_max = self.max_table_bytes.filter(|&max| table > max);
+        let short_of = self
+            .available_bytes
+            .filter(|&available| estimate.peak_bytes > available);
+        let reason = if table > MAX_TABLE_FILE_BYTES {
+            Some(format!(
+                "the table is above the largest table file, {} (MAX_TABLE_FILE_BYTES)",
+                human_bytes(MAX_TABLE_FILE_BYTES)
+            ))
+        } else if let Some(max) = over_max {
+            Some(format!("the table is above --max-table-bytes {max} bytes"))
+        } else {
+            short_of.map(|available| {
+                format!(
+                    "only {} of memory is available (MemAvailable)",
+                    human_bytes(available)
+                )
+            })
+        };
+        let source = if source.is_empty() {
+            String::new()
+        } else {
+            format!("{source}: ")
+        };
+        let Some(reason) = reason else {
+            if self.print_estimate {
+                eprintln!("{source}estimate: {}", estimate.describe());
+            }
+            return Ok(());
+        };
+        let instead = match estimate.kind {
+            TableKind::Precomputed => {
+                "use the tensor-mass model (tables build --kind tensor-mass, or [model] kind = \"dynamic\" in a scene), a coarser mesh, or fix more of the surface (fewer touchable vertices)"
+            }
+            TableKind::TensorMass => "use a coarser mesh",
+        };
+        anyhow::bail!(
+            "{source}{}; {reason}: refused before building; {instead}",
+            estimate.describe()
+        )
+    }
+}

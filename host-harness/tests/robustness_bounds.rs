@@ -1,0 +1,392 @@
+//! Issue 12, bounded runs and inputs: the probes that need the `palpate`
+//! binary (the in-process ones are `tests/host/robustness/bounds.rs`). Each
+//! once grew without bound or aborted; each now exits 2 with one line, fast.
+
+use core::time::Duration;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::Instant;
+
+fn palpate(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_palpate"))
+        .args(args)
+        .output()
+        .expect("run palpate")
+}
+
+/// Runs `palpate args` with `input` on its standard input (a pipe).
+fn palpate_with_stdin(args: &[&str], input: &[u8]) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_palpate"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run palpate");
+    let mut stdin = child.stdin.take().expect("stdin");
+    // The reader may stop early (and close the pipe): a write error is fine.
+    let _ = stdin.write_all(input);
+    drop(stdin);
+    child.wait_with_output().expect("wait")
+}
+
+fn reference(rel: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/reference")
+        .join(rel)
+        .display()
+        .to_string()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("palpate-bounds-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp folder");
+    dir.join(name)
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Exit 2, one line `error: …` containing `needle`, no panic.
+fn assert_one_line_error(out: &Output, needle: &str) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(needle), "stderr lacks '{needle}': {err}");
+    assert!(
+        err.starts_with("error: ") && err.lines().count() == 1,
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+fn build_cube_table(name: &str) -> PathBuf {
+    let table = temp(name);
+    let out = palpate(&[
+        "tables",
+        "build",
+        &reference("meshes/cube.msh"),
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "--quiet",
+        "-o",
+        &table.display().to_string(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    table
+}
+
+/// `precomputed solve /dev/zero` grew to 18.5 GB; `tables info /dev/zero`
+/// likewise. The header is read first: refused at once.
+#[test]
+fn dev_zero_is_not_a_table() {
+    let started = Instant::now();
+    let out = palpate(&[
+        "precomputed",
+        "solve",
+        "/dev/zero",
+        "--contact",
+        "194:0,0,-0.01",
+        "--json",
+    ]);
+    assert_one_line_error(&out, "/dev/zero: not a Palpate table");
+    let out = palpate(&["tables", "info", "/dev/zero"]);
+    assert_one_line_error(&out, "/dev/zero: not a Palpate table");
+    assert!(started.elapsed() < Duration::from_secs(5));
+}
+
+/// A table through a pipe (not a regular file: no size to check) is read up
+/// to the length its header declares: the exact table solves, one with
+/// bytes beyond that length is refused.
+#[test]
+fn piped_table_is_read_to_its_declared_length() {
+    let table = std::fs::read(build_cube_table("piped.tbl")).expect("table");
+    let args = [
+        "precomputed",
+        "solve",
+        "/dev/stdin",
+        "--contact",
+        "194:0,0,-0.01",
+        "--json",
+    ];
+    let out = palpate_with_stdin(&args, &table);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut longer = table.clone();
+    longer.extend_from_slice(&[0; 64]);
+    let out = palpate_with_stdin(&args, &longer);
+    assert_one_line_error(&out, "longer than the");
+    let out = palpate_with_stdin(&args, &table[..table.len() / 2]);
+    assert_one_line_error(&out, "truncated");
+}
+
+/// A trajectory with a row at `t = 1e9` ran 10¹² ticks (670 MB of output in
+/// a minute); `t = 1e300` printed "0 ticks" with exit 0; `haptic_hz = 1e7`
+/// was accepted. Each is refused before the run, naming the line or key.
+#[test]
+fn session_run_refuses_unbounded_trajectories_and_rates() {
+    let far = temp("far.csv");
+    std::fs::write(
+        &far,
+        "t,tool,x,y,z\n0,0,0.06,0.06,0.07\n1e9,0,0.06,0.06,0.07\n",
+    )
+    .expect("csv");
+    let huge = temp("huge.csv");
+    std::fs::write(
+        &huge,
+        "t,tool,x,y,z\n0,0,0.06,0.06,0.07\n1e300,0,0.06,0.06,0.07\n",
+    )
+    .expect("csv");
+    let out_csv = temp("far-out.csv");
+    let out_csv = out_csv.display().to_string();
+    for (trajectory, needle) in [
+        (
+            &far,
+            "line 3: time 1000000000 s is 1000000000 s from line 2 at 0 s",
+        ),
+        (&huge, "line 3: time 1e300 s is out of range"),
+    ] {
+        let started = Instant::now();
+        let out = palpate(&[
+            "session",
+            "run",
+            "built-in",
+            "--trajectory",
+            &trajectory.display().to_string(),
+            "--out",
+            &out_csv,
+        ]);
+        assert_one_line_error(&out, needle);
+        assert!(started.elapsed() < Duration::from_secs(5));
+    }
+    let scene = temp("fast.toml");
+    std::fs::write(
+        &scene,
+        "generated = { box = [0.1, 0.1, 0.05], cells = [2, 2, 1] }\nfix = [\"z<0.001\"]\n\
+         material = { young_pa = 3000, poisson = 0.45 }\nrates = { haptic_hz = 1e7 }\n",
+    )
+    .expect("scene");
+    let poke = temp("poke.csv");
+    std::fs::write(&poke, "t,tool,x,y,z\n0,0,0.05,0.05,0.06\n").expect("csv");
+    let out = palpate(&[
+        "session",
+        "run",
+        &scene.display().to_string(),
+        "--trajectory",
+        &poke.display().to_string(),
+        "--out",
+        &out_csv,
+    ]);
+    assert_one_line_error(
+        &out,
+        "[rates] haptic_hz = 10000000: above 10000 Hz (MAX_HAPTIC_HZ)",
+    );
+}
+
+/// `tables build` prints its estimate before building and refuses a table
+/// above `--max-table-bytes`, leaving no output.
+#[test]
+fn tables_build_prints_the_estimate_and_honours_max_table_bytes() {
+    let table = temp("limited.tbl");
+    let _ = std::fs::remove_file(&table);
+    let mesh = reference("meshes/cube.msh");
+    let table_arg = table.display().to_string();
+    let mut args = vec![
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "--quiet",
+        "-o",
+        &table_arg,
+    ];
+    let out = palpate(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("estimate: the pre-computed table (14210 compliance blocks: 180 free x 116 touchable vertices, f32) would be"),
+        "{err}"
+    );
+    let built = std::fs::metadata(&table).expect("table").len();
+    std::fs::remove_file(&table).expect("remove");
+    args.extend(["--max-table-bytes", "100000"]);
+    let out = palpate(&args);
+    assert_one_line_error(&out, "the table is above --max-table-bytes 100000 bytes");
+    assert!(!table.exists(), "no table written");
+    // At the real size plus the estimate's slack it builds.
+    let limit = (built + 32 * 152 + 16).to_string();
+    let last = args.len() - 1;
+    args[last] = &limit;
+    let out = palpate(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// A 40³-cell generated box (68 921 vertices, under the scene cap) aborted
+/// `session run` with "memory allocation of 33 830 337 528 bytes failed"
+/// (exit 134). Now refused from the estimate, fast and under a 4 GiB
+/// address-space limit (`ulimit -v`): the table is never allocated. So is
+/// `budget` on that scene.
+#[test]
+fn generated_scene_too_large_for_a_table_is_refused_without_allocating() {
+    let scene = temp("box40.toml");
+    std::fs::write(
+        &scene,
+        "generated = { box = [0.4, 0.4, 0.4], cells = [40, 40, 40] }\nfix = [\"z<0.001\"]\n\
+         material = { young_pa = 3000, poisson = 0.45 }\n",
+    )
+    .expect("scene");
+    let poke = temp("poke40.csv");
+    std::fs::write(&poke, "t,tool,x,y,z\n0,0,0.2,0.2,0.5\n0.01,0,0.2,0.2,0.5\n").expect("csv");
+    let out_csv = temp("box40-out.csv");
+    let command = format!(
+        "ulimit -v 4194304 && exec '{}' session run '{}' --trajectory '{}' --out '{}'",
+        env!("CARGO_BIN_EXE_palpate"),
+        scene.display(),
+        poke.display(),
+        out_csv.display()
+    );
+    let started = Instant::now();
+    let out = Command::new("sh")
+        .args(["-c", &command])
+        .output()
+        .expect("run sh");
+    let elapsed = started.elapsed();
+    assert_one_line_error(
+        &out,
+        "the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+    );
+    assert!(stderr(&out).contains("tensor-mass"), "{}", stderr(&out));
+    assert!(elapsed < Duration::from_secs(5), "{elapsed:?}");
+    // `budget` checks every size it measures (here 20³ and 40³ cells) before
+    // building the first.
+    let started = Instant::now();
+    let out = palpate(&[
+        "budget",
+        &scene.display().to_string(),
+        "--work-dir",
+        &temp("budget40").display().to_string(),
+    ]);
+    assert_one_line_error(&out, "would be 18.0 GB");
+    assert!(started.elapsed() < Duration::from_secs(5));
+}
+
+/// The same 40³-cell box as a TetGen mesh file: `tables build` aborted with
+/// the 33.8 GB allocation; now it prints nothing but one line with the
+/// estimate and exits 2 (under a 4 GiB address-space limit).
+#[test]
+fn tables_build_of_a_40_cubed_box_is_refused_without_allocating() {
+    use core::fmt::Write as _;
+    let mesh = palpate::mesh::generate::box_mesh([40, 40, 40], [0.4, 0.4, 0.4]);
+    let mut node = format!("{} 3 0 0\n", mesh.positions.len());
+    for (i, [x, y, z]) in mesh.positions.iter().enumerate() {
+        let _ = writeln!(node, "{i} {x} {y} {z}");
+    }
+    let mut ele = format!("{} 4 0\n", mesh.tets.len());
+    for (i, [a, b, c, d]) in mesh.tets.iter().enumerate() {
+        let _ = writeln!(ele, "{i} {a} {b} {c} {d}");
+    }
+    let base = temp("box40");
+    std::fs::write(base.with_extension("node"), node).expect("node");
+    std::fs::write(base.with_extension("ele"), ele).expect("ele");
+    let table = temp("box40.tbl");
+    let command = format!(
+        "ulimit -v 4194304 && exec '{}' tables build '{}' --young 3000 --poisson 0.45 --fix 'z<0.001' -o '{}'",
+        env!("CARGO_BIN_EXE_palpate"),
+        base.with_extension("node").display(),
+        table.display()
+    );
+    let started = Instant::now();
+    let out = Command::new("sh")
+        .args(["-c", &command])
+        .output()
+        .expect("run sh");
+    assert_one_line_error(
+        &out,
+        "box40.node: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+    );
+    assert!(started.elapsed() < Duration::from_secs(10));
+    assert!(!table.exists());
+}
+
+/// A mesh file above the limit is refused from its size, before reading (a
+/// sparse file: no disk used).
+#[test]
+fn oversized_mesh_file_is_refused_before_reading() {
+    let mesh = temp("big.msh");
+    let file = std::fs::File::create(&mesh).expect("create");
+    file.set_len((2 << 30) + 1).expect("sparse file");
+    drop(file);
+    let out = palpate(&[
+        "tables",
+        "build",
+        &mesh.display().to_string(),
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "-o",
+        &temp("big.tbl").display().to_string(),
+    ]);
+    assert_one_line_error(&out, "the limit for a mesh file (MAX_MESH_FILE_BYTES)");
+    std::fs::remove_file(&mesh).expect("remove");
+}
+
+/// The other inputs read whole are bounded the same way (sparse files just
+/// over each limit): a trajectory (1 GiB), a scene (1 MiB), a contact
+/// sequence (256 MiB).
+#[test]
+fn oversized_trajectory_scene_and_sequence_files_are_refused() {
+    let sparse = |name: &str, len: u64| {
+        let path = temp(name);
+        let file = std::fs::File::create(&path).expect("create");
+        file.set_len(len).expect("sparse file");
+        path.display().to_string()
+    };
+    let trajectory = sparse("big.csv", (1 << 30) + 1);
+    let scene = sparse("big.toml", (1 << 20) + 1);
+    let sequence = sparse("big.seq", (256 << 20) + 1);
+    let out_csv = temp("big-out.csv").display().to_string();
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        &trajectory,
+        "--out",
+        &out_csv,
+    ]);
+    assert_one_line_error(
+        &out,
+        "the limit for a trajectory file (MAX_TRAJECTORY_FILE_BYTES)",
+    );
+    let out = palpate(&[
+        "session",
+        "run",
+        &scene,
+        "--trajectory",
+        &trajectory,
+        "--out",
+        &out_csv,
+    ]);
+    assert_one_line_error(&out, "the limit for a scene file (MAX_SCENE_FILE_BYTES)");
+    let table = build_cube_table("seq.tbl").display().to_string();
+    let out = palpate(&["precomputed", "replay", &table, &sequence]);
+    assert_one_line_error(
+        &out,
+        "the limit for a sequence file (MAX_SEQUENCE_FILE_BYTES)",
+    );
+    for path in [trajectory, scene, sequence] {
+        std::fs::remove_file(path).expect("remove");
+    }
+}

@@ -1,0 +1,489 @@
+//! Issue 12, output safety, through the binary: a run killed while writing
+//! leaves the previous output byte-identical; a failed run leaves it too;
+//! an output that is an input is refused; a closed standard output is a
+//! normal end (exit 0, nothing on stderr) and a full one a one-line error
+//! (exit 2), never a panic. The in-process probes are in
+//! `tests/host/robustness/output.rs`.
+
+use core::time::Duration;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::Instant;
+
+fn palpate_command(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_palpate"));
+    command.args(args);
+    command
+}
+
+fn palpate(args: &[&str]) -> Output {
+    palpate_command(args).output().expect("run palpate")
+}
+
+fn reference(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/reference")
+        .join(rel)
+}
+
+/// An empty folder of its own for test `name`.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "palpate-robustness-output-cli-{name}-{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("test folder");
+    dir
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().expect("utf-8 path")
+}
+
+fn assert_one_line_error(out: &Output, needle: &str) {
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(needle), "stderr lacks '{needle}': {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+}
+
+/// The temporary files palpate leaves in `dir` (only a killed run may).
+fn temporaries(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .expect("read test folder")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().contains(".palpate-tmp."))
+        })
+        .collect()
+}
+
+/// Builds the f32 table of the reference cube into `table`.
+fn build_cube_table(table: &Path, extra: &[&str]) {
+    let mesh = reference("meshes/cube.msh");
+    let mut args = vec![
+        "tables",
+        "build",
+        s(&mesh),
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "--quiet",
+        "-o",
+        s(table),
+    ];
+    args.extend_from_slice(extra);
+    let out = palpate(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Kills `child` (if still running) and reaps it.
+fn kill(mut child: Child) {
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
+/// `session run --out` over previous results, killed once the run has
+/// written into its output (its temporary file holds bytes): the previous
+/// CSV is byte-identical. The old `File::create` truncated it at the start.
+/// The run is 100 s of trajectory on the dynamic block (about ten seconds
+/// or more of physics); the first 64 KiB reach the temporary file within
+/// the first few seconds of trajectory, so the kill comes long before the
+/// end. The poll waits up to two minutes.
+#[test]
+fn a_killed_session_run_leaves_the_previous_csv() {
+    let dir = fresh_dir("killed-session");
+    let trajectory = dir.join("still.csv");
+    // The probe held above the block: no contact, every tick a CSV line.
+    std::fs::write(
+        &trajectory,
+        "t,tool,x,y,z\n0,0,0.06,0.06,0.1\n100,0,0.06,0.06,0.1\n",
+    )
+    .expect("trajectory");
+    let csv = dir.join("forces.csv");
+    let old = b"t,fx,fy,fz,contacts,status\n0,0.1,0.2,0.3,1,ok\n".to_vec();
+    std::fs::write(&csv, &old).expect("previous results");
+
+    let mut child = palpate_command(&[
+        "session",
+        "run",
+        "built-in-dynamic",
+        "--trajectory",
+        s(&trajectory),
+        "--out",
+        s(&csv),
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .expect("spawn palpate");
+    let started = Instant::now();
+    let writing = loop {
+        let written = temporaries(&dir)
+            .iter()
+            .any(|t| std::fs::metadata(t).is_ok_and(|m| m.len() > 0));
+        if written {
+            break true;
+        }
+        if started.elapsed() > Duration::from_secs(120) || child.try_wait().ok().flatten().is_some()
+        {
+            break false;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    let status = child.try_wait().ok().flatten();
+    kill(child);
+    assert!(
+        writing,
+        "no temporary output with bytes seen (exited: {status:?})"
+    );
+    assert_eq!(std::fs::read(&csv).expect("csv"), old, "byte-identical");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A failed run keeps the previous output, through the binary:
+/// `session run` whose scene's mesh is missing (issue 12's first probe),
+/// and `tables build` over a good table whose `--fix` matches no vertex
+/// (the output was opened before the mesh was read). Nothing is left
+/// beside them.
+#[test]
+fn a_failed_run_keeps_the_previous_output() {
+    let dir = fresh_dir("failed-run");
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "mesh = \"missing.msh\"\nfix = [\"z<0.0001\"]\n[material]\nyoung_pa = 3000.0\npoisson = 0.45\n",
+    )
+    .expect("scene");
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{out:?}");
+    let csv = dir.join("forces.csv");
+    let old = b"previous results\n".to_vec();
+    std::fs::write(&csv, &old).expect("previous results");
+    let out = palpate(&[
+        "session",
+        "run",
+        s(&scene),
+        "--trajectory",
+        s(&trajectory),
+        "--out",
+        s(&csv),
+    ]);
+    assert_one_line_error(&out, "missing.msh");
+    assert_eq!(std::fs::read(&csv).expect("csv"), old);
+
+    let table = dir.join("cube.tbl");
+    build_cube_table(&table, &[]);
+    let good = std::fs::read(&table).expect("table");
+    let mesh = reference("meshes/cube.msh");
+    let out = palpate(&[
+        "tables",
+        "build",
+        s(&mesh),
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<-1",
+        "--quiet",
+        "-o",
+        s(&table),
+    ]);
+    assert_one_line_error(&out, "no vertex matches");
+    assert_eq!(std::fs::read(&table).expect("table"), good);
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// An output that is an input is refused with one line naming both, and
+/// the input keeps every byte: `tables build -o` the mesh (and the other
+/// file of a TetGen pair), `session run --out` the trajectory or the
+/// scene file.
+#[test]
+fn an_output_that_is_an_input_is_refused() {
+    let dir = fresh_dir("output-is-input");
+    let mesh = dir.join("cube.msh");
+    std::fs::copy(reference("meshes/cube.msh"), &mesh).expect("mesh");
+    let node = dir.join("cube.node");
+    let ele = dir.join("cube.ele");
+    std::fs::copy(reference("meshes/cube.node"), &node).expect("node");
+    std::fs::copy(reference("meshes/cube.ele"), &ele).expect("ele");
+    let before: Vec<Vec<u8>> = [&mesh, &node, &ele]
+        .iter()
+        .map(|p| std::fs::read(p).expect("input"))
+        .collect();
+    for (input, output) in [(&mesh, &mesh), (&node, &ele)] {
+        let out = palpate(&[
+            "tables",
+            "build",
+            s(input),
+            "--young",
+            "5000",
+            "--poisson",
+            "0.45",
+            "--fix",
+            "z<0.001",
+            "--quiet",
+            "-o",
+            s(output),
+        ]);
+        assert_one_line_error(
+            &out,
+            &format!(
+                "-o {} is the same file as the mesh {}",
+                s(output),
+                s(output)
+            ),
+        );
+    }
+    let after: Vec<Vec<u8>> = [&mesh, &node, &ele]
+        .iter()
+        .map(|p| std::fs::read(p).expect("input"))
+        .collect();
+    assert!(before == after, "inputs changed");
+
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{out:?}");
+    let poke = std::fs::read(&trajectory).expect("trajectory");
+    let scene = dir.join("scene.toml");
+    let scene_text =
+        "mesh = \"cube.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = 3000.0\npoisson = 0.45\n";
+    std::fs::write(&scene, scene_text).expect("scene");
+    for (scene_arg, output, needle) in [
+        ("built-in", &trajectory, "is the same file as --trajectory"),
+        (s(&scene), &scene, "is the same file as the scene"),
+        (s(&scene), &mesh, "is the same file as the scene's mesh"),
+    ] {
+        let out = palpate(&[
+            "session",
+            "run",
+            scene_arg,
+            "--trajectory",
+            s(&trajectory),
+            "--out",
+            s(output),
+        ]);
+        assert_one_line_error(&out, needle);
+    }
+    assert_eq!(std::fs::read(&trajectory).expect("trajectory"), poke);
+    assert_eq!(std::fs::read_to_string(&scene).expect("scene"), scene_text);
+    assert_eq!(std::fs::read(&mesh).expect("mesh"), before[0]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `--vtk` onto an existing file, or a folder palpate did not write: a
+/// clear one-line error before the run (not "File exists (os error 17)"),
+/// and the file or folder untouched.
+#[test]
+fn a_vtk_path_that_is_a_file_or_a_foreign_folder_is_refused() {
+    let dir = fresh_dir("vtk");
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{out:?}");
+    let file = dir.join("notes.txt");
+    std::fs::write(&file, "keep\n").expect("file");
+    let foreign = dir.join("results");
+    std::fs::create_dir(&foreign).expect("folder");
+    std::fs::write(foreign.join("paper.tex"), "keep\n").expect("file");
+    for (vtk, needle) in [
+        (&file, "is not a folder"),
+        (&foreign, "palpate did not write"),
+    ] {
+        let out = palpate(&[
+            "session",
+            "run",
+            "built-in",
+            "--trajectory",
+            s(&trajectory),
+            "--out",
+            s(&dir.join("forces.csv")),
+            "--vtk",
+            s(vtk),
+        ]);
+        assert_one_line_error(&out, needle);
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("os error 17"));
+    }
+    assert_eq!(std::fs::read_to_string(&file).expect("file"), "keep\n");
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("paper.tex")).expect("file"),
+        "keep\n"
+    );
+    assert!(!dir.join("forces.csv").exists());
+    let out = palpate(&["demo", "--out", s(&file)]);
+    assert_one_line_error(&out, "is not a folder");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The inputs of the standard-output probes: the f32 cube table, a replay
+/// sequence of `steps` steps, the deformed positions of the JSON reference.
+fn stdout_inputs(dir: &Path, steps: usize) -> (PathBuf, PathBuf, PathBuf) {
+    let table = dir.join("cube.tbl");
+    build_cube_table(&table, &[]);
+    let sequence = dir.join("steps.seq");
+    std::fs::write(&sequence, "194:0,0,-0.001\n".repeat(steps)).expect("sequence");
+    let text = std::fs::read_to_string(reference("svk/svk_cube.json")).expect("svk");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let deformed = dir.join("deformed.csv");
+    let lines: String = json["configs"][0]["x"]
+        .as_array()
+        .expect("positions")
+        .iter()
+        .map(|p| format!("{},{},{}\n", p[0], p[1], p[2]))
+        .collect();
+    std::fs::write(&deformed, lines).expect("deformed");
+    (table, sequence, deformed)
+}
+
+/// The commands that print, each with its arguments.
+fn printing_commands<'a>(
+    table: &'a str,
+    sequence: &'a str,
+    deformed: &'a str,
+    mesh: &'a str,
+    demo_out: &'a str,
+) -> Vec<Vec<&'a str>> {
+    vec![
+        vec!["precomputed", "replay", table, sequence],
+        vec![
+            "precomputed",
+            "solve",
+            table,
+            "--contact",
+            "194:0,0,-0.001",
+            "--json",
+        ],
+        vec![
+            "stvk",
+            "forces",
+            mesh,
+            "--young",
+            "5000",
+            "--poisson",
+            "0.45",
+            "--deformed",
+            deformed,
+            "--json",
+        ],
+        vec!["tables", "info", table],
+        vec!["demo", "--out", demo_out],
+    ]
+}
+
+/// `… | head -1`, `… | head -c10`: standard output closed by its reader
+/// is a normal end: exit 0, nothing on stderr (println! panicked, exit 134
+/// in release). Closed before the first write, and (`replay`, 3000 lines,
+/// more than a pipe holds) after reading one line.
+#[test]
+fn a_closed_standard_output_is_a_normal_end() {
+    let dir = fresh_dir("closed-stdout");
+    let (table, sequence, deformed) = stdout_inputs(&dir, 3000);
+    let mesh = reference("meshes/cube.msh");
+    let demo_out = dir.join("demo-out");
+    for args in printing_commands(
+        s(&table),
+        s(&sequence),
+        s(&deformed),
+        s(&mesh),
+        s(&demo_out),
+    ) {
+        let mut child = palpate_command(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn palpate");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().expect("wait");
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            out.stderr.is_empty(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    // The demo stopped at its first line: no series, nothing left beside.
+    assert!(!demo_out.exists());
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+
+    let mut child = palpate_command(&["precomputed", "replay", s(&table), s(&sequence)])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn palpate");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut first)
+        .expect("first line");
+    assert!(first.starts_with("step 0 "), "{first}");
+    let out = child.wait_with_output().expect("wait");
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    assert!(out.stderr.is_empty(), "{out:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `… > /dev/full`: a full standard output is one line `error: standard
+/// output: …` and exit 2, and a full `--out` names the file.
+#[test]
+fn a_full_standard_output_or_file_is_a_one_line_error() {
+    let full = Path::new("/dev/full");
+    if !full.exists() {
+        return; // not on this system
+    }
+    let dir = fresh_dir("full");
+    let (table, sequence, deformed) = stdout_inputs(&dir, 10);
+    let mesh = reference("meshes/cube.msh");
+    let demo_out = dir.join("demo-out");
+    for args in printing_commands(
+        s(&table),
+        s(&sequence),
+        s(&deformed),
+        s(&mesh),
+        s(&demo_out),
+    ) {
+        let device = std::fs::OpenOptions::new()
+            .write(true)
+            .open(full)
+            .expect("/dev/full");
+        let out = palpate_command(&args)
+            .stdout(device)
+            .output()
+            .expect("run palpate");
+        assert_one_line_error(&out, "error: standard output: ");
+    }
+    assert!(!demo_out.exists());
+
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{out:?}");
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        s(&trajectory),
+        "--out",
+        "/dev/full",
+    ]);
+    assert_one_line_error(&out, "/dev/full: cannot write: ");
+    let out = palpate(&["session", "generate", "slide", "-o", "/dev/full"]);
+    assert_one_line_error(&out, "/dev/full: cannot write: ");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,335 @@
+//! Issue 12, "wrong or unusable results with exit 0" and "messages", at the
+//! process level: each probe that once printed a wrong or unusable result
+//! with exit status 0, or an error naming nothing, now exits 2 with one line
+//! `error: …` naming the file, line, key or element (or gives the correct
+//! result). The in-process side is `tests/host/robustness/results.rs`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn palpate(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_palpate"))
+        .args(args)
+        .output()
+        .expect("run palpate")
+}
+
+fn reference(rel: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/reference")
+        .join(rel)
+        .display()
+        .to_string()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("palpate-results-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Exit status 2, stderr ending with one line `error: …` (the only one)
+/// containing every needle, nothing on stdout, no panic. (`tables build`
+/// prints its size estimate on stderr before it starts.)
+fn assert_one_line_error(out: &Output, needles: &[&str]) {
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    let last = stderr.trim_end().lines().last().unwrap_or_default();
+    assert!(last.starts_with("error: "), "{stderr}");
+    assert_eq!(stderr.matches("error:").count(), 1, "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in needles {
+        assert!(
+            last.contains(needle),
+            "the error lacks '{needle}': {stderr}"
+        );
+    }
+    assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
+}
+
+/// `tables build` of the reference cube (base fixed) with `extra` arguments.
+fn build(name: &str, young: &str, extra: &[&str]) -> (Output, PathBuf) {
+    let table = temp(name);
+    let (mesh, table_str) = (reference("meshes/cube.msh"), table.display().to_string());
+    let mut args = vec![
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        young,
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "--quiet",
+        "-o",
+        &table_str,
+    ];
+    args.extend_from_slice(extra);
+    (palpate(&args), table)
+}
+
+fn built(name: &str, extra: &[&str]) -> String {
+    let (out, table) = build(name, "5000", extra);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    table.display().to_string()
+}
+
+#[test]
+fn an_f32_table_out_of_range_is_refused_before_it_is_written() {
+    for young in ["1e300", "1e-300"] {
+        let (out, table) = build(&format!("cube-{young}.tbl"), young, &[]);
+        assert_one_line_error(
+            &out,
+            &[
+                "cube.msh",
+                "load check",
+                "overflow or underflow f32",
+                "--precision f64",
+            ],
+        );
+        assert!(!table.exists(), "no table written for E = {young}");
+        let (out, _) = build(
+            &format!("cube-tm-{young}.tbl"),
+            young,
+            &["--kind", "tensor-mass", "--density", "1000"],
+        );
+        assert_one_line_error(&out, &["cube.msh", "--precision f64"]);
+    }
+}
+
+#[test]
+fn info_reports_a_tensor_mass_table() {
+    let table = built(
+        "cube-tm.tbl",
+        &["--kind", "tensor-mass", "--density", "1000"],
+    );
+    let out = palpate(&["tables", "info", &table]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}{stdout}", text(&out.stderr));
+    for needle in [
+        "table kind: tensor-mass (dynamic)",
+        "edges: ",
+        "density: 1000 kg/m3",
+        "checksum: ok",
+        "validation: ok",
+    ] {
+        assert!(stdout.contains(needle), "{needle}: {stdout}");
+    }
+}
+
+#[test]
+fn solve_refuses_contacts_off_the_surface_triangles() {
+    let table = built("cube-bary.tbl", &[]);
+    for (bary, needle) in [
+        (
+            "194,194,201@0.2,0.3,0.5:0,0,-0.002",
+            "vertex 194 appears twice",
+        ),
+        (
+            "194,195,200@0.2,0.3,0.5:0,0,-0.002",
+            "vertices 194,195,200 are not a triangle",
+        ),
+    ] {
+        let out = palpate(&[
+            "precomputed",
+            "solve",
+            &table,
+            "--contact-bary",
+            bary,
+            "--json",
+        ]);
+        assert_one_line_error(&out, &["contact 0", needle]);
+    }
+    let out = palpate(&[
+        "precomputed",
+        "solve",
+        &table,
+        "--contact-bary",
+        "201,194,195@0.2,0.3,0.5:0,0,-0.002",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+/// One line `x,y,z` per vertex of the reference cube, scaled by `scale`.
+fn deformed_csv(name: &str, scale: f64, drop_last: bool) -> String {
+    let mesh = palpate::mesh::read_mesh(Path::new(&reference("meshes/cube.msh"))).unwrap();
+    let mut lines: Vec<String> = mesh
+        .0
+        .positions
+        .iter()
+        .map(|p| format!("{:e},{:e},{:e}", p[0] * scale, p[1] * scale, p[2] * scale))
+        .collect();
+    if drop_last {
+        lines.pop();
+    }
+    let path = temp(name);
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn stvk_forces_refuses_non_finite_results_and_names_the_csv() {
+    let mesh = reference("meshes/cube.msh");
+    let stvk = |csv: &str| {
+        palpate(&[
+            "stvk",
+            "forces",
+            &mesh,
+            "--young",
+            "5000",
+            "--poisson",
+            "0.45",
+            "--deformed",
+            csv,
+            "--json",
+        ])
+    };
+    let huge = deformed_csv("huge.csv", 1e200, false);
+    assert_one_line_error(&stvk(&huge), &["huge.csv", "non-finite"]);
+    let short = deformed_csv("short.csv", 1.0, true);
+    let out = stvk(&short);
+    assert_one_line_error(&out, &["short.csv: 215 lines", "216 vertices"]);
+    let rest = deformed_csv("rest.csv", 1.0, false);
+    let out = stvk(&rest);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(!text(&out.stdout).contains("null"));
+}
+
+#[test]
+fn critical_dt_without_a_critical_step_is_an_error() {
+    let mesh = reference("meshes/cube.msh");
+    let critical = |young: &str, fix: &str| {
+        palpate(&[
+            "dynamic",
+            "critical-dt",
+            &mesh,
+            "--young",
+            young,
+            "--poisson",
+            "0.45",
+            "--density",
+            "1000",
+            "--damping",
+            "2",
+            "--fix",
+            fix,
+            "--integrator",
+            "symplectic",
+            "--json",
+        ])
+    };
+    assert_one_line_error(
+        &critical("5000", "z>-1"),
+        &["cube.msh", "every vertex is fixed"],
+    );
+    assert_one_line_error(&critical("1e300", "z<0.001"), &["cube.msh", "SI units"]);
+}
+
+#[test]
+fn replay_errors_name_the_file() {
+    let table = built("cube-replay.tbl", &[]);
+    let sequence = temp("bad-sequence.txt");
+    std::fs::write(&sequence, "194:0,0,-0.001\n194:0,0\n").unwrap();
+    let sequence = sequence.display().to_string();
+    let out = palpate(&["precomputed", "replay", &table, &sequence]);
+    assert_one_line_error(&out, &["bad-sequence.txt: sequence line 2"]);
+    let table64 = built("cube-replay64.tbl", &["--precision", "f64"]);
+    let good = temp("good-sequence.txt");
+    std::fs::write(&good, "194:0,0,-0.001\n").unwrap();
+    let out = palpate(&[
+        "precomputed",
+        "replay",
+        &table64,
+        &good.display().to_string(),
+    ]);
+    assert_one_line_error(&out, &["cube-replay64.tbl: ", "--precision f32"]);
+}
+
+#[test]
+fn a_safety_limit_beyond_f32_names_its_key() {
+    let scene = temp("huge-force.toml");
+    std::fs::write(
+        &scene,
+        "fix = [\"z<0.001\"]\n[generated]\nbox_m = [0.1, 0.1, 0.05]\ncells = [2, 2, 1]\n\
+         [material]\nyoung_pa = 3000.0\npoisson = 0.45\n[safety]\nmax_force_n = 1e300\n",
+    )
+    .unwrap();
+    let out_csv = temp("huge-force-out.csv").display().to_string();
+    let out = palpate(&[
+        "session",
+        "run",
+        &scene.display().to_string(),
+        "--trajectory",
+        "/nonexistent-trajectory.csv",
+        "--out",
+        &out_csv,
+    ]);
+    assert_one_line_error(
+        &out,
+        &["huge-force.toml", "[safety] max_force_n = 1e300", "f32"],
+    );
+}
+
+#[test]
+fn negative_material_values_get_the_physics_message() {
+    let (out, _) = build("cube-negative.tbl", "-3000", &[]);
+    assert_one_line_error(
+        &out,
+        &["Young's modulus must be finite and > 0 Pa, got -3000"],
+    );
+    let table = temp("cube-negative-nu.tbl").display().to_string();
+    let mesh = reference("meshes/cube.msh");
+    let out = palpate(&[
+        "tables",
+        "build",
+        &mesh,
+        "--young",
+        "5000",
+        "--poisson",
+        "-0.1",
+        "--fix",
+        "z<0.001",
+        "--quiet",
+        "-o",
+        &table,
+    ]);
+    assert_one_line_error(
+        &out,
+        &["Poisson ratio must satisfy 0 <= nu < 0.5, got -0.1"],
+    );
+}
+
+#[test]
+fn an_msh_node_id_of_zero_is_named_as_written() {
+    let msh = temp("zero-node.msh");
+    std::fs::write(
+        &msh,
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+         4 0 0 1\n$EndNodes\n$Elements\n1\n7 4 2 1 1 1 2 0 4\n$EndElements\n",
+    )
+    .unwrap();
+    let table = temp("zero-node.tbl").display().to_string();
+    let out = palpate(&[
+        "tables",
+        "build",
+        &msh.display().to_string(),
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--fix",
+        "z<0.001",
+        "-o",
+        &table,
+    ]);
+    assert_one_line_error(
+        &out,
+        &["zero-node.msh", "element id 7", "node id 0 is not defined"],
+    );
+}
