@@ -1,68 +1,15 @@
 //! The `palpate` command-line contract (README.md): exact commands, JSON
 //! shapes, and exit status 2 with a one-line error for bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn palpate(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_palpate"))
-        .args(args)
-        .output()
-        .expect("run palpate")
-}
-
-fn reference(rel: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/reference")
-        .join(rel)
-        .display()
-        .to_string()
-}
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("palpate-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn assert_one_line_error(out: &Output, needle: &str) {
-    assert_eq!(out.status.code(), Some(2), "{out:?}");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains(needle), "stderr lacks '{needle}': {stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-}
-
-fn build_cube_table(name: &str, extra: &[&str]) -> PathBuf {
-    let table = temp(name);
-    let mesh = reference("meshes/cube.msh");
-    let mut args = vec![
-        "tables",
-        "build",
-        &mesh,
-        "--young",
-        "5000",
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "--quiet",
-        "-o",
-    ];
-    let table_str = table.display().to_string();
-    args.push(&table_str);
-    args.extend_from_slice(extra);
-    let out = palpate(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    table
-}
+use common::{assert_one_line_error, build_cube_table, palpate, reference, temp};
+use std::process::Output;
 
 #[test]
 fn build_info_and_solve_match_the_reference() {
-    let table = build_cube_table("cube64.tbl", &["--precision", "f64"]);
+    let table = temp("cube64.tbl");
+    build_cube_table(&table, &["--precision", "f64"]);
     let table_str = table.display().to_string();
     let info = palpate(&["tables", "info", &table_str]);
     assert!(info.status.success());
@@ -97,7 +44,8 @@ fn build_info_and_solve_match_the_reference() {
 
 #[test]
 fn contacts_come_out_in_argument_order() {
-    let table = build_cube_table("cube32.tbl", &[]);
+    let table = temp("cube32.tbl");
+    build_cube_table(&table, &[]);
     let table_str = table.display().to_string();
     let out = palpate(&[
         "precomputed",
@@ -124,10 +72,8 @@ fn contacts_come_out_in_argument_order() {
 
 #[test]
 fn build_tensor_mass_table_needs_density() {
-    let table = build_cube_table(
-        "cube-tensor-mass.tbl",
-        &["--kind", "tensor-mass", "--density", "1000"],
-    );
+    let table = temp("cube-tensor-mass.tbl");
+    build_cube_table(&table, &["--kind", "tensor-mass", "--density", "1000"]);
     let file = palpate::table::load::TableFile::read(&table).unwrap();
     let loaded = palpate_kernel::table::TensorMassTable::<f32>::load(file.bytes()).unwrap();
     assert_eq!(loaded.vertex_count(), 216);
@@ -149,9 +95,9 @@ fn build_tensor_mass_table_needs_density() {
         "/dev/null",
     ];
     let out = palpate(&[&base[..], &["--kind", "tensor-mass"]].concat());
-    assert_one_line_error(&out, "--kind tensor-mass needs --density");
+    assert_one_line_error(&out, &["--kind tensor-mass needs --density"]);
     let out = palpate(&[&base[..], &["--density", "1000"]].concat());
-    assert_one_line_error(&out, "--density applies to --kind tensor-mass only");
+    assert_one_line_error(&out, &["--density applies to --kind tensor-mass only"]);
 }
 
 #[test]
@@ -170,7 +116,7 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
         "-o",
         "/dev/null",
     ]);
-    assert_one_line_error(&out, "bad --fix predicate");
+    assert_one_line_error(&out, &["bad --fix predicate"]);
     let out = palpate(&[
         "tables",
         "build",
@@ -184,7 +130,7 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
         "-o",
         "/dev/null",
     ]);
-    assert_one_line_error(&out, "oisson");
+    assert_one_line_error(&out, &["oisson"]);
     let out = palpate(&[
         "tables",
         "build",
@@ -198,7 +144,7 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
         "-o",
         "/dev/null",
     ]);
-    assert_one_line_error(&out, "no vertex matches");
+    assert_one_line_error(&out, &["no vertex matches"]);
     let out = palpate(&[
         "tables",
         "build",
@@ -212,7 +158,7 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
         "-o",
         "/dev/null",
     ]);
-    assert_one_line_error(&out, "nonexistent.msh");
+    assert_one_line_error(&out, &["nonexistent.msh"]);
     let garbage = temp("garbage.tbl");
     std::fs::write(
         &garbage,
@@ -220,8 +166,9 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
     )
     .unwrap();
     let out = palpate(&["tables", "info", &garbage.display().to_string()]);
-    assert_one_line_error(&out, "failed validation");
-    let table = build_cube_table("cube-err.tbl", &[]);
+    assert_one_line_error(&out, &["failed validation"]);
+    let table = temp("cube-err.tbl");
+    build_cube_table(&table, &[]);
     let table_str = table.display().to_string();
     for (contact, error) in [
         ("0:0,0,-0.01", "vertex 0 is fixed"),
@@ -236,7 +183,7 @@ fn bad_arguments_and_files_exit_2_with_one_line() {
             contact,
             "--json",
         ]);
-        assert_one_line_error(&out, error);
+        assert_one_line_error(&out, &[error]);
     }
     let out = palpate(&["precomputed", "nonsense"]);
     assert_eq!(out.status.code(), Some(2));
@@ -324,7 +271,7 @@ fn dynamic_run_prints_the_contract_json() {
         "--cut-tets",
         "9999",
     ]);
-    assert_one_line_error(&out, "tet 9999 does not exist");
+    assert_one_line_error(&out, &["tet 9999 does not exist"]);
     let out = dynamic_run(&[
         "--damping",
         "0",
@@ -379,9 +326,9 @@ fn dynamic_run_takes_the_elastic_law() {
     assert!((tips[1] - tips[2]).abs() <= 1e-12 * tips[1].abs());
 
     let out = dynamic_run(&[&common[..], &["--model", "stvk-incompressible"]].concat());
-    assert_one_line_error(&out, "needs --incompressibility");
+    assert_one_line_error(&out, &["needs --incompressibility"]);
     let out = dynamic_run(&[&common[..], &["--incompressibility", "5"]].concat());
-    assert_one_line_error(&out, "applies to --model stvk-incompressible only");
+    assert_one_line_error(&out, &["applies to --model stvk-incompressible only"]);
 }
 
 /// `stvk forces --json` on the JSON reference's first cube configuration:
@@ -451,7 +398,7 @@ fn stvk_forces_prints_forces_and_energy() {
         bad.to_str().unwrap(),
         "--json",
     ]);
-    assert_one_line_error(&out, "line 2");
+    assert_one_line_error(&out, &["line 2"]);
 }
 
 /// `palpate budget <built-in|built-in-dynamic> --json --trajectory NAME`:
@@ -514,7 +461,7 @@ fn budget_refuses_an_unknown_trajectory() {
         "--work-dir",
         dir.to_str().unwrap(),
     ]);
-    assert_one_line_error(&out, "--trajectory wobble");
+    assert_one_line_error(&out, &["--trajectory wobble"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("strike"));
 }
 

@@ -2,84 +2,14 @@
 //! binary (the in-process ones are `tests/host/robustness/bounds.rs`). Each
 //! once grew without bound or aborted; each now exits 2 with one line, fast.
 
+mod common;
+
+use common::{
+    assert_one_line_error, build_cube_table, palpate, palpate_with_stdin, reference, stderr, temp,
+};
 use core::time::Duration;
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::Command;
 use std::time::Instant;
-
-fn palpate(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_palpate"))
-        .args(args)
-        .output()
-        .expect("run palpate")
-}
-
-/// Runs `palpate args` with `input` on its standard input (a pipe).
-fn palpate_with_stdin(args: &[&str], input: &[u8]) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_palpate"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run palpate");
-    let mut stdin = child.stdin.take().expect("stdin");
-    // The reader may stop early (and close the pipe): a write error is fine.
-    let _ = stdin.write_all(input);
-    drop(stdin);
-    child.wait_with_output().expect("wait")
-}
-
-fn reference(rel: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/reference")
-        .join(rel)
-        .display()
-        .to_string()
-}
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("palpate-bounds-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp folder");
-    dir.join(name)
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// Exit 2, one line `error: …` containing `needle`, no panic.
-fn assert_one_line_error(out: &Output, needle: &str) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains(needle), "stderr lacks '{needle}': {err}");
-    assert!(
-        err.starts_with("error: ") && err.lines().count() == 1,
-        "{err}"
-    );
-    assert!(!err.contains("panicked"), "{err}");
-}
-
-fn build_cube_table(name: &str) -> PathBuf {
-    let table = temp(name);
-    let out = palpate(&[
-        "tables",
-        "build",
-        &reference("meshes/cube.msh"),
-        "--young",
-        "5000",
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "--quiet",
-        "-o",
-        &table.display().to_string(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    table
-}
 
 /// `precomputed solve /dev/zero` grew to 18.5 GB; `tables info /dev/zero`
 /// likewise. The header is read first: refused at once.
@@ -94,9 +24,9 @@ fn dev_zero_is_not_a_table() {
         "194:0,0,-0.01",
         "--json",
     ]);
-    assert_one_line_error(&out, "/dev/zero: not a Palpate table");
+    assert_one_line_error(&out, &["/dev/zero: not a Palpate table"]);
     let out = palpate(&["tables", "info", "/dev/zero"]);
-    assert_one_line_error(&out, "/dev/zero: not a Palpate table");
+    assert_one_line_error(&out, &["/dev/zero: not a Palpate table"]);
     assert!(started.elapsed() < Duration::from_secs(5));
 }
 
@@ -105,7 +35,9 @@ fn dev_zero_is_not_a_table() {
 /// bytes beyond that length is refused.
 #[test]
 fn piped_table_is_read_to_its_declared_length() {
-    let table = std::fs::read(build_cube_table("piped.tbl")).expect("table");
+    let table = temp("piped.tbl");
+    build_cube_table(&table, &[]);
+    let table = std::fs::read(table).expect("table");
     let args = [
         "precomputed",
         "solve",
@@ -119,9 +51,9 @@ fn piped_table_is_read_to_its_declared_length() {
     let mut longer = table.clone();
     longer.extend_from_slice(&[0; 64]);
     let out = palpate_with_stdin(&args, &longer);
-    assert_one_line_error(&out, "longer than the");
+    assert_one_line_error(&out, &["longer than the"]);
     let out = palpate_with_stdin(&args, &table[..table.len() / 2]);
-    assert_one_line_error(&out, "truncated");
+    assert_one_line_error(&out, &["truncated"]);
 }
 
 /// A trajectory with a row at `t = 1e9` ran 10¹² ticks (670 MB of output in
@@ -160,7 +92,7 @@ fn session_run_refuses_unbounded_trajectories_and_rates() {
             "--out",
             &out_csv,
         ]);
-        assert_one_line_error(&out, needle);
+        assert_one_line_error(&out, &[needle]);
         assert!(started.elapsed() < Duration::from_secs(5));
     }
     let scene = temp("fast.toml");
@@ -183,7 +115,7 @@ fn session_run_refuses_unbounded_trajectories_and_rates() {
     ]);
     assert_one_line_error(
         &out,
-        "[rates] haptic_hz = 10000000: above 10000 Hz (MAX_HAPTIC_HZ)",
+        &["[rates] haptic_hz = 10000000: above 10000 Hz (MAX_HAPTIC_HZ)"],
     );
 }
 
@@ -220,7 +152,7 @@ fn tables_build_prints_the_estimate_and_honours_max_table_bytes() {
     std::fs::remove_file(&table).expect("remove");
     args.extend(["--max-table-bytes", "100000"]);
     let out = palpate(&args);
-    assert_one_line_error(&out, "the table is above --max-table-bytes 100000 bytes");
+    assert_one_line_error(&out, &["the table is above --max-table-bytes 100000 bytes"]);
     assert!(!table.exists(), "no table written");
     // At the real size plus the estimate's slack it builds.
     let limit = (built + 32 * 152 + 16).to_string();
@@ -262,7 +194,9 @@ fn generated_scene_too_large_for_a_table_is_refused_without_allocating() {
     let elapsed = started.elapsed();
     assert_one_line_error(
         &out,
-        "the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+        &[
+            "the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+        ],
     );
     assert!(stderr(&out).contains("tensor-mass"), "{}", stderr(&out));
     assert!(elapsed < Duration::from_secs(5), "{elapsed:?}");
@@ -275,7 +209,7 @@ fn generated_scene_too_large_for_a_table_is_refused_without_allocating() {
         "--work-dir",
         &temp("budget40").display().to_string(),
     ]);
-    assert_one_line_error(&out, "would be 18.0 GB");
+    assert_one_line_error(&out, &["would be 18.0 GB"]);
     assert!(started.elapsed() < Duration::from_secs(5));
 }
 
@@ -311,7 +245,9 @@ fn tables_build_of_a_40_cubed_box_is_refused_without_allocating() {
         .expect("run sh");
     assert_one_line_error(
         &out,
-        "box40.node: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+        &[
+            "box40.node: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+        ],
     );
     assert!(started.elapsed() < Duration::from_secs(10));
     assert!(!table.exists());
@@ -338,7 +274,7 @@ fn oversized_mesh_file_is_refused_before_reading() {
         "-o",
         &temp("big.tbl").display().to_string(),
     ]);
-    assert_one_line_error(&out, "the limit for a mesh file (MAX_MESH_FILE_BYTES)");
+    assert_one_line_error(&out, &["the limit for a mesh file (MAX_MESH_FILE_BYTES)"]);
     std::fs::remove_file(&mesh).expect("remove");
 }
 
@@ -368,7 +304,7 @@ fn oversized_trajectory_scene_and_sequence_files_are_refused() {
     ]);
     assert_one_line_error(
         &out,
-        "the limit for a trajectory file (MAX_TRAJECTORY_FILE_BYTES)",
+        &["the limit for a trajectory file (MAX_TRAJECTORY_FILE_BYTES)"],
     );
     let out = palpate(&[
         "session",
@@ -379,12 +315,14 @@ fn oversized_trajectory_scene_and_sequence_files_are_refused() {
         "--out",
         &out_csv,
     ]);
-    assert_one_line_error(&out, "the limit for a scene file (MAX_SCENE_FILE_BYTES)");
-    let table = build_cube_table("seq.tbl").display().to_string();
+    assert_one_line_error(&out, &["the limit for a scene file (MAX_SCENE_FILE_BYTES)"]);
+    let table = temp("seq.tbl");
+    build_cube_table(&table, &[]);
+    let table = table.display().to_string();
     let out = palpate(&["precomputed", "replay", &table, &sequence]);
     assert_one_line_error(
         &out,
-        "the limit for a sequence file (MAX_SEQUENCE_FILE_BYTES)",
+        &["the limit for a sequence file (MAX_SEQUENCE_FILE_BYTES)"],
     );
     for path in [trajectory, scene, sequence] {
         std::fs::remove_file(path).expect("remove");

@@ -5,49 +5,20 @@
 //! (exit 2), never a panic. The in-process probes are in
 //! `tests/host/robustness/output.rs`.
 
+mod common;
+
+use common::{
+    assert_one_line_error, build_cube_table, fresh_dir, palpate, palpate_command, reference,
+};
 use core::time::Duration;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Stdio};
 use std::time::Instant;
 
-fn palpate_command(args: &[&str]) -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_palpate"));
-    command.args(args);
-    command
-}
-
-fn palpate(args: &[&str]) -> Output {
-    palpate_command(args).output().expect("run palpate")
-}
-
-fn reference(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/reference")
-        .join(rel)
-}
-
-/// An empty folder of its own for test `name`.
-fn fresh_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "palpate-robustness-output-cli-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("test folder");
-    dir
-}
-
-fn s(path: &Path) -> &str {
-    path.to_str().expect("utf-8 path")
-}
-
-fn assert_one_line_error(out: &Output, needle: &str) {
-    assert_eq!(out.status.code(), Some(2), "{out:?}");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains(needle), "stderr lacks '{needle}': {stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+/// `path` as a `&str` argument (a `String` or a `Path`).
+fn s<P: AsRef<Path> + ?Sized>(path: &P) -> &str {
+    path.as_ref().to_str().expect("utf-8 path")
 }
 
 /// The temporary files palpate leaves in `dir` (only a killed run may).
@@ -60,32 +31,6 @@ fn temporaries(dir: &Path) -> Vec<PathBuf> {
                 .is_some_and(|n| n.to_string_lossy().contains(".palpate-tmp."))
         })
         .collect()
-}
-
-/// Builds the f32 table of the reference cube into `table`.
-fn build_cube_table(table: &Path, extra: &[&str]) {
-    let mesh = reference("meshes/cube.msh");
-    let mut args = vec![
-        "tables",
-        "build",
-        s(&mesh),
-        "--young",
-        "5000",
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "--quiet",
-        "-o",
-        s(table),
-    ];
-    args.extend_from_slice(extra);
-    let out = palpate(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 /// Kills `child` (if still running) and reaps it.
@@ -181,7 +126,7 @@ fn a_failed_run_keeps_the_previous_output() {
         "--out",
         s(&csv),
     ]);
-    assert_one_line_error(&out, "missing.msh");
+    assert_one_line_error(&out, &["missing.msh"]);
     assert_eq!(std::fs::read(&csv).expect("csv"), old);
 
     let table = dir.join("cube.tbl");
@@ -202,7 +147,7 @@ fn a_failed_run_keeps_the_previous_output() {
         "-o",
         s(&table),
     ]);
-    assert_one_line_error(&out, "no vertex matches");
+    assert_one_line_error(&out, &["no vertex matches"]);
     assert_eq!(std::fs::read(&table).expect("table"), good);
     assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
     std::fs::remove_dir_all(&dir).ok();
@@ -242,11 +187,11 @@ fn an_output_that_is_an_input_is_refused() {
         ]);
         assert_one_line_error(
             &out,
-            &format!(
+            &[&format!(
                 "-o {} is the same file as the mesh {}",
                 s(output),
                 s(output)
-            ),
+            )],
         );
     }
     let after: Vec<Vec<u8>> = [&mesh, &node, &ele]
@@ -277,7 +222,7 @@ fn an_output_that_is_an_input_is_refused() {
             "--out",
             s(output),
         ]);
-        assert_one_line_error(&out, needle);
+        assert_one_line_error(&out, &[needle]);
     }
     assert_eq!(std::fs::read(&trajectory).expect("trajectory"), poke);
     assert_eq!(std::fs::read_to_string(&scene).expect("scene"), scene_text);
@@ -314,7 +259,7 @@ fn a_vtk_path_that_is_a_file_or_a_foreign_folder_is_refused() {
             "--vtk",
             s(vtk),
         ]);
-        assert_one_line_error(&out, needle);
+        assert_one_line_error(&out, &[needle]);
         assert!(!String::from_utf8_lossy(&out.stderr).contains("os error 17"));
     }
     assert_eq!(std::fs::read_to_string(&file).expect("file"), "keep\n");
@@ -324,7 +269,7 @@ fn a_vtk_path_that_is_a_file_or_a_foreign_folder_is_refused() {
     );
     assert!(!dir.join("forces.csv").exists());
     let out = palpate(&["demo", "--out", s(&file)]);
-    assert_one_line_error(&out, "is not a folder");
+    assert_one_line_error(&out, &["is not a folder"]);
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -466,7 +411,7 @@ fn a_full_standard_output_or_file_is_a_one_line_error() {
             .stdout(device)
             .output()
             .expect("run palpate");
-        assert_one_line_error(&out, "error: standard output: ");
+        assert_one_line_error(&out, &["error: standard output: "]);
     }
     assert!(!demo_out.exists());
 
@@ -482,8 +427,8 @@ fn a_full_standard_output_or_file_is_a_one_line_error() {
         "--out",
         "/dev/full",
     ]);
-    assert_one_line_error(&out, "/dev/full: cannot write: ");
+    assert_one_line_error(&out, &["/dev/full: cannot write: "]);
     let out = palpate(&["session", "generate", "slide", "-o", "/dev/full"]);
-    assert_one_line_error(&out, "/dev/full: cannot write: ");
+    assert_one_line_error(&out, &["/dev/full: cannot write: "]);
     std::fs::remove_dir_all(&dir).ok();
 }

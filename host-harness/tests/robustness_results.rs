@@ -4,78 +4,35 @@
 //! `error: …` naming the file, line, key or element (or gives the correct
 //! result). The in-process side is `tests/host/robustness/results.rs`.
 
+mod common;
+
+use common::{build_cube, build_cube_table, palpate, reference, temp, text};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn palpate(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_palpate"))
-        .args(args)
-        .output()
-        .expect("run palpate")
-}
-
-fn reference(rel: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/reference")
-        .join(rel)
-        .display()
-        .to_string()
-}
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("palpate-results-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// Exit status 2, stderr ending with one line `error: …` (the only one)
-/// containing every needle, nothing on stdout, no panic. (`tables build`
-/// prints its size estimate on stderr before it starts.)
+/// [`common::assert_one_line_error`] (exit 2, stderr ending with its only
+/// `error: …` line, containing every needle, no panic; `tables build`
+/// prints its size estimate on stderr before it starts), and besides:
+/// `error:` nowhere else on stderr, nothing on stdout.
 fn assert_one_line_error(out: &Output, needles: &[&str]) {
+    common::assert_one_line_error(out, needles);
     let stderr = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{stderr}");
-    let last = stderr.trim_end().lines().last().unwrap_or_default();
-    assert!(last.starts_with("error: "), "{stderr}");
     assert_eq!(stderr.matches("error:").count(), 1, "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    for needle in needles {
-        assert!(
-            last.contains(needle),
-            "the error lacks '{needle}': {stderr}"
-        );
-    }
     assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
 }
 
-/// `tables build` of the reference cube (base fixed) with `extra` arguments.
+/// `tables build` of the reference cube (base fixed) with Young's modulus
+/// `young` and `extra` arguments into `temp(name)`: the run and that path.
 fn build(name: &str, young: &str, extra: &[&str]) -> (Output, PathBuf) {
     let table = temp(name);
-    let (mesh, table_str) = (reference("meshes/cube.msh"), table.display().to_string());
-    let mut args = vec![
-        "tables",
-        "build",
-        &mesh,
-        "--young",
-        young,
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "--quiet",
-        "-o",
-        &table_str,
-    ];
-    args.extend_from_slice(extra);
-    (palpate(&args), table)
+    (build_cube(&table, young, extra), table)
 }
 
+/// The reference cube's table built (E = 5000 Pa) with `extra` arguments:
+/// its path.
 fn built(name: &str, extra: &[&str]) -> String {
-    let (out, table) = build(name, "5000", extra);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let table = temp(name);
+    build_cube_table(&table, extra);
     table.display().to_string()
 }
 

@@ -20,9 +20,12 @@
 //! ([`precomputed::PrecomputedModel::displacements`]); tool positions at the
 //! haptic rate → [`haptic::HapticLoop::tick`] → a clamped device force.
 //!
-//! The physics is `MODELS.md` sections 1, 2 and 6; the source is Cotin,
+//! The physics is `docs/MODELS.md` in the repository (cited as `MODELS.md §n`
+//! throughout the kernel); the sources, in `docs/papers/`, are Cotin,
 //! Delingette and Ayache, *Efficient linear elastic models of soft tissues for
-//! real-time surgery simulation*, INRIA RR-3510 (1998), §4.
+//! real-time surgery simulation*, INRIA RR-3510 (1998), the same authors'
+//! TVCG 1999 paper on pre-computed real-time deformation and contact, and
+//! Picinbono, Delingette and Ayache (2001) on St Venant-Kirchhoff.
 //!
 //! Guarantees of the step path (everything after `load`): no allocation, no
 //! panic path (proven at link time by `tools/nopanic-check`), and every loop
