@@ -30,11 +30,15 @@ const STEP_S: f64 = 0.01;
 /// A VTK frame every this many steps.
 const FRAME_EVERY: usize = 4;
 
-/// Runs the demo, printing forces per phase and timings to `out`, and
-/// writing the VTK series into the folder `out_dir`, whole or not at all
-/// ([`SeriesDir`]: a fresh folder, or one a previous run wrote, replaced
-/// when the series is complete; anything else is refused before the run).
-pub fn run(out_dir: &Path, out: &mut dyn Write) -> anyhow::Result<()> {
+/// Runs the demo, writing the VTK series into the folder `out_dir`, whole
+/// or not at all ([`SeriesDir`]: a fresh folder, or one a previous run
+/// wrote, replaced when the series is complete; anything else is refused
+/// before the run), then printing forces per phase and timings to `out`.
+/// The report is printed once the series is in place, so a reader that
+/// closes `out` early (`palpate demo | head`) cannot stop the series.
+pub fn run(out_dir: &Path, printed: &mut dyn Write) -> anyhow::Result<()> {
+    let mut report_text = Vec::new();
+    let out: &mut dyn Write = &mut report_text;
     let series = SeriesDir::create(out_dir)?;
     let scene = Scene::built_in();
     let MeshSource::GeneratedBox { size_m, .. } = scene.mesh else {
@@ -170,6 +174,7 @@ pub fn run(out_dir: &Path, out: &mut dyn Write) -> anyhow::Result<()> {
         frames.len(),
         collection.display()
     )?;
+    printed.write_all(&report_text)?;
     Ok(())
 }
 

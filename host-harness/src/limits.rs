@@ -46,6 +46,22 @@ pub const MAX_TRAJECTORY_TIME_S: f64 = 4_294_967_296.0;
 /// scene changed in code).
 pub const MAX_SESSION_TICKS: usize = (MAX_TRAJECTORY_SPAN_S * MAX_HAPTIC_HZ) as usize + 1;
 
+/// Largest VTK series `session run --vtk` writes, bytes: 8 GiB (estimated before the run from
+/// the frame count and an upper bound on one ASCII frame's size).
+///
+/// A series is for looking at in ParaView: a frame per physics update of the built-in block is
+/// about 0.2 MB, so one second at 1 kHz physics is about 200 MB and an hour-long session would
+/// write most of a terabyte. Above the bound, update the physics less often
+/// (`[rates] physics_every`), shorten the trajectory or leave out `--vtk`.
+pub const MAX_VTK_SERIES_BYTES: u64 = 8 << 30;
+
+/// Upper bound on one legacy ASCII VTK frame of the harness's writer, bytes: a header, two
+/// lines of three `f64` per vertex (position and displacement, at most 25 characters a number
+/// with its separator) and a cell line plus a cell type per tet (at most 46 and 3 characters).
+pub fn vtk_frame_bytes(vertices: usize, tets: usize) -> u64 {
+    200 + 150 * vertices as u64 + 49 * tets as u64
+}
+
 /// Largest mesh file (each of a TetGen pair), bytes: 2 GiB.
 ///
 /// An ASCII mesh takes about 290 bytes per vertex with its ~6 tets, so 2 GiB is about 7 million

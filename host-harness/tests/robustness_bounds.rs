@@ -328,3 +328,40 @@ fn oversized_trajectory_scene_and_sequence_files_are_refused() {
         std::fs::remove_file(path).expect("remove");
     }
 }
+
+/// `session run --vtk` on a trajectory whose series would exceed
+/// `MAX_VTK_SERIES_BYTES` (a minute of the built-in block with a frame
+/// every 1 ms tick: about 60 000 frames of up to 0.43 MB, 26 GB) is refused
+/// before the table build, naming `--vtk` and the remedy; nothing is written.
+#[test]
+fn a_vtk_series_too_large_is_refused_before_the_run() {
+    let dir = temp("vtk-too-large");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let trajectory = dir.join("minute.csv");
+    std::fs::write(
+        &trajectory,
+        "t,tool,x,y,z\n0,0,0.06,0.06,0.1\n60,0,0.06,0.06,0.1\n",
+    )
+    .expect("trajectory");
+    let (out_csv, series) = (dir.join("forces.csv"), dir.join("series"));
+    let start = Instant::now();
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        trajectory.to_str().expect("utf-8"),
+        "--out",
+        out_csv.to_str().expect("utf-8"),
+        "--vtk",
+        series.to_str().expect("utf-8"),
+    ]);
+    assert_one_line_error(&out, &["--vtk", "physics_every", "GiB limit"]);
+    assert!(
+        start.elapsed() < Duration::from_secs(20),
+        "{:?}",
+        start.elapsed()
+    );
+    assert!(!out_csv.exists() && !series.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -8,7 +8,7 @@
 mod common;
 
 use common::{
-    assert_one_line_error, build_cube_table, fresh_dir, palpate, palpate_command, reference,
+    assert_one_line_error, build_cube_table, fresh_dir, palpate, palpate_command, reference, stderr,
 };
 use core::time::Duration;
 use std::io::{BufRead, BufReader};
@@ -364,8 +364,9 @@ fn a_closed_standard_output_is_a_normal_end() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    // The demo stopped at its first line: no series, nothing left beside.
-    assert!(!demo_out.exists());
+    // The demo puts its series in place before it prints: a closed output
+    // does not cost the files, and nothing is left beside them.
+    assert!(demo_out.join("demo.pvd").is_file());
     assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
 
     let mut child = palpate_command(&["precomputed", "replay", s(&table), s(&sequence)])
@@ -413,7 +414,8 @@ fn a_full_standard_output_or_file_is_a_one_line_error() {
             .expect("run palpate");
         assert_one_line_error(&out, &["error: standard output: "]);
     }
-    assert!(!demo_out.exists());
+    // The demo's series was complete before its report failed to print.
+    assert!(demo_out.join("demo.pvd").is_file());
 
     let trajectory = dir.join("poke.csv");
     let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
@@ -430,5 +432,42 @@ fn a_full_standard_output_or_file_is_a_one_line_error() {
     assert_one_line_error(&out, &["/dev/full: cannot write: "]);
     let out = palpate(&["session", "generate", "slide", "-o", "/dev/full"]);
     assert_one_line_error(&out, &["/dev/full: cannot write: "]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A session whose CSV cannot be written leaves the previous VTK series in
+/// place: the CSV is complete and synced before the series is swapped in,
+/// so a full disk (`--out /dev/full`) fails before the swap.
+#[test]
+fn a_csv_that_cannot_be_written_keeps_the_previous_series() {
+    let dir = fresh_dir("csv-before-series");
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let series = dir.join("series");
+    let forces = dir.join("forces.csv");
+    let run = |out_path: &str| {
+        palpate(&[
+            "session",
+            "run",
+            "built-in",
+            "--trajectory",
+            s(&trajectory),
+            "--out",
+            out_path,
+            "--vtk",
+            s(&series),
+        ])
+    };
+    let first = run(s(&forces));
+    assert!(first.status.success(), "{}", stderr(&first));
+    let pvd = std::fs::read(series.join("session.pvd")).expect("first series");
+    let failed = run("/dev/full");
+    assert_one_line_error(&failed, &["/dev/full"]);
+    assert_eq!(
+        std::fs::read(series.join("session.pvd")).expect("series kept"),
+        pvd
+    );
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -79,6 +79,27 @@ fn info_reports_a_tensor_mass_table() {
     }
 }
 
+/// `tables info` on headers crafted so that the section sizes overflow (a
+/// scalar size of 2²⁹ bytes, 2³²−1 touchable vertices): the report says
+/// the table failed validation, exit 2, never a panic on the arithmetic.
+#[test]
+fn info_on_a_crafted_header_reports_instead_of_panicking() {
+    let table = built("cube-crafted.tbl", &[]);
+    let good = std::fs::read(&table).expect("table");
+    // RawHeader offsets: scalar size at 16, touchable count at 40 (u32).
+    for (offset, value) in [(16usize, 0x2000_0000u32), (40, u32::MAX)] {
+        let mut bytes = good.clone();
+        bytes[offset..offset + 4].copy_from_slice(&value.to_le_bytes());
+        let crafted = temp(&format!("crafted-{offset}.tbl"));
+        std::fs::write(&crafted, &bytes).expect("write");
+        let out = palpate(&["tables", "info", crafted.to_str().expect("utf-8")]);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "offset {offset}: {err}");
+        assert!(!err.contains("panicked"), "offset {offset}: {err}");
+        assert!(err.contains("failed validation"), "offset {offset}: {err}");
+    }
+}
+
 #[test]
 fn solve_refuses_contacts_off_the_surface_triangles() {
     let table = built("cube-bary.tbl", &[]);

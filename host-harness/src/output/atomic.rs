@@ -196,6 +196,19 @@ impl AtomicFile {
         self.temp.as_deref()
     }
 
+    /// Flushes and syncs what was written, so that only the rename of
+    /// [`Self::commit`] is left to fail: call it before committing another
+    /// output that must not be replaced if this one fails (a session's VTK
+    /// series before its CSV).
+    pub fn prepare(&mut self) -> io::Result<()> {
+        let writer = self
+            .writer
+            .as_mut()
+            .ok_or_else(|| io::Error::other("internal: output already committed"))?;
+        let synced = writer.flush().and_then(|()| writer.get_ref().sync_all());
+        synced.map_err(|e| named(&self.shown, "cannot write", &e))
+    }
+
     /// Flushes and syncs the temporary file and renames it over the output,
     /// then syncs the folder. On error the temporary file is removed and the
     /// old output is untouched.

@@ -29,7 +29,9 @@ use palpate_kernel::tensor_mass::{
 use super::tool_points::{ForToolPoints, with_tool_points};
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
 use crate::fix::fixed_vertices;
-use crate::limits::{MAX_HAPTIC_HZ, MAX_SESSION_TICKS, MAX_TRAJECTORY_SPAN_S};
+use crate::limits::{
+    MAX_HAPTIC_HZ, MAX_SESSION_TICKS, MAX_TRAJECTORY_SPAN_S, MAX_VTK_SERIES_BYTES, vtk_frame_bytes,
+};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::output::atomic::{self, AtomicFile, SeriesDir};
 use crate::output::vtk;
@@ -187,11 +189,39 @@ pub fn run_session_to_files(
         &mut csv,
         series.as_ref().map(SeriesDir::dir),
     )?;
+    // The CSV is complete and synced before the series replaces the old
+    // one: after the swap only the CSV's rename is left to fail.
+    csv.prepare()?;
     if let Some(series) = series {
         series.commit()?;
     }
     csv.commit()?;
     Ok(summary)
+}
+
+/// Refuses a VTK series above [`MAX_VTK_SERIES_BYTES`], before the table build: a frame per
+/// physics update (every `physics_every` of `ticks`) of at most [`vtk_frame_bytes`].
+fn check_series_size(
+    scene: &Scene,
+    ticks: usize,
+    mesh: &TetMesh,
+    dir: &Path,
+) -> anyhow::Result<()> {
+    let every = scene.rates.physics_every.max(1) as usize;
+    let frames = ticks.div_ceil(every) as u64 + 1;
+    let bytes = frames.saturating_mul(vtk_frame_bytes(mesh.positions.len(), mesh.tets.len()));
+    if bytes > MAX_VTK_SERIES_BYTES {
+        bail!(
+            "--vtk {}: {frames} frames of up to {:.1} MB would write up to {:.1} GB, above the \
+             {} GiB limit of a VTK series; raise [rates] physics_every, shorten the trajectory \
+             or leave out --vtk",
+            dir.display(),
+            vtk_frame_bytes(mesh.positions.len(), mesh.tets.len()) as f64 / 1e6,
+            bytes as f64 / 1e9,
+            MAX_VTK_SERIES_BYTES >> 30
+        );
+    }
+    Ok(())
 }
 
 /// Runs `trajectory` through the haptic loop of `scene`, writing the CSV to
@@ -205,8 +235,12 @@ pub fn run_session(
     vtk_dir: Option<&Path>,
 ) -> anyhow::Result<SessionSummary> {
     // Bounded before any work: the table build can take minutes.
-    tick_count(trajectory, scene.tick_s()).with_context(|| scene.source.clone())?;
+    let tick_total =
+        tick_count(trajectory, scene.tick_s()).with_context(|| scene.source.clone())?;
     let (mesh, report) = scene.load_mesh()?;
+    if let Some(dir) = vtk_dir {
+        check_series_size(scene, tick_total, &mesh, dir)?;
+    }
     let mut session = Session {
         out,
         summary: SessionSummary::default(),

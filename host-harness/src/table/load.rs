@@ -245,16 +245,27 @@ impl TableFile {
             let _ = writeln!(out, "density: {} kg/m3", h.density_kg_m3);
         }
         let _ = writeln!(out, "mesh hash: {:016x}", h.mesh_hash);
-        let sections = kind.map_or(&[][..], TableKind::sections);
+        // Section sizes follow from a header not yet validated: only for a
+        // scalar size the format has, and with checked arithmetic.
+        let sections = match (kind, h.scalar_bytes) {
+            (Some(kind), 4 | 8) => kind.sections(),
+            _ => &[][..],
+        };
         for &kind in sections {
             if let Some(count) = kind.expected_count(&h) {
-                let size = count * u64::from(kind.elem_bytes(h.scalar_bytes));
-                let _ = writeln!(
-                    out,
-                    "section {}: {count} x {} bytes = {size} bytes",
-                    kind.name(),
-                    kind.elem_bytes(h.scalar_bytes)
-                );
+                let elem = kind.elem_bytes(h.scalar_bytes);
+                let _ = match count.checked_mul(u64::from(elem)) {
+                    Some(size) => writeln!(
+                        out,
+                        "section {}: {count} x {elem} bytes = {size} bytes",
+                        kind.name()
+                    ),
+                    None => writeln!(
+                        out,
+                        "section {}: {count} x {elem} bytes: overflows 64 bits",
+                        kind.name()
+                    ),
+                };
             }
         }
         let checksum_ok = bytes.len() >= HEADER_LEN + CRC_LEN && {
