@@ -10,7 +10,7 @@
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Vector3;
 use palpate_fuzz::table_layouts;
-use palpate_kernel::table::VertexSlot;
+use palpate_kernel::table::{VertexSlot, within};
 use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable, Real};
 
 fuzz_target!(|data: &[u8]| table_layouts(data, load_both));
@@ -95,7 +95,7 @@ fn check<T: Real>(table: &PrecomputedTable<'_, T>) {
     for p in &probes {
         let cell = index.cell_of(p);
         assert!(cell.iter().zip(index.dims()).all(|(&c, d)| c < d));
-        let _ = index.is_near(p, T::of_f64(1e-3));
+        let _ = within(p, &index.reach(T::of_f64(1e-3)));
         let mut near = 0usize;
         for v in index.vertices_near(p) {
             assert!(v.get() < n);

@@ -5,10 +5,8 @@ use std::fs::File;
 use std::path::Path;
 
 use anyhow::{Context, bail};
-use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::table::format::{
-    CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, TableKind,
-};
+use palpate_kernel::table::format::{CRC_LEN, CRC32, HEADER_LEN, RawHeader, TableKind};
+use palpate_kernel::table::{LoadError, TensorMassTable};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
 use crate::limits::{MAX_TABLE_FILE_BYTES, read_bounded};
@@ -68,15 +66,12 @@ impl TableFile {
             );
         }
         let h: RawHeader = bytemuck::pod_read_unaligned(&head);
-        if h.magic != MAGIC {
-            bail!("{name}: not a Palpate table (its first 8 bytes are not the magic PALPTBL)");
-        }
-        if h.format_version != FORMAT_VERSION {
-            bail!(
-                "{name}: table format version {}, this build reads version {FORMAT_VERSION} (rebuild the table with tables build)",
-                h.format_version
-            );
-        }
+        h.check_identity().map_err(|e| match e {
+            LoadError::UnsupportedVersion { .. } => {
+                anyhow::anyhow!("{name}: {e}: rebuild the table with tables build")
+            }
+            _ => anyhow::anyhow!("{name}: {e}"),
+        })?;
         let declared = h.file_len;
         if declared > MAX_TABLE_FILE_BYTES {
             bail!(

@@ -13,7 +13,9 @@ use nalgebra::Vector3;
 
 use super::Contact;
 use crate::Real;
-use crate::table::{PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex};
+use crate::table::{
+    PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex, within,
+};
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
 /// walk; a contact that would slide further stops at the last triangle).
@@ -231,12 +233,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let slack_m = tolerance * self.index.cell_m();
         let mut best: Option<(T, TriangleIndex, [T; 3])> = None;
         let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
-        let near_grid = |p: &Vector3<T>| self.index.is_near(p, radius_m);
-        let (to_in, from_in) = (near_grid(to_m), near_grid(from_m));
+        let reach = self.index.reach(radius_m);
+        let (to_in, from_in) = (within(to_m, &reach), within(from_m, &reach));
         let (near_to, near_from) = (to_in, !same_cell && from_in);
         // The swept segment, clipped to the reach of the grid when exactly
         // one end lies outside it (both outside: no candidate is tested).
-        let reach = self.reach(radius_m);
         let (start_m, end_m) = match (from_in, to_in) {
             (false, true) => (clip_towards(to_m, from_m, &reach), *to_m),
             (true, false) => (*from_m, clip_towards(from_m, to_m, &reach)),
@@ -278,20 +279,6 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let (_, triangle, weights) = best?;
         let face = self.face(triangle)?;
         Some(self.contact(tool, triangle, &face, weights, to_m, radius_m))
-    }
-
-    /// The box a sphere of radius `radius_m` must reach into to be near
-    /// the grid ([`SurfaceIndex::is_near`]): its lowest and highest corners,
-    /// m.
-    fn reach(&self, radius_m: T) -> [Vector3<T>; 2] {
-        let (origin, cell) = (self.index.origin_m(), self.index.cell_m());
-        let margin = cell + radius_m;
-        let [nx, ny, nz] = self.index.dims().map(|d| T::of_f64(f64::from(d)) * cell);
-        let margin3 = Vector3::new(margin, margin, margin);
-        [
-            origin - margin3,
-            origin + Vector3::new(nx, ny, nz) + margin3,
-        ]
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of

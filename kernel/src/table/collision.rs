@@ -60,6 +60,14 @@ pub struct Grid<T> {
     pub dims: [u32; 3],
 }
 
+/// `true` if `p` lies in the box `[lo, hi]` (a non-finite coordinate does
+/// not).
+pub fn within<T: Real>(p: &Vector3<T>, [lo, hi]: &[Vector3<T>; 2]) -> bool {
+    p.iter()
+        .zip(lo.iter().zip(hi.iter()))
+        .all(|(&x, (&l, &h))| x >= l && x <= h)
+}
+
 /// Cell coordinates or counts per axis, widened for indexing.
 #[inline(always)]
 fn widen(c: [u32; 3]) -> [usize; 3] {
@@ -354,22 +362,18 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         self.grid.cell_of(p)
     }
 
-    /// `true` if `p` (m) lies within one cell edge plus `margin_m` of the
-    /// grid's box (a point farther out has no surface vertex within a cell).
-    pub fn is_near(&self, p: &Vector3<T>, margin_m: T) -> bool {
+    /// The box within one cell edge plus `margin_m` (m) of the grid: its
+    /// lowest and highest corners, m. A point farther out has no surface
+    /// vertex within a cell.
+    pub fn reach(&self, margin_m: T) -> [Vector3<T>; 2] {
         let Grid {
             origin_m,
             cell_m,
             dims,
         } = &self.grid;
-        let reach = *cell_m + margin_m;
-        p.iter()
-            .zip(origin_m.iter())
-            .zip(dims)
-            .all(|((&x, &o), &d)| {
-                let extent = *cell_m * T::of_f64(f64::from(d));
-                x >= o - reach && x <= o + extent + reach
-            })
+        let margin = Vector3::repeat(*cell_m + margin_m);
+        let extent = Vector3::from(dims.map(|d| *cell_m * T::of_f64(f64::from(d))));
+        [origin_m - margin, origin_m + extent + margin]
     }
 
     /// The surface vertices filed in the 27 cells around the cell of `p`

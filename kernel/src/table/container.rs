@@ -75,14 +75,7 @@ fn read_header(bytes: &[u8]) -> Result<RawHeader, LoadError> {
 }
 
 fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result<(), LoadError> {
-    if h.magic != format::MAGIC {
-        return Err(LoadError::BadMagic);
-    }
-    if h.format_version != format::FORMAT_VERSION {
-        return Err(LoadError::UnsupportedVersion {
-            found: h.format_version,
-        });
-    }
+    h.check_identity()?;
     if h.file_len != bytes.len() as u64 {
         return Err(LoadError::LengthMismatch {
             declared: h.file_len,

@@ -103,6 +103,24 @@ pub struct RawHeader {
     pub surface_vertex_count: u32,
 }
 
+impl RawHeader {
+    /// The checks that come before any other, on the header alone: the
+    /// magic and the format version. The loader starts with them, and a
+    /// reader that has only the header so far (the host reading a file
+    /// header first) calls them before reading on.
+    pub fn check_identity(&self) -> Result<(), super::LoadError> {
+        if self.magic != MAGIC {
+            return Err(super::LoadError::BadMagic);
+        }
+        if self.format_version != FORMAT_VERSION {
+            return Err(super::LoadError::UnsupportedVersion {
+                found: self.format_version,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Size of [`RawHeader`] in bytes.
 pub const HEADER_LEN: usize = core::mem::size_of::<RawHeader>();
 const _: () = assert!(HEADER_LEN == 112);
