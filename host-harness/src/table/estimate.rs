@@ -28,13 +28,11 @@
 //! [`SectionKind::expected_count`]: palpate_kernel::table::format::SectionKind::expected_count
 
 use bytemuck::Zeroable;
-use palpate_kernel::table::format::{
-    CRC_LEN, HEADER_LEN, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN, TableKind,
-};
+use palpate_kernel::table::format::{RawHeader, TableKind};
 
 use super::build::{BuildOptions, TableKindOptions};
 use super::collision::CELLS_PER_SURFACE_VERTEX;
-use super::file::Precision;
+use super::file::{Precision, layout};
 use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
 use crate::mesh::{MeshReport, Surface, TetMesh};
 
@@ -213,7 +211,7 @@ fn precision_name(p: Precision) -> &'static str {
 }
 
 /// The file size of a table of `kind` in `precision` for counts `c`: the writer's layout
-/// (`table::file::write_container`: header, directory, sections aligned to 16 bytes, CRC) with
+/// ([`layout`]: header, directory, sections aligned to 16 bytes, CRC) with
 /// the format's section counts. The grid's cell count is its bound. `u64::MAX` when a count
 /// does not fit the header's `u32` or the sum overflows.
 fn file_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> u64 {
@@ -222,10 +220,7 @@ fn file_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> u64 {
 
 fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Option<u64> {
     let u32_of = |x: u64| u32::try_from(x).ok();
-    let scalar_bytes: u32 = match precision {
-        Precision::F32 => 4,
-        Precision::F64 => 8,
-    };
+    let scalar_bytes = precision.scalar_bytes();
     let mut header = RawHeader {
         vertex_count: u32_of(c.vertices)?,
         tet_count: u32_of(c.tets)?,
@@ -255,17 +250,16 @@ fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Optio
             header.mesh_triangle_count = mesh_triangles;
         }
     }
-    let sections = kind.sections();
-    let align = SECTION_ALIGN as u64;
-    let directory = (HEADER_LEN + sections.len() * SECTION_ENTRY_LEN) as u64;
-    let mut offset = directory.checked_next_multiple_of(align)?;
-    for &section in sections {
-        let bytes = section
-            .expected_count(&header)?
-            .checked_mul(u64::from(section.elem_bytes(scalar_bytes)))?;
-        offset = offset.checked_add(bytes)?.checked_next_multiple_of(align)?;
-    }
-    offset.checked_add(CRC_LEN as u64)
+    let sizes = kind
+        .sections()
+        .iter()
+        .map(|section| {
+            section
+                .expected_count(&header)?
+                .checked_mul(u64::from(section.elem_bytes(scalar_bytes)))
+        })
+        .collect::<Option<Vec<u64>>>()?;
+    layout(&sizes).map(|(_, file_len)| file_len)
 }
 
 /// What a table build may produce and use, checked by [`SizeLimits::check`] before the arrays

@@ -124,6 +124,33 @@ impl Section {
     }
 }
 
+impl Precision {
+    /// Bytes of one stored scalar (the header's `scalar_bytes`).
+    pub fn scalar_bytes(self) -> u32 {
+        match self {
+            Precision::F32 => 4,
+            Precision::F64 => 8,
+        }
+    }
+}
+
+/// The container's layout for sections of `sizes` bytes, in order: each
+/// section's offset (after the header and directory, aligned to
+/// [`SECTION_ALIGN`]) and the file length with the CRC-32 trailer. `None`
+/// if a length overflows. The one layout of the writer and of the size
+/// estimate (`super::estimate`).
+pub fn layout(sizes: &[u64]) -> Option<(Vec<u64>, u64)> {
+    let align = SECTION_ALIGN as u64;
+    let directory = (HEADER_LEN + sizes.len() * SECTION_ENTRY_LEN) as u64;
+    let mut offset = directory.checked_next_multiple_of(align)?;
+    let mut offsets = Vec::with_capacity(sizes.len());
+    for &size in sizes {
+        offsets.push(offset);
+        offset = offset.checked_add(size)?.checked_next_multiple_of(align)?;
+    }
+    Some((offsets, offset.checked_add(CRC_LEN as u64)?))
+}
+
 /// Lays out any table: `header` supplies the kind, counts and material; this
 /// fills in magic, version, lengths, scalar width and section count, aligns
 /// each section to 16 bytes and appends the CRC-32 trailer.
@@ -132,23 +159,22 @@ pub fn write_container(
     precision: Precision,
     sections: &[Section],
 ) -> Vec<u8> {
-    let scalar_bytes: u32 = match precision {
-        Precision::F32 => 4,
-        Precision::F64 => 8,
-    };
+    let scalar_bytes = precision.scalar_bytes();
     let header_len = HEADER_LEN + sections.len() * SECTION_ENTRY_LEN;
-    let mut offset = header_len.next_multiple_of(SECTION_ALIGN);
-    let mut entries = Vec::with_capacity(sections.len());
-    for section in sections {
-        entries.push(SectionEntry {
+    let sizes: Vec<u64> = sections.iter().map(|s| s.bytes.len() as u64).collect();
+    // In-memory section lengths: their sum fits a `u64`.
+    let (offsets, file_len) = layout(&sizes).unwrap_or_default();
+    let file_len = file_len as usize;
+    let entries: Vec<SectionEntry> = sections
+        .iter()
+        .zip(&offsets)
+        .map(|(section, &offset)| SectionEntry {
             kind: section.kind as u32,
             elem_bytes: section.kind.elem_bytes(scalar_bytes),
-            offset: offset as u64,
+            offset,
             count: section.count,
-        });
-        offset = (offset + section.bytes.len()).next_multiple_of(SECTION_ALIGN);
-    }
-    let file_len = offset + CRC_LEN;
+        })
+        .collect();
     header.magic = MAGIC;
     header.format_version = FORMAT_VERSION;
     header.header_len = header_len as u32;
@@ -164,7 +190,7 @@ pub fn write_container(
         out.resize(entry.offset as usize, 0);
         out.extend_from_slice(&section.bytes);
     }
-    out.resize(offset, 0);
+    out.resize(file_len - CRC_LEN, 0);
     let crc = crc::Crc::<u32>::new(&CRC32).checksum(&out);
     out.extend_from_slice(&crc.to_le_bytes());
     out
