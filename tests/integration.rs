@@ -18,6 +18,7 @@ mod host {
 mod kernel {
     mod haptic;
     mod haptic_dynamic;
+    mod haptic_tools;
     mod layers;
     mod precomputed;
     mod stvk;

@@ -35,6 +35,8 @@ const PHYSICS: PhysicsConfig<f32> = PhysicsConfig {
     integrator: Integrator::SymplecticEuler,
     dt_s: 5e-4,
     substeps: 1,
+    cut_capacity_tets: 8,
+    tearing: None,
 };
 
 /// Presses `P` points 2 mm in (a physics update after every tick), then

@@ -68,7 +68,7 @@ fn tick(c: &mut Criterion) {
                 let mut work = ContactWork::default();
                 black_box(surface.detect(
                     0,
-                    black_box(&from),
+                    Some(black_box(&from)),
                     black_box(&to),
                     TOOL_RADIUS_M,
                     &mut work,

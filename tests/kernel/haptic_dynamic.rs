@@ -61,9 +61,7 @@ fn loop_config() -> LoopConfig<f64> {
 fn symplectic(extrapolation: Extrapolation, dt_s: f64, substeps: u32) -> PhysicsConfig<f64> {
     PhysicsConfig {
         extrapolation,
-        integrator: Integrator::SymplecticEuler,
-        dt_s,
-        substeps,
+        ..PhysicsConfig::new(Integrator::SymplecticEuler, dt_s, substeps)
     }
 }
 
@@ -113,7 +111,7 @@ fn rebinned_surface_follows_the_deformation() {
             let geometry = surface.geometry(Supports::TensorMass(&table));
             let contact = geometry.detect(
                 0,
-                &Vector3::new(x, 0.0291, top_m + RADIUS_M + 1e-3),
+                Some(&Vector3::new(x, 0.0291, top_m + RADIUS_M + 1e-3)),
                 &Vector3::new(x, 0.0291, top_m + RADIUS_M - 1e-3),
                 RADIUS_M,
                 work,
@@ -473,12 +471,7 @@ proptest! {
         let model = TensorMassModel::new(table, state.buffers(), params).expect("model");
         let mut owned = OwnedSurface::for_model(&model);
         let (buffers, forces) = owned.buffers();
-        let physics = PhysicsConfig {
-            extrapolation: Extrapolation::Secant,
-            integrator: Integrator::SymplecticEuler,
-            dt_s: 5e-4f32,
-            substeps: 2,
-        };
+        let physics = PhysicsConfig::new(Integrator::SymplecticEuler, 5e-4f32, 2);
         let tissue = DynamicTissue::<f32, 2>::new(model, buffers, forces, physics).expect("tissue");
         let limits = SafetyLimits { max_force_n: 4.0f32, max_slew_n_per_s: 2000.0 };
         let config = LoopConfig { radius_m: 0.002f32, dt_s: 1e-3, limits };

@@ -340,6 +340,8 @@ impl<'t> DynamicSetup<'t> {
                 substeps: scene
                     .dynamic_substeps()
                     .context("physics period is not a whole number of dt_s")?,
+                cut_capacity_tets: 8,
+                tearing: None,
             },
             config: loop_config(scene),
         })

@@ -89,6 +89,9 @@ impl<T: Real> OwnedState<T> {
 /// dynamic tissue's force scratch (what firmware keeps in static arrays).
 pub struct OwnedSurface<T> {
     positions_m: Vec<[T; 3]>,
+    triangles: Vec<[u32; 3]>,
+    face_slot: Vec<u32>,
+    slot_tet: Vec<u32>,
     planes: Vec<[T; 4]>,
     vertex_triangle_start: Vec<u32>,
     vertex_triangle: Vec<u32>,
@@ -111,6 +114,9 @@ impl<T: Real> OwnedSurface<T> {
         let n = SurfaceBuffers::<T>::lengths(model, surface_vertices);
         Self {
             positions_m: vec![[T::zero(); 3]; n.vertices],
+            triangles: vec![[0; 3]; n.triangles],
+            face_slot: vec![0; n.triangles],
+            slot_tet: vec![0; n.triangles],
             planes: vec![[T::zero(); 4]; n.triangles],
             vertex_triangle_start: vec![0; n.vertex_triangle_start],
             vertex_triangle: vec![0; n.vertex_triangle],
@@ -125,6 +131,9 @@ impl<T: Real> OwnedSurface<T> {
         (
             SurfaceBuffers {
                 positions_m: &mut self.positions_m,
+                triangles: &mut self.triangles,
+                face_slot: &mut self.face_slot,
+                slot_tet: &mut self.slot_tet,
                 planes: &mut self.planes,
                 vertex_triangle_start: &mut self.vertex_triangle_start,
                 vertex_triangle: &mut self.vertex_triangle,

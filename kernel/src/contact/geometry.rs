@@ -4,10 +4,21 @@
 //! ([`crate::tensor_mass::DeformingSurface`]). A tool point is a sphere of radius
 //! `r`; its contact is a point of a surface triangle (barycentric weights),
 //! created when the sphere's motion segment crosses the triangle from
-//! outside, moved with the tool (frictionless sliding: the contact point is
-//! the projection of the sphere's lowest point onto the surface, walking
-//! across triangle edges), and released when the sphere no longer
-//! penetrates.
+//! outside, or when the sphere is found penetrating the surface where it
+//! stands (the surface moved onto it: a rebound, tissue another tool
+//! pushes, a falling flap), moved with the tool (frictionless sliding: the
+//! contact point is the projection of the sphere's lowest point onto the
+//! surface, walking across triangle edges; a grasped point stays where it
+//! is held), and released when the sphere no longer penetrates.
+//!
+//! Relative motion: the tool moves every tick, the deforming surface at
+//! each physics update. The sweep catches the tool's own motion across the
+//! surface as it stands; the penetration test catches the surface's motion
+//! onto a tool, for a surface that moves less than a grid cell (the
+//! longest surface edge) per update, which bounds it: the nearest triangle
+//! under the sphere's centre among those around the 27 cells of its
+//! centre decides, so a tool under a thin flap, nearer the flap's lower
+//! face, is outside it.
 
 use nalgebra::Vector3;
 
@@ -202,17 +213,20 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             tip_m: *tip_m,
             gap_m: (tip_m - point_m).dot(&face.normal) - radius_m,
             force_n: Vector3::zeros(),
+            grip_offset_m: None,
         }
     }
 
-    /// The first surface triangle that a sphere of radius `radius_m` moving
-    /// from `from_m` to `to_m` (its centre, m) hits from outside, with the
-    /// contact point; triangles with all three vertices fixed (a rigid
-    /// support, no compliance) are not touchable. Candidates: the triangles
-    /// around the surface vertices in the 27 grid cells around `to_m` and
-    /// around `from_m` (once when both are in the same cell; none for a
-    /// point more than a cell plus the radius outside the grid). Bounded by
-    /// `2 × max_query_triangles` triangle tests, most rejected by two dot
+    /// The contact of a sphere of radius `radius_m` whose centre moved from
+    /// `from_m` (`None`: no earlier position) to `to_m` (m): the first
+    /// surface triangle the motion hits from outside, else the triangle it
+    /// penetrates where it stands ([`Self::penetration`]); triangles with
+    /// all three vertices fixed (a rigid support, no compliance) are not
+    /// touchable. Sweep candidates: the triangles around the surface
+    /// vertices in the 27 grid cells around `to_m` and around `from_m`
+    /// (once when both are in the same cell; none for a point more than a
+    /// cell plus the radius outside the grid). Bounded by
+    /// `3 × max_query_triangles` triangle tests, most rejected by two dot
     /// products with the stored plane.
     ///
     /// An end outside that reach is first moved along the segment to where
@@ -221,6 +235,21 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// 1e10 m) would otherwise swamp the intersection's arithmetic, in f32
     /// every digit of the part near the surface.
     pub fn detect(
+        &self,
+        tool: usize,
+        from_m: Option<&Vector3<T>>,
+        to_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+    ) -> Option<Contact<T>> {
+        from_m
+            .and_then(|from_m| self.sweep(tool, from_m, to_m, radius_m, work))
+            .or_else(|| self.penetration(tool, to_m, radius_m, work))
+    }
+
+    /// The first surface triangle a sphere moving from `from_m` to `to_m`
+    /// hits from outside ([`Self::detect`]'s sweep).
+    fn sweep(
         &self,
         tool: usize,
         from_m: &Vector3<T>,
@@ -281,12 +310,66 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         Some(self.contact(tool, triangle, &face, weights, to_m, radius_m))
     }
 
+    /// The contact of a sphere (centre `tip_m`, radius `radius_m`, m) found
+    /// already inside the tissue: among the candidate triangles around the
+    /// 27 cells of `tip_m` whose plane has the centre's projection inside
+    /// the triangle, the one with the nearest plane (the lowest index of
+    /// equals) decides; if the sphere reaches behind it (signed gap < 0)
+    /// that is the contact, pushed out along its outward normal, else there
+    /// is none (also when the nearest is a rigid support). Bounded by
+    /// `max_query_triangles` triangle tests.
+    pub fn penetration(
+        &self,
+        tool: usize,
+        tip_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+    ) -> Option<Contact<T>> {
+        if !within(tip_m, &self.index.reach(radius_m)) {
+            return None;
+        }
+        let tolerance = T::WEIGHT_TOLERANCE;
+        let mut nearest: Option<(T, TriangleIndex, [T; 3])> = None;
+        for v in self.index.vertices_near(tip_m) {
+            for t in self.index.triangles_of(v) {
+                work.triangles_tested = work.triangles_tested.saturating_add(1);
+                let Some((normal, offset)) = self.index.plane(t) else {
+                    continue;
+                };
+                let distance = normal.dot(tip_m) - offset;
+                if normal == Vector3::zeros()
+                    || nearest
+                        .as_ref()
+                        .is_some_and(|(d, _, _)| d.abs() <= distance.abs())
+                {
+                    continue;
+                }
+                let Some(f) = self.corners(t) else { continue };
+                let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance));
+                if w.iter().all(|&wi| wi >= -tolerance) {
+                    nearest = Some((distance, t, clamp_weights(w)));
+                }
+            }
+        }
+        let (distance, triangle, weights) = nearest?;
+        let face = self.face(triangle)?;
+        if distance - radius_m >= T::zero()
+            || face.vertices.iter().all(|&v| self.supports.is_fixed(v))
+        {
+            return None;
+        }
+        Some(self.contact(tool, triangle, &face, weights, tip_m, radius_m))
+    }
+
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
     /// the sphere's lowest point `tip − r n` onto the surface, walking to
     /// the neighbouring triangle across any edge it falls outside of (at
     /// most [`MAX_WALK_STEPS`]; never straight back, which over a concave
     /// fold would swing between the two triangles). Returns the moved
     /// contact, with its signed gap (negative while the sphere penetrates).
+    /// A held contact ([`Contact::grip_offset_m`]) keeps its triangle and
+    /// weights (its point is where the surface has them now). `None` when
+    /// the triangle has left the surface (a cut or a tear removed its tet).
     pub fn track(
         &self,
         contact: &Contact<T>,
@@ -297,6 +380,19 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let tolerance = T::WEIGHT_TOLERANCE;
         let mut triangle = contact.triangle;
         let mut face = self.face(triangle)?;
+        if contact.grip_offset_m.is_some() {
+            return Some(Contact {
+                grip_offset_m: contact.grip_offset_m,
+                ..self.contact(
+                    contact.tool,
+                    triangle,
+                    &face,
+                    contact.weights,
+                    tip_m,
+                    radius_m,
+                )
+            });
+        }
         let mut came_from = None;
         for _ in 0..MAX_WALK_STEPS {
             let w = barycentric(

@@ -25,7 +25,7 @@
 use nalgebra::Vector3;
 
 use crate::Real;
-use crate::table::{Grid, max_row};
+use crate::table::{DEAD_TRIANGLE, Grid, max_row};
 
 /// Factor by which the cell edge grows until the grid fits its capacity.
 pub const CELL_GROWTH: f64 = 1.25;
@@ -64,7 +64,8 @@ pub struct Binned<T> {
 
 /// Each vertex's surface triangles, ascending, as a CSR list: `start` has
 /// `N + 1` entries, `list` `3 T` (a counting sort over the triangles, which
-/// visits them in order). A corner beyond the last vertex (a corrupted
+/// visits them in order; [`DEAD_TRIANGLE`] slots are skipped, so `list`
+/// then has room to spare). A corner beyond the last vertex (a corrupted
 /// input) is filed under the last vertex, which keeps the list at `3 T` so
 /// that the loader reports the triangle itself. Returns the most triangles
 /// around one vertex.
@@ -72,7 +73,7 @@ pub fn vertex_triangles(triangles: &[[u32; 3]], start: &mut [u32], list: &mut [u
     start.fill(0);
     let last = start.len().saturating_sub(2);
     let row = |v: u32| (v as usize).min(last);
-    for tri in triangles {
+    for tri in triangles.iter().filter(|t| **t != DEAD_TRIANGLE) {
         for &v in tri {
             if let Some(s) = start.get_mut(row(v) + 1) {
                 *s += 1;
@@ -83,6 +84,9 @@ pub fn vertex_triangles(triangles: &[[u32; 3]], start: &mut [u32], list: &mut [u
     // `start[v]` is the cursor of vertex v while filling; it ends at the
     // start of v + 1, then everything shifts back by one.
     for (t, tri) in triangles.iter().enumerate() {
+        if *tri == DEAD_TRIANGLE {
+            continue;
+        }
         for &v in tri {
             if let Some(cursor) = start.get_mut(row(v)) {
                 place(list, cursor, t as u32);
@@ -136,6 +140,10 @@ fn planes<T: Real>(positions_m: &[[T; 3]], triangles: &[[u32; 3]], planes: &mut 
     };
     let mut longest2 = T::zero();
     for (plane, tri) in planes.iter_mut().zip(triangles) {
+        if *tri == DEAD_TRIANGLE {
+            *plane = [T::zero(); 4];
+            continue;
+        }
         let [a, b, c] = tri.map(at);
         for e in [b - a, c - b, a - c] {
             longest2 = longest2.max(e.norm_squared());

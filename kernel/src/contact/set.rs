@@ -33,14 +33,37 @@ pub struct Contact<T> {
     pub gap_m: T,
     /// Force the tool applies to the tissue here, N, written by the
     /// tissue's solve (zero before it; `force · normal > 0` is adhesive:
-    /// the tool would pull).
+    /// the tool would pull, which only a grip may).
     pub force_n: Vector3<T>,
+    /// `Some` while a grasper's jaw holds the contact point (MODELS.md §6):
+    /// the offset `tip − target` from the point's held position to the
+    /// tool sphere's centre, m, fixed when the grip closed. A held point
+    /// stays at its barycentric place on its triangle and follows the tool
+    /// in all three directions: pulling transmits force.
+    pub grip_offset_m: Option<Vector3<T>>,
 }
 
 impl<T: Real> Contact<T> {
-    /// The imposed displacement of the contact point, `gap · normal`, m.
+    /// The displacement to impose on the contact point from where the
+    /// surface has it (`point_m`), m: `gap · normal` onto the tool sphere,
+    /// or for a held point the way to its held position
+    /// `tip − grip_offset − point`.
     pub fn displacement_m(&self) -> Vector3<T> {
-        self.normal * self.gap_m
+        match self.grip_offset_m {
+            Some(offset) => self.tip_m - offset - self.point_m,
+            None => self.normal * self.gap_m,
+        }
+    }
+
+    /// This contact held where it is now: from here on the contact point
+    /// keeps its place on the triangle and its offset from the tool
+    /// sphere's centre (the grip continues the imposed displacement
+    /// `gap · normal` without a jump).
+    pub fn gripped(self) -> Self {
+        Self {
+            grip_offset_m: Some(self.tip_m - self.point_m - self.normal * self.gap_m),
+            ..self
+        }
     }
 }
 

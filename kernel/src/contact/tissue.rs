@@ -32,6 +32,11 @@ pub trait Tissue<T: Real, const M: usize> {
     /// Called once at the start of every tick (a clock for models that
     /// extrapolate between physics updates).
     fn begin_tick(&mut self) {}
+    /// Whether an enabled blade cuts this tissue (the tensor-mass model) or
+    /// only touches it (the pre-computed model).
+    fn can_cut(&self) -> bool {
+        false
+    }
     /// Forgets the last solution (a fault dropped every contact).
     fn forget(&mut self);
     /// Back to rest with no contact.

@@ -18,9 +18,10 @@
 use nalgebra::Vector3;
 
 use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
+use super::tool::{ToolAction, ToolInput};
 use crate::contact::{Contact, ContactSet, ContactWork, Refusal, Tissue};
 use crate::precomputed::{ContactSolution, PrecomputedTissue};
-use crate::tensor_mass::{DynamicTissue, PhysicsError, StepReport};
+use crate::tensor_mass::{Blade, Blades, DynamicTissue, PhysicsError, StepReport};
 use crate::{MAX_CONTACTS, Real};
 
 /// What the device receives each tick.
@@ -35,6 +36,9 @@ pub struct ForceOutput<T> {
     /// Tool points whose new contact was refused this tick (capacity `M`
     /// reached, or a contact set the model refused); never silently dropped.
     pub refused: u8,
+    /// An enabled blade touches a tissue that cannot be cut (the
+    /// pre-computed model): it acts as a probe, and says so.
+    pub cut_refused: bool,
 }
 
 /// Per-tick work counters (for timing budgets: deterministic counts).
@@ -84,6 +88,7 @@ pub struct HapticLoop<T: Real, B, const P: usize, const M: usize> {
     config: LoopConfig<T>,
     supervisor: Supervisor<T>,
     previous_m: Option<[Vector3<T>; P]>,
+    actions: [ToolAction<T>; P],
     contacts: [Option<Contact<T>>; P],
     counters: TickCounters,
 }
@@ -115,6 +120,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             config,
             supervisor: Supervisor::new(config.limits).map_err(LoopError::BadLimits)?,
             previous_m: None,
+            actions: [ToolAction::Touch; P],
             contacts: [None; P],
             counters: TickCounters::default(),
         })
@@ -141,20 +147,34 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         self.supervisor.reset();
         self.contacts = [None; P];
         self.previous_m = None;
+        self.actions = [ToolAction::Touch; P];
         self.tissue.reset();
     }
 
-    /// One haptic tick with the tool points at `tool_m` (sphere centres, m).
+    /// One haptic tick of probes at `tool_m` (sphere centres, m):
+    /// [`Self::tick_tools`] with every action [`ToolAction::Touch`].
+    pub fn tick(&mut self, tool_m: &[Vector3<T>; P]) -> ForceOutput<T> {
+        self.tick_tools(&tool_m.map(ToolInput::touch))
+    }
+
+    /// One haptic tick with each tool point's sphere centre (m) and action.
     /// Bounded: detection and tracking per point (see
     /// [`crate::contact::SurfaceGeometry::detect`] and `track`), then at
     /// most `P + 1` contact solves of at most `M` contacts.
-    pub fn tick(&mut self, tool_m: &[Vector3<T>; P]) -> ForceOutput<T> {
+    pub fn tick_tools(&mut self, tools: &[ToolInput<T>; P]) -> ForceOutput<T> {
         self.counters = TickCounters::default();
         self.tissue.begin_tick();
         let dt = self.config.dt_s;
-        if !tool_m.iter().all(|p| p.iter().all(|x| x.finite())) {
+        let tool_m = tools.map(|t| t.position_m);
+        let finite = |v: &Vector3<T>| v.iter().all(|x| x.finite());
+        let blades_finite = tools.iter().all(|t| match t.action {
+            ToolAction::Cut { blade_m } => finite(&blade_m),
+            _ => true,
+        });
+        if !(tool_m.iter().all(finite) && blades_finite) {
             self.contacts = [None; P];
             self.previous_m = None;
+            self.actions = [ToolAction::Touch; P];
             self.tissue.forget();
             return self.output(Err(SafetyFault::NonFiniteInput), dt, 0);
         }
@@ -162,10 +182,11 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             // Latched: no contact is held (a physics update releases them).
             self.contacts = [None; P];
             self.tissue.forget();
-            self.previous_m = Some(*tool_m);
+            self.previous_m = Some(tool_m);
+            self.actions = [ToolAction::Touch; P];
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
-        let mut refused = self.track_and_detect(tool_m);
+        let mut refused = self.track_and_detect(tools);
         let mut set = self.contact_set();
         // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
         // the model refuses, and solve again. Each pass removes one.
@@ -175,7 +196,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                 Ok(device_force_n) => {
                     let adhesive = set
                         .iter()
-                        .find(|c| c.force_n.dot(&c.normal) > T::zero())
+                        .find(|c| c.grip_offset_m.is_none() && c.force_n.dot(&c.normal) > T::zero())
                         .map(|c| c.tool);
                     let Some(tool) = adhesive else {
                         return self.output(Ok(device_force_n), dt, refused);
@@ -197,27 +218,43 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         self.output(Err(SafetyFault::ModelFault), dt, refused)
     }
 
-    /// Tracks existing contacts and detects new ones from the motion
-    /// segment; returns how many new contacts the capacity `M` refused.
-    fn track_and_detect(&mut self, tool_m: &[Vector3<T>; P]) -> u8 {
+    /// Tracks existing contacts (a grip closing on one holds it, a grip
+    /// opening lets it go) and detects new ones from the motion segment or
+    /// the penetration where the tool stands; returns how many new
+    /// contacts the capacity `M` refused.
+    fn track_and_detect(&mut self, tools: &[ToolInput<T>; P]) -> u8 {
         let radius = self.config.radius_m;
         let surface = self.tissue.geometry();
         let mut refused = 0u8;
         let mut active = 0usize;
-        for (p, tip) in tool_m.iter().enumerate() {
+        for (p, (tool, was)) in tools.iter().zip(&self.actions).enumerate() {
             let Some(slot) = self.contacts.get_mut(p) else {
                 continue;
             };
+            let tip = &tool.position_m;
+            let gripping = tool.action == ToolAction::Grip;
+            let closing = gripping && *was != ToolAction::Grip;
             let work = &mut self.counters.contact;
             *slot = match slot {
-                Some(c) => surface
-                    .track(c, tip, radius, work)
-                    .filter(|c| self.tissue.keeps(c.gap_m)),
-                None => self
-                    .previous_m
-                    .as_ref()
-                    .and_then(|prev| prev.get(p))
-                    .and_then(|from| surface.detect(p, from, tip, radius, work)),
+                Some(c) => {
+                    let held = c.grip_offset_m.filter(|_| gripping);
+                    surface
+                        .track(
+                            &Contact {
+                                grip_offset_m: held,
+                                ..*c
+                            },
+                            tip,
+                            radius,
+                            work,
+                        )
+                        .filter(|c| c.grip_offset_m.is_some() || self.tissue.keeps(c.gap_m))
+                        .map(|c| if closing { c.gripped() } else { c })
+                }
+                None => {
+                    let from = self.previous_m.as_ref().and_then(|prev| prev.get(p));
+                    surface.detect(p, from, tip, radius, work)
+                }
             };
             if slot.is_some() {
                 if active < M {
@@ -228,7 +265,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                 }
             }
         }
-        self.previous_m = Some(*tool_m);
+        self.previous_m = Some(tools.map(|t| t.position_m));
+        self.actions = tools.map(|t| t.action);
         refused
     }
 
@@ -256,11 +294,17 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         refused: u8,
     ) -> ForceOutput<T> {
         let (force_n, status) = self.supervisor.output(requested, dt);
+        let cutting = self
+            .actions
+            .iter()
+            .zip(&self.contacts)
+            .any(|(a, c)| matches!(a, ToolAction::Cut { .. }) && c.is_some());
         ForceOutput {
             force_n,
             status,
             contacts: self.contacts.iter().filter(|c| c.is_some()).count() as u8,
             refused,
+            cut_refused: cutting && !self.tissue.can_cut(),
         }
     }
 }
@@ -275,11 +319,31 @@ impl<'a, T: Real, const P: usize, const M: usize> PrecomputedLoop<'a, T, P, M> {
 
 impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
     /// One physics update of the dynamic model with the current contacts at
-    /// the last tick's tool positions (call it every `physics_every` ticks,
-    /// after the tick). On failure the next tick latches a model fault
-    /// (zero force) until [`Self::reset`].
+    /// the last tick's tool positions and the last tick's enabled blades
+    /// (call it every `physics_every` ticks, after the tick). On failure the
+    /// next tick latches a model fault (zero force) until [`Self::reset`].
     pub fn physics_update(&mut self) -> Result<StepReport<T>, PhysicsError> {
         let set = self.contact_set();
-        self.tissue.update(&set)
+        let mut blades = Blades::new();
+        if let Some(tips) = &self.previous_m {
+            for (p, ((tip, action), contact)) in tips
+                .iter()
+                .zip(&self.actions)
+                .zip(&self.contacts)
+                .enumerate()
+            {
+                if let ToolAction::Cut { blade_m } = *action {
+                    // At most P blades, the capacity of `Blades`.
+                    let _ = blades.push(Blade {
+                        tool: p,
+                        from_m: *tip,
+                        to_m: tip + blade_m,
+                        radius_m: self.config.radius_m,
+                        pressing: contact.filter(|c| c.gap_m < T::zero()).map(|c| c.triangle),
+                    });
+                }
+            }
+        }
+        self.tissue.update(&set, &blades)
     }
 }

@@ -7,8 +7,10 @@
 
 mod haptic_loop;
 mod safety;
+mod tool;
 
 pub use haptic_loop::{
     DynamicLoop, ForceOutput, HapticLoop, LoopConfig, LoopError, PrecomputedLoop, TickCounters,
 };
 pub use safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
+pub use tool::{ToolAction, ToolInput};

@@ -140,6 +140,13 @@ pub(crate) struct BuiltLists<'a, T> {
     pub(crate) max_valence: u32,
 }
 
+/// A triangle slot that holds no triangle (a face of the deforming
+/// surface's list that is not on the surface now: an interior face no cut
+/// has exposed, or a face whose tets are gone). Skipped by
+/// `contact::grid`'s builders; never a valid triangle (its corners are
+/// out of every vertex range).
+pub const DEAD_TRIANGLE: [u32; 3] = [u32::MAX; 3];
+
 /// `true` if `starts` begins at 0, never decreases and ends at `total`.
 fn csr_ok(starts: &[u32], total: usize) -> bool {
     starts.first() == Some(&0)
@@ -398,8 +405,13 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// The vertices of surface triangle `t`; `None` for an index of
     /// another surface beyond this one's triangles.
     pub fn triangle(&self, t: TriangleIndex) -> Option<[VertexIndex; 3]> {
-        // Triangle corners are vertices of the surface (invariant).
-        Some(self.triangles.get(t.get())?.map(VertexIndex::checked))
+        // Triangle corners are vertices of the surface (invariant), but for
+        // an empty slot of a deforming surface.
+        let tri = self.triangles.get(t.get())?;
+        if *tri == DEAD_TRIANGLE {
+            return None;
+        }
+        Some(tri.map(VertexIndex::checked))
     }
 
     /// The stored plane of surface triangle `t`: unit outward normal and

@@ -19,7 +19,7 @@ mod precomputed;
 mod tensor_mass;
 
 pub(crate) use collision::BuiltLists;
-pub use collision::{Grid, SurfaceIndex, max_row, within};
+pub use collision::{DEAD_TRIANGLE, Grid, SurfaceIndex, max_row, within};
 pub use error::LoadError;
 pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};

@@ -54,11 +54,16 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
             .table
             .tet(tet)
             .ok_or(RemoveError::TetOutOfRange { tet })?;
-        self.remove(t)
+        self.remove(t, &mut |_| {})
     }
 
-    /// [`Self::remove_tet`] of a checked tet.
-    fn remove(&mut self, t: TetIndex) -> Result<u32, RemoveError> {
+    /// [`Self::remove_tet`] of a checked tet, telling `removed` each tet it
+    /// removes (`t` first).
+    pub(super) fn remove(
+        &mut self,
+        t: TetIndex,
+        removed: &mut dyn FnMut(TetIndex),
+    ) -> Result<u32, RemoveError> {
         let tet = t.as_u32();
         match self.state.tet_alive.get(t.get()) {
             None => return Err(RemoveError::TetOutOfRange { tet }),
@@ -66,17 +71,20 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
             Some(true) => {}
         }
         self.subtract(t);
-        let mut removed = 1;
+        removed(t);
+        let mut count = 1;
         for other in self.table.neighbours_of(t).into_iter().flatten() {
             if self.is_alive(other) && self.live_face_neighbours(other) == 0 {
                 self.subtract(other);
-                removed += 1;
+                removed(other);
+                count += 1;
             }
         }
-        Ok(removed)
+        Ok(count)
     }
 
-    fn is_alive(&self, tet: TetIndex) -> bool {
+    /// `true` while `tet` has not been removed.
+    pub(super) fn is_alive(&self, tet: TetIndex) -> bool {
         self.state.tet_alive.get(tet.get()) == Some(&true)
     }
 
@@ -218,6 +226,18 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         radius_m: T,
         capacity: u32,
     ) -> CutReport {
+        self.cut_reporting(a_m, b_m, radius_m, capacity, &mut |_| {})
+    }
+
+    /// [`Self::cut_with_tool`], telling `removed` each tet it removes.
+    pub(super) fn cut_reporting(
+        &mut self,
+        a_m: Vector3<T>,
+        b_m: Vector3<T>,
+        radius_m: T,
+        capacity: u32,
+        removed: &mut dyn FnMut(TetIndex),
+    ) -> CutReport {
         let axis = b_m - a_m;
         let length2 = axis.norm_squared();
         let r2 = radius_m * radius_m;
@@ -231,20 +251,36 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
             };
             (p - (a_m + axis * t)).norm_squared() <= r2
         };
-        self.remove_where(capacity, |model, tet| {
-            tet.iter().any(|&v| model.position(v).is_some_and(touches))
-        })
+        self.remove_where(
+            capacity,
+            |model, tet| tet.iter().any(|&v| model.position(v).is_some_and(touches)),
+            removed,
+        )
     }
 
     /// Removes every live tet past a [`TearThresholds`] criterion, at most
     /// `capacity` per call. Bounded: one scan of the tets.
     pub fn tear(&mut self, thresholds: &TearThresholds<T>, capacity: u32) -> CutReport {
+        self.tear_reporting(thresholds, capacity, &mut |_| {})
+    }
+
+    /// [`Self::tear`], telling `removed` each tet it removes.
+    pub(super) fn tear_reporting(
+        &mut self,
+        thresholds: &TearThresholds<T>,
+        capacity: u32,
+        removed: &mut dyn FnMut(TetIndex),
+    ) -> CutReport {
         let thresholds = *thresholds;
-        self.remove_where(capacity, move |model, tet| {
-            model
-                .corners(tet)
-                .is_some_and(|(now, rest)| exceeds(&now, &rest, &thresholds))
-        })
+        self.remove_where(
+            capacity,
+            move |model, tet| {
+                model
+                    .corners(tet)
+                    .is_some_and(|(now, rest)| exceeds(&now, &rest, &thresholds))
+            },
+            removed,
+        )
     }
 
     /// Current and rest corner positions of `tet`, m.
@@ -265,6 +301,7 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         &mut self,
         capacity: u32,
         qualifies: impl Fn(&Self, [VertexIndex; 4]) -> bool,
+        removed: &mut dyn FnMut(TetIndex),
     ) -> CutReport {
         let mut report = CutReport::default();
         for t in self.table.tet_indices() {
@@ -278,7 +315,7 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
                 report.pending = true;
                 break;
             }
-            report.removed += self.remove(t).unwrap_or(0);
+            report.removed += self.remove(t, removed).unwrap_or(0);
         }
         report
     }

@@ -39,6 +39,7 @@ pub use surface::{
     DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers, SurfaceLengths,
 };
 pub use tissue::{
-    DynamicTissue, DynamicTissueError, Extrapolation, HeldContact, MAX_SUBSTEPS,
-    MIN_MOVABLE_WEIGHT2, PhysicsConfig, PhysicsError, SECANT_MIN_MOTION_M,
+    Blade, Blades, DynamicTissue, DynamicTissueError, Extrapolation, HeldContact,
+    MAX_REMOVAL_CAPACITY, MAX_REMOVED_PER_UPDATE, MAX_SUBSTEPS, MIN_MOVABLE_WEIGHT2, PhysicsConfig,
+    PhysicsError, SECANT_MIN_MOTION_M, Tearing,
 };

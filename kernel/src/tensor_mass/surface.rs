@@ -1,13 +1,29 @@
 //! The collision surface of a deforming (dynamic tensor-mass) tissue: the
-//! table's boundary triangles at the current vertex positions, re-binned
+//! boundary of the live tets at the current vertex positions, re-binned
 //! into a fresh bucket grid at every physics update (Cotin 1999 §4: "the
 //! bucket data structure must be updated" for a deformed mesh; MODELS.md
 //! §6).
 //!
+//! Faces a cut exposes (Picinbono 2001 §3.1; MODELS.md §3): the surface
+//! keeps one triangle slot per mesh triangle (face) of the table, so that
+//! a triangle's index never changes while the session runs. Slots
+//! `0..B` hold the table's `B` boundary triangles in the table's order (an
+//! uncut tissue numbers its triangles exactly as the table does); slots
+//! `B..F` the interior faces, in mesh-triangle order, empty
+//! ([`DEAD_TRIANGLE`]) until a removal exposes one. Removing tet `t`
+//! ([`DeformingSurface::remove_tets`]) updates its 4 faces in constant time
+//! each: a face shared with a live neighbour becomes a surface triangle
+//! oriented outward from that neighbour, any other face of `t` leaves the
+//! surface. The vertex-to-triangle lists are rebuilt at the next re-bin
+//! (one pass over the slots and the vertices), so the exposed faces are
+//! touchable from that physics update on.
+//!
 //! Bounded re-binning: [`DeformingSurface::rebin`] moves the vertices (one
 //! pass over the `N` vertices) and re-bins them with the crate's one grid
 //! builder ([`crate::contact::grid::bin`], whose sizing rule and bounds are
-//! documented there) into the caller's buffers.
+//! documented there) into the caller's buffers; after removals it first
+//! rebuilds the vertex-to-triangle lists (one pass over the `F` slots and
+//! two over the vertices).
 
 use core::fmt;
 
@@ -17,20 +33,31 @@ use super::TensorMassModel;
 use crate::Real;
 use crate::contact::grid::{self, BinBuffers, Binned};
 use crate::contact::{Supports, SurfaceGeometry};
-use crate::table::{BuiltLists, Grid, SurfaceIndex};
+use crate::table::format::{NO_NEIGHBOUR, tet_face_vertices};
+use crate::table::{
+    BuiltLists, DEAD_TRIANGLE, Grid, SurfaceIndex, TensorMassTable, TetIndex, TriangleIndex,
+};
 
 /// The caller's buffers of a deforming surface (static arrays on
-/// firmware). Lengths for a table of `N` vertices and `T` surface
-/// triangles: see each field; [`SurfaceBuffers::lengths`] computes them.
+/// firmware). Lengths for a table of `N` vertices and `F` mesh triangles
+/// (faces, boundary and interior): see each field;
+/// [`SurfaceBuffers::lengths`] computes them.
 pub struct SurfaceBuffers<'s, T> {
     /// Current position of every vertex, m: `N`.
     pub positions_m: &'s mut [[T; 3]],
-    /// Plane of every surface triangle (unit outward normal, offset `n·p`
-    /// in m): `T`.
+    /// The triangle in each slot (module docs), outward right-hand order,
+    /// or [`DEAD_TRIANGLE`]: `F`.
+    pub triangles: &'s mut [[u32; 3]],
+    /// The slot of each mesh triangle: `F`.
+    pub face_slot: &'s mut [u32],
+    /// The live tet whose face each surface slot holds: `F`.
+    pub slot_tet: &'s mut [u32],
+    /// Plane of every slot's triangle (unit outward normal, offset `n·p`
+    /// in m; zero for an empty slot): `F`.
     pub planes: &'s mut [[T; 4]],
     /// Start of each vertex's triangle list: `N + 1`.
     pub vertex_triangle_start: &'s mut [u32],
-    /// The triangles around each vertex, ascending: `3 T`.
+    /// The triangles around each vertex, ascending: `3 F`.
     pub vertex_triangle: &'s mut [u32],
     /// Start of each grid cell's vertex list: the grid's capacity in cells
     /// plus one, at least 2 (more cells: fewer vertices per bucket).
@@ -45,7 +72,7 @@ pub struct SurfaceBuffers<'s, T> {
 pub struct SurfaceLengths {
     /// `positions_m` and `grid_vertex`.
     pub vertices: usize,
-    /// `planes`.
+    /// `triangles`, `face_slot`, `slot_tet` and `planes`.
     pub triangles: usize,
     /// `vertex_triangle_start`.
     pub vertex_triangle_start: usize,
@@ -59,7 +86,7 @@ impl<T> SurfaceBuffers<'_, T> {
     /// The lengths for `model`'s table with room for `cells` grid cells.
     pub fn lengths<R: Real>(model: &TensorMassModel<'_, '_, R>, cells: usize) -> SurfaceLengths {
         let n = model.table().vertex_count();
-        let t = model.table().surface_triangles().len();
+        let t = model.table().mesh_triangles().len();
         SurfaceLengths {
             vertices: n,
             triangles: t,
@@ -108,12 +135,13 @@ impl fmt::Display for NonFinitePosition {
 
 impl core::error::Error for NonFinitePosition {}
 
-/// The deforming surface: the table's surface triangles at the positions
+/// The deforming surface: the boundary of the live tets at the positions
 /// of the last [`Self::rebin`].
 pub struct DeformingSurface<'a, 's, T: Real> {
-    rest_m: &'a [[T; 3]],
-    triangles: &'a [[u32; 3]],
+    table: TensorMassTable<'a, T>,
     buffers: SurfaceBuffers<'s, T>,
+    /// Faces changed since the vertex-to-triangle lists were built.
+    dirty: bool,
     grid: Grid<T>,
     /// Cells of the current grid.
     cells: usize,
@@ -136,6 +164,9 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
         let need = SurfaceBuffers::<T>::lengths(model, 1);
         let checks = [
             ("positions_m", need.vertices, buffers.positions_m.len()),
+            ("triangles", need.triangles, buffers.triangles.len()),
+            ("face_slot", need.triangles, buffers.face_slot.len()),
+            ("slot_tet", need.triangles, buffers.slot_tet.len()),
             ("planes", need.triangles, buffers.planes.len()),
             (
                 "vertex_triangle_start",
@@ -163,11 +194,10 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
                 found: buffers.cell_start.len(),
             });
         }
-        let table = model.table();
         let mut surface = Self {
-            rest_m: table.rest_positions(),
-            triangles: table.surface_triangles(),
+            table: *model.table(),
             buffers,
+            dirty: true,
             grid: Grid {
                 origin_m: Vector3::zeros(),
                 cell_m: T::one(),
@@ -178,11 +208,8 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             max_bucket: 0,
             max_valence: 0,
         };
-        surface.max_valence = grid::vertex_triangles(
-            surface.triangles,
-            surface.buffers.vertex_triangle_start,
-            surface.buffers.vertex_triangle,
-        );
+        surface.reset_faces();
+        surface.remove_tets(model.tet_alive(), model.table().tet_indices());
         // The rest state is finite (validated table), so this bins.
         let displacement = model.displacements_m().unwrap_or(&[]);
         surface
@@ -205,7 +232,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             .buffers
             .positions_m
             .iter_mut()
-            .zip(self.rest_m)
+            .zip(self.table.rest_positions())
             .enumerate()
         {
             let u = displacement_m.get(v).unwrap_or(&zero);
@@ -214,6 +241,14 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
                 return Err(NonFinitePosition { vertex: v as u32 });
             }
         }
+        if self.dirty {
+            self.max_valence = grid::vertex_triangles(
+                self.buffers.triangles,
+                self.buffers.vertex_triangle_start,
+                self.buffers.vertex_triangle,
+            );
+            self.dirty = false;
+        }
         let Binned {
             grid,
             cells,
@@ -221,7 +256,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             max_bucket,
         } = grid::bin(
             self.buffers.positions_m,
-            self.triangles,
+            self.buffers.triangles,
             self.buffers.vertex_triangle_start,
             BinBuffers {
                 planes: self.buffers.planes,
@@ -238,7 +273,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
         SurfaceIndex::assembled(
             self.grid,
             BuiltLists {
-                triangles: self.triangles,
+                triangles: self.buffers.triangles,
                 cell_start: self.buffers.cell_start.get(..=self.cells).unwrap_or(&[]),
                 grid_vertex: self.buffers.grid_vertex.get(..self.filed).unwrap_or(&[]),
                 vertex_triangle_start: self.buffers.vertex_triangle_start,
@@ -253,6 +288,112 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
     /// The current vertex positions, m.
     pub fn positions_m(&self) -> &[[T; 3]] {
         self.buffers.positions_m
+    }
+
+    /// The triangle slots (module docs): each live slot's vertices in
+    /// outward order, [`DEAD_TRIANGLE`] for the others. As of the last
+    /// [`Self::remove_tets`]; the collision lists follow at the next re-bin.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        self.buffers.triangles
+    }
+
+    /// The live tet whose face surface triangle `t` is; `None` for an
+    /// empty slot or an index beyond the slots.
+    pub fn tet_of(&self, t: TriangleIndex) -> Option<TetIndex> {
+        if *self.buffers.triangles.get(t.get())? == DEAD_TRIANGLE {
+            return None;
+        }
+        self.table.tet(*self.buffers.slot_tet.get(t.get())?)
+    }
+
+    /// The uncut surface: the table's boundary triangles in slots `0..B`,
+    /// the interior faces empty in the slots after them (module docs).
+    /// Cost: `B` binary searches in the `F` mesh triangles, one pass over
+    /// the slots and one over the tets' faces.
+    pub fn reset_faces(&mut self) {
+        let b = &mut self.buffers;
+        let mesh = self.table.mesh_triangles();
+        b.face_slot.fill(u32::MAX);
+        b.triangles.fill(DEAD_TRIANGLE);
+        for (k, (tri, slot)) in self
+            .table
+            .surface_triangles()
+            .iter()
+            .zip(b.triangles.iter_mut())
+            .enumerate()
+        {
+            let mut sorted = *tri;
+            sorted.sort_unstable();
+            if let Some(m) = mesh
+                .binary_search(&sorted)
+                .ok()
+                .and_then(|m| b.face_slot.get_mut(m))
+            {
+                *m = k as u32;
+                *slot = *tri;
+            }
+        }
+        // The interior faces take the slots after the boundary, in order.
+        let mut next = self.table.surface_triangles().len() as u32;
+        for slot in b.face_slot.iter_mut().filter(|s| **s == u32::MAX) {
+            *slot = next;
+            next = next.saturating_add(1);
+        }
+        b.slot_tet.fill(u32::MAX);
+        for (t, faces) in self.table.tet_triangles().iter().enumerate() {
+            for &m in faces {
+                if let Some(owner) = b
+                    .face_slot
+                    .get(m as usize)
+                    .filter(|&&s| b.triangles.get(s as usize) != Some(&DEAD_TRIANGLE))
+                    .and_then(|&s| b.slot_tet.get_mut(s as usize))
+                {
+                    *owner = t as u32;
+                }
+            }
+        }
+        self.dirty = true;
+    }
+
+    /// Updates the faces of every tet of `removed` whose `alive` entry is
+    /// `false` (module docs): each face shared with a live neighbour becomes
+    /// a surface triangle outward from it, the others leave the surface.
+    /// Reads only the final `alive` states, so the order of `removed` does
+    /// not matter. Constant work per tet; the collision lists follow at
+    /// the next re-bin.
+    pub fn remove_tets(&mut self, alive: &[bool], removed: impl Iterator<Item = TetIndex>) {
+        let table = &self.table;
+        let b = &mut self.buffers;
+        let is_alive = |t: u32| alive.get(t as usize) == Some(&true);
+        for t in removed.filter(|t| !is_alive(t.as_u32())) {
+            let (Some(faces), Some(neighbours)) = (
+                table.tet_triangles().get(t.get()),
+                table.tet_neighbours().get(t.get()),
+            ) else {
+                continue;
+            };
+            for (&m, &other) in faces.iter().zip(neighbours) {
+                let Some(&slot) = b.face_slot.get(m as usize) else {
+                    continue;
+                };
+                let exposed = (other != NO_NEIGHBOUR && is_alive(other))
+                    .then(|| {
+                        let vertices = *table.tets().get(other as usize)?;
+                        let across = table.tet_neighbours().get(other as usize)?;
+                        let j = across.iter().position(|&n| n == t.as_u32())?;
+                        tet_face_vertices(vertices).get(j).copied()
+                    })
+                    .flatten();
+                if let (Some(tri), Some(owner)) = (
+                    b.triangles.get_mut(slot as usize),
+                    b.slot_tet.get_mut(slot as usize),
+                ) {
+                    *tri = exposed.unwrap_or(DEAD_TRIANGLE);
+                    *owner = if exposed.is_some() { other } else { u32::MAX };
+                }
+            }
+            self.dirty = true;
+        }
     }
 
     /// The surface at the last re-bin, for detection and tracking;

@@ -43,16 +43,41 @@
 //! device in `k` equal steps instead of one jump; the price is that it
 //! arrives over one physics period instead of at once. (The offset is
 //! taken from the force the tissue last requested, before the supervisor.)
+//!
+//! Grasping (MODELS.md §6): a held contact ([`Contact::grip_offset_m`])
+//! imposes the full vector [`Contact::displacement_m`] on its triangle's
+//! vertices with the same shares, and the hand feels the full vector
+//! `Σ s_i f_i` at the update, extrapolated with the contact's 3×3
+//! stiffness `K_c = Σ_ij s_i s_j K_ij` (`α = 1`): `F = F_update − K_c (tip −
+//! tip_update)`. A held contact may pull.
+//!
+//! Cutting and tearing (Picinbono 2001 §3.1; MODELS.md §3): at each update,
+//! first each enabled [`Blade`] removes the tets it touches, and the tet
+//! its sphere presses into, at most [`Tearing::capacity_tets`]-like
+//! [`PhysicsConfig::cut_capacity_tets`] per update over all blades (the
+//! rest at the next updates: nothing is lost, the scan finds them again);
+//! after the steps, tets past the [`Tearing`] thresholds are removed, at
+//! most its capacity. The removed tets' faces update the deforming surface
+//! ([`DeformingSurface::remove_tets`]) before it is re-binned, so the
+//! faces they expose are touchable from this update on. A contact whose
+//! triangle left the surface is not imposed nor held (its vertices are
+//! released), and tracking drops it at the next tick: a grasp torn off
+//! loses its hold, and its force falls through the supervisor's slew limit.
+//! [`DynamicTissue::removed`] lists the tets the last update removed, in
+//! removal order (a replay repeats them exactly).
 
 use core::fmt;
 
 use nalgebra::Vector3;
 
+use nalgebra::Matrix3;
+
+use super::cut::TearThresholds;
 use super::surface::{DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers};
 use super::{Integrator, StepError, StepReport, TensorMassModel};
-use crate::Real;
 use crate::contact::{Contact, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue};
-use crate::table::VertexIndex;
+use crate::table::{TetIndex, TriangleIndex, VertexIndex};
+use crate::{MAX_CONTACTS, Real};
 
 /// Least `Σ w_i²` over a contact triangle's movable vertices for the
 /// tissue to hold it: below it (a contact point near a fixed vertex) the
@@ -68,6 +93,46 @@ pub const MAX_SUBSTEPS: u32 = 10_000;
 /// Least normal tool motion over a physics period, m, for a new secant
 /// stiffness ratio (below it the ratio is noise: kept from before).
 pub const SECANT_MIN_MOTION_M: f64 = 1e-6;
+
+/// Most tets one physics update removes on purpose, per kind (cutting,
+/// tearing): the largest [`PhysicsConfig::cut_capacity_tets`] and
+/// [`Tearing::capacity_tets`].
+pub const MAX_REMOVAL_CAPACITY: u32 = 64;
+
+/// Most tets one physics update removes in all: each kind stops at its
+/// capacity, plus the at most 4 tets the last removal leaves hanging
+/// (`remove_tet`), plus one pressed tet per blade.
+pub const MAX_REMOVED_PER_UPDATE: usize = 2 * (MAX_REMOVAL_CAPACITY as usize + 4) + MAX_CONTACTS;
+
+/// An enabled blade at a physics update (MODELS.md §6; built by the
+/// haptic loop from a [`crate::haptic::ToolAction::Cut`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blade<T> {
+    /// The tool point.
+    pub tool: usize,
+    /// One end of the blade (the tool point), m.
+    pub from_m: Vector3<T>,
+    /// The other end, m.
+    pub to_m: Vector3<T>,
+    /// The blade's half-thickness (the tool sphere's radius), m: tets with
+    /// a vertex this close to the segment are cut.
+    pub radius_m: T,
+    /// The surface triangle the tool sphere presses into (negative gap),
+    /// if any: its tet is cut too (the tissue ahead of the blade).
+    pub pressing: Option<TriangleIndex>,
+}
+
+/// The enabled blades of one update, at most one per tool point.
+pub type Blades<T> = heapless::Vec<Blade<T>, MAX_CONTACTS>;
+
+/// Tearing at each physics update (MODELS.md §3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tearing<T> {
+    /// The thresholds.
+    pub thresholds: TearThresholds<T>,
+    /// Most tets removed per update (in `1..=MAX_REMOVAL_CAPACITY`).
+    pub capacity_tets: u32,
+}
 
 /// How the force is extrapolated between physics updates (module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -92,6 +157,27 @@ pub struct PhysicsConfig<T> {
     /// Steps per physics update (in `1..=MAX_SUBSTEPS`; the physics period
     /// is `substeps · dt_s`).
     pub substeps: u32,
+    /// Most tets the blades remove per update, over all blades (in
+    /// `1..=MAX_REMOVAL_CAPACITY`).
+    pub cut_capacity_tets: u32,
+    /// Tearing, or none.
+    pub tearing: Option<Tearing<T>>,
+}
+
+impl<T: Real> PhysicsConfig<T> {
+    /// Secant extrapolation, `substeps` steps of `dt_s` (s) with
+    /// `integrator` per update, a cut capacity of 8 tets per update, no
+    /// tearing.
+    pub fn new(integrator: Integrator, dt_s: T, substeps: u32) -> Self {
+        Self {
+            extrapolation: Extrapolation::Secant,
+            integrator,
+            dt_s,
+            substeps,
+            cut_capacity_tets: 8,
+            tearing: None,
+        }
+    }
 }
 
 /// Why a dynamic tissue was not built.
@@ -106,8 +192,9 @@ pub enum DynamicTissueError {
         /// Entries given.
         found: usize,
     },
-    /// `dt_s` not finite and positive, or `substeps` not in
-    /// `1..=MAX_SUBSTEPS`.
+    /// `dt_s` not finite and positive, `substeps` not in
+    /// `1..=MAX_SUBSTEPS`, or a removal capacity not in
+    /// `1..=MAX_REMOVAL_CAPACITY`.
     BadPhysics,
 }
 
@@ -119,7 +206,7 @@ impl fmt::Display for DynamicTissueError {
                 write!(f, "force buffer: length {found}, expected {expected}")
             }
             Self::BadPhysics => {
-                f.write_str("physics dt_s must be finite and > 0, substeps in 1..=MAX_SUBSTEPS")
+                f.write_str("physics dt_s must be finite and > 0, substeps in 1..=MAX_SUBSTEPS, removal capacities in 1..=MAX_REMOVAL_CAPACITY")
             }
         }
     }
@@ -168,9 +255,11 @@ pub struct HeldContact<T> {
     pub contact: Contact<T>,
     /// Each vertex's share `s_i` of the contact point's displacement.
     pub shares: [T; 3],
-    /// `k = Σ_ij s_i s_j n · K_ij n` of the held vertices along `normal`,
-    /// N/m (computed once per update: the tensors change only by cuts).
+    /// `k = n · K_c n` of the held vertices along `normal`, N/m.
     pub stiffness_n_per_m: T,
+    /// `K_c = Σ_ij s_i s_j K_ij` of the held vertices, N/m (computed once
+    /// per update: the tensors change only by cuts).
+    pub stiffness_tensor_n_per_m: Matrix3<T>,
     /// Extrapolation stiffness ratio `α`, in `[0, 1]`.
     pub scale: T,
     /// Normal force sent just before the update minus the update's, N
@@ -186,6 +275,7 @@ pub struct DynamicTissue<'a, 's, T: Real, const P: usize> {
     forces_n: &'s mut [[T; 3]],
     physics: PhysicsConfig<T>,
     held: [Option<HeldContact<T>>; P],
+    removed: heapless::Vec<u32, MAX_REMOVED_PER_UPDATE>,
     fault: Option<PhysicsError>,
     /// Ticks since the last update, and in the period before it (≥ 1).
     ticks_since_update: u32,
@@ -208,9 +298,14 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 found: forces_n.len(),
             });
         }
+        let capacity = 1..=MAX_REMOVAL_CAPACITY;
         if !(physics.dt_s.finite()
             && physics.dt_s > T::zero()
-            && (1..=MAX_SUBSTEPS).contains(&physics.substeps))
+            && (1..=MAX_SUBSTEPS).contains(&physics.substeps)
+            && capacity.contains(&physics.cut_capacity_tets)
+            && physics
+                .tearing
+                .is_none_or(|t| capacity.contains(&t.capacity_tets)))
         {
             return Err(DynamicTissueError::BadPhysics);
         }
@@ -222,10 +317,17 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             forces_n,
             physics,
             held: [None; P],
+            removed: heapless::Vec::new(),
             fault: None,
             ticks_since_update: 0,
             period_ticks: 1,
         })
+    }
+
+    /// The tets the last physics update removed (blades, then tearing, each
+    /// with the tets it left hanging), in removal order.
+    pub fn removed(&self) -> &[u32] {
+        &self.removed
     }
 
     /// The model.
@@ -296,47 +398,59 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         }
     }
 
-    /// `k = Σ_ij s_i s_j n · K_ij n` (N/m): the change of the normal force
-    /// on the hand per metre of normal displacement of the contact point,
-    /// shared out as `s` over `vertices` (module docs). Cost: 9 tensor
-    /// products and 6 edge look-ups.
-    fn normal_stiffness(&self, vertices: &[VertexIndex; 3], shares: &[T; 3], n: &Vector3<T>) -> T {
+    /// `K_c = Σ_ij s_i s_j K_ij` (N/m): the change of the force on the hand
+    /// per metre of displacement of the contact point, shared out as `s`
+    /// over `vertices` (module docs); `n · K_c n` is the normal stiffness.
+    /// Cost: 9 tensor reads and 6 edge look-ups.
+    fn contact_stiffness(&self, vertices: &[VertexIndex; 3], shares: &[T; 3]) -> Matrix3<T> {
         let table = self.model.table();
-        let mut k = T::zero();
+        let mut k = Matrix3::zeros();
         for (&i, &si) in vertices.iter().zip(shares) {
             for (&j, &sj) in vertices.iter().zip(shares) {
                 if si == T::zero() || sj == T::zero() {
                     continue;
                 }
-                let nkn = if i == j {
+                let kij = if i == j {
                     self.model
                         .vertex_tensors()
                         .get(i.get())
-                        .map_or(T::zero(), |kij| n.dot(&product(kij, n, false)))
+                        .map(|kij| Matrix3::from_row_slice(kij))
                 } else {
                     // The stored edge tensor is K_{lo,hi}; K_{hi,lo} is its transpose.
                     table
                         .edge_between(i, j)
                         .and_then(|e| self.model.edge_tensors().get(e.get()))
-                        .map_or(T::zero(), |kij| n.dot(&product(kij, n, i > j)))
+                        .map(|kij| {
+                            let m = Matrix3::from_row_slice(kij);
+                            if i > j { m.transpose() } else { m }
+                        })
                 };
-                k += si * sj * nkn;
+                if let Some(kij) = kij {
+                    k += kij * (si * sj);
+                }
             }
         }
         k
     }
 
     /// The force sent for contact `t` (in the rest frame, with its vertices'
-    /// `shares`) at this tick: its direction and its normal component, N,
-    /// positive pushing the tool out (module docs). With a held triangle the
-    /// gap is the tool's motion along the held normal since the update,
-    /// whatever triangle tracking has reached since; a new contact uses its
-    /// own triangle and gap.
-    fn extrapolate(&self, t: &Contact<T>, shares: &[T; 3]) -> (Vector3<T>, T) {
+    /// `shares`) at this tick, on the hand, N (module docs). With a held
+    /// triangle the motion is the tool's since the update, whatever
+    /// triangle tracking has reached since; a new contact uses its own
+    /// triangle and imposed displacement. A probe's force is along the held
+    /// normal (positive pushing the tool out); a grip's is the full vector.
+    fn extrapolate(&self, t: &Contact<T>, shares: &[T; 3]) -> Vector3<T> {
         let Some(h) = carried(&self.held, t) else {
-            let k = self.normal_stiffness(&t.vertices, shares, &t.normal);
-            return (t.normal, -k * t.gap_m);
+            let k = self.contact_stiffness(&t.vertices, shares);
+            return match t.grip_offset_m {
+                Some(_) => -(k * t.displacement_m()),
+                None => t.normal * (-t.normal.dot(&(k * t.normal)) * t.gap_m),
+            };
         };
+        let motion = t.tip_m - h.contact.tip_m;
+        if t.grip_offset_m.is_some() {
+            return -h.contact.force_n - h.stiffness_tensor_n_per_m * motion;
+        }
         // 1 − j/period at the j-th tick after the update: zero by the next
         // one, so corrections never accumulate.
         let ticks = T::of_f64(f64::from(self.ticks_since_update));
@@ -348,11 +462,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             T::zero()
         };
         let n = h.contact.normal;
-        let gap = (t.tip_m - h.contact.tip_m).dot(&n);
-        (
-            n,
-            -h.contact.force_n.dot(&n) - h.scale * h.stiffness_n_per_m * gap + blend * h.offset_n,
-        )
+        let gap = motion.dot(&n);
+        n * (-h.contact.force_n.dot(&n) - h.scale * h.stiffness_n_per_m * gap + blend * h.offset_n)
     }
 
     /// The extrapolation ratio after an update that changed the force on
@@ -382,14 +493,17 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     }
 
     /// The physics update for contact set `set` (the loop's current
-    /// contacts at the current tool position): release, impose, step
-    /// `substeps` times, read the held forces, re-bin. Bounded by the
-    /// model's step and the re-bin. On failure the tissue is faulted.
+    /// contacts at the current tool position) and the enabled `blades`:
+    /// cut, release, impose, step `substeps` times, tear, read the held
+    /// forces, re-bin (module docs). Bounded by the cut scans (one pass over
+    /// the tets per blade, one for tearing), the model's step and the
+    /// re-bin. On failure the tissue is faulted.
     pub fn update<const M: usize>(
         &mut self,
         set: &ContactSet<T, M>,
+        blades: &Blades<T>,
     ) -> Result<StepReport<T>, PhysicsError> {
-        let result = self.try_update(set);
+        let result = self.try_update(set, blades);
         if let Err(e) = result {
             self.fault = Some(e);
             self.held = [None; P];
@@ -397,30 +511,87 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         result
     }
 
+    /// Removes what the blades touch, at most the cut capacity over all.
+    fn cut(&mut self, blades: &Blades<T>) {
+        let capacity = self.physics.cut_capacity_tets;
+        let mut left = capacity;
+        let log = &mut self.removed;
+        let mut record = |t: TetIndex| {
+            // MAX_REMOVED_PER_UPDATE bounds what one update removes.
+            let _ = log.push(t.as_u32());
+        };
+        for blade in blades {
+            if left == 0 {
+                break;
+            }
+            let pressed = blade.pressing.and_then(|t| self.surface.tet_of(t));
+            if let Some(t) = pressed.filter(|&t| self.model.is_alive(t)) {
+                let n = self.model.remove(t, &mut record).unwrap_or(0);
+                left = left.saturating_sub(n);
+            }
+            if left == 0 {
+                break;
+            }
+            let report = self.model.cut_reporting(
+                blade.from_m,
+                blade.to_m,
+                blade.radius_m,
+                left,
+                &mut record,
+            );
+            left = left.saturating_sub(report.removed);
+        }
+    }
+
+    /// Brings the surface's faces up to the removals from entry `from` of
+    /// the log on.
+    fn expose(&mut self, from: usize) {
+        let table = *self.model.table();
+        let removed = self.removed.get(from..).unwrap_or(&[]);
+        self.surface.remove_tets(
+            self.model.tet_alive(),
+            removed.iter().filter_map(|&t| table.tet(t)),
+        );
+    }
+
+    /// `true` while contact `t`'s triangle is on the surface.
+    fn on_surface(&self, t: &Contact<T>) -> bool {
+        self.surface.tet_of(t.triangle).is_some()
+    }
+
     fn try_update<const M: usize>(
         &mut self,
         set: &ContactSet<T, M>,
+        blades: &Blades<T>,
     ) -> Result<StepReport<T>, PhysicsError> {
         if let Some(fault) = self.fault {
             return Err(fault);
         }
-        // Each contact in the rest frame with its shares, computed once.
+        // What the last tick sent, per tool point (the corrections'
+        // reference), before a cut changes the tensors.
+        let mut sent = [T::zero(); P];
+        for t in set {
+            let t = self.in_rest_frame(t);
+            if let Some(x) = sent.get_mut(t.tool) {
+                *x = self.extrapolate(&t, &self.shares(&t)).dot(&t.normal);
+            }
+        }
+        self.removed.clear();
+        self.cut(blades);
+        self.expose(0);
+        // Each contact still on the surface, in the rest frame with its
+        // shares, computed once.
         let mut set_now: ContactSet<T, M> = ContactSet::new();
         let mut shares = [[T::zero(); 3]; M];
-        for (t, s) in set.iter().zip(shares.iter_mut()) {
+        for t in set.iter().filter(|t| self.on_surface(t)) {
             let t = self.in_rest_frame(t);
-            *s = self.shares(&t);
+            if let Some(s) = shares.get_mut(set_now.len()) {
+                *s = self.shares(&t);
+            }
             let _ = set_now.push(t);
         }
         let now = || set_now.iter().zip(&shares);
         let previous = self.held;
-        // What the last tick sent, per tool point (the corrections' reference).
-        let mut sent = [T::zero(); P];
-        for (t, s) in now() {
-            if let Some(x) = sent.get_mut(t.tool) {
-                *x = self.extrapolate(t, s).1;
-            }
-        }
         // Release what no current contact holds (a vertex whose share fell
         // to zero at the contact point's far edge included).
         for held in previous.iter().flatten() {
@@ -438,12 +609,13 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             }
         }
         self.held = [None; P];
-        // Impose: move each contact point by gap · n, shared out over its
-        // triangle's vertices; a vertex two contacts share gets the sum of
-        // both shifts from where it was (at most 3M entries, 9M² sums). A
-        // gap is a tick's measurement: with no tick since the last update
-        // it has been imposed already, so a back-to-back update (a late
-        // physics thread catching up) holds the contacts where they are.
+        // Impose: move each contact point by its displacement (gap · n, or
+        // a grip's vector), shared out over its triangle's vertices; a
+        // vertex two contacts share gets the sum of both shifts from where
+        // it was (at most 3M entries, 9M² sums). A displacement is a tick's
+        // measurement: with no tick since the last update it has been
+        // imposed already, so a back-to-back update (a late physics thread
+        // catching up) holds the contacts where they are.
         let measured = if self.ticks_since_update > 0 {
             T::one()
         } else {
@@ -455,12 +627,13 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 .model
                 .displacements_m()
                 .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
+            let d = t.displacement_m() * measured;
             for ((slot, &v), &share) in slots.iter_mut().zip(&t.vertices).zip(s) {
                 if share != T::zero() {
                     let from = u
                         .get(v.get())
                         .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]));
-                    *slot = (Some(v), from, t.normal * (t.gap_m * share * measured));
+                    *slot = (Some(v), from, d * share);
                 }
             }
         }
@@ -485,11 +658,28 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                     .map_err(PhysicsError::Step)?,
             );
         }
+        if let Some(tearing) = self.physics.tearing {
+            let torn_from = self.removed.len();
+            let log = &mut self.removed;
+            self.model
+                .tear_reporting(&tearing.thresholds, tearing.capacity_tets, &mut |t| {
+                    let _ = log.push(t.as_u32());
+                });
+            self.expose(torn_from);
+        }
         // The force each contact's held vertices resist.
         self.model.elastic_forces_n(self.forces_n);
         for (t, &shares) in now() {
+            if !self.on_surface(t) {
+                // Torn off: its hold is lost.
+                for &v in &t.vertices {
+                    let _ = self.model.release(v.as_u32());
+                }
+                continue;
+            }
             // The work-conjugate of the contact point's displacement: Σ s_i f_i.
-            let stiffness_n_per_m = self.normal_stiffness(&t.vertices, &shares, &t.normal);
+            let tensor = self.contact_stiffness(&t.vertices, &shares);
+            let stiffness_n_per_m = t.normal.dot(&(tensor * t.normal));
             let mut force_n = Vector3::zeros();
             for (&v, &share) in t.vertices.iter().zip(&shares) {
                 if let Some(f) = self.forces_n.get(v.get()) {
@@ -506,6 +696,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 },
                 shares,
                 stiffness_n_per_m,
+                stiffness_tensor_n_per_m: tensor,
                 scale: T::one(),
                 offset_n: T::zero(),
             });
@@ -524,6 +715,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                     },
                     shares,
                     stiffness_n_per_m,
+                    stiffness_tensor_n_per_m: tensor,
                     scale,
                     offset_n,
                 });
@@ -550,12 +742,6 @@ fn carried<T: Real, const P: usize>(
         .copied()
         .flatten()
         .filter(|h| h.contact.vertices.iter().any(|v| t.vertices.contains(v)))
-}
-
-/// `K x`, or `Kᵀ x` when `transposed`, for a row-major 3×3 `K`.
-fn product<T: Real>(k: &[T; 9], x: &Vector3<T>, transposed: bool) -> Vector3<T> {
-    let m = nalgebra::Matrix3::from_row_slice(k);
-    if transposed { m.transpose() * x } else { m * x }
 }
 
 impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_, '_, T, P> {
@@ -585,12 +771,15 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
             if shares == [T::zero(); 3] {
                 return Err(Refusal::Contact(q));
             }
-            let (normal, force) = self.extrapolate(&t, &shares);
-            let force_n = normal * force;
+            let force_n = self.extrapolate(&t, &shares);
             device_force_n += force_n;
             c.force_n = -force_n;
         }
         Ok(device_force_n)
+    }
+
+    fn can_cut(&self) -> bool {
+        true
     }
 
     fn begin_tick(&mut self) {
@@ -599,9 +788,12 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_,
 
     fn forget(&mut self) {}
 
-    /// Back to rest: the model's reset, nothing held, the surface at rest.
+    /// Back to rest: the model's reset (every tet alive again), nothing
+    /// held, the surface uncut and at rest.
     fn reset(&mut self) {
         self.model.reset();
+        self.surface.reset_faces();
+        self.removed.clear();
         self.held = [None; P];
         self.fault = None;
         self.ticks_since_update = 0;
