@@ -12,6 +12,7 @@ mod host {
     mod robustness;
     mod session;
     mod session_run;
+    mod session_tools;
     mod stability;
 }
 

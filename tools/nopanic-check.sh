@@ -9,8 +9,9 @@
 #   per-vertex inputs, the step with each of the four integrators and each
 #   elastic law, tet removal, cutting, tearing, the live surface and the
 #   outputs, round after round on one model;
-# - the haptic loop over each model: construction, tick, reset, and for the
-#   dynamic model the physics update with its deforming surface.
+# - the haptic loop over each model: construction, tick_tools (probe, grip
+#   and blade actions), reset, and for the dynamic model the physics update
+#   with its blades, tearing, exposed faces and deforming surface.
 # Both tables are built from the firmware example's box by tools/box-table.sh.
 #
 # On failure it rebuilds with `--features locate` (a panic handler that links)
@@ -35,8 +36,9 @@ if cargo build --release 2>"$log"; then
         "step (explicit Euler, symplectic Euler, RK4, central difference; linear and" \
         "St Venant-Kirchhoff, incompressibility on and off), remove_tet, cut_with_tool," \
         "tear, surface_triangles, displacements_m, velocities_m_s, elastic_forces_n, fault;" \
-        "HapticLoop::new, tick, reset (pre-computed); DynamicTissue::new, HapticLoop::new, tick," \
-        "physics_update, reset (tensor-mass, deforming surface)"
+        "HapticLoop::new, tick_tools, reset (pre-computed); DynamicTissue::new, HapticLoop::new," \
+        "tick_tools (touch, grip, cut), physics_update (blades, tearing, exposed faces), removed," \
+        "reset (tensor-mass, deforming surface)"
     exit 0
 fi
 

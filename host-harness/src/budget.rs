@@ -34,15 +34,16 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, bail};
-use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::contact::{MAX_WALK_STEPS, Tissue};
-use palpate_kernel::haptic::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters};
+use palpate_kernel::haptic::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters, ToolInput};
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 
 use crate::mesh::{MeshReport, TetMesh};
+use crate::session::generate::surgery;
 use crate::session::run::{DynamicSetup, loop_config, scene_table, ticks};
+use crate::session::scene::{ToolKind, ToolSpec};
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
 use crate::session::{ModelSpec, Scene, Trajectory};
 use crate::table::load::TableFile;
@@ -96,7 +97,7 @@ pub fn budget_table(
     mesh: &TetMesh,
     report: &MeshReport,
 ) -> anyhow::Result<(Vec<u8>, u64)> {
-    let points = scene.tool.points as u64;
+    let points = scene.tool.kernel_points() as u64;
     let bytes = scene_table(scene, mesh, report)?;
     let file = TableFile::from_bytes(&bytes);
     let load = |e| anyhow::anyhow!("table: {e}");
@@ -118,9 +119,9 @@ pub fn budget_table(
 #[inline(never)]
 pub fn budget_tick<B: Tissue<f32, P>, const P: usize>(
     haptic: &mut HapticLoop<f32, B, P, P>,
-    tool_m: &[Vector3<f32>; P],
+    tools: &[ToolInput<f32>; P],
 ) -> ForceOutput<f32> {
-    haptic.tick(tool_m)
+    haptic.tick_tools(tools)
 }
 
 /// Runs every tick of `trajectory` through [`budget_tick`] on the loop of
@@ -130,7 +131,7 @@ pub fn budget_tick<B: Tissue<f32, P>, const P: usize>(
 /// every `physics_every` ticks, after the tick and outside [`budget_tick`].
 pub fn probe(table: &[u8], scene: &Scene, trajectory: &Trajectory) -> anyhow::Result<Probe> {
     with_tool_points(
-        scene.tool.points,
+        scene.tool.kernel_points(),
         ProbeRun {
             bytes: table,
             scene,
@@ -199,7 +200,7 @@ fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
     let every = scene.rates.physics_every.max(1) as usize;
     let mut counters = Vec::new();
     let mut ticks_s = 0.0;
-    for (k, (_, tool)) in ticks::<P>(trajectory, scene.tick_s())?.enumerate() {
+    for (k, (_, tool)) in ticks::<P>(trajectory, scene.tick_s(), &scene.tool)?.enumerate() {
         let started = std::time::Instant::now();
         core::hint::black_box(budget_tick(haptic, &tool));
         ticks_s += started.elapsed().as_secs_f64();
@@ -300,11 +301,15 @@ pub struct BudgetRow {
 /// Cortex-M4F-class controller at 168 MHz, one instruction per cycle.
 pub const M4F_IPS: f64 = 168e6;
 
-/// The generated trajectories of the budget, by name (`pinch` needs two
-/// tool points and is skipped below that).
-pub fn trajectories(points: usize) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
+/// The generated trajectories a budget runs for `tool`: for probes the
+/// poke, press-hold, slide and strike (and the pinch with two points); for a
+/// scene with a grasper or a cutter, [`surgery`].
+pub fn trajectories(tool: &ToolSpec) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
     use crate::session::{Generator, Pinch, Poke, PressHold, Slide, Strike};
     let err = |e: crate::session::GenerateError| anyhow::anyhow!("{e}");
+    if tool.kinds.iter().any(|k| *k != ToolKind::Probe) {
+        return Ok(vec![("surgery", surgery(tool).map_err(err)?)]);
+    }
     let mut out = vec![
         ("poke", Poke::default().trajectory().map_err(err)?),
         (
@@ -314,7 +319,7 @@ pub fn trajectories(points: usize) -> anyhow::Result<Vec<(&'static str, Trajecto
         ("slide", Slide::default().trajectory().map_err(err)?),
         ("strike", Strike::default().trajectory().map_err(err)?),
     ];
-    if points >= 2 {
+    if tool.points >= 2 {
         out.push(("pinch", Pinch::default().trajectory().map_err(err)?));
     }
     Ok(out)

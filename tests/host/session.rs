@@ -102,13 +102,7 @@ fn hand_written_scene_with_every_field() {
             extrapolation: Extrapolation::Instantaneous,
         })
     );
-    assert_eq!(
-        s.tool,
-        ToolSpec {
-            points: 2,
-            radius_m: 0.0015
-        }
-    );
+    assert_eq!(s.tool, ToolSpec::probes(2, 0.0015));
     assert_eq!(
         s.rates,
         Rates {
@@ -152,13 +146,7 @@ poisson = 0.45
     );
     assert_eq!(s.material.density_kg_m3, 1000.0);
     assert_eq!(s.model, ModelSpec::Precomputed);
-    assert_eq!(
-        s.tool,
-        ToolSpec {
-            points: 1,
-            radius_m: 0.002
-        }
-    );
+    assert_eq!(s.tool, ToolSpec::probes(1, 0.002));
     assert_eq!(
         s.rates,
         Rates {
@@ -342,11 +330,11 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
         // Syntax, unknown keys, types: the parser's message with the line.
         (
             format!("colour = 1\n{BASE}"),
-            "bad.toml: line 1: unknown field `colour`, expected one of `mesh`, `generated`, `fix`, `material`, `model`, `tool`, `rates`, `safety`",
+            "bad.toml: line 1: unknown field `colour`, expected one of `mesh`, `generated`, `fix`, `material`, `model`, `tool`, `cutting`, `tearing`, `rates`, `safety`",
         ),
         (
             format!("{BASE}[tool]\nradius = 0.002\n"),
-            "bad.toml: line 7: unknown field `radius`, expected `points` or `radius_m`",
+            "bad.toml: line 7: unknown field `radius`, expected one of `points`, `radius_m`, `kind`, `jaw_axis`, `grip_opening_m`, `blade_m`",
         ),
         (
             format!("{BASE}[tool]\npoints = \"one\"\n"),
@@ -543,7 +531,9 @@ fn positions_are_interpolated_linearly_per_tool_point() {
         Sample {
             t_s: 2.0,
             tool: 1,
-            position_m: [1.0, 1.0, 3.0]
+            position_m: [1.0, 1.0, 3.0],
+            jaw_m: 0.0,
+            cut: false,
         }
     );
     assert_eq!((t.start_s(), t.end_s()), (0.0, 3.0));
@@ -594,21 +584,29 @@ fn trajectory_round_trips_through_write_csv() {
             t_s: 0.0,
             tool: 0,
             position_m: [0.1, -0.0, 1e-7],
+            jaw_m: 0.0,
+            cut: false,
         },
         Sample {
             t_s: 0.0,
             tool: 1,
             position_m: [1.0 / 3.0, 2.0f64.sqrt(), -123.456],
+            jaw_m: 0.0,
+            cut: false,
         },
         Sample {
             t_s: 0.001,
             tool: 1,
             position_m: [f64::MIN_POSITIVE, 1e300, -5e-324],
+            jaw_m: 0.0,
+            cut: false,
         },
         Sample {
             t_s: 0.30000000000000004,
             tool: 0,
             position_m: [0.06, 0.06, 0.055],
+            jaw_m: 0.0,
+            cut: false,
         },
     ];
     let t = Trajectory::from_samples(samples.clone(), 2).unwrap();
@@ -674,22 +672,22 @@ fn every_trajectory_error_names_the_file_and_line() {
         (
             "".into(),
             1,
-            "traj.csv: empty: expected the header line `t,tool,x,y,z`",
+            "traj.csv: empty: expected the header line `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`",
         ),
         (
             "\n\n# only comments\n".into(),
             1,
-            "traj.csv: empty: expected the header line `t,tool,x,y,z`",
+            "traj.csv: empty: expected the header line `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`",
         ),
         (
             "0,0,0,0,0\n".into(),
             1,
-            "traj.csv: line 1: expected the header `t,tool,x,y,z`, found `0,0,0,0,0`",
+            "traj.csv: line 1: expected the header `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`, found `0,0,0,0,0`",
         ),
         (
             "time,tool,x,y,z\n".into(),
             1,
-            "traj.csv: line 1: expected the header `t,tool,x,y,z`, found `time,tool,x,y,z`",
+            "traj.csv: line 1: expected the header `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`, found `time,tool,x,y,z`",
         ),
         (h.into(), 1, "traj.csv: no samples after the header"),
         (
@@ -795,6 +793,8 @@ fn every_trajectory_error_names_the_file_and_line() {
         t_s,
         tool,
         position_m: [0.0; 3],
+        jaw_m: 0.0,
+        cut: false,
     };
     let msg = Trajectory::from_samples(vec![s(0.0, 0), s(1.0, 0), s(0.5, 0)], 1)
         .unwrap_err()
@@ -1118,6 +1118,8 @@ fn two_probes_by_concatenating_keyframes() {
         tool: 0,
         t_s,
         position_m: [0.0, 0.0, z],
+        jaw_m: 0.0,
+        cut: false,
         label,
     };
     let t = sample_keyframes(
@@ -1237,6 +1239,8 @@ fn every_generator_error_names_the_parameter() {
         tool: 0,
         t_s,
         position_m: [0.0; 3],
+        jaw_m: 0.0,
+        cut: false,
         label: "x",
     };
     assert_eq!(

@@ -10,7 +10,6 @@ use palpate::fem::material::Material;
 use palpate::mesh::MeshReport;
 use palpate::mesh::generate::box_mesh;
 use palpate::table::build::{BuildOptions, build};
-use palpate::table::compliance::Solver;
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate::tensor_mass::run::f64_table;
@@ -22,7 +21,6 @@ use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::DeformingSurface;
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
 use palpate_kernel::tensor_mass::{DynamicTissue, Extrapolation, PhysicsConfig};
-use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable};
 use proptest::prelude::*;
 
 /// A 6 × 6 × 3 cm block of 648 tets (1 cm cells), bottom fixed, E = 3 kPa,
@@ -232,39 +230,16 @@ fn held_force_at_rest_matches_the_static_solve() {
         let held = haptic.tissue().held()[0].expect("held");
         let u = haptic.tissue().model().displacements_m().expect("finite");
         // The vertices with a share are the held ones.
-        let (contacts, shares): (Vec<Constraint<f64>>, Vec<f64>) = held
+        let vertices: Vec<(u32, Vector3<f64>, f64)> = held
             .contact
             .vertices
             .iter()
             .zip(&held.shares)
             .filter(|(_, s)| **s != 0.0)
-            .map(|(&v, &s)| {
-                (
-                    Constraint::at_vertex(v.as_u32(), Vector3::from(u[v.get()])),
-                    s,
-                )
-            })
-            .unzip();
+            .map(|(&v, &s)| (v.as_u32(), Vector3::from(u[v.get()]), s))
+            .collect();
         let mesh = box_mesh([6, 6, 3], SIZE_M);
-        let options = BuildOptions::precomputed(
-            Material::new(3000.0, 0.45).expect("material"),
-            vec!["z<0.001".parse().expect("predicate")],
-            Solver::Cholesky,
-            Precision::F64,
-        );
-        let built = build(&mesh, &MeshReport::default(), &options).expect("pre-computed table");
-        let bytes = TableFile::from_bytes(&built.bytes);
-        let static_table = PrecomputedTable::<f64>::load(bytes.bytes()).expect("load");
-        let solution = PrecomputedModel::new(static_table)
-            .contact_forces::<3>(&contacts)
-            .expect("static solve");
-        // The same work-conjugate: Σ s_i (−g_i), g_i the force on vertex i.
-        let reaction: Vector3<f64> = solution
-            .contact_forces_n()
-            .iter()
-            .zip(&shares)
-            .map(|(g, s)| -g * *s)
-            .sum();
+        let reaction = palpate_tests::static_reaction(&mesh, "z<0.001", &vertices);
         let normal = held.contact.normal;
         let error = (force.norm() - reaction.dot(&normal)).abs() / force.norm();
         println!(

@@ -237,3 +237,49 @@ pub fn live_mesh(mesh: &palpate::mesh::TetMesh, alive: &[bool]) -> palpate::mesh
             .collect(),
     }
 }
+
+/// The force on the hand of contacts holding vertices at imposed
+/// displacements, from one global static linear FEM solve of `mesh`
+/// (E = 3 kPa, ν = 0.45, vertices matching `fix` fixed; a pre-computed table
+/// by sparse Cholesky, Cotin 1999 §3): each held vertex `(v, u, s)` imposed
+/// at `u` (m), and the result `Σ s (−g_v)`, `g_v` the force on vertex `v`,
+/// N: the work-conjugate a dynamic contact with shares `s` sends.
+pub fn static_reaction(
+    mesh: &palpate::mesh::TetMesh,
+    fix: &str,
+    held: &[(u32, nalgebra::Vector3<f64>, f64)],
+) -> nalgebra::Vector3<f64> {
+    use palpate::table::build::{BuildOptions, build};
+    use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable};
+    let options = BuildOptions::precomputed(
+        palpate::fem::material::Material::new(3000.0, 0.45).expect("material"),
+        vec![fix.parse().expect("predicate")],
+        palpate::table::compliance::Solver::Cholesky,
+        palpate::table::file::Precision::F64,
+    );
+    let built = build(mesh, &palpate::mesh::MeshReport::default(), &options).expect("table");
+    let bytes = palpate::table::load::TableFile::from_bytes(&built.bytes);
+    let table = PrecomputedTable::<f64>::load(bytes.bytes()).expect("load");
+    // A vertex two contacts hold is one constraint with both shares.
+    let mut merged: Vec<(u32, nalgebra::Vector3<f64>, f64)> = Vec::new();
+    for &(v, u, s) in held {
+        match merged.iter_mut().find(|(w, _, _)| *w == v) {
+            Some((_, _, total)) => *total += s,
+            None => merged.push((v, u, s)),
+        }
+    }
+    let held = &merged;
+    let contacts: Vec<Constraint<f64>> = held
+        .iter()
+        .map(|&(v, u, _)| Constraint::at_vertex(v, u))
+        .collect();
+    let solution = PrecomputedModel::new(table)
+        .contact_forces::<8>(&contacts)
+        .expect("static solve");
+    solution
+        .contact_forces_n()
+        .iter()
+        .zip(held)
+        .map(|(g, (_, _, s))| -g * *s)
+        .sum()
+}

@@ -16,7 +16,7 @@ use super::stdout;
 /// `palpate budget`'s arguments.
 #[derive(clap::Args)]
 pub struct BudgetArgs {
-    /// Scene file (TOML), `built-in` or `built-in-dynamic`.
+    /// Scene file (TOML), `built-in`, `built-in-dynamic` or `built-in-tools`.
     scene: String,
     /// Working folder for tables, trajectories and callgrind dumps.
     #[arg(long, default_value = "budget-out")]
@@ -76,8 +76,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             },
         );
     }
-    let points = scene.tool.points;
-    let mut chosen = trajectories(points)?;
+    let mut chosen = trajectories(&scene.tool)?;
     if let Some(unknown) = only
         .iter()
         .find(|name| !chosen.iter().any(|(known, _)| known == name))

@@ -5,9 +5,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
 use palpate::output::atomic::{self, AtomicFile};
-use palpate::session::run::run_session_to_files;
+use palpate::session::generate::surgery;
+use palpate::session::run::{removed_path, removes_tets, run_session_to_files};
 use palpate::session::{
-    Generator, MeshSource, Pinch, Poke, PressHold, Scene, Slide, Strike, Trajectory,
+    CutLine, Generator, GraspPull, MeshSource, Pinch, Poke, PressHold, Scene, Slide, Strike,
+    Trajectory,
 };
 
 use super::mesh_files;
@@ -16,13 +18,20 @@ use super::mesh_files;
 pub enum SessionCommand {
     /// Drive the haptic loop tick by tick; write `t,fx,fy,fz,contacts,status` per tick.
     Run {
-        /// Scene file (TOML), `built-in` (the demo block, pre-computed model) or
-        /// `built-in-dynamic` (the same block on the dynamic model).
+        /// Scene file (TOML), `built-in` (the demo block, pre-computed model),
+        /// `built-in-dynamic` (the same block on the dynamic model) or
+        /// `built-in-tools` (the dynamic block with a grasper and a cutter).
         scene: String,
-        /// Trajectory file: CSV `t,tool,x,y,z` (s, tool point, m) with a header.
+        /// Trajectory file: CSV `t,tool,x,y,z` (s, tool point, m) with a header,
+        /// optionally with the tool columns `jaw_m,cut` (header
+        /// `t,tool,x,y,z,jaw_m,cut`: a grasper's jaw opening, m; `1` enables a
+        /// cutter's blade, `0` not).
         #[arg(long)]
         trajectory: PathBuf,
         /// Output CSV, one line per tick (replaced only when the run succeeds).
+        /// A dynamic scene with a cutter or tearing also writes the removed
+        /// tets, `t,tet` per tet in removal order, to OUT with the extension
+        /// `removed.csv`.
         #[arg(long)]
         out: PathBuf,
         /// Folder for a VTK frame per physics update and `session.pvd`: created,
@@ -53,6 +62,12 @@ pub enum TrajectoryKind {
     Slide,
     Pinch,
     Strike,
+    // A grasper (tool point 0: its centre) grasping the block, pulling and releasing.
+    GraspPull,
+    // A cutter (tool point 0: the blade's upper end) cutting a 6 cm line in the block.
+    CutLine,
+    // The `built-in-tools` scene's grasper (tool 0) and cutter (tool 1) at work together.
+    Surgery,
 }
 
 /// Runs a `session` command.
@@ -70,7 +85,7 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             // scene's mesh once the scene names it).
             let scene_file = Path::new(&scene);
             let mut inputs: Vec<(&str, PathBuf)> = vec![("--trajectory", trajectory.clone())];
-            if !matches!(scene.as_str(), "built-in" | "built-in-dynamic") {
+            if !Scene::BUILT_IN.contains(&scene.as_str()) {
                 inputs.push(("the scene", scene_file.to_path_buf()));
             }
             refuse_inputs(&out, vtk.as_deref(), &inputs)?;
@@ -80,6 +95,11 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                     inputs.push(("the scene's mesh", file));
                 }
                 refuse_inputs(&out, vtk.as_deref(), &inputs)?;
+            }
+            if removes_tets(&scene) {
+                let inputs: Vec<(&str, &Path)> =
+                    inputs.iter().map(|(l, p)| (*l, p.as_path())).collect();
+                atomic::refuse_input(("the removed-tets file", &removed_path(&out)), &inputs)?;
             }
             let points = scene.tool.points;
             let trajectory = if lenient {
@@ -102,6 +122,19 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                 summary.max_jump_n,
                 summary.frames
             );
+            if removes_tets(&scene) {
+                eprintln!(
+                    "{} tets removed (cuts and tears), listed in {}",
+                    summary.removed_tets,
+                    removed_path(&out).display()
+                );
+            }
+            if summary.cut_refused > 0 {
+                eprintln!(
+                    "{} ticks with an enabled blade on tissue the pre-computed model cannot cut (status cut-refused)",
+                    summary.cut_refused
+                );
+            }
             if let Some(e) = summary.physics_error {
                 eprintln!("physics update failed at {e}; the force was zero from the next tick on");
             }
@@ -114,6 +147,9 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                 TrajectoryKind::Slide => Slide::default().trajectory(),
                 TrajectoryKind::Pinch => Pinch::default().trajectory(),
                 TrajectoryKind::Strike => Strike::default().trajectory(),
+                TrajectoryKind::GraspPull => GraspPull::default().trajectory(),
+                TrajectoryKind::CutLine => CutLine::default().trajectory(),
+                TrajectoryKind::Surgery => surgery(&Scene::built_in_tools().tool),
             }
             .map_err(|e| anyhow::anyhow!("{e}"))?;
             let mut file = AtomicFile::create(&output)?;

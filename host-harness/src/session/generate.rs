@@ -1,17 +1,22 @@
-//! Trajectory generators: poke, press-and-hold, slide, two-point pinch, fast strike.
+//! Trajectory generators: poke, press-and-hold, slide, two-point pinch, fast strike (probes),
+//! grasp-and-pull (a grasper), cut line (a cutter).
 //!
 //! Every generator describes a piecewise-linear path per tool point by its [`Keyframe`]s (start,
 //! contact, deepest, ... each labelled), and [`sample_keyframes`] samples it at `rate_hz` on the
 //! grid `t = k / rate_hz` (k = 0, 1, ...) plus every keyframe time, so that
 //! [`Trajectory::positions_at`] reproduces the path exactly: the requested depth is reached
 //! exactly at the deepest keyframe's time. Paths start at `t = 0` and end at the last keyframe.
+//! A keyframe also carries the tool columns of the trajectory file (module
+//! [`super::trajectory`]): the jaw opening `jaw_m`, linear between keyframes as the position, and
+//! the blade's `cut`, held from a keyframe to the next. The probe generators leave them at 0 and
+//! off and write the 5-column format; [`GraspPull`] and [`CutLine`] write the 7-column one.
 //!
 //! The geometry of a press is a [`Press`]: a surface point, its outward normal, a standoff above
 //! the surface and a depth below it, and the approach and withdraw speeds. Defaults are on the
 //! built-in scene's block (top face `z = 0.06` m, centre `(0.06, 0.06)`), at 1 kHz.
 
 use super::scene::MAX_TOOL_POINTS;
-use super::trajectory::{Sample, Trajectory, position_on};
+use super::trajectory::{Sample, ToolState, Trajectory, state_on};
 
 /// Largest number of samples a generator produces, so a typo (a speed of 1e-9 m/s) is an error
 /// rather than an exhausted memory.
@@ -34,8 +39,10 @@ fn err(param: &'static str, msg: impl Into<String>) -> GenerateError {
     }
 }
 
-/// A point of a tool point's path: at `t_s` the tool point `tool` is at `position_m`; between
-/// two keyframes of a tool point it moves in a straight line at constant speed.
+/// A point of a tool point's path: at `t_s` the tool point `tool` is at `position_m` with the jaw
+/// opening `jaw_m` and the blade enabled if `cut`; between two keyframes of a tool point it moves
+/// in a straight line at constant speed, its jaw opening changes linearly, and its `cut` stays
+/// the earlier keyframe's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Keyframe {
     /// Tool point index, 0-based.
@@ -44,10 +51,40 @@ pub struct Keyframe {
     pub t_s: f64,
     /// Position, m.
     pub position_m: [f64; 3],
-    /// Which point of the path: `start`, `contact` (crossing the rest surface on the way in),
-    /// `deepest`, `held` (end of a hold), `slid` (end of a slide), `closed` (pinch closed),
-    /// `release` (crossing the rest surface on the way out), `end`.
+    /// A grasper's jaw opening, m, finite and ≥ 0 (0 for other tool kinds).
+    pub jaw_m: f64,
+    /// Whether a cutter's blade is enabled from this keyframe to the next (false for other tool
+    /// kinds).
+    pub cut: bool,
+    /// Which point of the path: `start`, `contact` (crossing the rest surface on the way in; for
+    /// a grasper, its jaw spheres touching it; for a cutter, its blade tip reaching it, the blade
+    /// enabled from there), `deepest`, `held` (end of a hold), `slid` (end of a slide), `closed`
+    /// (pinch or grasper closed), `gripped` (end of the hold closed, before the pull), `pulled`
+    /// (end of a pull), `opened` (grasper opened), `cut` (end of a cut line, the blade disabled
+    /// from there), `release` (crossing the rest surface on the way out), `end`.
     pub label: &'static str,
+}
+
+impl Keyframe {
+    /// A keyframe with the jaws at 0 and the blade off (a probe's).
+    fn at(tool: usize, t_s: f64, position_m: [f64; 3], label: &'static str) -> Self {
+        Self {
+            tool,
+            t_s,
+            position_m,
+            jaw_m: 0.0,
+            cut: false,
+            label,
+        }
+    }
+
+    fn state(&self) -> ToolState {
+        ToolState {
+            position_m: self.position_m,
+            jaw_m: self.jaw_m,
+            cut: self.cut,
+        }
+    }
 }
 
 /// A generator of a trajectory.
@@ -62,23 +99,42 @@ pub trait Generator {
     /// Sampling rate, Hz.
     fn rate_hz(&self) -> f64;
 
-    /// The sampled trajectory: [`sample_keyframes`] of [`Generator::keyframes`].
+    /// Whether the trajectory has the tool columns `jaw_m,cut` even if no keyframe needs them
+    /// (a grasper's or a cutter's path): false by default.
+    fn tool_columns(&self) -> bool {
+        false
+    }
+
+    /// The sampled trajectory: [`sample_keyframes_with_tool_columns`] of
+    /// [`Generator::keyframes`].
     fn trajectory(&self) -> Result<Trajectory, GenerateError> {
-        sample_keyframes(&self.keyframes()?, self.rate_hz())
+        sample_keyframes_with_tool_columns(&self.keyframes()?, self.rate_hz(), self.tool_columns())
     }
 }
 
 /// Sample piecewise-linear paths at `rate_hz`: for every tool point, a sample at every keyframe
 /// time and at every `k / rate_hz` from 0 to the last keyframe time of all tool points (grid times
 /// within a millionth of a period of a keyframe are dropped: the keyframe stands for them).
-/// Positions between keyframes are linear in time; a tool point holds its last keyframe.
+/// Positions and jaw openings between keyframes are linear in time, a `cut` is the one of the
+/// latest keyframe at or before the sample's time; a tool point holds its last keyframe.
 ///
-/// Requirements: at least one keyframe; finite values; keyframe times `≥ 0` and non-decreasing
-/// per tool point (equal times with different positions are a jump); tool indices below
-/// `MAX_TOOL_POINTS`, every index below the largest used; `rate_hz` finite and `> 0`; at most
-/// [`MAX_GENERATED_SAMPLES`] samples. Samples are ordered by time, then tool point. The
-/// trajectory's tool point count is the largest index + 1.
+/// Requirements: at least one keyframe; finite values, jaw openings `≥ 0`; keyframe times `≥ 0`
+/// and non-decreasing per tool point (equal times with different states are a jump); tool
+/// indices below `MAX_TOOL_POINTS`, every index below the largest used; `rate_hz` finite and
+/// `> 0`; at most [`MAX_GENERATED_SAMPLES`] samples. Samples are ordered by time, then tool
+/// point. The trajectory's tool point count is the largest index + 1; it has the tool columns
+/// `jaw_m,cut` if a keyframe has a jaw opening other than 0 or a `cut`.
 pub fn sample_keyframes(keyframes: &[Keyframe], rate_hz: f64) -> Result<Trajectory, GenerateError> {
+    sample_keyframes_with_tool_columns(keyframes, rate_hz, false)
+}
+
+/// [`sample_keyframes`], with the tool columns `jaw_m,cut` also when no keyframe needs them if
+/// `tool_columns`.
+pub fn sample_keyframes_with_tool_columns(
+    keyframes: &[Keyframe],
+    rate_hz: f64,
+    tool_columns: bool,
+) -> Result<Trajectory, GenerateError> {
     if !(rate_hz.is_finite() && rate_hz > 0.0) {
         return Err(err(
             "rate_hz",
@@ -97,13 +153,18 @@ pub fn sample_keyframes(keyframes: &[Keyframe], rate_hz: f64) -> Result<Trajecto
             ),
         ));
     }
-    let mut paths: Vec<Vec<(f64, [f64; 3])>> = vec![Vec::new(); tool_count];
+    let mut paths: Vec<Vec<(f64, ToolState)>> = vec![Vec::new(); tool_count];
     for k in keyframes {
-        if !(k.t_s.is_finite() && k.t_s >= 0.0 && k.position_m.iter().all(|x| x.is_finite())) {
+        if !(k.t_s.is_finite()
+            && k.t_s >= 0.0
+            && k.position_m.iter().all(|x| x.is_finite())
+            && k.jaw_m.is_finite()
+            && k.jaw_m >= 0.0)
+        {
             return Err(err(
                 "keyframes",
                 format!(
-                    "{} of tool point {}: non-finite value or negative time",
+                    "{} of tool point {}: non-finite value, negative time or negative jaw_m",
                     k.label, k.tool
                 ),
             ));
@@ -122,8 +183,8 @@ pub fn sample_keyframes(keyframes: &[Keyframe], rate_hz: f64) -> Result<Trajecto
                 ));
             }
             // A zero-length phase (no hold, no standoff): the same keyframe again.
-            Some(&(t, p)) if k.t_s == t && k.position_m == p => {}
-            _ => path.push((k.t_s, k.position_m)),
+            Some(&(t, p)) if k.t_s == t && k.state() == p => {}
+            _ => path.push((k.t_s, k.state())),
         }
     }
     if let Some(tool) = paths.iter().position(Vec::is_empty) {
@@ -164,23 +225,26 @@ pub fn sample_keyframes(keyframes: &[Keyframe], rate_hz: f64) -> Result<Trajecto
         times.sort_by(f64::total_cmp);
         let mut keys = path.iter().peekable();
         for t in times {
-            // A keyframe time gives that keyframe's own position (each of a jump's two).
-            let position_m = match keys.peek() {
+            // A keyframe time gives that keyframe's own state (each of a jump's two).
+            let state = match keys.peek() {
                 Some(&&(tk, p)) if tk == t => {
                     keys.next();
                     p
                 }
-                _ => position_on(path, t),
+                _ => state_on(path, t),
             };
             samples.push(Sample {
                 t_s: t,
                 tool,
-                position_m,
+                position_m: state.position_m,
+                jaw_m: state.jaw_m,
+                cut: state.cut,
             });
         }
     }
     samples.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
-    Trajectory::from_samples(samples, tool_count).map_err(|e| err("keyframes", e.to_string()))
+    Trajectory::from_samples_with_tool_columns(samples, tool_count, tool_columns)
+        .map_err(|e| err("keyframes", e.to_string()))
 }
 
 /// `a + s·d`, componentwise.
@@ -342,12 +406,7 @@ impl Press {
         offset_m: [f64; 3],
     ) -> Result<(Vec<Keyframe>, PressPath), GenerateError> {
         let p = self.path()?;
-        let at = |t_s, x: [f64; 3], label| Keyframe {
-            tool,
-            t_s,
-            position_m: along(x, offset_m, 1.0),
-            label,
-        };
+        let at = |t_s, x: [f64; 3], label| Keyframe::at(tool, t_s, along(x, offset_m, 1.0), label);
         let keys = vec![
             at(0.0, p.start, "start"),
             at(p.contact_s, self.surface_m, "contact"),
@@ -361,18 +420,13 @@ impl Press {
     fn way_out(&self, tool: usize, n: [f64; 3], from: [f64; 3], t_s: f64) -> [Keyframe; 2] {
         let release_s = t_s + self.depth_m / self.withdraw_speed_m_s;
         [
-            Keyframe {
+            Keyframe::at(tool, release_s, along(from, n, self.depth_m), "release"),
+            Keyframe::at(
                 tool,
-                t_s: release_s,
-                position_m: along(from, n, self.depth_m),
-                label: "release",
-            },
-            Keyframe {
-                tool,
-                t_s: release_s + self.standoff_m / self.withdraw_speed_m_s,
-                position_m: along(from, n, self.depth_m + self.standoff_m),
-                label: "end",
-            },
+                release_s + self.standoff_m / self.withdraw_speed_m_s,
+                along(from, n, self.depth_m + self.standoff_m),
+                "end",
+            ),
         ]
     }
 }
@@ -449,12 +503,7 @@ impl Generator for PressHold {
         check_finite_at_least(self.hold_s, 0.0, "press_hold.hold_s", "s")?;
         let (mut keys, p) = self.press.way_in(self.tool, [0.0; 3])?;
         let held_s = p.in_s + self.hold_s;
-        keys.push(Keyframe {
-            tool: self.tool,
-            t_s: held_s,
-            position_m: p.deepest,
-            label: "held",
-        });
+        keys.push(Keyframe::at(self.tool, held_s, p.deepest, "held"));
         keys.extend(self.press.way_out(self.tool, p.n, p.deepest, held_s));
         Ok(keys)
     }
@@ -506,12 +555,7 @@ impl Generator for Slide {
         let t = tangent(self.direction, p.n, "slide.direction")?;
         let slid = along(p.deepest, t, self.distance_m);
         let slid_s = p.in_s + self.distance_m / self.slide_speed_m_s;
-        keys.push(Keyframe {
-            tool: self.tool,
-            t_s: slid_s,
-            position_m: slid,
-            label: "slid",
-        });
+        keys.push(Keyframe::at(self.tool, slid_s, slid, "slid"));
         keys.extend(self.press.way_out(self.tool, p.n, slid, slid_s));
         Ok(keys)
     }
@@ -585,18 +629,8 @@ impl Generator for Pinch {
             let closed_s = p.in_s + close_m / self.close_speed_m_s;
             let held_s = closed_s + self.hold_s;
             keys.extend(way_in);
-            keys.push(Keyframe {
-                tool,
-                t_s: closed_s,
-                position_m: closed,
-                label: "closed",
-            });
-            keys.push(Keyframe {
-                tool,
-                t_s: held_s,
-                position_m: closed,
-                label: "held",
-            });
+            keys.push(Keyframe::at(tool, closed_s, closed, "closed"));
+            keys.push(Keyframe::at(tool, held_s, closed, "held"));
             keys.extend(self.press.way_out(tool, n, closed, held_s));
         }
         Ok(keys)
@@ -655,5 +689,728 @@ impl Generator for Strike {
 
     fn rate_hz(&self) -> f64 {
         self.rate_hz
+    }
+}
+
+/// Grasp and pull with a grasper: tool point `tool` is the grasper's centre, and the scene puts
+/// its two jaw spheres (radius `radius_m`) at the centre ± `jaw_m`/2 along its jaw axis. The
+/// centre starts `standoff_m` above `surface_m` along the outward `normal` with the jaws open at
+/// `open_m`, goes down at `approach_speed_m_s` until the jaw spheres are `depth_m` into the rest
+/// surface (the centre `radius_m − depth_m` above it), closes the jaws to `closed_m` in
+/// `close_s` (the grasper grips once the opening is at or below the scene's grip opening), holds
+/// `hold_closed_s`, pulls `pull_m` outward at `pull_speed_m_s`, holds `hold_pulled_s`, opens the
+/// jaws back to `open_m` in `open_s` (releasing the hold), and withdraws `withdraw_m` outward at
+/// `withdraw_speed_m_s`.
+///
+/// Keyframes: `start`, `contact` (the jaw spheres touch the rest surface), `deepest`, `closed`,
+/// `gripped` (end of the hold closed), `pulled`, `held` (end of the hold pulled), `opened`, `end`.
+/// The trajectory has the tool columns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GraspPull {
+    /// Tool point index, `< MAX_TOOL_POINTS`.
+    pub tool: usize,
+    /// The point of the rest surface under the grasper's centre, m.
+    pub surface_m: [f64; 3],
+    /// Outward surface normal at `surface_m`; any finite non-zero length (normalized).
+    pub normal: [f64; 3],
+    /// Radius of the jaw spheres (the scene's `[tool] radius_m`), m, finite and > 0.
+    pub radius_m: f64,
+    /// Start height of the centre above the surface along the normal, m, finite and
+    /// `≥ radius_m` (the jaws start clear of the surface).
+    pub standoff_m: f64,
+    /// How far the jaw spheres go into the surface, m, finite and ≥ 0.
+    pub depth_m: f64,
+    /// Speed on the way down, m/s, finite and > 0.
+    pub approach_speed_m_s: f64,
+    /// Jaw opening at the start and after the release, m, finite and `> closed_m`.
+    pub open_m: f64,
+    /// Jaw opening when closed, m, finite and ≥ 0.
+    pub closed_m: f64,
+    /// Time to close the jaws, s, finite and ≥ 0.
+    pub close_s: f64,
+    /// Time closed before the pull, s, finite and ≥ 0.
+    pub hold_closed_s: f64,
+    /// Length of the pull along the normal, m, finite and ≥ 0.
+    pub pull_m: f64,
+    /// Speed of the pull, m/s, finite and > 0.
+    pub pull_speed_m_s: f64,
+    /// Time held after the pull, closed, s, finite and ≥ 0.
+    pub hold_pulled_s: f64,
+    /// Time to open the jaws, s, finite and ≥ 0.
+    pub open_s: f64,
+    /// Distance along the normal from the pulled position to the end, m, finite and ≥ 0.
+    pub withdraw_m: f64,
+    /// Speed on the way out, m/s, finite and > 0.
+    pub withdraw_speed_m_s: f64,
+    /// Sampling rate, Hz.
+    pub rate_hz: f64,
+}
+
+impl Default for GraspPull {
+    /// Tool point 0 over the top-face centre of the built-in block, `(0.06, 0.06, 0.06)` m,
+    /// normal +z, jaw spheres of radius 2 mm (the built-in tool's): from 10 mm above with the
+    /// jaws open at 12 mm (the spheres at x = 0.054 and 0.066 m), down at 20 mm/s until the
+    /// spheres are 1 mm into the surface (0.45 s), closed to 4.5 mm in 0.3 s (below the default
+    /// grip opening, 2.5 radii = 5 mm), held 0.2 s, pulled 8 mm up at 10 mm/s (0.8 s), held
+    /// 0.5 s, opened to 12 mm in 0.2 s, out 10 mm at 20 mm/s (0.5 s): 2.95 s in all, 1 kHz.
+    fn default() -> Self {
+        Self {
+            tool: 0,
+            surface_m: [0.06, 0.06, 0.06],
+            normal: [0.0, 0.0, 1.0],
+            radius_m: 0.002,
+            standoff_m: 0.01,
+            depth_m: 0.001,
+            approach_speed_m_s: 0.02,
+            open_m: 0.012,
+            closed_m: 0.0045,
+            close_s: 0.3,
+            hold_closed_s: 0.2,
+            pull_m: 0.008,
+            pull_speed_m_s: 0.01,
+            hold_pulled_s: 0.5,
+            open_s: 0.2,
+            withdraw_m: 0.01,
+            withdraw_speed_m_s: 0.02,
+            rate_hz: 1000.0,
+        }
+    }
+}
+
+impl Generator for GraspPull {
+    fn keyframes(&self) -> Result<Vec<Keyframe>, GenerateError> {
+        check_tool(self.tool, "grasp_pull.tool")?;
+        if !self.surface_m.iter().all(|x| x.is_finite()) {
+            return Err(err(
+                "grasp_pull.surface_m",
+                format!("must be finite, got {:?}", self.surface_m),
+            ));
+        }
+        let n = unit(self.normal, "grasp_pull.normal")?;
+        check_positive(self.radius_m, "grasp_pull.radius_m", "m")?;
+        check_finite_at_least(
+            self.standoff_m,
+            self.radius_m,
+            "grasp_pull.standoff_m",
+            "m (grasp_pull.radius_m)",
+        )?;
+        check_finite_at_least(self.depth_m, 0.0, "grasp_pull.depth_m", "m")?;
+        check_positive(
+            self.approach_speed_m_s,
+            "grasp_pull.approach_speed_m_s",
+            "m/s",
+        )?;
+        check_finite_at_least(self.closed_m, 0.0, "grasp_pull.closed_m", "m")?;
+        if !(self.open_m.is_finite() && self.open_m > self.closed_m) {
+            return Err(err(
+                "grasp_pull.open_m",
+                format!(
+                    "must be finite and > closed_m = {} m, got {}",
+                    self.closed_m, self.open_m
+                ),
+            ));
+        }
+        check_finite_at_least(self.close_s, 0.0, "grasp_pull.close_s", "s")?;
+        check_finite_at_least(self.hold_closed_s, 0.0, "grasp_pull.hold_closed_s", "s")?;
+        check_finite_at_least(self.pull_m, 0.0, "grasp_pull.pull_m", "m")?;
+        check_positive(self.pull_speed_m_s, "grasp_pull.pull_speed_m_s", "m/s")?;
+        check_finite_at_least(self.hold_pulled_s, 0.0, "grasp_pull.hold_pulled_s", "s")?;
+        check_finite_at_least(self.open_s, 0.0, "grasp_pull.open_s", "s")?;
+        check_finite_at_least(self.withdraw_m, 0.0, "grasp_pull.withdraw_m", "m")?;
+        check_positive(
+            self.withdraw_speed_m_s,
+            "grasp_pull.withdraw_speed_m_s",
+            "m/s",
+        )?;
+
+        let contact_s = (self.standoff_m - self.radius_m) / self.approach_speed_m_s;
+        let deepest_s = contact_s + self.depth_m / self.approach_speed_m_s;
+        let closed_s = deepest_s + self.close_s;
+        let gripped_s = closed_s + self.hold_closed_s;
+        let pulled_s = gripped_s + self.pull_m / self.pull_speed_m_s;
+        let held_s = pulled_s + self.hold_pulled_s;
+        let opened_s = held_s + self.open_s;
+        let end_s = opened_s + self.withdraw_m / self.withdraw_speed_m_s;
+
+        let start = along(self.surface_m, n, self.standoff_m);
+        let contact = along(self.surface_m, n, self.radius_m);
+        let deepest = along(self.surface_m, n, self.radius_m - self.depth_m);
+        let pulled = along(deepest, n, self.pull_m);
+        let key = |t_s, position_m, jaw_m, label| Keyframe {
+            jaw_m,
+            ..Keyframe::at(self.tool, t_s, position_m, label)
+        };
+        let (open, closed) = (self.open_m, self.closed_m);
+        Ok(vec![
+            key(0.0, start, open, "start"),
+            key(contact_s, contact, open, "contact"),
+            key(deepest_s, deepest, open, "deepest"),
+            key(closed_s, deepest, closed, "closed"),
+            key(gripped_s, deepest, closed, "gripped"),
+            key(pulled_s, pulled, closed, "pulled"),
+            key(held_s, pulled, closed, "held"),
+            key(opened_s, pulled, open, "opened"),
+            key(end_s, along(pulled, n, self.withdraw_m), open, "end"),
+        ])
+    }
+
+    fn rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    fn tool_columns(&self) -> bool {
+        true
+    }
+}
+
+/// A cut along a line with a cutter: tool point `tool` is the blade's upper end, and the blade
+/// runs from it to its tip at the tool point + `blade_m` (the scene's blade vector). The blade
+/// tip follows `press`: from `press.standoff_m` above `press.surface_m`, down at
+/// `press.approach_speed_m_s` to `press.depth_m` below the rest surface, the blade enabled
+/// (`cut = 1`) from the moment the tip reaches the surface; then along the surface
+/// (`direction`, its normal part removed) for `distance_m` at `cut_speed_m_s`, still enabled;
+/// then disabled, and out `withdraw_m` along the normal at `press.withdraw_speed_m_s`.
+///
+/// Keyframes: `start` (blade off), `contact` (the tip at the rest surface, blade on),
+/// `deepest`, `cut` (end of the line, blade off from there), `release` (the tip back at the rest
+/// surface), `end`. The trajectory has the tool columns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CutLine {
+    /// Tool point index, `< MAX_TOOL_POINTS`.
+    pub tool: usize,
+    /// Where and how the blade tip goes in (`press.standoff_m` and `press.depth_m` are the
+    /// tip's); `press.withdraw_speed_m_s` is the speed on the way out.
+    pub press: Press,
+    /// From the tool point (the blade's upper end) to the blade tip, m, finite: the scene's blade
+    /// vector.
+    pub blade_m: [f64; 3],
+    /// Direction of the cut; its part along the normal is removed (it must not be along the
+    /// normal).
+    pub direction: [f64; 3],
+    /// Length of the cut, m, finite and ≥ 0.
+    pub distance_m: f64,
+    /// Speed of the cut, m/s, finite and > 0.
+    pub cut_speed_m_s: f64,
+    /// Distance along the normal from the end of the cut to the end, m, finite and
+    /// `≥ press.depth_m` (the blade leaves the tissue).
+    pub withdraw_m: f64,
+    /// Sampling rate, Hz.
+    pub rate_hz: f64,
+}
+
+impl Default for CutLine {
+    /// Tool point 0, the default blade `[0, 0, −0.01]` m (straight down): the tip from 5 mm above
+    /// the built-in block's top face at `(0.03, 0.06)` down at 20 mm/s to 4 mm below it (the
+    /// blade enabled from the surface on, at 0.25 s; 0.45 s in all), along +x at 10 mm/s for
+    /// 60 mm to x = 0.09 m (6 s), then disabled and out 15 mm up at 20 mm/s (0.75 s): 7.2 s in
+    /// all, 1 kHz.
+    fn default() -> Self {
+        Self {
+            tool: 0,
+            press: Press {
+                surface_m: [0.03, 0.06, 0.06],
+                normal: [0.0, 0.0, 1.0],
+                standoff_m: 0.005,
+                depth_m: 0.004,
+                approach_speed_m_s: 0.02,
+                withdraw_speed_m_s: 0.02,
+            },
+            blade_m: [0.0, 0.0, -0.01],
+            direction: [1.0, 0.0, 0.0],
+            distance_m: 0.06,
+            cut_speed_m_s: 0.01,
+            withdraw_m: 0.015,
+            rate_hz: 1000.0,
+        }
+    }
+}
+
+impl Generator for CutLine {
+    fn keyframes(&self) -> Result<Vec<Keyframe>, GenerateError> {
+        check_tool(self.tool, "cut_line.tool")?;
+        if !self.blade_m.iter().all(|x| x.is_finite()) {
+            return Err(err(
+                "cut_line.blade_m",
+                format!("must be finite, got {:?}", self.blade_m),
+            ));
+        }
+        check_finite_at_least(self.distance_m, 0.0, "cut_line.distance_m", "m")?;
+        check_positive(self.cut_speed_m_s, "cut_line.cut_speed_m_s", "m/s")?;
+        // The tool point is the tip moved back along the blade.
+        let upper = self.blade_m.map(|x| -x);
+        let (mut keys, p) = self.press.way_in(self.tool, upper)?;
+        check_finite_at_least(
+            self.withdraw_m,
+            self.press.depth_m,
+            "cut_line.withdraw_m",
+            "m (press.depth_m)",
+        )?;
+        let t = tangent(self.direction, p.n, "cut_line.direction")?;
+        for k in &mut keys {
+            k.cut = k.label != "start";
+        }
+        let cut = along(p.deepest, t, self.distance_m);
+        let cut_s = p.in_s + self.distance_m / self.cut_speed_m_s;
+        let speed = self.press.withdraw_speed_m_s;
+        let key = |t_s, tip, label| Keyframe::at(self.tool, t_s, along(tip, upper, 1.0), label);
+        keys.extend([
+            key(cut_s, cut, "cut"),
+            key(
+                cut_s + self.press.depth_m / speed,
+                along(cut, p.n, self.press.depth_m),
+                "release",
+            ),
+            key(
+                cut_s + self.withdraw_m / speed,
+                along(cut, p.n, self.withdraw_m),
+                "end",
+            ),
+        ]);
+        Ok(keys)
+    }
+
+    fn rate_hz(&self) -> f64 {
+        self.rate_hz
+    }
+
+    fn tool_columns(&self) -> bool {
+        true
+    }
+}
+
+/// The tools of `tool` at work on the built-in block's top, one generator
+/// per trajectory tool point `i` by its kind, at `y = 0.03 + 0.025 i` m:
+/// a grasper's [`GraspPull`], a cutter's [`CutLine`] (with the scene's
+/// blade), a probe's [`PressHold`]; all sampled at 1 kHz with the tool
+/// columns (`session generate surgery` writes it for `built-in-tools`).
+pub fn surgery(tool: &super::scene::ToolSpec) -> Result<Trajectory, GenerateError> {
+    use super::scene::ToolKind;
+    let mut keyframes = Vec::new();
+    for (i, kind) in tool.kinds.iter().enumerate() {
+        let y = 0.03 + 0.025 * i as f64;
+        keyframes.extend(match kind {
+            ToolKind::Grasper => GraspPull {
+                tool: i,
+                surface_m: [0.06, y, 0.06],
+                ..GraspPull::default()
+            }
+            .keyframes()?,
+            ToolKind::Cutter => {
+                let mut cut = CutLine {
+                    tool: i,
+                    blade_m: tool.blade_m,
+                    ..CutLine::default()
+                };
+                cut.press.surface_m[1] = y;
+                cut.keyframes()?
+            }
+            ToolKind::Probe => {
+                let mut press = PressHold {
+                    tool: i,
+                    ..PressHold::default()
+                };
+                press.press.surface_m[1] = y;
+                press.keyframes()?
+            }
+        });
+    }
+    sample_keyframes_with_tool_columns(&keyframes, 1000.0, true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(keys: &[Keyframe], label: &str) -> Keyframe {
+        match keys.iter().find(|k| k.label == label) {
+            Some(&k) => k,
+            None => panic!("no keyframe {label} in {keys:?}"),
+        }
+    }
+
+    /// Keyframe `label` is at time `t_s` and position `position_m` (within 1e-12) with this jaw
+    /// opening and cut.
+    fn assert_key(
+        keys: &[Keyframe],
+        label: &str,
+        t_s: f64,
+        position_m: [f64; 3],
+        jaw_m: f64,
+        cut: bool,
+    ) {
+        let k = key(keys, label);
+        assert!((k.t_s - t_s).abs() < 1e-12, "{label}: {k:?}");
+        for (a, b) in k.position_m.iter().zip(&position_m) {
+            assert!((a - b).abs() < 1e-12, "{label}: {k:?}");
+        }
+        assert!((k.jaw_m - jaw_m).abs() < 1e-15, "{label}: {k:?}");
+        assert_eq!(k.cut, cut, "{label}: {k:?}");
+        assert_eq!(k.tool, 0, "{label}");
+    }
+
+    fn csv(t: &Trajectory) -> String {
+        let mut bytes = Vec::new();
+        t.write_csv(&mut bytes).unwrap();
+        String::from_utf8(bytes).unwrap()
+    }
+
+    /// 64-bit FNV-1a.
+    fn fnv1a(bytes: &[u8]) -> u64 {
+        bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+    }
+
+    /// The probe generators write exactly what they wrote before the tool columns existed (the
+    /// length, hash and first lines of `palpate session generate KIND` then).
+    #[test]
+    fn probe_generators_are_unchanged() {
+        let cases: [(&str, Trajectory, usize, u64, &str); 5] = [
+            (
+                "poke",
+                Poke::default().trajectory().unwrap(),
+                27593,
+                0x2896_391a_54eb_7515,
+                "t,tool,x,y,z\n0,0,0.06,0.06,0.065\n0.001,0,0.06,0.06,0.06498\n",
+            ),
+            (
+                "press-hold",
+                PressHold::default().trajectory().unwrap(),
+                51714,
+                0x3cda_84a1_40e3_0e7c,
+                "t,tool,x,y,z\n0,0,0.06,0.06,0.065\n0.001,0,0.06,0.06,0.06498\n",
+            ),
+            (
+                "slide",
+                Slide::default().trajectory().unwrap(),
+                72574,
+                0xc367_8e59_387e_1841,
+                "t,tool,x,y,z\n0,0,0.06,0.06,0.065\n0.001,0,0.06,0.06,0.06498\n",
+            ),
+            (
+                "pinch",
+                Pinch::default().trajectory().unwrap(),
+                171_626,
+                0xfce8_f25c_6315_0ceb,
+                "t,tool,x,y,z\n0,0,0.039999999999999994,0.06,0.065\n0,1,0.08,0.06,0.065\n",
+            ),
+            (
+                "strike",
+                Strike::default().trajectory().unwrap(),
+                26795,
+                0x7932_8067_f2ff_6617,
+                "t,tool,x,y,z\n0,0,0.06,0.06,0.06999999999999999\n0.001,0,0.06,0.06,0.06949999999999999\n",
+            ),
+        ];
+        for (name, trajectory, len, hash, head) in cases {
+            assert!(!trajectory.has_tool_columns(), "{name}");
+            let text = csv(&trajectory);
+            assert!(text.starts_with(head), "{name}: {}", &text[..200]);
+            assert_eq!((text.len(), fnv1a(text.as_bytes())), (len, hash), "{name}");
+        }
+    }
+
+    #[test]
+    fn grasp_pull_keyframes() {
+        let g = GraspPull::default();
+        let keys = g.keyframes().unwrap();
+        let labels: Vec<_> = keys.iter().map(|k| k.label).collect();
+        assert_eq!(
+            labels,
+            [
+                "start", "contact", "deepest", "closed", "gripped", "pulled", "held", "opened",
+                "end"
+            ]
+        );
+        let (open, closed) = (0.012, 0.0045);
+        let at = |z| [0.06, 0.06, z];
+        assert_key(&keys, "start", 0.0, at(0.07), open, false);
+        // The jaw spheres (radius 2 mm) touch the top face, then are 1 mm into it.
+        assert_key(&keys, "contact", 0.4, at(0.062), open, false);
+        assert_key(
+            &keys,
+            "deepest",
+            0.45,
+            at(0.06 + 0.002 - 0.001),
+            open,
+            false,
+        );
+        assert_key(&keys, "closed", 0.75, at(0.061), closed, false);
+        assert_key(&keys, "gripped", 0.95, at(0.061), closed, false);
+        assert_key(&keys, "pulled", 1.75, at(0.069), closed, false);
+        assert_key(&keys, "held", 2.25, at(0.069), closed, false);
+        assert_key(&keys, "opened", 2.45, at(0.069), open, false);
+        assert_key(&keys, "end", 2.95, at(0.079), open, false);
+        // The jaw spheres at the start: x = 0.054 and 0.066.
+        let start = key(&keys, "start");
+        let jaws = [-0.5, 0.5].map(|s| start.position_m[0] + s * start.jaw_m);
+        assert!((jaws[0] - 0.054).abs() < 1e-15 && (jaws[1] - 0.066).abs() < 1e-15);
+
+        let t = g.trajectory().unwrap();
+        assert!(t.has_tool_columns());
+        assert_eq!(t.tool_count(), 1);
+        assert_eq!(t.samples().len(), 2951);
+        assert!(t.samples().iter().all(|s| !s.cut));
+        // At the keyframes exactly their state; between them, the jaw linear.
+        for k in &keys {
+            assert_eq!(t.tools_at(k.t_s), [k.state()], "{}", k.label);
+        }
+        let mid_close = t.tools_at(0.6)[0];
+        assert!((mid_close.jaw_m - 0.008_25).abs() < 1e-12, "{mid_close:?}");
+        let mid_open = t.tools_at(2.35)[0];
+        assert!((mid_open.jaw_m - 0.008_25).abs() < 1e-12, "{mid_open:?}");
+        let mid_pull = t.tools_at(1.35)[0];
+        assert!((mid_pull.position_m[2] - 0.065).abs() < 1e-12 && mid_pull.jaw_m == closed);
+        let text = csv(&t);
+        assert!(
+            text.starts_with("t,tool,x,y,z,jaw_m,cut\n0,0,0.06,0.06,0.06999999999999999,0.012,0\n"),
+            "{}",
+            &text[..100]
+        );
+        // Read back: the same trajectory.
+        assert_eq!(Trajectory::from_csv_str(&text, "g", 1).unwrap(), t);
+    }
+
+    #[test]
+    fn cut_line_keyframes_and_blade() {
+        let c = CutLine::default();
+        let keys = c.keyframes().unwrap();
+        let labels: Vec<_> = keys.iter().map(|k| k.label).collect();
+        assert_eq!(
+            labels,
+            ["start", "contact", "deepest", "cut", "release", "end"]
+        );
+        // The tool point is the blade's upper end, 10 mm above the tip.
+        assert_key(&keys, "start", 0.0, [0.03, 0.06, 0.075], 0.0, false);
+        assert_key(&keys, "contact", 0.25, [0.03, 0.06, 0.07], 0.0, true);
+        assert_key(&keys, "deepest", 0.45, [0.03, 0.06, 0.066], 0.0, true);
+        assert_key(&keys, "cut", 6.45, [0.09, 0.06, 0.066], 0.0, false);
+        assert_key(&keys, "release", 6.65, [0.09, 0.06, 0.07], 0.0, false);
+        assert_key(&keys, "end", 7.2, [0.09, 0.06, 0.081], 0.0, false);
+
+        let t = c.trajectory().unwrap();
+        assert!(t.has_tool_columns());
+        assert_eq!(t.samples().len(), 7201);
+        let (on, off) = (key(&keys, "contact").t_s, key(&keys, "cut").t_s);
+        // Enabled from the tip reaching the surface to the end of the line.
+        for s in t.samples() {
+            assert_eq!(s.cut, s.t_s >= on && s.t_s < off, "{s:?}");
+            assert_eq!(s.jaw_m, 0.0);
+        }
+        let cases = [
+            (0.1, false),
+            (on, true),
+            (0.3, true),
+            (3.0, true),
+            (6.449_5, true),
+            (off, false),
+            (7.0, false),
+            (100.0, false),
+        ];
+        for (time, cut) in cases {
+            assert_eq!(t.tools_at(time)[0].cut, cut, "t = {time}");
+        }
+        let middle = t.tools_at(3.0)[0].position_m;
+        assert!((middle[0] - 0.0555).abs() < 1e-12 && (middle[2] - 0.066).abs() < 1e-12);
+        let text = csv(&t);
+        assert!(
+            text.starts_with("t,tool,x,y,z,jaw_m,cut\n0,0,0.03,0.06,0.075,0,0\n"),
+            "{}",
+            &text[..100]
+        );
+        assert_eq!(Trajectory::from_csv_str(&text, "c", 1).unwrap(), t);
+    }
+
+    #[test]
+    fn sampled_keyframes_interpolate_the_jaw_and_hold_the_cut() {
+        let k = |t_s, z, jaw_m, cut, label| Keyframe {
+            jaw_m,
+            cut,
+            ..Keyframe::at(0, t_s, [0.0, 0.0, z], label)
+        };
+        let keys = [
+            k(0.0, 0.01, 0.01, false, "start"),
+            k(0.01, 0.0, 0.0, true, "contact"),
+            // The same place and time, the blade switched off: a jump.
+            k(0.02, 0.0, 0.0, true, "held"),
+            k(0.02, 0.0, 0.0, false, "cut"),
+            k(0.03, 0.0, 0.0, false, "end"),
+        ];
+        let t = sample_keyframes(&keys, 1000.0).unwrap();
+        assert!(t.has_tool_columns());
+        // 31 grid times, plus the jump's second sample.
+        assert_eq!(t.samples().len(), 32);
+        for s in t.samples() {
+            let expected_jaw = (0.01 - s.t_s).max(0.0);
+            assert!((s.jaw_m - expected_jaw).abs() < 1e-15, "{s:?}");
+            assert!((s.position_m[2] - expected_jaw).abs() < 1e-15, "{s:?}");
+        }
+        let cuts: Vec<(f64, bool)> = t.samples().iter().map(|s| (s.t_s, s.cut)).collect();
+        assert_eq!(cuts[9], (0.009, false));
+        assert_eq!(cuts[10], (0.01, true));
+        assert_eq!(cuts[19], (0.019, true));
+        assert_eq!(cuts[20], (0.02, true));
+        assert_eq!(cuts[21], (0.02, false));
+        assert_eq!(cuts[22], (0.021, false));
+        assert!(!t.tools_at(0.02)[0].cut && t.tools_at(0.0195)[0].cut);
+        assert!((t.tools_at(0.0025)[0].jaw_m - 0.0075).abs() < 1e-15);
+
+        // No jaw and no cut: the 5-column format, unless asked for.
+        let plain = [
+            k(0.0, 0.01, 0.0, false, "start"),
+            k(0.01, 0.0, 0.0, false, "end"),
+        ];
+        assert!(!sample_keyframes(&plain, 1000.0).unwrap().has_tool_columns());
+        let with = sample_keyframes_with_tool_columns(&plain, 1000.0, true).unwrap();
+        assert!(with.has_tool_columns());
+        assert_eq!(
+            with.samples(),
+            sample_keyframes(&plain, 1000.0).unwrap().samples()
+        );
+
+        // A jaw opening below 0 or not finite is refused.
+        for jaw in [-0.001, f64::NAN, f64::INFINITY] {
+            let bad = [
+                k(0.0, 0.0, 0.0, false, "start"),
+                k(1.0, 0.0, jaw, false, "closed"),
+            ];
+            assert_eq!(
+                sample_keyframes(&bad, 10.0).unwrap_err().to_string(),
+                "keyframes: closed of tool point 0: non-finite value, negative time or negative jaw_m"
+            );
+        }
+    }
+
+    #[test]
+    fn bad_grasp_and_cut_parameters_name_the_field() {
+        let grasp = |g: GraspPull| g.keyframes().unwrap_err().to_string();
+        let d = GraspPull::default();
+        let cases = [
+            (
+                grasp(GraspPull { open_m: 0.004, ..d }),
+                "grasp_pull.open_m: must be finite and > closed_m = 0.0045 m, got 0.004",
+            ),
+            (
+                grasp(GraspPull {
+                    closed_m: -0.001,
+                    ..d
+                }),
+                "grasp_pull.closed_m: must be finite and >= 0 m, got -0.001",
+            ),
+            (
+                grasp(GraspPull {
+                    standoff_m: 0.001,
+                    ..d
+                }),
+                "grasp_pull.standoff_m: must be finite and >= 0.002 m (grasp_pull.radius_m), got 0.001",
+            ),
+            (
+                grasp(GraspPull { radius_m: 0.0, ..d }),
+                "grasp_pull.radius_m: must be finite and > 0 m, got 0",
+            ),
+            (
+                grasp(GraspPull {
+                    normal: [0.0; 3],
+                    ..d
+                }),
+                "grasp_pull.normal: must be a finite non-zero vector, got [0.0, 0.0, 0.0]",
+            ),
+            (
+                grasp(GraspPull {
+                    surface_m: [f64::NAN, 0.0, 0.0],
+                    ..d
+                }),
+                "grasp_pull.surface_m: must be finite, got [NaN, 0.0, 0.0]",
+            ),
+            (
+                grasp(GraspPull {
+                    close_s: f64::NAN,
+                    ..d
+                }),
+                "grasp_pull.close_s: must be finite and >= 0 s, got NaN",
+            ),
+            (
+                grasp(GraspPull {
+                    pull_speed_m_s: 0.0,
+                    ..d
+                }),
+                "grasp_pull.pull_speed_m_s: must be finite and > 0 m/s, got 0",
+            ),
+            (
+                grasp(GraspPull {
+                    tool: MAX_TOOL_POINTS,
+                    ..d
+                }),
+                &format!(
+                    "grasp_pull.tool: tool point {MAX_TOOL_POINTS} out of range 0..{MAX_TOOL_POINTS}"
+                ),
+            ),
+        ];
+        let cut = |c: CutLine| c.keyframes().unwrap_err().to_string();
+        let d = CutLine::default();
+        let more = [
+            (
+                cut(CutLine {
+                    blade_m: [0.0, f64::INFINITY, 0.0],
+                    ..d
+                }),
+                "cut_line.blade_m: must be finite, got [0.0, inf, 0.0]",
+            ),
+            (
+                cut(CutLine {
+                    direction: [0.0, 0.0, -2.0],
+                    ..d
+                }),
+                "cut_line.direction: [0.0, 0.0, -2.0] is along the surface normal",
+            ),
+            (
+                cut(CutLine {
+                    withdraw_m: 0.003,
+                    ..d
+                }),
+                "cut_line.withdraw_m: must be finite and >= 0.004 m (press.depth_m), got 0.003",
+            ),
+            (
+                cut(CutLine {
+                    cut_speed_m_s: -1.0,
+                    ..d
+                }),
+                "cut_line.cut_speed_m_s: must be finite and > 0 m/s, got -1",
+            ),
+            (
+                cut(CutLine {
+                    distance_m: -0.01,
+                    ..d
+                }),
+                "cut_line.distance_m: must be finite and >= 0 m, got -0.01",
+            ),
+            (
+                cut(CutLine {
+                    press: Press {
+                        depth_m: -1.0,
+                        ..d.press
+                    },
+                    ..d
+                }),
+                "press.depth_m: must be finite and >= 0 m, got -1",
+            ),
+        ];
+        for (got, expected) in cases
+            .iter()
+            .map(|(g, e)| (g, *e))
+            .chain(more.iter().map(|(g, e)| (g, *e)))
+        {
+            assert_eq!(got, expected);
+        }
+        assert_eq!(
+            GraspPull {
+                rate_hz: 0.0,
+                ..GraspPull::default()
+            }
+            .trajectory()
+            .unwrap_err()
+            .to_string(),
+            "rate_hz: must be finite and > 0 Hz, got 0"
+        );
     }
 }

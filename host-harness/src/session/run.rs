@@ -1,15 +1,26 @@
 //! `palpate session run`: drives the kernel's haptic loop
 //! ([`palpate_kernel::haptic::HapticLoop`]) tick by tick from a
 //! trajectory and writes one CSV line per tick, `t,fx,fy,fz,contacts,status`
-//! (s, N, N, N, count, `ok` | `clamped` | `faulted:<reason>`).
+//! (s, N, N, N, count, `ok` | `clamped` | `faulted:<reason>` |
+//! `cut-refused`: an enabled blade touched tissue the model cannot cut, the
+//! pre-computed model; the force is the probe's, unclamped).
+//!
+//! The scene's tools ([`super::tools`]): probes, graspers (two jaws that
+//! hold what they touch once closed) and cutters (a blade that removes the
+//! tets it touches at each physics update of the dynamic model), from the
+//! trajectory's positions, `jaw_m` and `cut` columns. With a cutter or
+//! `[tearing]`, the tets each physics update removed are written, in
+//! removal order, as `t,tet` lines (s, tet index of the mesh) to a side
+//! file ([`removed_path`]): what a replay needs to repeat the cuts exactly.
 //!
 //! The table is built in memory from the scene (f32, the firmware
 //! precision), pre-computed or tensor-mass by the scene's model. The force
 //! is computed every tick (see the loop's docs); every `physics_every`
 //! ticks comes the physics update: for the pre-computed model the
 //! deformation field from the last contact solution, for the dynamic model
-//! a [`DynamicLoop::physics_update`] (steps, held forces, re-binning). With
-//! `--vtk` each update's field is written as a VTK frame.
+//! a [`DynamicLoop::physics_update`] (cuts, steps, tearing, held forces,
+//! re-binning). With `--vtk` each update's field is written as a VTK frame
+//! of the live tets (a cut shows as the tets gone, its faces as surface).
 
 use std::io::Write;
 use std::path::Path;
@@ -18,15 +29,20 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{
-    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits,
+    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits, ToolInput,
 };
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, ElasticLaw, PhysicsConfig, StvkForm, TensorMassModel,
+    DynamicParams, DynamicTissue, ElasticLaw, PhysicsConfig, StvkForm, TearThresholds, Tearing,
+    TensorMassModel,
 };
 
+use super::scene::{ToolKind, ToolSpec};
+use super::stability::check_stable_step;
 use super::tool_points::{ForToolPoints, with_tool_points};
+use super::tools::kernel_tools;
+use super::trajectory::ToolState;
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
 use crate::fix::fixed_vertices;
 use crate::limits::{
@@ -121,26 +137,59 @@ pub fn tick_count(trajectory: &Trajectory, tick_s: f64) -> anyhow::Result<usize>
     Ok(periods as usize + 1)
 }
 
-/// The ticks of `trajectory` at period `tick_s`: `(t_s, tool positions)`
-/// for `t = start + k·tick_s` up to the end, [`tick_count`] of them (its
-/// error if the count is out of range); a tool point the trajectory lacks is
-/// NaN (the loop faults on it).
-pub fn ticks<const P: usize>(
-    trajectory: &Trajectory,
+/// The ticks of `trajectory` at period `tick_s`: `(t_s, kernel tool
+/// points)` for `t = start + k·tick_s` up to the end, [`tick_count`] of them
+/// (its error if the count is out of range), each trajectory tool point
+/// expanded by its kind in `tools` ([`kernel_tools`]); a tool point the
+/// trajectory lacks is NaN (the loop faults on it).
+pub fn ticks<'a, const P: usize>(
+    trajectory: &'a Trajectory,
     tick_s: f64,
-) -> anyhow::Result<impl Iterator<Item = (f64, [Vector3<f32>; P])> + '_> {
+    tools: &'a ToolSpec,
+) -> anyhow::Result<impl Iterator<Item = (f64, [ToolInput<f32>; P])> + 'a> {
     let start = trajectory.start_s();
     let count = tick_count(trajectory, tick_s)?;
-    let mut positions = vec![[0.0; 3]; trajectory.tool_count()];
+    let idle = ToolState {
+        position_m: [f64::NAN; 3],
+        jaw_m: 0.0,
+        cut: false,
+    };
+    let mut states = vec![idle; trajectory.tool_count()];
     Ok((0..count).map(move |k| {
         let t = start + k as f64 * tick_s;
-        trajectory.positions_at_into(t, &mut positions);
-        let tool = core::array::from_fn(|p| {
-            let x = positions.get(p).copied().unwrap_or([f64::NAN; 3]);
-            Vector3::new(x[0] as f32, x[1] as f32, x[2] as f32)
-        });
-        (t, tool)
+        trajectory.tools_at_into(t, &mut states);
+        (t, kernel_tools(tools, &states))
     }))
+}
+
+/// Refuses a trajectory without the `jaw_m,cut` columns for a scene with a
+/// grasper or a cutter (they would never close or cut).
+pub fn check_tool_columns(scene: &Scene, trajectory: &Trajectory) -> anyhow::Result<()> {
+    if let Some(kind) = scene.tool.kinds.iter().find(|k| **k != ToolKind::Probe)
+        && !trajectory.has_tool_columns()
+    {
+        bail!(
+            "{}: [tool] kind has a {}: the trajectory needs the header t,tool,x,y,z,jaw_m,cut \
+             (jaw opening in m, cut 0 or 1), not t,tool,x,y,z",
+            scene.source,
+            kind.name()
+        );
+    }
+    Ok(())
+}
+
+/// Where `session run --out OUT` writes the removed tets of a scene that
+/// can cut or tear: `OUT` with its extension replaced by `removed.csv`
+/// (`session.csv` → `session.removed.csv`).
+pub fn removed_path(out: &Path) -> std::path::PathBuf {
+    out.with_extension("removed.csv")
+}
+
+/// `true` for a dynamic scene with a cutter or tearing: its session
+/// removes tets.
+pub fn removes_tets(scene: &Scene) -> bool {
+    matches!(scene.model, ModelSpec::Dynamic(_))
+        && (scene.tool.kinds.contains(&ToolKind::Cutter) || scene.tearing.is_some())
 }
 
 /// What a session did.
@@ -163,6 +212,10 @@ pub struct SessionSummary {
     /// The first failed physics update of a dynamic model (the loop
     /// faulted from the next tick on).
     pub physics_error: Option<String>,
+    /// Tets removed by cutting and tearing.
+    pub removed_tets: usize,
+    /// Ticks whose blade touched tissue that cannot be cut.
+    pub cut_refused: usize,
 }
 
 /// [`run_session`] into files, as `palpate session run` does: the CSV to the
@@ -182,18 +235,30 @@ pub fn run_session_to_files(
         atomic::refuse_inside(("--vtk", dir), &[("--out", out)])?;
     }
     let mut csv = AtomicFile::create(out)?;
+    let mut removed = removes_tets(scene)
+        .then(|| AtomicFile::create(&removed_path(out)))
+        .transpose()?;
     let series = vtk.map(SeriesDir::create).transpose()?;
-    let summary = run_session(
+    let summary = run_session_into(
         scene,
         trajectory,
-        &mut csv,
-        series.as_ref().map(SeriesDir::dir),
+        SessionOutputs {
+            csv: &mut csv,
+            removed: removed.as_mut().map(|f| f as &mut dyn Write),
+            vtk_dir: series.as_ref().map(SeriesDir::dir),
+        },
     )?;
-    // The CSV is complete and synced before the series replaces the old
-    // one: after the swap only the CSV's rename is left to fail.
+    // The CSVs are complete and synced before the series replaces the old
+    // one: after the swap only the CSVs' renames are left to fail.
     csv.prepare()?;
+    if let Some(removed) = &mut removed {
+        removed.prepare()?;
+    }
     if let Some(series) = series {
         series.commit()?;
+    }
+    if let Some(removed) = removed {
+        removed.commit()?;
     }
     csv.commit()?;
     Ok(summary)
@@ -234,15 +299,55 @@ pub fn run_session(
     out: &mut dyn Write,
     vtk_dir: Option<&Path>,
 ) -> anyhow::Result<SessionSummary> {
+    run_session_into(
+        scene,
+        trajectory,
+        SessionOutputs {
+            csv: out,
+            removed: None,
+            vtk_dir,
+        },
+    )
+}
+
+/// Where a session writes.
+pub struct SessionOutputs<'o> {
+    /// The per-tick CSV.
+    pub csv: &'o mut dyn Write,
+    /// The removed tets, `t,tet` lines (module docs), if wanted.
+    pub removed: Option<&'o mut dyn Write>,
+    /// The VTK series folder (see [`run_session`]), if wanted.
+    pub vtk_dir: Option<&'o Path>,
+}
+
+/// [`run_session`] into `outputs`. Before any work: the tick count, the
+/// trajectory's tool columns for the scene's tools, and, for a dynamic
+/// scene, its step against the mesh's stable step ([`check_stable_step`]).
+pub fn run_session_into(
+    scene: &Scene,
+    trajectory: &Trajectory,
+    outputs: SessionOutputs<'_>,
+) -> anyhow::Result<SessionSummary> {
+    let SessionOutputs {
+        csv: out,
+        mut removed,
+        vtk_dir,
+    } = outputs;
     // Bounded before any work: the table build can take minutes.
     let tick_total =
         tick_count(trajectory, scene.tick_s()).with_context(|| scene.source.clone())?;
+    check_tool_columns(scene, trajectory)?;
     let (mesh, report) = scene.load_mesh()?;
+    check_stable_step(scene, &mesh, &report)?;
     if let Some(dir) = vtk_dir {
         check_series_size(scene, tick_total, &mesh, dir)?;
     }
+    if let Some(removed) = removed.as_mut() {
+        writeln!(removed, "t,tet")?;
+    }
     let mut session = Session {
         out,
+        removed,
         summary: SessionSummary::default(),
         last: Vector3::zeros(),
         rest: &mesh.positions,
@@ -253,6 +358,7 @@ pub fn run_session(
     writeln!(session.out, "t,fx,fy,fz,contacts,status")?;
     let ticks = Ticks {
         trajectory,
+        tools: &scene.tool,
         tick_s: scene.tick_s(),
         every: scene.rates.physics_every.max(1) as usize,
     };
@@ -268,7 +374,7 @@ pub fn run_session(
         }
     };
     with_tool_points(
-        scene.tool.points,
+        scene.tool.kernel_points(),
         SessionTicks {
             ticks: &ticks,
             tissue: &tissue,
@@ -286,13 +392,13 @@ enum SessionTissue<'t> {
 }
 
 /// A session's ticks on its tissue, run with the scene's tool points.
-struct SessionTicks<'a, 't, 'o> {
+struct SessionTicks<'a, 't, 'o, 'm> {
     ticks: &'a Ticks<'a>,
     tissue: &'a SessionTissue<'t>,
-    session: &'a mut Session<'o>,
+    session: &'a mut Session<'o, 'm>,
 }
 
-impl ForToolPoints for SessionTicks<'_, '_, '_> {
+impl ForToolPoints for SessionTicks<'_, '_, '_, '_> {
     type Output = anyhow::Result<()>;
 
     fn call<const P: usize>(self) -> anyhow::Result<()> {
@@ -317,7 +423,8 @@ impl<'t> DynamicSetup<'t> {
     /// The settings of dynamic `scene` (model `spec`) over `table`: its law,
     /// penalty and damping, no gravity (the tissue rests in its meshed
     /// shape), divergence when a displacement exceeds the mesh's
-    /// bounding-box diagonal; the physics period in steps of `dt_s`.
+    /// bounding-box diagonal; the physics period in steps of `dt_s`; the
+    /// scene's cut capacity and tearing.
     pub fn of(
         scene: &Scene,
         spec: &DynamicSpec,
@@ -340,8 +447,15 @@ impl<'t> DynamicSetup<'t> {
                 substeps: scene
                     .dynamic_substeps()
                     .context("physics period is not a whole number of dt_s")?,
-                cut_capacity_tets: 8,
-                tearing: None,
+                cut_capacity_tets: scene.cutting.capacity_tets,
+                tearing: scene.tearing.map(|t| Tearing {
+                    thresholds: TearThresholds {
+                        volume_change: t.volume_change.map(|x| x as f32),
+                        mean_elongation: t.mean_elongation.map(|x| x as f32),
+                        max_elongation: t.max_elongation.map(|x| x as f32),
+                    },
+                    capacity_tets: t.capacity_tets,
+                }),
             },
             config: loop_config(scene),
         })
@@ -372,9 +486,10 @@ impl<'t> DynamicSetup<'t> {
     }
 }
 
-/// The trajectory's ticks and the physics period in ticks.
+/// The trajectory's ticks, the tools and the physics period in ticks.
 struct Ticks<'r> {
     trajectory: &'r Trajectory,
+    tools: &'r ToolSpec,
     tick_s: f64,
     every: usize,
 }
@@ -384,14 +499,14 @@ impl Ticks<'_> {
         &self,
         table: &PrecomputedTable<'_, f32>,
         config: LoopConfig<f32>,
-        session: &mut Session<'_>,
+        session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
         let mut haptic = PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(table), config)
             .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
         let model = *haptic.tissue().model();
         let mut field = vec![[0.0f32; 3]; session.rest.len()];
-        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s)?.enumerate() {
-            session.record(t, &haptic.tick(&tool))?;
+        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s, self.tools)?.enumerate() {
+            session.record(t, &haptic.tick_tools(&tool))?;
             if session.dir.is_some() && k % self.every == 0 {
                 match haptic.solution() {
                     Some(solution) => model
@@ -399,7 +514,7 @@ impl Ticks<'_> {
                         .map_err(|e| anyhow::anyhow!("displacements: {e}"))?,
                     None => field.fill([0.0; 3]),
                 }
-                session.frame(t, &field)?;
+                session.frame(t, &field, None)?;
             }
         }
         Ok(())
@@ -408,7 +523,7 @@ impl Ticks<'_> {
     fn dynamic<const P: usize>(
         &self,
         setup: &DynamicSetup<'_>,
-        session: &mut Session<'_>,
+        session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
         setup.with_loop::<P, _>(|haptic| self.dynamic_ticks(haptic, session))
     }
@@ -416,10 +531,10 @@ impl Ticks<'_> {
     fn dynamic_ticks<const P: usize>(
         &self,
         haptic: &mut DynamicLoop<'_, '_, f32, P, P>,
-        session: &mut Session<'_>,
+        session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
-        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s)?.enumerate() {
-            session.record(t, &haptic.tick(&tool))?;
+        for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s, self.tools)?.enumerate() {
+            session.record(t, &haptic.tick_tools(&tool))?;
             if (k + 1) % self.every != 0 {
                 continue;
             }
@@ -428,9 +543,11 @@ impl Ticks<'_> {
             {
                 session.summary.physics_error = Some(format!("t = {t} s: {e}"));
             }
+            session.removed(t, haptic.tissue().removed())?;
             if session.dir.is_some() {
-                let u = haptic.tissue().model().displacements_m().unwrap_or(&[]);
-                session.frame(t, u)?;
+                let model = haptic.tissue().model();
+                let u = model.displacements_m().unwrap_or(&[]);
+                session.frame(t, u, Some(model.tet_alive()))?;
             }
         }
         Ok(())
@@ -438,21 +555,26 @@ impl Ticks<'_> {
 }
 
 /// The CSV, the summary and the VTK frames of a running session.
-struct Session<'o> {
+struct Session<'o, 'm> {
     out: &'o mut dyn Write,
+    removed: Option<&'o mut dyn Write>,
     summary: SessionSummary,
     last: Vector3<f32>,
-    rest: &'o [[f64; 3]],
-    tets: &'o [[u32; 4]],
+    rest: &'m [[f64; 3]],
+    tets: &'m [[u32; 4]],
     dir: Option<&'o Path>,
     frames: Vec<(f64, std::path::PathBuf)>,
 }
 
-impl Session<'_> {
+impl Session<'_, '_> {
     /// One tick's CSV line and its share of the summary.
     fn record(&mut self, t: f64, output: &ForceOutput<f32>) -> anyhow::Result<()> {
         let summary = &mut self.summary;
         let status = match output.status {
+            OutputStatus::Ok if output.cut_refused => {
+                summary.cut_refused += 1;
+                "cut-refused".to_string()
+            }
             OutputStatus::Ok => "ok".to_string(),
             OutputStatus::Clamped => {
                 summary.clamped += 1;
@@ -477,14 +599,40 @@ impl Session<'_> {
         Ok(())
     }
 
-    /// A VTK frame of displacement field `u` (m; zero where missing) at `t`.
-    fn frame(&mut self, t: f64, u: &[[f32; 3]]) -> anyhow::Result<()> {
+    /// The tets a physics update at `t` removed, one `t,tet` line each.
+    fn removed(&mut self, t: f64, tets: &[u32]) -> anyhow::Result<()> {
+        self.summary.removed_tets += tets.len();
+        if let Some(out) = self.removed.as_mut() {
+            for tet in tets {
+                writeln!(out, "{t},{tet}")?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A VTK frame of displacement field `u` (m; zero where missing) at `t`,
+    /// of the tets `alive` keeps (all without it).
+    fn frame(&mut self, t: f64, u: &[[f32; 3]], alive: Option<&[bool]>) -> anyhow::Result<()> {
         let Some(dir) = self.dir else { return Ok(()) };
         let u: Vec<[f64; 3]> = (0..self.rest.len())
             .map(|v| u.get(v).map_or([0.0; 3], |d| d.map(f64::from)))
             .collect();
+        let live: Vec<[u32; 4]>;
+        let tets = match alive {
+            Some(alive) if alive.contains(&false) => {
+                live = self
+                    .tets
+                    .iter()
+                    .zip(alive)
+                    .filter(|(_, a)| **a)
+                    .map(|(t, _)| *t)
+                    .collect();
+                &live
+            }
+            _ => self.tets,
+        };
         let path = dir.join(format!("frame_{:06}.vtk", self.frames.len()));
-        vtk::write_frame(&path, self.rest, self.tets, &u)?;
+        vtk::write_frame(&path, self.rest, tets, &u)?;
         self.frames.push((t, path));
         Ok(())
     }

@@ -24,8 +24,29 @@
 //!                              # "instantaneous" (palpate_kernel::tensor_mass::tissue)
 //!
 //! [tool]
-//! points = 1                   # default 1, in 1..=4 (MAX_TOOL_POINTS)
+//! points = 1                   # trajectory tool points: default 1, in 1..=4 (MAX_TOOL_POINTS)
 //! radius_m = 0.002             # default 0.002
+//! kind = "probe"               # "probe" (default), "grasper" or "cutter" for every trajectory
+//!                              # tool point, or one per point: kind = ["grasper", "cutter"]
+//!                              # (as many as `points`); a grasper is 2 kernel tool points (its
+//!                              # jaws), a probe or cutter 1, at most 4 in all (MAX_TOOL_POINTS)
+//! jaw_axis = [1.0, 0.0, 0.0]   # grasper: direction from jaw 0 to jaw 1, finite, non-zero;
+//!                              # stored normalized; default x
+//! grip_opening_m = 0.005       # grasper: jaw opening (m) at or below which the jaws hold what
+//!                              # they touch; finite, > 0; default 2.5 * radius_m
+//! blade_m = [0.0, 0.0, -0.01]  # cutter: blade (m) from the tool point (the blade's upper end)
+//!                              # to its tip; finite, length in (0, 0.1]; default [0, 0, -0.01]
+//!
+//! [cutting]                    # optional; only meaningful for the dynamic model
+//! capacity_tets = 8            # tets one physics update removes at most (the rest on the next
+//!                              # updates); 1..=64, default 8
+//!
+//! [tearing]                    # optional, dynamic model only; absent: no tearing
+//! volume_change = 0.5          # tear a tet past |V - V0|/V0 ...
+//! mean_elongation = 0.4        # ... or past this mean relative elongation of its 6 edges ...
+//! max_elongation = 0.6         # ... or past this one of any edge (each optional, absent = off,
+//!                              # finite and > 0; at least one; TearThresholds in the kernel)
+//! capacity_tets = 8            # tets one physics update tears at most; 1..=64, default 8
 //!
 //! [rates]
 //! haptic_hz = 1000.0           # default 1000, at most 10000 (crate::limits::MAX_HAPTIC_HZ)
@@ -38,7 +59,12 @@
 //!
 //! Unknown keys are refused, so a typo is an error, not a silently ignored setting. TOML integers
 //! are accepted where a real is expected (`young_pa = 3000`). Every error names the file and, for
-//! a syntax or type error, the line; for a value out of range, the key.
+//! a syntax or type error, the line; for a value out of range, the key. The grasper and cutter
+//! keys are checked even when no tool point is of that kind (and then unused), as is `[cutting]`
+//! on the pre-computed model, which cannot be cut.
+//!
+//! Whether `dt_s` is stable on the scene's mesh needs the mesh: [`crate::session::stability`]
+//! checks it once the mesh is loaded.
 
 use std::path::{Path, PathBuf};
 
@@ -54,8 +80,10 @@ use crate::limits::{MAX_HAPTIC_HZ, MAX_SCENE_FILE_BYTES, read_bounded};
 use crate::mesh::generate::box_mesh;
 use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh};
 
-/// Largest number of tool points of a scene: the kernel's contact capacity
-/// ([`palpate_kernel::MAX_CONTACTS`]), one contact per tool point.
+/// Largest number of tool points of a scene, both the trajectory's tool points (`[tool] points`)
+/// and the kernel tool points their kinds need ([`ToolSpec::kernel_points`]: a grasper's two jaws
+/// count two): the kernel's contact capacity ([`palpate_kernel::MAX_CONTACTS`]), one contact per
+/// kernel tool point.
 pub const MAX_TOOL_POINTS: usize = MAX_CONTACTS;
 
 /// Largest vertex count of a `[generated]` box, so a typo cannot ask for a mesh that does not
@@ -164,13 +192,110 @@ pub struct DynamicSpec {
     pub extrapolation: Extrapolation,
 }
 
-/// The tool: a few points with a radius.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// What a trajectory tool point is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToolKind {
+    /// A probe tip: one sphere that pushes (one kernel tool point).
+    Probe,
+    /// A grasper: two jaws along [`ToolSpec::jaw_axis`] (two kernel tool points) that hold what
+    /// they touch once closed to [`ToolSpec::grip_opening_m`].
+    Grasper,
+    /// A cutter: a blade [`ToolSpec::blade_m`] from the tool point that removes the tets it
+    /// touches (one kernel tool point).
+    Cutter,
+}
+
+impl ToolKind {
+    /// Every kind, in documentation order.
+    pub const ALL: [ToolKind; 3] = [ToolKind::Probe, ToolKind::Grasper, ToolKind::Cutter];
+
+    /// The scene file's name: `probe`, `grasper` or `cutter`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToolKind::Probe => "probe",
+            ToolKind::Grasper => "grasper",
+            ToolKind::Cutter => "cutter",
+        }
+    }
+
+    /// Kernel tool points (contact spheres) of one such trajectory tool point: a grasper's two
+    /// jaws, one otherwise.
+    pub fn kernel_points(self) -> usize {
+        match self {
+            ToolKind::Grasper => 2,
+            ToolKind::Probe | ToolKind::Cutter => 1,
+        }
+    }
+
+    /// The kind a scene file names, if any.
+    fn from_name(name: &str) -> Option<ToolKind> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// The tool: a few trajectory tool points, each of a [`ToolKind`], with a radius.
+#[derive(Clone, Debug, PartialEq)]
 pub struct ToolSpec {
-    /// Number of tool points (probe tip = 1, grasper jaws = 2), in `1..=MAX_TOOL_POINTS`.
+    /// Number of trajectory tool points (the trajectory's tool columns), in
+    /// `1..=MAX_TOOL_POINTS`.
     pub points: usize,
-    /// Radius of every tool point, m, finite and > 0.
+    /// Radius of every kernel tool point (probe tip, jaw, blade), m, finite and > 0.
     pub radius_m: f64,
+    /// The kind of each trajectory tool point: `points` of them, needing at most
+    /// [`MAX_TOOL_POINTS`] kernel tool points in all ([`Self::kernel_points`]).
+    pub kinds: Vec<ToolKind>,
+    /// Grasper: unit direction from jaw 0 to jaw 1 (finite; the file's value is normalized).
+    pub jaw_axis: [f64; 3],
+    /// Grasper: jaw opening, m, at or below which the jaws hold what they touch; finite and > 0.
+    pub grip_opening_m: f64,
+    /// Cutter: the blade, m, from the tool point (its upper end) to its tip; finite, length in
+    /// `(0, MAX_BLADE_M]`.
+    pub blade_m: [f64; 3],
+}
+
+impl ToolSpec {
+    /// `points` probes of radius `radius_m`, the grasper and cutter settings at their defaults
+    /// ([`DEFAULT_JAW_AXIS`], [`DEFAULT_GRIP_OPENING_RADII`] × `radius_m`, [`DEFAULT_BLADE_M`]).
+    pub fn probes(points: usize, radius_m: f64) -> ToolSpec {
+        ToolSpec {
+            points,
+            radius_m,
+            kinds: vec![ToolKind::Probe; points.min(MAX_TOOL_POINTS)],
+            jaw_axis: DEFAULT_JAW_AXIS,
+            grip_opening_m: DEFAULT_GRIP_OPENING_RADII * radius_m,
+            blade_m: DEFAULT_BLADE_M,
+        }
+    }
+
+    /// Kernel tool points the kinds need: the sum of [`ToolKind::kernel_points`] (a grasper is
+    /// two jaws).
+    pub fn kernel_points(&self) -> usize {
+        self.kinds.iter().map(|k| k.kernel_points()).sum()
+    }
+}
+
+/// Cutting by the scene's cutters (`[cutting]`; only the dynamic model can be cut).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CuttingSpec {
+    /// Tets one physics update removes at most (the rest on the next updates), in
+    /// `1..=MAX_CAPACITY_TETS`.
+    pub capacity_tets: u32,
+}
+
+/// Tearing by thresholds (`[tearing]`, dynamic model only): the kernel's
+/// [`palpate_kernel::tensor_mass::TearThresholds`] and a per-update capacity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TearingSpec {
+    /// Tear a tet whose `|V − V₀| / V₀` exceeds this (`None`: criterion off); finite and > 0.
+    pub volume_change: Option<f64>,
+    /// Tear a tet whose mean relative edge elongation `(l − l₀)/l₀` over its 6 edges exceeds
+    /// this (`None`: off); finite and > 0.
+    pub mean_elongation: Option<f64>,
+    /// Tear a tet one of whose edges' relative elongation exceeds this (`None`: off); finite
+    /// and > 0.
+    pub max_elongation: Option<f64>,
+    /// Tets one physics update tears at most, in `1..=MAX_CAPACITY_TETS`.
+    pub capacity_tets: u32,
 }
 
 /// Loop rates.
@@ -186,8 +311,9 @@ pub struct Rates {
 ///
 /// Invariants (checked by [`Scene::validate`], which every constructor runs): the ranges stated
 /// on each field's type; a pre-computed scene has at least one `fix` predicate (a free body has
-/// no compliance); a dynamic scene's physics period is a whole number (1..=[`MAX_SUBSTEPS`]) of
-/// `dt_s`. Fields are public for reading and for tests; after changing one, call
+/// no compliance) and no tearing; a dynamic scene's physics period is a whole number
+/// (1..=[`MAX_SUBSTEPS`]) of `dt_s`; the tool has one kind per trajectory tool point and needs
+/// at most [`MAX_TOOL_POINTS`] kernel tool points. Fields are public for reading and for tests; after changing one, call
 /// [`Scene::validate`] again.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
@@ -203,6 +329,10 @@ pub struct Scene {
     pub model: ModelSpec,
     /// The tool.
     pub tool: ToolSpec,
+    /// Cutting (used by the dynamic model's cutters).
+    pub cutting: CuttingSpec,
+    /// Tearing (`None`: off); only with the dynamic model.
+    pub tearing: Option<TearingSpec>,
     /// Loop rates.
     pub rates: Rates,
     /// Limits of the safety supervisor on the device force (N, N/s), each finite and > 0;
@@ -224,6 +354,9 @@ struct SceneFile {
     model: ModelFile,
     #[serde(default)]
     tool: ToolFile,
+    #[serde(default)]
+    cutting: CuttingFile,
+    tearing: Option<TearingFile>,
     #[serde(default)]
     rates: RatesFile,
     #[serde(default)]
@@ -307,6 +440,62 @@ struct ToolFile {
     points: usize,
     #[serde(default = "default_radius")]
     radius_m: f64,
+    kind: Option<KindsFile>,
+    jaw_axis: Option<[f64; 3]>,
+    grip_opening_m: Option<f64>,
+    blade_m: Option<[f64; 3]>,
+}
+
+/// `[tool] kind`: one name for every tool point, or one per tool point. Names are checked after
+/// parsing, so that a bad one is an error naming the key.
+enum KindsFile {
+    One(String),
+    Many(Vec<String>),
+}
+
+impl<'de> Deserialize<'de> for KindsFile {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Kinds;
+        impl<'de> serde::de::Visitor<'de> for Kinds {
+            type Value = KindsFile;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str(
+                    "a tool kind (\"probe\", \"grasper\" or \"cutter\") or an array of them",
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<KindsFile, E> {
+                Ok(KindsFile::One(name.to_owned()))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<KindsFile, A::Error> {
+                let mut names = Vec::new();
+                while let Some(name) = seq.next_element::<String>()? {
+                    names.push(name);
+                }
+                Ok(KindsFile::Many(names))
+            }
+        }
+        deserializer.deserialize_any(Kinds)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CuttingFile {
+    #[serde(default = "default_capacity_tets")]
+    capacity_tets: u32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TearingFile {
+    volume_change: Option<f64>,
+    mean_elongation: Option<f64>,
+    max_elongation: Option<f64>,
+    #[serde(default = "default_capacity_tets")]
+    capacity_tets: u32,
 }
 
 #[derive(Deserialize)]
@@ -337,6 +526,19 @@ pub const DEFAULT_TOOL_RADIUS_M: f64 = 0.002;
 pub const DEFAULT_HAPTIC_HZ: f64 = 1000.0;
 /// Default physics update interval, ticks.
 pub const DEFAULT_PHYSICS_EVERY: u32 = 1;
+/// Default grasper jaw axis (from jaw 0 to jaw 1): +x.
+pub const DEFAULT_JAW_AXIS: [f64; 3] = [1.0, 0.0, 0.0];
+/// Default grasper grip opening, in tool radii: `grip_opening_m = 2.5 × radius_m`.
+pub const DEFAULT_GRIP_OPENING_RADII: f64 = 2.5;
+/// Default cutter blade, m: 1 cm straight down from the tool point.
+pub const DEFAULT_BLADE_M: [f64; 3] = [0.0, 0.0, -0.01];
+/// Longest cutter blade, m.
+pub const MAX_BLADE_M: f64 = 0.1;
+/// Default number of tets one physics update cuts or tears at most.
+pub const DEFAULT_CAPACITY_TETS: u32 = 8;
+/// Largest number of tets one physics update may cut or tear (`[cutting]` and `[tearing]`
+/// `capacity_tets`), so an update's removal work stays bounded.
+pub const MAX_CAPACITY_TETS: u32 = 64;
 /// Default device force clamp, N (desktop haptic devices peak at 3–8 N).
 pub const DEFAULT_MAX_FORCE_N: f64 = 4.0;
 /// Default slew limit, N/s (full force in 2 ms).
@@ -350,6 +552,9 @@ fn default_points() -> usize {
 }
 fn default_radius() -> f64 {
     DEFAULT_TOOL_RADIUS_M
+}
+fn default_capacity_tets() -> u32 {
+    DEFAULT_CAPACITY_TETS
 }
 fn default_haptic_hz() -> f64 {
     DEFAULT_HAPTIC_HZ
@@ -369,6 +574,18 @@ impl Default for ToolFile {
         Self {
             points: DEFAULT_TOOL_POINTS,
             radius_m: DEFAULT_TOOL_RADIUS_M,
+            kind: None,
+            jaw_axis: None,
+            grip_opening_m: None,
+            blade_m: None,
+        }
+    }
+}
+
+impl Default for CuttingFile {
+    fn default() -> Self {
+        Self {
+            capacity_tets: DEFAULT_CAPACITY_TETS,
         }
     }
 }
@@ -411,10 +628,11 @@ impl Scene {
                 density_kg_m3: DEFAULT_DENSITY_KG_M3,
             },
             model: ModelSpec::Precomputed,
-            tool: ToolSpec {
-                points: DEFAULT_TOOL_POINTS,
-                radius_m: DEFAULT_TOOL_RADIUS_M,
+            tool: ToolSpec::probes(DEFAULT_TOOL_POINTS, DEFAULT_TOOL_RADIUS_M),
+            cutting: CuttingSpec {
+                capacity_tets: DEFAULT_CAPACITY_TETS,
             },
+            tearing: None,
             rates: Rates {
                 haptic_hz: DEFAULT_HAPTIC_HZ,
                 physics_every: DEFAULT_PHYSICS_EVERY,
@@ -448,12 +666,37 @@ impl Scene {
         }
     }
 
+    /// The built-in surgical scene: the dynamic block of [`Self::built_in_dynamic`] with two
+    /// tools, a grasper (trajectory tool 0, jaws along x, holding at 5 mm) and a cutter (tool
+    /// 1, the default blade 1 cm up from its tip), cutting at most 8 tets per physics update,
+    /// and tearing where an edge stretches by more than 100 % (8 tets per update).
+    pub fn built_in_tools() -> Scene {
+        let mut tool = ToolSpec::probes(2, DEFAULT_TOOL_RADIUS_M);
+        tool.kinds = vec![ToolKind::Grasper, ToolKind::Cutter];
+        Scene {
+            source: "built-in tools scene".into(),
+            tool,
+            tearing: Some(TearingSpec {
+                volume_change: None,
+                mean_elongation: None,
+                max_elongation: Some(1.0),
+                capacity_tets: DEFAULT_CAPACITY_TETS,
+            }),
+            ..Self::built_in_dynamic()
+        }
+    }
+
+    /// The built-in scene names [`Self::named`] knows.
+    pub const BUILT_IN: [&'static str; 3] = ["built-in", "built-in-dynamic", "built-in-tools"];
+
     /// The scene a command line names: `built-in` ([`Self::built_in`]), `built-in-dynamic`
-    /// ([`Self::built_in_dynamic`]), or a scene file ([`Self::read`]).
+    /// ([`Self::built_in_dynamic`]), `built-in-tools` ([`Self::built_in_tools`]), or a scene
+    /// file ([`Self::read`]).
     pub fn named(name: &str) -> Result<Scene, SceneError> {
         match name {
             "built-in" => Ok(Self::built_in()),
             "built-in-dynamic" => Ok(Self::built_in_dynamic()),
+            "built-in-tools" => Ok(Self::built_in_tools()),
             path => Self::read(Path::new(path)),
         }
     }
@@ -543,6 +786,7 @@ impl Scene {
             .collect::<Result<Vec<_>, _>>()?;
         let model = model_spec(&raw.model, raw.rates.haptic_hz, raw.rates.physics_every)
             .map_err(|(key, msg)| invalid(&key, msg))?;
+        let tool = tool_spec(&raw.tool).map_err(|(key, msg)| invalid(&key, msg))?;
         let scene = Scene {
             source: source.to_owned(),
             mesh,
@@ -553,10 +797,16 @@ impl Scene {
                 density_kg_m3: raw.material.density_kg_m3,
             },
             model,
-            tool: ToolSpec {
-                points: raw.tool.points,
-                radius_m: raw.tool.radius_m,
+            tool,
+            cutting: CuttingSpec {
+                capacity_tets: raw.cutting.capacity_tets,
             },
+            tearing: raw.tearing.map(|t| TearingSpec {
+                volume_change: t.volume_change,
+                mean_elongation: t.mean_elongation,
+                max_elongation: t.max_elongation,
+                capacity_tets: t.capacity_tets,
+            }),
             rates: Rates {
                 haptic_hz: raw.rates.haptic_hz,
                 physics_every: raw.rates.physics_every,
@@ -647,6 +897,13 @@ impl Scene {
                 "must be finite and > 0 m",
             );
         }
+        let in_file = |(key, msg): (String, String)| SceneError::Invalid {
+            file: self.source.clone(),
+            key,
+            msg,
+        };
+        check_tool(&self.tool).map_err(in_file)?;
+        check_removal(&self.cutting, self.tearing.as_ref(), &self.model).map_err(in_file)?;
         if !positive(self.rates.haptic_hz) {
             return invalid(
                 format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
@@ -703,6 +960,7 @@ impl Scene {
                 "N/s",
             ),
             ("[tool] radius_m", self.tool.radius_m, "m"),
+            ("[tool] grip_opening_m", self.tool.grip_opening_m, "m"),
         ] {
             if !in_f32(value) {
                 return invalid(
@@ -717,14 +975,14 @@ impl Scene {
                 &format!("out of range of the loop's f32: 1/haptic_hz must lie {f32_range} s"),
             );
         }
+        if !in_f32(length(self.tool.blade_m)) {
+            return invalid(
+                format!("[tool] blade_m = {:?}", self.tool.blade_m),
+                &format!("out of range of the loop's f32: its length must lie {f32_range} m"),
+            );
+        }
         if let ModelSpec::Dynamic(d) = &self.model {
-            check_dynamic(d, self.physics_period_s()).map_err(|(key, msg)| {
-                SceneError::Invalid {
-                    file: self.source.clone(),
-                    key,
-                    msg,
-                }
-            })?;
+            check_dynamic(d, self.physics_period_s()).map_err(in_file)?;
         }
         Ok(())
     }
@@ -870,6 +1128,183 @@ fn model_spec(
     }))
 }
 
+/// The tool of the `[tool]` table; errors are `(key, message)`. Kinds are expanded to one per
+/// tool point (at most [`MAX_TOOL_POINTS`], so a huge `points` allocates nothing before
+/// [`Scene::validate`] refuses it); a finite, non-zero `jaw_axis` is normalized. The ranges are
+/// [`Scene::validate`]'s.
+fn tool_spec(raw: &ToolFile) -> Result<ToolSpec, (String, String)> {
+    let kind = |name: &str, key: String| {
+        ToolKind::from_name(name).ok_or_else(|| {
+            (
+                key,
+                "expected \"probe\", \"grasper\" or \"cutter\"".to_owned(),
+            )
+        })
+    };
+    let kinds = match &raw.kind {
+        None => vec![ToolKind::Probe; raw.points.min(MAX_TOOL_POINTS)],
+        Some(KindsFile::One(name)) => {
+            let k = kind(name, format!("[tool] kind = {name:?}"))?;
+            vec![k; raw.points.min(MAX_TOOL_POINTS)]
+        }
+        Some(KindsFile::Many(names)) => names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| kind(name, format!("[tool] kind[{i}] = {name:?}")))
+            .collect::<Result<_, _>>()?,
+    };
+    Ok(ToolSpec {
+        points: raw.points,
+        radius_m: raw.radius_m,
+        kinds,
+        jaw_axis: raw.jaw_axis.map_or(DEFAULT_JAW_AXIS, normalized),
+        grip_opening_m: raw
+            .grip_opening_m
+            .unwrap_or(DEFAULT_GRIP_OPENING_RADII * raw.radius_m),
+        blade_m: raw.blade_m.unwrap_or(DEFAULT_BLADE_M),
+    })
+}
+
+/// `a / |a|` computed without overflow or underflow (scaled by the largest component first), to
+/// within a few ulps of unit length; `a` itself if it is not finite or is zero.
+fn normalized(a: [f64; 3]) -> [f64; 3] {
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(a.iter().all(|x| x.is_finite()) && scale > 0.0) {
+        return a;
+    }
+    let b = a.map(|x| x / scale);
+    let length = b.iter().map(|x| x * x).sum::<f64>().sqrt();
+    b.map(|x| x / length)
+}
+
+/// Euclidean length of `a` (overflows to infinity only past `f64::MAX`; NaN if a component is).
+fn length(a: [f64; 3]) -> f64 {
+    if a.iter().any(|x| x.is_nan()) {
+        return f64::NAN;
+    }
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(scale.is_finite() && scale > 0.0) {
+        return scale;
+    }
+    scale
+        * a.map(|x| x / scale)
+            .iter()
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt()
+}
+
+/// The ranges of a [`ToolSpec`] (after `points` and `radius_m`); errors are `(key, message)`.
+fn check_tool(tool: &ToolSpec) -> Result<(), (String, String)> {
+    let names = || {
+        let names: Vec<&str> = tool.kinds.iter().map(|k| k.name()).collect();
+        format!("[tool] kind = {names:?}")
+    };
+    if tool.kinds.len() != tool.points {
+        return Err((
+            names(),
+            format!(
+                "{} given for points = {}: give one kind per trajectory tool point, or a single kind for all",
+                tool.kinds.len(),
+                tool.points
+            ),
+        ));
+    }
+    let needed = tool.kernel_points();
+    if needed > MAX_TOOL_POINTS {
+        return Err((
+            names(),
+            format!(
+                "needs {needed} kernel tool points (a grasper is 2 jaws, a probe or cutter 1): at most {MAX_TOOL_POINTS} (MAX_TOOL_POINTS, the kernel's contact capacity)"
+            ),
+        ));
+    }
+    let axis = tool.jaw_axis;
+    if !axis.iter().all(|x| x.is_finite()) || axis.iter().all(|&x| x == 0.0) {
+        return Err((
+            format!("[tool] jaw_axis = {axis:?}"),
+            "must be finite and non-zero (the direction from jaw 0 to jaw 1)".into(),
+        ));
+    }
+    if (length(axis) - 1.0).abs() > 1e-12 {
+        return Err((
+            format!("[tool] jaw_axis = {axis:?}"),
+            "must have unit length (a scene file's jaw_axis is normalized when read)".into(),
+        ));
+    }
+    let grip = tool.grip_opening_m;
+    if !(grip.is_finite() && grip > 0.0) {
+        return Err((
+            format!("[tool] grip_opening_m = {grip}"),
+            "must be finite and > 0 m".into(),
+        ));
+    }
+    let blade = tool.blade_m;
+    let blade_length = length(blade);
+    if !(blade.iter().all(|x| x.is_finite()) && blade_length > 0.0 && blade_length <= MAX_BLADE_M) {
+        return Err((
+            format!("[tool] blade_m = {blade:?}"),
+            format!(
+                "must be finite, with a length > 0 and at most {MAX_BLADE_M} m (MAX_BLADE_M), from the tool point to the blade's tip"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The ranges of `[cutting]` and `[tearing]`; errors are `(key, message)`.
+fn check_removal(
+    cutting: &CuttingSpec,
+    tearing: Option<&TearingSpec>,
+    model: &ModelSpec,
+) -> Result<(), (String, String)> {
+    let capacity = |table: &str, capacity: u32| {
+        if (1..=MAX_CAPACITY_TETS).contains(&capacity) {
+            Ok(())
+        } else {
+            Err((
+                format!("[{table}] capacity_tets = {capacity}"),
+                format!(
+                    "must be in 1..={MAX_CAPACITY_TETS} (MAX_CAPACITY_TETS: tets one physics update removes at most)"
+                ),
+            ))
+        }
+    };
+    capacity("cutting", cutting.capacity_tets)?;
+    let Some(tearing) = tearing else {
+        return Ok(());
+    };
+    if *model == ModelSpec::Precomputed {
+        return Err((
+            "[tearing]".into(),
+            "applies to kind = \"dynamic\" only (this scene is \"precomputed\", which cannot tear)"
+                .into(),
+        ));
+    }
+    let criteria = [
+        ("volume_change", tearing.volume_change),
+        ("mean_elongation", tearing.mean_elongation),
+        ("max_elongation", tearing.max_elongation),
+    ];
+    if criteria.iter().all(|(_, value)| value.is_none()) {
+        return Err((
+            "[tearing]".into(),
+            "no criterion: give at least one of volume_change, mean_elongation and max_elongation (or remove the table: no tearing)".into(),
+        ));
+    }
+    for (key, value) in criteria {
+        if let Some(x) = value
+            && !(x.is_finite() && x > 0.0)
+        {
+            return Err((
+                format!("[tearing] {key} = {x}"),
+                "must be finite and > 0".into(),
+            ));
+        }
+    }
+    capacity("tearing", tearing.capacity_tets)
+}
+
 /// The ranges of a [`DynamicSpec`]; errors are `(key, message)`.
 fn check_dynamic(d: &DynamicSpec, physics_period_s: f64) -> Result<(), (String, String)> {
     if let Some(gamma) = d.incompressibility_n
@@ -901,4 +1336,351 @@ fn check_dynamic(d: &DynamicSpec, physics_period_s: f64) -> Result<(), (String, 
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    //! The tool kinds, `[cutting]` and `[tearing]` (the rest of the format is tested in
+    //! tests/host/session.rs).
+
+    use super::*;
+
+    /// A pre-computed scene without tool, cutting or tearing keys.
+    const BASE: &str =
+        "mesh = \"a.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = 3000\npoisson = 0.45\n";
+    /// `BASE` on the dynamic model.
+    const DYNAMIC: &str = "mesh = \"a.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = 3000\n\
+                           poisson = 0.45\n[model]\nkind = \"dynamic\"\ndamping_per_s = 2\n";
+
+    fn scene(text: &str) -> Scene {
+        match Scene::from_toml_str_named(text, "scene.toml", Path::new("/scenes")) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    fn scene_err(text: &str) -> String {
+        match Scene::from_toml_str_named(text, "bad.toml", Path::new("/scenes")) {
+            Ok(s) => panic!("expected an error, got {s:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn tool_kinds_cutting_and_tearing_with_every_key() {
+        let s = scene(&format!(
+            "{DYNAMIC}\
+             [tool]\n\
+             points = 2\n\
+             radius_m = 0.0015\n\
+             kind = [\"grasper\", \"cutter\"]\n\
+             jaw_axis = [0, 3, -4]          # normalized\n\
+             grip_opening_m = 0.004\n\
+             blade_m = [0.0, 0.005, -0.02]\n\
+             [cutting]\n\
+             capacity_tets = 16\n\
+             [tearing]\n\
+             volume_change = 0.5\n\
+             mean_elongation = 0.4\n\
+             max_elongation = 0.6\n\
+             capacity_tets = 4\n"
+        ));
+        assert_eq!(
+            s.tool,
+            ToolSpec {
+                points: 2,
+                radius_m: 0.0015,
+                kinds: vec![ToolKind::Grasper, ToolKind::Cutter],
+                jaw_axis: [0.0, 0.6, -0.8],
+                grip_opening_m: 0.004,
+                blade_m: [0.0, 0.005, -0.02],
+            }
+        );
+        assert_eq!(s.tool.kernel_points(), 3);
+        assert_eq!(s.cutting, CuttingSpec { capacity_tets: 16 });
+        assert_eq!(
+            s.tearing,
+            Some(TearingSpec {
+                volume_change: Some(0.5),
+                mean_elongation: Some(0.4),
+                max_elongation: Some(0.6),
+                capacity_tets: 4,
+            })
+        );
+        s.validate().unwrap();
+    }
+
+    #[test]
+    fn tool_kinds_cutting_and_tearing_defaults() {
+        // No key: one probe, the grasper and cutter settings at their defaults, cutting 8 tets
+        // per update, no tearing.
+        let s = scene(BASE);
+        assert_eq!(s.tool, ToolSpec::probes(1, 0.002));
+        assert_eq!(s.tool.kinds, [ToolKind::Probe]);
+        assert_eq!(s.tool.jaw_axis, [1.0, 0.0, 0.0]);
+        assert_eq!(s.tool.grip_opening_m, 2.5 * 0.002);
+        assert_eq!(s.tool.blade_m, [0.0, 0.0, -0.01]);
+        assert_eq!(s.tool.kernel_points(), 1);
+        assert_eq!(s.cutting, CuttingSpec { capacity_tets: 8 });
+        assert_eq!(s.tearing, None);
+
+        // One kind for every point; the grip opening follows the radius; one tearing criterion.
+        let s = scene(&format!(
+            "{DYNAMIC}[tool]\npoints = 3\nkind = \"cutter\"\nradius_m = 0.004\n\
+             [tearing]\nmax_elongation = 0.3\n"
+        ));
+        assert_eq!(s.tool.kinds, [ToolKind::Cutter; 3]);
+        assert_eq!(s.tool.kernel_points(), 3);
+        assert_eq!(s.tool.grip_opening_m, 0.01);
+        assert_eq!(
+            s.tearing,
+            Some(TearingSpec {
+                volume_change: None,
+                mean_elongation: None,
+                max_elongation: Some(0.3),
+                capacity_tets: 8,
+            })
+        );
+
+        // Two graspers fill the kernel's 4 tool points; a blade of exactly 0.1 m is accepted;
+        // tiny and huge jaw axes are normalized without underflow or overflow.
+        let s = scene(&format!(
+            "{BASE}[tool]\npoints = 2\nkind = \"grasper\"\njaw_axis = [1e-300, 0, -1e-300]\n\
+             blade_m = [0, 0.1, 0]\n"
+        ));
+        assert_eq!(s.tool.kernel_points(), 4);
+        let h = core::f64::consts::FRAC_1_SQRT_2;
+        assert!((s.tool.jaw_axis[0] - h).abs() < 1e-15 && (s.tool.jaw_axis[2] + h).abs() < 1e-15);
+        let s = scene(&format!("{BASE}[tool]\njaw_axis = [1e308, 1e308, 0]\n"));
+        assert!((s.tool.jaw_axis[0] - h).abs() < 1e-15 && s.tool.jaw_axis[2] == 0.0);
+        assert!((length(s.tool.jaw_axis) - 1.0).abs() <= 1e-12);
+
+        // `[cutting]` is accepted on the pre-computed model (which has nothing to cut).
+        assert_eq!(
+            scene(&format!("{BASE}[cutting]\ncapacity_tets = 64\n")).cutting,
+            CuttingSpec { capacity_tets: 64 }
+        );
+    }
+
+    #[test]
+    fn tool_kind_names_and_kernel_points() {
+        let named: Vec<(&str, usize)> = ToolKind::ALL
+            .iter()
+            .map(|k| (k.name(), k.kernel_points()))
+            .collect();
+        assert_eq!(named, [("probe", 1), ("grasper", 2), ("cutter", 1)]);
+        for kind in ToolKind::ALL {
+            assert_eq!(ToolKind::from_name(kind.name()), Some(kind));
+        }
+        assert_eq!(ToolKind::from_name("Probe"), None);
+    }
+
+    #[test]
+    fn built_in_scenes_have_one_probe_and_no_tearing() {
+        for s in [Scene::built_in(), Scene::built_in_dynamic()] {
+            s.validate().unwrap();
+            assert_eq!(s.tool, ToolSpec::probes(1, 0.002));
+            assert_eq!(s.cutting, CuttingSpec { capacity_tets: 8 });
+            assert_eq!(s.tearing, None);
+        }
+    }
+
+    #[test]
+    fn every_tool_cutting_and_tearing_error_names_the_key() {
+        let tool = |keys: &str| format!("{BASE}[tool]\n{keys}");
+        let cases: Vec<(String, &str)> = vec![
+            // Parser errors, with the line.
+            (
+                tool("blade = 1\n"),
+                "bad.toml: line 7: unknown field `blade`, expected one of `points`, `radius_m`, `kind`, `jaw_axis`, `grip_opening_m`, `blade_m`",
+            ),
+            (
+                tool("kind = 3\n"),
+                "bad.toml: line 7: invalid type: integer `3`, expected a tool kind (\"probe\", \"grasper\" or \"cutter\") or an array of them",
+            ),
+            (
+                tool("points = 2\nkind = [\"probe\", 1]\n"),
+                "bad.toml: line 8: invalid type: integer `1`, expected a string",
+            ),
+            (
+                tool("jaw_axis = [1, 0]\n"),
+                "bad.toml: line 7: invalid length 2, expected an array of length 3",
+            ),
+            (
+                format!("{BASE}[cutting]\ncapacity = 8\n"),
+                "bad.toml: line 7: unknown field `capacity`, expected `capacity_tets`",
+            ),
+            (
+                format!("{BASE}[cutting]\ncapacity_tets = -1\n"),
+                "bad.toml: line 7: invalid value: integer `-1`, expected u32",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\nstrain = 0.5\n"),
+                "bad.toml: line 10: unknown field `strain`, expected one of `volume_change`, `mean_elongation`, `max_elongation`, `capacity_tets`",
+            ),
+            // Kinds.
+            (
+                tool("kind = \"knife\"\n"),
+                "bad.toml: [tool] kind = \"knife\": expected \"probe\", \"grasper\" or \"cutter\"",
+            ),
+            (
+                tool("points = 2\nkind = [\"probe\", \"Scalpel\"]\n"),
+                "bad.toml: [tool] kind[1] = \"Scalpel\": expected \"probe\", \"grasper\" or \"cutter\"",
+            ),
+            (
+                tool("points = 3\nkind = [\"grasper\", \"cutter\"]\n"),
+                "bad.toml: [tool] kind = [\"grasper\", \"cutter\"]: 2 given for points = 3: give one kind per trajectory tool point, or a single kind for all",
+            ),
+            (
+                tool("kind = []\n"),
+                "bad.toml: [tool] kind = []: 0 given for points = 1: give one kind per trajectory tool point, or a single kind for all",
+            ),
+            (
+                tool("points = 3\nkind = [\"grasper\", \"probe\", \"grasper\"]\n"),
+                "bad.toml: [tool] kind = [\"grasper\", \"probe\", \"grasper\"]: needs 5 kernel tool points (a grasper is 2 jaws, a probe or cutter 1): at most 4 (MAX_TOOL_POINTS, the kernel's contact capacity)",
+            ),
+            (
+                tool("points = 3\nkind = \"grasper\"\n"),
+                "bad.toml: [tool] kind = [\"grasper\", \"grasper\", \"grasper\"]: needs 6 kernel tool points (a grasper is 2 jaws, a probe or cutter 1): at most 4 (MAX_TOOL_POINTS, the kernel's contact capacity)",
+            ),
+            (
+                tool("points = 5\nkind = \"grasper\"\n"),
+                "bad.toml: [tool] points = 5: must be in 1..=4 (the kernel's contact capacity)",
+            ),
+            // Grasper.
+            (
+                tool("jaw_axis = [0, 0, 0]\n"),
+                "bad.toml: [tool] jaw_axis = [0.0, 0.0, 0.0]: must be finite and non-zero (the direction from jaw 0 to jaw 1)",
+            ),
+            (
+                tool("jaw_axis = [nan, 0, 1]\n"),
+                "bad.toml: [tool] jaw_axis = [NaN, 0.0, 1.0]: must be finite and non-zero (the direction from jaw 0 to jaw 1)",
+            ),
+            (
+                tool("jaw_axis = [inf, 0, 0]\n"),
+                "bad.toml: [tool] jaw_axis = [inf, 0.0, 0.0]: must be finite and non-zero (the direction from jaw 0 to jaw 1)",
+            ),
+            (
+                tool("grip_opening_m = 0\n"),
+                "bad.toml: [tool] grip_opening_m = 0: must be finite and > 0 m",
+            ),
+            (
+                tool("grip_opening_m = -0.001\n"),
+                "bad.toml: [tool] grip_opening_m = -0.001: must be finite and > 0 m",
+            ),
+            (
+                tool("grip_opening_m = nan\n"),
+                "bad.toml: [tool] grip_opening_m = NaN: must be finite and > 0 m",
+            ),
+            (
+                tool("grip_opening_m = 1e-300\n"),
+                "bad.toml: [tool] grip_opening_m = 1e-300: out of range of the loop's f32: must lie between 1.1754944e-38 and 3.4028235e38 m",
+            ),
+            // Cutter.
+            (
+                tool("blade_m = [0, 0, -0.2]\n"),
+                "bad.toml: [tool] blade_m = [0.0, 0.0, -0.2]: must be finite, with a length > 0 and at most 0.1 m (MAX_BLADE_M), from the tool point to the blade's tip",
+            ),
+            (
+                tool("blade_m = [0.08, 0, -0.08]\n"),
+                "bad.toml: [tool] blade_m = [0.08, 0.0, -0.08]: must be finite, with a length > 0 and at most 0.1 m (MAX_BLADE_M), from the tool point to the blade's tip",
+            ),
+            (
+                tool("blade_m = [0, 0, 0]\n"),
+                "bad.toml: [tool] blade_m = [0.0, 0.0, 0.0]: must be finite, with a length > 0 and at most 0.1 m (MAX_BLADE_M), from the tool point to the blade's tip",
+            ),
+            (
+                tool("blade_m = [0, 0, -inf]\n"),
+                "bad.toml: [tool] blade_m = [0.0, 0.0, -inf]: must be finite, with a length > 0 and at most 0.1 m (MAX_BLADE_M), from the tool point to the blade's tip",
+            ),
+            (
+                tool("blade_m = [0, 0, -1e-300]\n"),
+                "bad.toml: [tool] blade_m = [0.0, 0.0, -1e-300]: out of range of the loop's f32: its length must lie between 1.1754944e-38 and 3.4028235e38 m",
+            ),
+            // Capacities.
+            (
+                format!("{DYNAMIC}[cutting]\ncapacity_tets = 0\n"),
+                "bad.toml: [cutting] capacity_tets = 0: must be in 1..=64 (MAX_CAPACITY_TETS: tets one physics update removes at most)",
+            ),
+            (
+                format!("{DYNAMIC}[cutting]\ncapacity_tets = 65\n"),
+                "bad.toml: [cutting] capacity_tets = 65: must be in 1..=64 (MAX_CAPACITY_TETS: tets one physics update removes at most)",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\nvolume_change = 0.5\ncapacity_tets = 0\n"),
+                "bad.toml: [tearing] capacity_tets = 0: must be in 1..=64 (MAX_CAPACITY_TETS: tets one physics update removes at most)",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\nvolume_change = 0.5\ncapacity_tets = 65\n"),
+                "bad.toml: [tearing] capacity_tets = 65: must be in 1..=64 (MAX_CAPACITY_TETS: tets one physics update removes at most)",
+            ),
+            // Tearing.
+            (
+                format!("{BASE}[tearing]\nvolume_change = 0.5\n"),
+                "bad.toml: [tearing]: applies to kind = \"dynamic\" only (this scene is \"precomputed\", which cannot tear)",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\ncapacity_tets = 4\n"),
+                "bad.toml: [tearing]: no criterion: give at least one of volume_change, mean_elongation and max_elongation (or remove the table: no tearing)",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\n"),
+                "bad.toml: [tearing]: no criterion: give at least one of volume_change, mean_elongation and max_elongation (or remove the table: no tearing)",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\nvolume_change = 0\n"),
+                "bad.toml: [tearing] volume_change = 0: must be finite and > 0",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\nvolume_change = 0.5\nmean_elongation = -0.1\n"),
+                "bad.toml: [tearing] mean_elongation = -0.1: must be finite and > 0",
+            ),
+            (
+                format!("{DYNAMIC}[tearing]\nmax_elongation = inf\n"),
+                "bad.toml: [tearing] max_elongation = inf: must be finite and > 0",
+            ),
+        ];
+        for (text, expected) in cases {
+            let msg = scene_err(&text);
+            assert!(
+                msg == expected,
+                "\n   got: {msg}\nwanted: {expected}\n  text:\n{text}"
+            );
+            assert!(!msg.contains('\n'), "one line: {msg}");
+        }
+    }
+
+    #[test]
+    fn changed_tools_are_checked_again() {
+        let mut s = Scene::built_in();
+        s.tool.points = 2;
+        assert_eq!(
+            s.validate().unwrap_err().to_string(),
+            "built-in scene: [tool] kind = [\"probe\"]: 1 given for points = 2: give one kind per trajectory tool point, or a single kind for all"
+        );
+        s.tool.kinds = vec![ToolKind::Grasper, ToolKind::Probe];
+        s.validate().unwrap();
+        s.tool.jaw_axis = [0.0, 2.0, 0.0];
+        assert_eq!(
+            s.validate().unwrap_err().to_string(),
+            "built-in scene: [tool] jaw_axis = [0.0, 2.0, 0.0]: must have unit length (a scene file's jaw_axis is normalized when read)"
+        );
+        s.tool.jaw_axis = [0.0, 1.0, 0.0];
+        s.tearing = Some(TearingSpec {
+            volume_change: Some(0.5),
+            mean_elongation: None,
+            max_elongation: None,
+            capacity_tets: 8,
+        });
+        assert_eq!(
+            s.validate().unwrap_err().to_string(),
+            "built-in scene: [tearing]: applies to kind = \"dynamic\" only (this scene is \"precomputed\", which cannot tear)"
+        );
+        s.model = Scene::built_in_dynamic().model;
+        s.rates = Scene::built_in_dynamic().rates;
+        s.validate().unwrap();
+        // `probes` caps the kinds at MAX_TOOL_POINTS, so a bad count is refused, not allocated.
+        let tool = ToolSpec::probes(usize::MAX, 0.002);
+        assert_eq!(tool.kinds.len(), MAX_TOOL_POINTS);
+    }
 }

@@ -1,10 +1,19 @@
 //! Tool trajectories: where each tool point is over time, from a CSV file or a generator.
 //!
-//! File format: a header line `t,tool,x,y,z`, then one sample per line: time (s), tool point
-//! index (0-based integer), position (m). One record per line (CSV quoting applies within a
-//! line); fields may be padded with blanks; blank lines and lines starting with `#` are skipped.
-//! Line numbers are the file's physical lines, 1-based: the header is line 1 when nothing
-//! precedes it.
+//! File format: a header line, then one sample per line with as many fields as the header. Two
+//! headers are accepted:
+//! - `t,tool,x,y,z` ([`HEADER`]): time (s), tool point index (0-based integer), position (m);
+//! - `t,tool,x,y,z,jaw_m,cut` ([`TOOL_HEADER`]): the same, then the tool columns:
+//!   - `jaw_m`: a grasper's jaw opening, m, finite and ≥ 0 (the distance between its two jaws,
+//!     placed by the scene at the tool point ± `jaw_m`/2 along its jaw axis); ignored by other
+//!     tool kinds;
+//!   - `cut`: exactly `0` or `1` (after the blanks around it are trimmed); `1` enables a
+//!     cutter's blade. Ignored by other tool kinds.
+//!
+//! A file without the tool columns reads as `jaw_m = 0`, `cut = 0` on every line. One record per
+//! line (CSV quoting applies within a line); fields may be padded with blanks; blank lines and
+//! lines starting with `#` are skipped. Line numbers are the file's physical lines, 1-based: the
+//! header is line 1 when nothing precedes it.
 //!
 //! ```text
 //! t,tool,x,y,z
@@ -14,8 +23,23 @@
 //! 0.5,1,0.07,0.06,0.055
 //! ```
 //!
+//! ```text
+//! t,tool,x,y,z,jaw_m,cut
+//! 0.0,0,0.06,0.06,0.07,0.012,0
+//! 0.45,0,0.06,0.06,0.061,0.012,0
+//! 0.75,0,0.06,0.06,0.061,0.0045,0
+//! ```
+//!
+//! (a grasper's centre going down, then its jaws closing from 12 to 4.5 mm; a cutter's lines
+//! would have `jaw_m = 0` and `cut = 1` while its blade is to cut).
+//!
+//! Between samples, `jaw_m` is interpolated linearly like the position
+//! ([`Trajectory::tools_at`]); `cut` is sample-and-hold: at time `t` a tool point's blade is
+//! enabled if its latest sample at or before `t` says `1` (before its first sample, the first
+//! sample's value), so a blade switches exactly at a sample's time, never between samples.
+//!
 //! Rules checked by [`Trajectory::read`] (each error names the file and the line):
-//! - every value is finite;
+//! - every value is finite; `jaw_m` is ≥ 0; `cut` is `0` or `1`;
 //! - time never decreases from one line to the next, whatever the tool point: the file is one
 //!   time-ordered stream, as a device log is. Samples of different tool points may share a time,
 //!   and so may two samples of the same point: that is a jump (see [`Trajectory::positions_at`]);
@@ -25,13 +49,15 @@
 //!   and the line it is too far from;
 //! - the tool index is below the scene's tool point count, and every tool point has at least one
 //!   sample;
-//! - exactly 5 fields per line, numbers that parse, the header first; one record per line (a
-//!   carriage return inside a line, outside quotes, would end the record: refused).
+//! - the header first, then exactly as many fields per line as the header has (5 or 7: a file
+//!   does not mix them), numbers that parse; one record per line (a carriage return inside a
+//!   line, outside quotes, would end the record: refused).
 //!
 //! [`Trajectory::read_unchecked`] is the lenient reader for robustness tests: it keeps non-finite
-//! values and backward times (reporting each such line as a finding) so that they can be fed to
-//! the kernel, which must fault and output zero force; a finite time out of range or beyond the
-//! span is an error there too (it would only make the run unbounded).
+//! values, negative jaw openings and backward times (reporting each such line as a finding) so
+//! that they can be fed to the kernel, which must fault and output zero force; a finite time out
+//! of range or beyond the span is an error there too (it would only make the run unbounded), and
+//! so is a `cut` other than `0` or `1` (there is no value to keep).
 //!
 //! A file is read whole, at most [`MAX_TRAJECTORY_FILE_BYTES`] (`crate::limits::read_bounded`).
 
@@ -43,10 +69,14 @@ use crate::limits::{
     MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S, read_bounded,
 };
 
-/// The header line's fields, in order.
+/// The header line's fields, in order, of a file without the tool columns.
 pub const HEADER: [&str; 5] = ["t", "tool", "x", "y", "z"];
 
-/// One line of a trajectory: tool point `tool` is at `position_m` at time `t_s`.
+/// The header line's fields, in order, of a file with the tool columns `jaw_m` and `cut`.
+pub const TOOL_HEADER: [&str; 7] = ["t", "tool", "x", "y", "z", "jaw_m", "cut"];
+
+/// One line of a trajectory: tool point `tool` is at `position_m` at time `t_s`, with the jaw
+/// opening `jaw_m` and the blade enabled if `cut`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
     /// Time, s.
@@ -55,35 +85,76 @@ pub struct Sample {
     pub tool: usize,
     /// Position `[x, y, z]`, m.
     pub position_m: [f64; 3],
+    /// A grasper's jaw opening, m, finite and ≥ 0 in a checked trajectory (ignored by other tool
+    /// kinds); 0 in a file without the tool columns.
+    pub jaw_m: f64,
+    /// Whether a cutter's blade is enabled from this sample on (ignored by other tool kinds);
+    /// false in a file without the tool columns.
+    pub cut: bool,
+}
+
+impl Sample {
+    /// The sample's position, jaw opening and blade.
+    pub fn tool_state(&self) -> ToolState {
+        ToolState {
+            position_m: self.position_m,
+            jaw_m: self.jaw_m,
+            cut: self.cut,
+        }
+    }
+
+    /// Whether writing the sample needs the tool columns: a `jaw_m` other than `+0` (bit for
+    /// bit: `-0` too) or `cut`.
+    fn needs_tool_columns(&self) -> bool {
+        self.jaw_m.to_bits() != 0.0f64.to_bits() || self.cut
+    }
+}
+
+/// A tool point's state at one time ([`Trajectory::tools_at`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolState {
+    /// Position `[x, y, z]`, m.
+    pub position_m: [f64; 3],
+    /// A grasper's jaw opening, m (linear between samples).
+    pub jaw_m: f64,
+    /// Whether a cutter's blade is enabled (sample-and-hold).
+    pub cut: bool,
 }
 
 /// A time-ordered list of samples of `tool_count` tool points.
 ///
 /// Invariants: `1 ≤ tool_count ≤ MAX_TOOL_POINTS`; every sample's tool index is below
-/// `tool_count`; every tool point has at least one sample. For a checked trajectory (every
-/// constructor but the `*_unchecked` readers) also: every value is finite and times never
-/// decrease in sample order.
+/// `tool_count`; every tool point has at least one sample; a trajectory without the tool columns
+/// has `jaw_m = +0` and `cut = false` in every sample. For a checked trajectory (every
+/// constructor but the `*_unchecked` readers) also: every value is finite, every `jaw_m` is ≥ 0
+/// and times never decrease in sample order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trajectory {
     /// All samples, in file order.
     samples: Vec<Sample>,
-    /// Per tool point, its `(t_s, position_m)` in file order.
-    tracks: Vec<Vec<(f64, [f64; 3])>>,
+    /// Per tool point, its `(t_s, state)` in file order.
+    tracks: Vec<Vec<(f64, ToolState)>>,
+    /// Whether it has the `jaw_m,cut` columns ([`Trajectory::has_tool_columns`]).
+    tool_columns: bool,
 }
 
 /// What is wrong with one line.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LineProblem {
-    /// The first line is not the header.
-    #[error("expected the header `t,tool,x,y,z`, found `{0}`")]
+    /// The first line is not a header.
+    #[error("expected the header `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`, found `{0}`")]
     MissingHeader(String),
-    /// Not exactly 5 fields.
+    /// Not exactly 5 fields in a file whose header is `t,tool,x,y,z`.
     #[error("expected 5 fields t,tool,x,y,z, found {0}")]
     ColumnCount(usize),
-    /// A coordinate or time that does not parse as a number.
+    /// Not exactly 7 fields in a file whose header is `t,tool,x,y,z,jaw_m,cut` (every line of
+    /// such a file has the tool columns).
+    #[error("expected 7 fields t,tool,x,y,z,jaw_m,cut as the header, found {0}")]
+    ToolColumnCount(usize),
+    /// A coordinate, time or jaw opening that does not parse as a number.
     #[error("{column} = `{text}` is not a number")]
     NotANumber {
-        /// `t`, `x`, `y` or `z`.
+        /// `t`, `x`, `y`, `z` or `jaw_m`.
         column: &'static str,
         /// The field as written.
         text: String,
@@ -91,14 +162,20 @@ pub enum LineProblem {
     /// A tool field that is not a non-negative integer.
     #[error("tool = `{0}` is not a tool point index (an integer >= 0)")]
     BadToolIndex(String),
-    /// NaN or infinite time or coordinate.
+    /// A cut field that is not `0` or `1`.
+    #[error("cut = `{0}` is not 0 or 1")]
+    BadCut(String),
+    /// NaN or infinite time, coordinate or jaw opening.
     #[error("non-finite {column} = {value}")]
     NonFinite {
-        /// `t`, `x`, `y` or `z`.
+        /// `t`, `x`, `y`, `z` or `jaw_m`.
         column: &'static str,
         /// The value read.
         value: f64,
     },
+    /// A negative jaw opening.
+    #[error("jaw_m = {0} m is negative: a jaw opening is >= 0")]
+    NegativeJaw(f64),
     /// A tool index at or above the scene's tool point count.
     #[error("tool point {tool} does not exist: the scene has {count} (indices 0 to {})", .count.saturating_sub(1))]
     UnknownTool {
@@ -148,7 +225,7 @@ pub enum LineProblem {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FileProblem {
     /// No line at all (not even the header).
-    #[error("empty: expected the header line `t,tool,x,y,z`")]
+    #[error("empty: expected the header line `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`")]
     Empty,
     /// A header but no sample.
     #[error("no samples after the header")]
@@ -207,7 +284,10 @@ struct Builder<'a> {
     file: &'a str,
     mode: Mode,
     samples: Vec<Sample>,
-    tracks: Vec<Vec<(f64, [f64; 3])>>,
+    tracks: Vec<Vec<(f64, ToolState)>>,
+    /// The tool columns are wanted even if no sample needs them (the 7-field header, or asked
+    /// for by [`Trajectory::from_samples_with_tool_columns`]).
+    tool_columns: bool,
     /// Line and time of the last sample with a non-NaN time.
     previous: Option<(usize, f64)>,
     /// Line and time of the earliest and of the latest finite time so far.
@@ -229,6 +309,7 @@ impl<'a> Builder<'a> {
             mode,
             samples: Vec::new(),
             tracks: vec![Vec::new(); tool_count],
+            tool_columns: false,
             previous: None,
             earliest: None,
             latest: None,
@@ -263,9 +344,13 @@ impl<'a> Builder<'a> {
             ("x", sample.position_m[0]),
             ("y", sample.position_m[1]),
             ("z", sample.position_m[2]),
+            ("jaw_m", sample.jaw_m),
         ];
         if let Some(&(column, value)) = values.iter().find(|(_, v)| !v.is_finite()) {
             self.soft(line, LineProblem::NonFinite { column, value })?;
+        }
+        if sample.jaw_m.is_finite() && sample.jaw_m < 0.0 {
+            self.soft(line, LineProblem::NegativeJaw(sample.jaw_m))?;
         }
         if let Some((previous_line, previous_s)) = self.previous
             && sample.t_s < previous_s
@@ -294,7 +379,7 @@ impl<'a> Builder<'a> {
                 },
             ));
         };
-        track.push((sample.t_s, sample.position_m));
+        track.push((sample.t_s, sample.tool_state()));
         self.samples.push(sample);
         Ok(())
     }
@@ -345,18 +430,21 @@ impl<'a> Builder<'a> {
         if let Some(tool) = self.tracks.iter().position(Vec::is_empty) {
             return Err(whole(FileProblem::ToolWithoutSamples(tool)));
         }
+        let tool_columns = self.tool_columns || self.samples.iter().any(Sample::needs_tool_columns);
         Ok((
             Trajectory {
                 samples: self.samples,
                 tracks: self.tracks,
+                tool_columns,
             },
             self.findings,
         ))
     }
 }
 
-/// Parse one data record (5 fields checked by the caller) into a sample.
-fn parse_record(record: &csv::StringRecord) -> Result<Sample, LineProblem> {
+/// Parse one data record (5 fields, or 7 with `tool_columns`, checked by the caller) into a
+/// sample.
+fn parse_record(record: &csv::StringRecord, tool_columns: bool) -> Result<Sample, LineProblem> {
     let field = |i: usize| record.get(i).unwrap_or("");
     let number = |i: usize, column: &'static str| {
         field(i)
@@ -370,10 +458,24 @@ fn parse_record(record: &csv::StringRecord) -> Result<Sample, LineProblem> {
     let tool = field(1)
         .parse::<usize>()
         .map_err(|_| LineProblem::BadToolIndex(field(1).to_owned()))?;
+    let position_m = [number(2, "x")?, number(3, "y")?, number(4, "z")?];
+    let (jaw_m, cut) = if tool_columns {
+        let jaw_m = number(5, "jaw_m")?;
+        let cut = match field(6) {
+            "0" => false,
+            "1" => true,
+            other => return Err(LineProblem::BadCut(other.to_owned())),
+        };
+        (jaw_m, cut)
+    } else {
+        (0.0, false)
+    };
     Ok(Sample {
         t_s,
         tool,
-        position_m: [number(2, "x")?, number(3, "y")?, number(4, "z")?],
+        position_m,
+        jaw_m,
+        cut,
     })
 }
 
@@ -395,7 +497,8 @@ fn read_csv(
         .flexible(true)
         .trim(csv::Trim::All)
         .buffer_capacity(256);
-    let mut header_seen = false;
+    // The header's field count, once seen.
+    let mut header_columns = None;
     let mut record = csv::StringRecord::new();
     let mut extra = csv::ByteRecord::new();
     for (index, text) in bytes.split(|&b| b == b'\n').enumerate() {
@@ -419,21 +522,31 @@ fn read_csv(
                 ),
             ));
         }
-        if !header_seen {
-            if record.iter().ne(HEADER) {
+        let Some(columns) = header_columns else {
+            if record.iter().eq(HEADER) {
+                header_columns = Some(HEADER.len());
+            } else if record.iter().eq(TOOL_HEADER) {
+                header_columns = Some(TOOL_HEADER.len());
+                builder.tool_columns = true;
+            } else {
                 let found = record.iter().collect::<Vec<_>>().join(",");
                 return Err(builder.line_error(line, LineProblem::MissingHeader(found)));
             }
-            header_seen = true;
             continue;
+        };
+        if record.len() != columns {
+            let problem = if builder.tool_columns {
+                LineProblem::ToolColumnCount(record.len())
+            } else {
+                LineProblem::ColumnCount(record.len())
+            };
+            return Err(builder.line_error(line, problem));
         }
-        if record.len() != HEADER.len() {
-            return Err(builder.line_error(line, LineProblem::ColumnCount(record.len())));
-        }
-        let sample = parse_record(&record).map_err(|problem| builder.line_error(line, problem))?;
+        let sample = parse_record(&record, builder.tool_columns)
+            .map_err(|problem| builder.line_error(line, problem))?;
         builder.push(line, sample)?;
     }
-    if !header_seen {
+    if header_columns.is_none() {
         return Err(TrajectoryError::File {
             file: file.to_owned(),
             problem: FileProblem::Empty,
@@ -442,20 +555,30 @@ fn read_csv(
     builder.finish()
 }
 
-/// Position on a track at `t_s` (see [`Trajectory::positions_at`]); a track is never empty in a
-/// [`Trajectory`], an empty one gives NaN.
-pub(crate) fn position_on(track: &[(f64, [f64; 3])], t_s: f64) -> [f64; 3] {
+/// State on a track at `t_s` (see [`Trajectory::tools_at`]): position and jaw opening linear
+/// between samples, the blade's `cut` held from the latest sample at or before `t_s` (the first
+/// before it). A track is never empty in a [`Trajectory`]; an empty one gives NaN and no cut.
+pub(crate) fn state_on(track: &[(f64, ToolState)], t_s: f64) -> ToolState {
     let i = track.partition_point(|&(t, _)| t <= t_s);
     let before = i.checked_sub(1).and_then(|j| track.get(j));
     match (before, track.get(i)) {
         // At a sample's own time, that sample (even if the next one is not finite).
-        (Some(&(t0, p0)), _) if t_s == t0 => p0,
-        (Some(&(t0, p0)), Some(&(t1, p1))) => {
+        (Some(&(t0, s0)), _) if t_s == t0 => s0,
+        (Some(&(t0, s0)), Some(&(t1, s1))) => {
             let s = (t_s - t0) / (t1 - t0);
-            [0, 1, 2].map(|k| p0[k] + (p1[k] - p0[k]) * s)
+            let lerp = |a: f64, b: f64| a + (b - a) * s;
+            ToolState {
+                position_m: [0, 1, 2].map(|k| lerp(s0.position_m[k], s1.position_m[k])),
+                jaw_m: lerp(s0.jaw_m, s1.jaw_m),
+                cut: s0.cut,
+            }
         }
-        (Some(&(_, p)), None) | (None, Some(&(_, p))) => p,
-        (None, None) => [f64::NAN; 3],
+        (Some(&(_, s)), None) | (None, Some(&(_, s))) => s,
+        (None, None) => ToolState {
+            position_m: [f64::NAN; 3],
+            jaw_m: f64::NAN,
+            cut: false,
+        },
     }
 }
 
@@ -495,13 +618,13 @@ impl Trajectory {
         read_csv(text.as_bytes(), source, tool_count, Mode::Checked).map(|(t, _)| t)
     }
 
-    /// The lenient reader, for robustness tests: non-finite values and times going backwards
-    /// are kept, and each such problem is returned as a finding, in line order (the errors
-    /// [`Trajectory::read`] refuses with; a line can give two: a non-finite coordinate and a
-    /// backward time). A missing header, a wrong field count, a field that is
-    /// not a number, an unknown tool point or a tool point without a sample are still errors: there
-    /// is no value to keep; so are a finite time out of range and a span beyond the limit (module
-    /// doc).
+    /// The lenient reader, for robustness tests: non-finite values, negative jaw openings and
+    /// times going backwards are kept, and each such problem is returned as a finding, in line
+    /// order (the errors [`Trajectory::read`] refuses with; a line can give several: a non-finite
+    /// value, a negative jaw opening, a backward time). A missing header, a wrong field count, a
+    /// field that is not a number, a `cut` other than `0` or `1`, an unknown tool point or a tool
+    /// point without a sample are still errors: there is no value to keep; so are a finite time
+    /// out of range and a span beyond the limit (module doc).
     pub fn read_unchecked(
         path: &Path,
         tool_count: usize,
@@ -520,12 +643,24 @@ impl Trajectory {
 
     /// A checked trajectory from samples in order. Errors name the source `samples` and the line
     /// each sample would have in the file [`Trajectory::write_csv`] writes (sample `i` on line
-    /// `i + 2`).
+    /// `i + 2`). It has the tool columns if a sample needs them: a `jaw_m` other than `+0` or a
+    /// `cut` (so that [`Trajectory::write_csv`] keeps them).
     pub fn from_samples(
         samples: Vec<Sample>,
         tool_count: usize,
     ) -> Result<Trajectory, TrajectoryError> {
+        Self::from_samples_with_tool_columns(samples, tool_count, false)
+    }
+
+    /// [`Trajectory::from_samples`], with the tool columns also when no sample needs them if
+    /// `tool_columns` (a grasper held open at 0 m, a cutter never enabled).
+    pub fn from_samples_with_tool_columns(
+        samples: Vec<Sample>,
+        tool_count: usize,
+        tool_columns: bool,
+    ) -> Result<Trajectory, TrajectoryError> {
         let mut builder = Builder::new("samples", tool_count, Mode::Checked)?;
+        builder.tool_columns = tool_columns;
         for (i, sample) in samples.into_iter().enumerate() {
             builder.push(i + 2, sample)?;
         }
@@ -535,6 +670,13 @@ impl Trajectory {
     /// Number of tool points: [`Trajectory::positions_at`] returns this many positions.
     pub fn tool_count(&self) -> usize {
         self.tracks.len()
+    }
+
+    /// Whether the trajectory has the tool columns `jaw_m,cut`: read from a file with the
+    /// 7-field header, or built from samples that need them (or asked to have them).
+    /// [`Trajectory::write_csv`] writes them if and only if it has.
+    pub fn has_tool_columns(&self) -> bool {
+        self.tool_columns
     }
 
     /// All samples, in file order.
@@ -574,25 +716,57 @@ impl Trajectory {
     /// kernel to refuse) and times out of order give a deterministic but unspecified mix of
     /// samples; nothing panics.
     pub fn positions_at(&self, t_s: f64) -> Vec<[f64; 3]> {
-        self.tracks.iter().map(|tr| position_on(tr, t_s)).collect()
+        self.tracks
+            .iter()
+            .map(|tr| state_on(tr, t_s).position_m)
+            .collect()
     }
 
     /// [`Trajectory::positions_at`] into `out`, without allocating: fills
     /// `min(out.len(), tool_count)` entries.
     pub fn positions_at_into(&self, t_s: f64, out: &mut [[f64; 3]]) {
         for (o, tr) in out.iter_mut().zip(&self.tracks) {
-            *o = position_on(tr, t_s);
+            *o = state_on(tr, t_s).position_m;
         }
     }
 
-    /// Write the trajectory as CSV: the header, then every sample in order. Numbers use Rust's
-    /// shortest round-trip format, so reading the output back gives the same bits (non-finite
-    /// values are written `NaN`, `inf`, `-inf`, which [`Trajectory::read_unchecked`] reads back).
+    /// Every tool point's state at time `t_s`: its position exactly as
+    /// [`Trajectory::positions_at`], its jaw opening `jaw_m` interpolated by the same rule (linear
+    /// between samples, held before the first and after the last, a jump at two samples of the
+    /// same time), and its `cut` sample-and-hold: the `cut` of its latest sample at or before
+    /// `t_s` (of the last of several at that time; before its first sample, the first's). A NaN
+    /// `t_s` gives the first samples.
+    pub fn tools_at(&self, t_s: f64) -> Vec<ToolState> {
+        self.tracks.iter().map(|tr| state_on(tr, t_s)).collect()
+    }
+
+    /// [`Trajectory::tools_at`] into `out`, without allocating: fills
+    /// `min(out.len(), tool_count)` entries.
+    pub fn tools_at_into(&self, t_s: f64, out: &mut [ToolState]) {
+        for (o, tr) in out.iter_mut().zip(&self.tracks) {
+            *o = state_on(tr, t_s);
+        }
+    }
+
+    /// Write the trajectory as CSV: the header, then every sample in order; with the tool
+    /// columns ([`TOOL_HEADER`], `cut` as `0` or `1`) if [`Trajectory::has_tool_columns`],
+    /// without ([`HEADER`]) otherwise. Numbers use Rust's shortest round-trip format, so reading
+    /// the output back gives the same bits (non-finite values are written `NaN`, `inf`, `-inf`,
+    /// which [`Trajectory::read_unchecked`] reads back).
     pub fn write_csv<W: io::Write>(&self, mut out: W) -> io::Result<()> {
-        writeln!(out, "{}", HEADER.join(","))?;
-        for s in &self.samples {
-            let [x, y, z] = s.position_m;
-            writeln!(out, "{},{},{x},{y},{z}", s.t_s, s.tool)?;
+        if self.tool_columns {
+            writeln!(out, "{}", TOOL_HEADER.join(","))?;
+            for s in &self.samples {
+                let [x, y, z] = s.position_m;
+                let cut = u8::from(s.cut);
+                writeln!(out, "{},{},{x},{y},{z},{},{cut}", s.t_s, s.tool, s.jaw_m)?;
+            }
+        } else {
+            writeln!(out, "{}", HEADER.join(","))?;
+            for s in &self.samples {
+                let [x, y, z] = s.position_m;
+                writeln!(out, "{},{},{x},{y},{z}", s.t_s, s.tool)?;
+            }
         }
         out.flush()
     }
@@ -606,5 +780,372 @@ impl Trajectory {
         };
         let file = std::fs::File::create(path).map_err(io_error)?;
         self.write_csv(io::BufWriter::new(file)).map_err(io_error)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn traj(text: &str, tools: usize) -> Trajectory {
+        match Trajectory::from_csv_str(text, "traj.csv", tools) {
+            Ok(t) => t,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    fn traj_err(text: &str, tools: usize) -> String {
+        match Trajectory::from_csv_str(text, "traj.csv", tools) {
+            Ok(t) => panic!("expected an error, got {} samples", t.samples().len()),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    fn csv(t: &Trajectory) -> String {
+        let mut bytes = Vec::new();
+        t.write_csv(&mut bytes).unwrap();
+        String::from_utf8(bytes).unwrap()
+    }
+
+    fn state(position_m: [f64; 3], jaw_m: f64, cut: bool) -> ToolState {
+        ToolState {
+            position_m,
+            jaw_m,
+            cut,
+        }
+    }
+
+    /// Two tool points with the tool columns; tool 0 jumps at t = 3 (jaw and cut too).
+    const TOOLS: &str = "\
+t,tool,x,y,z,jaw_m,cut
+0,0,0,0,0,0.012,0
+0,1,1,1,1,0,1
+1,0,0.5,0,-0.25,0.004,1
+2,1,1,1,3,0,0
+3,0,1.5,0,-1.25,0.008,1
+3,0,1.5,0,-2.25,0.01,0
+";
+
+    #[test]
+    fn five_columns_read_as_no_jaw_and_no_cut_and_write_back_unchanged() {
+        let text = "t,tool,x,y,z\n0,0,0.06,0.06,0.07\n0.5,0,0.06,0.06,0.055\n";
+        let t = traj(text, 1);
+        assert!(!t.has_tool_columns());
+        assert!(t.samples().iter().all(|s| s.jaw_m == 0.0 && !s.cut));
+        assert_eq!(csv(&t), text);
+        assert_eq!(t.tools_at(0.25), [state([0.06, 0.06, 0.0625], 0.0, false)]);
+    }
+
+    #[test]
+    fn tool_columns_interpolate_the_jaw_and_hold_the_cut() {
+        let t = traj(TOOLS, 2);
+        assert!(t.has_tool_columns());
+        assert_eq!(
+            t.samples()[2],
+            Sample {
+                t_s: 1.0,
+                tool: 0,
+                position_m: [0.5, 0.0, -0.25],
+                jaw_m: 0.004,
+                cut: true,
+            }
+        );
+        let cases: [(f64, [ToolState; 2]); 10] = [
+            // Before the first sample: the first sample, its cut included.
+            (
+                -1.0,
+                [state([0.0; 3], 0.012, false), state([1.0; 3], 0.0, true)],
+            ),
+            (
+                0.0,
+                [state([0.0; 3], 0.012, false), state([1.0; 3], 0.0, true)],
+            ),
+            // Between samples: the jaw linear, the cut of the sample before.
+            (
+                0.5,
+                [
+                    state([0.25, 0.0, -0.125], 0.008, false),
+                    state([1.0, 1.0, 1.5], 0.0, true),
+                ],
+            ),
+            // At a sample: exactly the sample, its cut from then on.
+            (
+                1.0,
+                [
+                    state([0.5, 0.0, -0.25], 0.004, true),
+                    state([1.0, 1.0, 2.0], 0.0, true),
+                ],
+            ),
+            (
+                1.5,
+                [
+                    state([0.75, 0.0, -0.5], 0.005, true),
+                    state([1.0, 1.0, 2.5], 0.0, true),
+                ],
+            ),
+            (
+                2.0,
+                [
+                    state([1.0, 0.0, -0.75], 0.006, true),
+                    state([1.0, 1.0, 3.0], 0.0, false),
+                ],
+            ),
+            // After tool 1's last sample: held.
+            (
+                2.5,
+                [
+                    state([1.25, 0.0, -1.0], 0.007, true),
+                    state([1.0, 1.0, 3.0], 0.0, false),
+                ],
+            ),
+            // The jump: from t = 3 on, the later sample (jaw and cut too).
+            (
+                3.0,
+                [
+                    state([1.5, 0.0, -2.25], 0.01, false),
+                    state([1.0, 1.0, 3.0], 0.0, false),
+                ],
+            ),
+            (
+                10.0,
+                [
+                    state([1.5, 0.0, -2.25], 0.01, false),
+                    state([1.0, 1.0, 3.0], 0.0, false),
+                ],
+            ),
+            (
+                f64::NAN,
+                [state([0.0; 3], 0.012, false), state([1.0; 3], 0.0, true)],
+            ),
+        ];
+        for (time, expected) in cases {
+            let got = t.tools_at(time);
+            for (g, e) in got.iter().zip(&expected) {
+                assert_eq!(g.cut, e.cut, "t = {time}: {g:?}");
+                assert!((g.jaw_m - e.jaw_m).abs() < 1e-15, "t = {time}: {g:?}");
+            }
+            let mut out = [state([9.0; 3], 9.0, true); 3];
+            t.tools_at_into(time, &mut out);
+            assert_eq!(&out[..2], got.as_slice(), "t = {time}");
+            assert_eq!(out[2], state([9.0; 3], 9.0, true), "t = {time}");
+            // The positions are those of positions_at, and as expected.
+            let positions = t.positions_at(time);
+            assert_eq!(
+                positions,
+                got.iter().map(|s| s.position_m).collect::<Vec<_>>()
+            );
+            let expected_positions: Vec<_> = expected.iter().map(|s| s.position_m).collect();
+            assert_eq!(positions, expected_positions, "t = {time}");
+        }
+        // At a sample's own time, exactly the sample's jaw.
+        assert_eq!(t.tools_at(1.0)[0].jaw_m, 0.004);
+        // Just before the jump: on the way to the first of the two samples, cut still held.
+        let before = t.tools_at(2.999_999)[0];
+        assert!(
+            (before.jaw_m - 0.008).abs() < 1e-8 && before.cut,
+            "{before:?}"
+        );
+    }
+
+    #[test]
+    fn tool_columns_round_trip_bit_for_bit() {
+        let s = |t_s, tool, jaw_m, cut| Sample {
+            t_s,
+            tool,
+            position_m: [0.1, -0.0, 1e-7],
+            jaw_m,
+            cut,
+        };
+        let samples = vec![
+            s(0.0, 0, 1.0 / 3.0, false),
+            s(0.0, 1, -0.0, true),
+            s(0.001, 1, f64::MIN_POSITIVE, true),
+            s(0.30000000000000004, 0, 5e-324, false),
+            s(0.4, 0, 1e300, true),
+        ];
+        let t = Trajectory::from_samples(samples.clone(), 2).unwrap();
+        assert!(t.has_tool_columns());
+        let text = csv(&t);
+        assert!(
+            text.starts_with(
+                "t,tool,x,y,z,jaw_m,cut\n0,0,0.1,-0,0.0000001,0.3333333333333333,0\n0,1,0.1,-0,0.0000001,-0,1\n"
+            ),
+            "{text}"
+        );
+        let back = traj(&text, 2);
+        let bits = |t: &Trajectory| -> Vec<(u64, usize, [u64; 3], u64, bool)> {
+            t.samples()
+                .iter()
+                .map(|s| {
+                    (
+                        s.t_s.to_bits(),
+                        s.tool,
+                        s.position_m.map(f64::to_bits),
+                        s.jaw_m.to_bits(),
+                        s.cut,
+                    )
+                })
+                .collect()
+        };
+        assert_eq!(bits(&back), bits(&t));
+        assert_eq!(back, t);
+        assert_eq!(csv(&back), text);
+        // The lenient reader reads the same.
+        let (lenient, findings) = Trajectory::from_csv_str_unchecked(&text, "r", 2).unwrap();
+        assert!(findings.is_empty());
+        assert_eq!(lenient, t);
+    }
+
+    #[test]
+    fn tool_columns_are_kept_when_asked_for_or_needed() {
+        let s = |t_s, jaw_m, cut| Sample {
+            t_s,
+            tool: 0,
+            position_m: [0.0; 3],
+            jaw_m,
+            cut,
+        };
+        // Nothing needs them: 5 columns, unless asked for (or read from a 7-column file).
+        let plain = vec![s(0.0, 0.0, false), s(1.0, 0.0, false)];
+        let t = Trajectory::from_samples(plain.clone(), 1).unwrap();
+        assert!(!t.has_tool_columns());
+        assert_eq!(csv(&t), "t,tool,x,y,z\n0,0,0,0,0\n1,0,0,0,0\n");
+        let t = Trajectory::from_samples_with_tool_columns(plain, 1, true).unwrap();
+        assert!(t.has_tool_columns());
+        let text = csv(&t);
+        assert_eq!(
+            text,
+            "t,tool,x,y,z,jaw_m,cut\n0,0,0,0,0,0,0\n1,0,0,0,0,0,0\n"
+        );
+        let back = traj(&text, 1);
+        assert!(back.has_tool_columns());
+        assert_eq!(back, t);
+        // A jaw opening, a cut, or a jaw of -0 needs them.
+        for samples in [
+            vec![s(0.0, 0.001, false)],
+            vec![s(0.0, 0.0, true)],
+            vec![s(0.0, -0.0, false)],
+        ] {
+            let t = Trajectory::from_samples_with_tool_columns(samples, 1, false).unwrap();
+            assert!(t.has_tool_columns());
+            assert_eq!(traj(&csv(&t), 1), t);
+        }
+        // from_samples refuses what the reader refuses, naming the would-be line.
+        let msg = Trajectory::from_samples(vec![s(0.0, 0.0, false), s(1.0, -0.5, true)], 1)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            msg,
+            "samples: line 3: jaw_m = -0.5 m is negative: a jaw opening is >= 0"
+        );
+    }
+
+    #[test]
+    fn every_tool_column_error_names_the_file_and_line() {
+        let h = "t,tool,x,y,z,jaw_m,cut\n";
+        let cases: Vec<(String, &str)> = vec![
+            // Bad cut values.
+            (
+                format!("{h}0,0,0,0,0,0,2\n"),
+                "traj.csv: line 2: cut = `2` is not 0 or 1",
+            ),
+            (
+                format!("{h}0,0,0,0,0,0,\n"),
+                "traj.csv: line 2: cut = `` is not 0 or 1",
+            ),
+            (
+                format!("{h}0,0,0,0,0,0,0\n1,0,0,0,0,0,true\n"),
+                "traj.csv: line 3: cut = `true` is not 0 or 1",
+            ),
+            (
+                format!("{h}0,0,0,0,0,0,1.0\n"),
+                "traj.csv: line 2: cut = `1.0` is not 0 or 1",
+            ),
+            // Bad jaw openings.
+            (
+                format!("{h}0,0,0,0,0,abc,0\n"),
+                "traj.csv: line 2: jaw_m = `abc` is not a number",
+            ),
+            (
+                format!("{h}0,0,0,0,0,NaN,0\n"),
+                "traj.csv: line 2: non-finite jaw_m = NaN",
+            ),
+            (
+                format!("{h}0,0,0,0,0,inf,1\n"),
+                "traj.csv: line 2: non-finite jaw_m = inf",
+            ),
+            (
+                format!("{h}\n# c\n0,0,0,0,0,-0.001,0\n"),
+                "traj.csv: line 4: jaw_m = -0.001 m is negative: a jaw opening is >= 0",
+            ),
+            // Mixed field counts: the header decides.
+            (
+                format!("{h}0,0,0,0,0,0,0\n1,0,0,0,0\n"),
+                "traj.csv: line 3: expected 7 fields t,tool,x,y,z,jaw_m,cut as the header, found 5",
+            ),
+            (
+                format!("{h}0,0,0,0,0,0\n"),
+                "traj.csv: line 2: expected 7 fields t,tool,x,y,z,jaw_m,cut as the header, found 6",
+            ),
+            (
+                "t,tool,x,y,z\n0,0,0,0,0\n1,0,0,0,0,0,0\n".into(),
+                "traj.csv: line 3: expected 5 fields t,tool,x,y,z, found 7",
+            ),
+            // Headers.
+            (
+                "t,tool,x,y,z,jaw_m\n0,0,0,0,0,0\n".into(),
+                "traj.csv: line 1: expected the header `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`, found `t,tool,x,y,z,jaw_m`",
+            ),
+            (
+                "t,tool,x,y,z,cut,jaw_m\n".into(),
+                "traj.csv: line 1: expected the header `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`, found `t,tool,x,y,z,cut,jaw_m`",
+            ),
+            (
+                "".into(),
+                "traj.csv: empty: expected the header line `t,tool,x,y,z` or `t,tool,x,y,z,jaw_m,cut`",
+            ),
+            (h.into(), "traj.csv: no samples after the header"),
+        ];
+        for (text, expected) in cases {
+            assert_eq!(traj_err(&text, 1), expected, "\n{text}");
+        }
+        // Padded fields and a quoted cut are read as in any other column.
+        let t = traj(&format!("{h} 0 , 0 , 0 , 0 , 0 , 0.002 ,\"1\"\n"), 1);
+        assert_eq!(t.tools_at(0.0), [state([0.0; 3], 0.002, true)]);
+    }
+
+    #[test]
+    fn the_lenient_reader_keeps_bad_jaws_but_not_bad_cuts() {
+        let text =
+            "t,tool,x,y,z,jaw_m,cut\n0,0,0,0,0,NaN,1\n1,0,0,0,0,-0.5,0\n0.5,0,0,0,0,0.001,0\n";
+        let (t, findings) = Trajectory::from_csv_str_unchecked(text, "r", 1).unwrap();
+        let findings: Vec<String> = findings.iter().map(ToString::to_string).collect();
+        assert_eq!(
+            findings,
+            [
+                "r: line 2: non-finite jaw_m = NaN",
+                "r: line 3: jaw_m = -0.5 m is negative: a jaw opening is >= 0",
+                "r: line 4: time 0.5 s goes backwards: line 3 is at 1 s",
+            ]
+        );
+        assert!(t.has_tool_columns());
+        assert!(t.samples()[0].jaw_m.is_nan() && t.samples()[0].cut);
+        assert_eq!(t.samples()[1].jaw_m, -0.5);
+        // Written and read back: the same values and findings.
+        let (again, again_findings) = Trajectory::from_csv_str_unchecked(&csv(&t), "r", 1).unwrap();
+        assert_eq!(again_findings.len(), 3);
+        assert!(again.samples()[0].jaw_m.is_nan());
+        assert_eq!(again.samples()[1..], t.samples()[1..]);
+        // The checked reader refuses the first of them.
+        assert_eq!(
+            traj_err(text, 1),
+            "traj.csv: line 2: non-finite jaw_m = NaN"
+        );
+        // A cut other than 0 or 1 has no value to keep.
+        let msg =
+            Trajectory::from_csv_str_unchecked("t,tool,x,y,z,jaw_m,cut\n0,0,0,0,0,0,-1\n", "r", 1)
+                .unwrap_err()
+                .to_string();
+        assert_eq!(msg, "r: line 2: cut = `-1` is not 0 or 1");
     }
 }

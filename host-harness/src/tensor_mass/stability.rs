@@ -1,5 +1,7 @@
 //! `palpate dynamic critical-dt`: the largest stable step of an integrator,
-//! measured by bisection, next to the estimate `2/ω_max` (MODELS.md §3).
+//! measured by bisection, next to the estimate `2/ω_max` (MODELS.md §3);
+//! and [`stable_step_limit`], the same limit from `ω_max` and each scheme's
+//! stability condition, fast enough to check a scene when it is loaded.
 
 use anyhow::bail;
 use nalgebra::Vector3;
@@ -237,4 +239,321 @@ pub fn critical_dt_of_mesh(
         );
     }
     Ok(result)
+}
+
+/// The largest stable step of an integrator on a mesh, from `ω_max`
+/// ([`stable_step_limit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StableStep {
+    /// Largest circular eigenfrequency of `M⁻¹K` over the moving vertices,
+    /// rad/s (Lanczos, from below).
+    pub omega_max: f64,
+    /// The integrator's largest stable step for every mode up to
+    /// `omega_max` with the scene's damping, s (0 when no step is stable).
+    pub limit_dt_s: f64,
+    /// How `limit_dt_s` follows from `omega_max`, in words.
+    pub rule: &'static str,
+}
+
+/// Largest number of Lanczos steps of [`lanczos_omega_max`].
+pub const LANCZOS_MAX_STEPS: usize = 300;
+/// [`lanczos_omega_max`] stops when the largest Ritz value grew by at most
+/// this fraction over the last [`LANCZOS_WINDOW`] steps.
+pub const LANCZOS_TOLERANCE: f64 = 1e-10;
+/// Steps over which [`lanczos_omega_max`] measures its progress.
+pub const LANCZOS_WINDOW: usize = 10;
+
+/// The largest stable step of `integrator` with mass-proportional damping
+/// `damping_per_s` (`c`, 1/s) on the tensor-mass model of `mesh` (table
+/// `options`, built in f64): `ω_max` by [`lanczos_omega_max`] on the linear
+/// model at rest, then the scheme's stability condition on the modal
+/// equation `ü = −c u̇ − ω² u` of every mode `ω ≤ ω_max` (the kernel's
+/// updates, `palpate_kernel::tensor_mass::Integrator`; MODELS.md §3):
+///
+/// - symplectic Euler: the update matrix has determinant `1 − cΔt` and trace
+///   `2 − cΔt − (ωΔt)²`; both roots lie in the unit disk iff
+///   `(ωΔt)² + 2cΔt ≤ 4`, i.e. `Δt ≤ 4/(c + sqrt(c² + 4ω²))`: `2/ω_max`
+///   undamped, slightly less with damping (0.985 × `2/ω_max` on the
+///   reference cube with `c = 2/s`, as the bisection measures);
+/// - central difference (damping in the coefficients):
+///   `(1 + cΔt/2) z² − (2 − (ωΔt)²) z + (1 − cΔt/2)`, stable iff
+///   `ωΔt ≤ 2` whatever `c ≥ 0`: `2/ω_max`;
+/// - explicit Euler: determinant `1 − cΔt + (ωΔt)²`, so an under-damped mode
+///   needs `Δt ≤ c/ω²` and an over-damped one `Δt ≤ 4/(c + sqrt(c² − 4ω²))`
+///   `≥ 2/c`: `min(c/ω_max², 2/c)`, zero undamped (no step is stable). This
+///   is the asymptotic limit; the bisection's finite trial passes far longer
+///   steps, on which the energy grows by under 1e6 in its 2000 steps (3.5×
+///   with `c = 30/s`, 44× with `c = 2/s` on a 64-vertex box);
+/// - RK4: `|R(λΔt)| ≤ 1` with `R(z) = 1 + z + z²/2 + z³/6 + z⁴/24` for
+///   every eigenvalue `λ = −c/2 ± i sqrt(ω² − c²/4)` of a mode `ω ≤ ω_max`
+///   (256 modes spread over `(c/2, ω_max]`) and for `λ = −c` (the
+///   over-damped modes' bound), each by the radius of RK4's stability region
+///   along `λ`: `2√2/ω_max` undamped.
+///
+/// The limit is that of the linear model at rest; St Venant-Kirchhoff
+/// stiffens under strain, and removing tets (cutting, tearing) removes
+/// their masses too, which can raise `ω_max`: a caller checking a scene
+/// keeps a margin ([`crate::session::stability`]).
+///
+/// Cost: the f64 table build and up to [`LANCZOS_MAX_STEPS`] force passes
+/// (no stepping), linear in the mesh: 0.1 s for a 6144-tet cylinder, the
+/// table build 55 ms and the Lanczos iteration 8 ms of it (the bisection of
+/// [`critical_dt_of_mesh`] takes 2.5 s there). Errors: nothing free to move,
+/// a table that does not build, a non-finite `ω_max`.
+pub fn stable_step_limit(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    damping_per_s: f64,
+    integrator: Integrator,
+) -> anyhow::Result<StableStep> {
+    if !(damping_per_s.is_finite() && damping_per_s >= 0.0) {
+        bail!("the damping must be finite and >= 0 1/s, got {damping_per_s}");
+    }
+    let file = f64_table(mesh, report, options)?;
+    let table = palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes())?;
+    let mut state = OwnedState::for_table(&table);
+    let params = host_params(&mesh.positions, damping_per_s);
+    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    let moving = (0..model.modes().len())
+        .any(|v| model.modes()[v] == VertexMode::Free && model.masses_kg()[v] > 0.0);
+    if !moving {
+        bail!(
+            "every vertex is fixed (by the fix predicates, or unreferenced by any tet): nothing \
+             moves, so there is no stable step to find"
+        );
+    }
+    let omega = lanczos_omega_max(&mut model);
+    if !(omega.is_finite() && omega > 0.0) {
+        let young_pa = options.material.young_pa;
+        bail!(
+            "the largest eigenfrequency of M^-1 K is {omega} rad/s (f64 overflow or underflow \
+             with E = {young_pa:e} Pa and this mesh and density): give E in Pa, the density in \
+             kg/m3 and the mesh in metres (SI units)"
+        );
+    }
+    let (limit_dt_s, rule) = integrator_limit(integrator, omega, damping_per_s);
+    Ok(StableStep {
+        omega_max: omega,
+        limit_dt_s,
+        rule,
+    })
+}
+
+/// The largest stable step of `integrator` for every mode up to `omega`
+/// (rad/s) with damping `c` (1/s), s, and its rule (see
+/// [`stable_step_limit`]).
+pub fn integrator_limit(integrator: Integrator, omega: f64, c: f64) -> (f64, &'static str) {
+    match integrator {
+        Integrator::SymplecticEuler if c == 0.0 => (
+            2.0 / omega,
+            "2/omega_max, symplectic Euler's undamped bound",
+        ),
+        Integrator::SymplecticEuler => (
+            4.0 / (c + c.hypot(2.0 * omega)),
+            "4/(c + sqrt(c^2 + 4 omega_max^2)), symplectic Euler's bound with damping c \
+             (2/omega_max undamped)",
+        ),
+        Integrator::CentralDifference => (
+            2.0 / omega,
+            "2/omega_max, the central difference's bound whatever the damping",
+        ),
+        Integrator::ExplicitEuler if c == 0.0 => (
+            0.0,
+            "none: explicit Euler amplifies every undamped mode by sqrt(1 + (omega dt)^2) per step",
+        ),
+        Integrator::ExplicitEuler => (
+            (c / (omega * omega)).min(2.0 / c),
+            "min(c/omega_max^2, 2/c), explicit Euler's bound with damping c",
+        ),
+        Integrator::Rk4 => (
+            rk4_limit(omega, c),
+            "min over the eigenvalues lambda of the modes of RK4's stability radius along \
+             lambda over |lambda|, lambda = -c/2 +- i sqrt(omega^2 - c^2/4) for omega <= \
+             omega_max and -c (2 sqrt(2)/omega_max undamped)",
+        ),
+    }
+}
+
+/// Modes of [`rk4_limit`] spread over `(c/2, ω_max]`.
+const RK4_MODES: usize = 256;
+
+/// The largest `Δt` for which RK4 is stable on every eigenvalue of the modes
+/// `ω ≤ omega` with damping `c` (see [`stable_step_limit`]).
+fn rk4_limit(omega: f64, c: f64) -> f64 {
+    let mut limit = f64::INFINITY;
+    if c > 0.0 {
+        // Over-damped modes: real eigenvalues in [-c, 0).
+        limit = rk4_radius(-1.0, 0.0) / c;
+    }
+    let lowest = 0.5 * c;
+    if omega > lowest {
+        for k in 0..RK4_MODES {
+            let w = omega - (omega - lowest) * k as f64 / RK4_MODES as f64;
+            let im = (w * w - lowest * lowest).max(0.0).sqrt();
+            // |λ| = w for an under-damped mode.
+            limit = limit.min(rk4_radius(-lowest / w, im / w) / w);
+        }
+    }
+    limit
+}
+
+/// The first `r > 0` at which `|R(r·d)| > 1` for RK4's amplification factor
+/// `R` along the unit direction `d = (re, im)` (`re ≤ 0`): marched in steps
+/// of 1/256, then bisected. RK4's stability region lies within `|z| < 3` in
+/// the left half-plane, so the march ends by `r = 4`.
+fn rk4_radius(re: f64, im: f64) -> f64 {
+    let unstable = |r: f64| {
+        let (x, y) = (r * re, r * im);
+        // R(z) = 1 + z(1 + z/2 (1 + z/3 (1 + z/4))), Horner in complex form.
+        let mut a = (1.0, 0.0);
+        for k in [4.0, 3.0, 2.0, 1.0] {
+            a = (1.0 + (x * a.0 - y * a.1) / k, (x * a.1 + y * a.0) / k);
+        }
+        a.0 * a.0 + a.1 * a.1 > 1.0 + 1e-12
+    };
+    let step = 1.0 / 256.0;
+    let mut r = step;
+    while r < 4.0 && !unstable(r) {
+        r += step;
+    }
+    let (mut lo, mut hi) = (r - step, r);
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if unstable(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    lo
+}
+
+/// `ω_max = sqrt(λ_max(M⁻¹K))`, rad/s, over the free vertices with mass, by
+/// the Lanczos iteration on the symmetric `M^{-1/2} K M^{-1/2}` from the
+/// [`perturbation`] pattern (three vectors, no reorthogonalization): its
+/// largest Ritz value never exceeds `λ_max` (to rounding, Paige 1980) and
+/// grows towards it, converging far faster than the power iteration of
+/// [`omega_max`] when the top of the spectrum is clustered, as on a fine
+/// mesh. Stops when the Ritz value grew by at most [`LANCZOS_TOLERANCE`]
+/// over [`LANCZOS_WINDOW`] steps, at an invariant subspace, or after
+/// [`LANCZOS_MAX_STEPS`] steps. `K` is the model's current stiffness (its
+/// elastic forces at rest; use the linear law).
+pub fn lanczos_omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
+    model.reset();
+    let n = model.modes().len();
+    let inv_sqrt_mass: Vec<f64> = (0..n)
+        .map(|v| {
+            let m = model.masses_kg()[v];
+            if model.modes()[v] == VertexMode::Free && m > 0.0 {
+                1.0 / m.sqrt()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let dot = |a: &[[f64; 3]], b: &[[f64; 3]]| -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+            .sum()
+    };
+    let mut q: Vec<[f64; 3]> = (0..n)
+        .map(|v| {
+            if inv_sqrt_mass[v] > 0.0 {
+                perturbation(v, 1.0).into()
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    let norm = dot(&q, &q).sqrt();
+    if norm == 0.0 {
+        return 0.0;
+    }
+    q.iter_mut().for_each(|x| *x = x.map(|c| c / norm));
+    let mut q_previous = vec![[0.0; 3]; n];
+    let mut x = vec![[0.0; 3]; n];
+    let mut w = vec![[0.0; 3]; n];
+    let (mut alphas, mut betas) = (Vec::new(), Vec::new());
+    let mut ritz: Vec<f64> = Vec::new();
+    let mut beta_previous = 0.0;
+    for _ in 0..LANCZOS_MAX_STEPS {
+        // w = M^{-1/2} K M^{-1/2} q, with K u = -(elastic forces of u).
+        for v in 0..n {
+            x[v] = q[v].map(|c| c * inv_sqrt_mass[v]);
+        }
+        model.elastic_forces_of(&x, &mut w);
+        for v in 0..n {
+            w[v] = w[v].map(|c| -c * inv_sqrt_mass[v]);
+        }
+        let alpha = dot(&q, &w);
+        for v in 0..n {
+            for k in 0..3 {
+                w[v][k] -= alpha * q[v][k] + beta_previous * q_previous[v][k];
+            }
+        }
+        alphas.push(alpha);
+        let theta = tridiagonal_max(&alphas, &betas);
+        ritz.push(theta);
+        let beta = dot(&w, &w).sqrt();
+        let settled = ritz.len() > LANCZOS_WINDOW
+            && theta - ritz[ritz.len() - 1 - LANCZOS_WINDOW] <= LANCZOS_TOLERANCE * theta;
+        if settled || !beta.is_finite() || beta <= 1e-12 * theta.abs() {
+            break;
+        }
+        betas.push(beta);
+        beta_previous = beta;
+        core::mem::swap(&mut q_previous, &mut q);
+        for v in 0..n {
+            q[v] = w[v].map(|c| c / beta);
+        }
+    }
+    ritz.last().copied().unwrap_or(0.0).max(0.0).sqrt()
+}
+
+/// Largest eigenvalue of the symmetric tridiagonal matrix with diagonal
+/// `alphas` and off-diagonal `betas` (one fewer), by bisection on the Sturm
+/// count (the number of negative pivots of `T − x I`) inside the
+/// Gershgorin bounds.
+fn tridiagonal_max(alphas: &[f64], betas: &[f64]) -> f64 {
+    let off = |i: usize| betas.get(i).copied().unwrap_or(0.0).abs();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (i, &a) in alphas.iter().enumerate() {
+        let radius = off(i) + if i > 0 { off(i - 1) } else { 0.0 };
+        lo = lo.min(a - radius);
+        hi = hi.max(a + radius);
+    }
+    // Eigenvalues below x.
+    let below = |x: f64| {
+        let mut count = 0;
+        let mut d = 1.0;
+        for (i, &a) in alphas.iter().enumerate() {
+            let coupling = match i.checked_sub(1) {
+                Some(j) => betas[j] * betas[j] / d,
+                None => 0.0,
+            };
+            d = a - x - coupling;
+            if d == 0.0 {
+                d = -f64::EPSILON * (x.abs() + a.abs()).max(f64::MIN_POSITIVE);
+            }
+            if d < 0.0 {
+                count += 1;
+            }
+        }
+        count
+    };
+    let n = alphas.len();
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if below(mid) < n {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }

@@ -214,6 +214,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             gap_m: (tip_m - point_m).dot(&face.normal) - radius_m,
             force_n: Vector3::zeros(),
             grip_offset_m: None,
+            entry_gap_m: T::zero(),
         }
     }
 
@@ -315,8 +316,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// 27 cells of `tip_m` whose plane has the centre's projection inside
     /// the triangle, the one with the nearest plane (the lowest index of
     /// equals) decides; if the sphere reaches behind it (signed gap < 0)
-    /// that is the contact, pushed out along its outward normal, else there
-    /// is none (also when the nearest is a rigid support). Bounded by
+    /// that is the contact, pushed out along its outward normal (its
+    /// [`Contact::entry_gap_m`] the penetration), else there is none (also
+    /// when the nearest is a rigid support). Bounded by
     /// `max_query_triangles` triangle tests.
     pub fn penetration(
         &self,
@@ -358,7 +360,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         {
             return None;
         }
-        Some(self.contact(tool, triangle, &face, weights, tip_m, radius_m))
+        let contact = self.contact(tool, triangle, &face, weights, tip_m, radius_m);
+        Some(Contact {
+            entry_gap_m: contact.gap_m,
+            ..contact
+        })
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
@@ -383,6 +389,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         if contact.grip_offset_m.is_some() {
             return Some(Contact {
                 grip_offset_m: contact.grip_offset_m,
+                entry_gap_m: contact.entry_gap_m,
                 ..self.contact(
                     contact.tool,
                     triangle,
@@ -425,6 +432,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         }
         let x_plane = tip_m - face.normal * radius_m;
         let weights = clamp_weights(barycentric(&face.corners, &face.normal, &x_plane));
-        Some(self.contact(contact.tool, triangle, &face, weights, tip_m, radius_m))
+        Some(Contact {
+            entry_gap_m: contact.entry_gap_m,
+            ..self.contact(contact.tool, triangle, &face, weights, tip_m, radius_m)
+        })
     }
 }

@@ -41,6 +41,12 @@ pub struct Contact<T> {
     /// stays at its barycentric place on its triangle and follows the tool
     /// in all three directions: pulling transmits force.
     pub grip_offset_m: Option<Vector3<T>>,
+    /// The signed gap when the contact was made, m: zero when the sphere's
+    /// motion crossed the surface, the penetration when the sphere was
+    /// found already inside (the surface moved onto it). A model that
+    /// extrapolates from the tool's motion counts it from here, so a
+    /// contact found inside starts from zero force instead of a jump.
+    pub entry_gap_m: T,
 }
 
 impl<T: Real> Contact<T> {

@@ -215,10 +215,13 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         Some(Vector3::new(p[0] + u[0], p[1] + u[1], p[2] + u[2]))
     }
 
-    /// Removes every live tet with a vertex (current position) within
-    /// `radius_m` of the tool segment `a_m`–`b_m` (a point when equal), at
-    /// most `capacity` per call (Picinbono 2001 §3.1: the electric scalpel
-    /// removes the tets it touches). Bounded: one scan of the tets.
+    /// Removes every live tet the tool segment `a_m`–`b_m` (a point when
+    /// equal) touches, at its current shape: a vertex within `radius_m` of
+    /// the segment, or the segment passing through the tet (a blade longer
+    /// than the tets cuts every tet along it, whatever the spacing of their
+    /// vertices). At most `capacity` per call (Picinbono 2001 §3.1: the
+    /// electric scalpel removes the tets it touches). Bounded: one scan of
+    /// the tets.
     pub fn cut_with_tool(
         &mut self,
         a_m: Vector3<T>,
@@ -253,7 +256,12 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         };
         self.remove_where(
             capacity,
-            |model, tet| tet.iter().any(|&v| model.position(v).is_some_and(touches)),
+            |model, tet| {
+                tet.iter().any(|&v| model.position(v).is_some_and(touches))
+                    || model
+                        .corners(tet)
+                        .is_some_and(|(now, _)| crosses(&now, &a_m, &b_m))
+            },
             removed,
         )
     }
@@ -323,6 +331,43 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
 
 /// The four corner positions of a tet, m.
 type Corners<T> = [Vector3<T>; 4];
+
+/// `true` if the segment `a`–`b` has a point inside the tet with corners
+/// `p` (m): the segment clipped by the 4 face half-spaces (Cyrus–Beck) is
+/// not empty. A degenerate (flat or inverted) tet is never crossed.
+fn crosses<T: Real>(p: &Corners<T>, a: &Vector3<T>, b: &Vector3<T>) -> bool {
+    let (mut lo, mut hi) = (T::zero(), T::one());
+    for j in 0..4 {
+        // The face opposite corner j, its normal pointing towards j.
+        let (Some(&o), Some(&f0), Some(&f1), Some(&f2)) = (
+            p.get(j),
+            p.get((j + 1) % 4),
+            p.get((j + 2) % 4),
+            p.get((j + 3) % 4),
+        ) else {
+            return false;
+        };
+        let mut n = (f1 - f0).cross(&(f2 - f0));
+        let height = n.dot(&(o - f0));
+        if height == T::zero() || !height.finite() {
+            return false;
+        }
+        if height < T::zero() {
+            n = -n;
+        }
+        let (da, db) = (n.dot(&(a - f0)), n.dot(&(b - f0)));
+        if da < T::zero() && db < T::zero() {
+            return false;
+        }
+        // Inside where n·(x − f0) ≥ 0 along x = a + t (b − a).
+        if da < T::zero() {
+            lo = lo.max(da / (da - db));
+        } else if db < T::zero() {
+            hi = hi.min(da / (da - db));
+        }
+    }
+    lo <= hi
+}
 
 /// Signed volume of a tet, m³.
 fn volume<T: Real>(p: &[Vector3<T>; 4]) -> T {

@@ -444,7 +444,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             let k = self.contact_stiffness(&t.vertices, shares);
             return match t.grip_offset_m {
                 Some(_) => -(k * t.displacement_m()),
-                None => t.normal * (-t.normal.dot(&(k * t.normal)) * t.gap_m),
+                None => t.normal * (-t.normal.dot(&(k * t.normal)) * (t.gap_m - t.entry_gap_m)),
             };
         };
         let motion = t.tip_m - h.contact.tip_m;

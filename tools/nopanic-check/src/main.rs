@@ -30,38 +30,54 @@
 //! - the outputs `displacements_m`, `velocities_m_s`, `elastic_forces_n`,
 //!   `fault`;
 //!
-//! and of the haptic loop over each model:
+//! and of the haptic loop over each model, driven by `tick_tools` (`tick` is
+//! `tick_tools` with every action `Touch`, so it is covered too) with, for
+//! each of two tool points, a volatile position, a volatile action selector
+//! (`ToolAction::Touch`, `Grip` or `Cut`) and a volatile blade vector:
 //! - over the pre-computed table, `HapticLoop::new` (configuration and limits
-//!   from volatile inputs) and `tick` (contact detection in the collision
-//!   grid, sliding, the contact solve with releases and refusals, the safety
-//!   supervisor) on volatile tool positions of two tool points, with `reset`
-//!   on a volatile flag;
+//!   from volatile inputs) and `tick_tools` (contact detection in the
+//!   collision grid from the motion segment or the penetration, sliding,
+//!   grips closing, holding and opening, the contact solve with releases and
+//!   refusals, a blade on a tissue that cannot cut, `cut_refused`, the safety
+//!   supervisor), with `reset` on a volatile flag;
 //! - over the tensor-mass table, `DynamicTissue::new` (every surface buffer
-//!   length volatile, so the length refusals are reachable; the physics
-//!   configuration volatile) with its `DeformingSurface`, then `tick`,
-//!   `physics_update` (impose, step, held forces, re-binning; on a volatile
-//!   flag) and `reset`, on volatile tool positions.
+//!   length volatile, the face buffers `triangles`, `face_slot`, `slot_tet`
+//!   and `planes` included, so the length refusals are reachable; the
+//!   physics configuration volatile: integrator, extrapolation, step,
+//!   sub-steps, the cut capacity, and tearing off or on with each threshold
+//!   volatile and optional and a volatile capacity, so the capacity
+//!   refusals are reachable) with its `DeformingSurface`, then
+//!   `tick_tools`, `physics_update` (on a volatile flag: the blades of the
+//!   last tick's cuts remove the tets they touch and the one pressed into,
+//!   held grips impose their full displacement, the step, tearing, the
+//!   exposed-face update of the surface, held forces, re-binning) and
+//!   `reset`; the tets each update removed (`DynamicTissue::removed`) are
+//!   published.
 //!
 //! Why the proof holds for every input, not just one: every input (the table
 //! lengths, the contact count, each contact's kind, vertices, barycentric
 //! weights and imposed displacement, the output buffer lengths; for the
 //! tensor-mass model every state-buffer length, the law and parameters, the
-//! number of rounds on one model and whether each resets it, each vertex
-//! index and value, the integrator, the time step, the tet index, the tool
-//! segment, radius and capacity, which tearing criteria are on, their
+//! number of rounds on one model and whether each resets it, each vertex index
+//! and value, the integrator, the time step, the tet index, the tool segment,
+//! radius and capacity, which tearing criteria are on, their thresholds and
+//! capacity; for the haptic loops each tool point's position, action and blade,
+//! each surface buffer length, the cut capacity, whether tearing is on, its
 //! thresholds and capacity) is read with `core::ptr::read_volatile` from a
 //! `static mut` each time round the loop, so the optimiser must assume any
-//! value (a debugger could write them). The tensor-mass calls run in a loop
-//! of a volatile number of rounds on one model, so each also runs on any
-//! state the others leave (tets removed, faulted, central-difference history
-//! valid). Every result is written with
+//! value (a debugger could write them). The tensor-mass calls run in a loop of
+//! a volatile number of rounds on one model, so each also runs on any state the
+//! others leave (tets removed, faulted, central-difference history valid);
+//! likewise the loops tick a volatile number of times, so each tick and physics
+//! update also runs on the contacts, grips and surface (faces exposed by cuts
+//! and tears) the earlier ones leave. Every result is written with
 //! `core::ptr::write_volatile`, so no computation can be dropped as dead.
 //! `core::hint::black_box` is not used: its documentation says it must not be
-//! relied on for correctness, and a too-weak barrier would make this check
-//! pass vacuously. The table bytes themselves are link-time constants (only
-//! the length passed to `load` is opaque), so strictly the proof is for these
-//! two tables; the kernel does not rely on their values, as it reads every
-//! index taken from a table through `get`.
+//! relied on for correctness, and a too-weak barrier would make this check pass
+//! vacuously. The table bytes themselves are link-time constants (only the
+//! length passed to `load` is opaque), so strictly the proof is for these two
+//! tables; the kernel does not rely on their values, as it reads every index
+//! taken from a table through `get`.
 //!
 //! Never run; only linked. `tools/nopanic-check.sh` builds it.
 #![no_std]
@@ -75,7 +91,8 @@ use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 use cortex_m_rt::entry;
 use nalgebra::Vector3;
 use palpate_kernel::haptic::{
-    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits,
+    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits, ToolAction,
+    ToolInput,
 };
 use palpate_kernel::precomputed::{Constraint, PrecomputedTissue};
 use palpate_kernel::table::TensorMassTable;
@@ -84,8 +101,9 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, ElasticLaw, Extrapolation, Fault, Integrator, PhysicsConfig,
-    StateBuffers, StvkForm, SurfaceBuffers, TearThresholds, TensorMassModel, VertexMode,
+    DynamicParams, DynamicTissue, ElasticLaw, Extrapolation, Fault, Integrator,
+    MAX_REMOVED_PER_UPDATE, PhysicsConfig, StateBuffers, StvkForm, SurfaceBuffers, TearThresholds,
+    Tearing, TensorMassModel, VertexMode,
 };
 use palpate_kernel::{MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
@@ -195,10 +213,55 @@ struct HapticInputs {
     config: [f32; 4],
     /// Ticks per round on one loop.
     ticks: u32,
-    /// Tool point positions each tick, m (read again every tick).
-    tool_m: [[f32; 3]; TOOL_POINTS],
+    /// The tool points each tick (read again every tick).
+    tools: ToolInputs,
     /// Non-zero: `reset` before the tick.
     reset: u8,
+}
+
+/// Each tool point's position and action, opaque to the optimiser.
+#[derive(Clone, Copy)]
+struct ToolInputs {
+    /// Sphere centres, m.
+    position_m: [[f32; 3]; TOOL_POINTS],
+    /// `ToolAction` by index (any value: taken modulo 3; 0 touch, 1 grip,
+    /// 2 cut).
+    action: [u8; TOOL_POINTS],
+    /// The blade of a cut, from the tool point to its other end, m.
+    blade_m: [[f32; 3]; TOOL_POINTS],
+}
+
+/// All tool points touching at the origin.
+const TOOLS_AT_REST: ToolInputs = ToolInputs {
+    position_m: [[0.0; 3]; TOOL_POINTS],
+    action: [0; TOOL_POINTS],
+    blade_m: [[0.0; 3]; TOOL_POINTS],
+};
+
+impl ToolInputs {
+    /// The loop's input: each point's position and the action its selector
+    /// names (a cut with its blade vector).
+    fn inputs(&self) -> [ToolInput<f32>; TOOL_POINTS] {
+        core::array::from_fn(|p| {
+            let (Some(&position_m), Some(&action), Some(&blade_m)) = (
+                self.position_m.get(p),
+                self.action.get(p),
+                self.blade_m.get(p),
+            ) else {
+                return ToolInput::touch(Vector3::zeros());
+            };
+            ToolInput {
+                position_m: position_m.into(),
+                action: match action % 3 {
+                    0 => ToolAction::Touch,
+                    1 => ToolAction::Grip,
+                    _ => ToolAction::Cut {
+                        blade_m: blade_m.into(),
+                    },
+                },
+            }
+        })
+    }
 }
 
 /// The haptic inputs, read with `read_volatile` only.
@@ -206,7 +269,7 @@ static mut HAPTIC_INPUTS: HapticInputs = HapticInputs {
     table_len: usize::MAX,
     config: [0.002, 1e-3, 4.0, 2000.0],
     ticks: 1,
-    tool_m: [[0.0; 3]; TOOL_POINTS],
+    tools: TOOLS_AT_REST,
     reset: 0,
 };
 
@@ -216,7 +279,12 @@ struct HapticOutputs {
     status: u8,
     contacts: u8,
     refused: u8,
+    cut_refused: bool,
     solves: u32,
+    /// The dynamic loop: tets the last physics update removed, how many
+    /// and which (in removal order).
+    removed_count: u32,
+    removed: [u32; MAX_REMOVED_PER_UPDATE],
 }
 
 /// The haptic outputs.
@@ -225,7 +293,10 @@ static mut HAPTIC_OUTPUTS: HapticOutputs = HapticOutputs {
     status: 0,
     contacts: 0,
     refused: 0,
+    cut_refused: false,
     solves: 0,
+    removed_count: 0,
+    removed: [0; MAX_REMOVED_PER_UPDATE],
 };
 
 /// The loop configuration from `[radius m, tick s, max force N, slew N/s]`.
@@ -240,8 +311,8 @@ fn loop_config([radius_m, dt_s, max_force_n, max_slew_n_per_s]: [f32; 4]) -> Loo
     }
 }
 
-/// Load, build the loop, then tick on volatile tool positions (`reset` on
-/// a volatile flag), publishing every output.
+/// Load, build the loop, then tick on volatile tool positions and actions
+/// (`reset` on a volatile flag), publishing every output.
 fn haptic_step(inputs: &HapticInputs) {
     let bytes = TABLE.get(..inputs.table_len).unwrap_or(TABLE);
     let Ok(table) = PrecomputedTable::<f32>::load(bytes) else {
@@ -261,7 +332,7 @@ fn haptic_step(inputs: &HapticInputs) {
         if tick.reset != 0 {
             haptic.reset();
         }
-        let out = haptic.tick(&tick.tool_m.map(Vector3::from));
+        let out = haptic.tick_tools(&tick.tools.inputs());
         publish_tick(&out, haptic.counters().solves);
     }
 }
@@ -280,6 +351,7 @@ fn publish_tick(out: &ForceOutput<f32>, solves: u32) {
         write_volatile(addr_of_mut!((*o).status), status);
         write_volatile(addr_of_mut!((*o).contacts), out.contacts);
         write_volatile(addr_of_mut!((*o).refused), out.refused);
+        write_volatile(addr_of_mut!((*o).cut_refused), out.cut_refused);
         write_volatile(addr_of_mut!((*o).solves), solves);
     }
 }
@@ -289,10 +361,11 @@ const CELLS: usize = 128;
 
 /// The dynamic haptic loop's inputs beyond the tensor-mass ones.
 struct DynamicInputs {
-    /// Entries given to `positions_m`, `planes`, `vertex_triangle_start`,
-    /// `vertex_triangle`, `cell_start`, `grid_vertex` and the force scratch
-    /// (each clamped to its capacity).
-    surface_lengths: [usize; 7],
+    /// Entries given to `positions_m`, `triangles`, `face_slot`,
+    /// `slot_tet`, `planes`, `vertex_triangle_start`, `vertex_triangle`,
+    /// `cell_start`, `grid_vertex` and the force scratch (each clamped to
+    /// its capacity).
+    surface_lengths: [usize; 10],
     /// Integrator (as `TensorInputs::integrator`), extrapolation (0:
     /// secant, else instantaneous).
     integrator: u8,
@@ -300,12 +373,21 @@ struct DynamicInputs {
     /// Physics step, s, and steps per update.
     dt_s: f32,
     substeps: u32,
+    /// Most tets the blades remove per update.
+    cut_capacity_tets: u32,
+    /// Non-zero: tearing on, with each criterion (volume change, mean
+    /// elongation, max elongation) on where `tear_on` is non-zero, with its
+    /// threshold, and the capacity.
+    tearing: u8,
+    tear_on: [u8; 3],
+    tear_thresholds: [f32; 3],
+    tear_capacity_tets: u32,
     /// Loop configuration, as `HapticInputs::config`.
     config: [f32; 4],
     /// Ticks per round.
     ticks: u32,
-    /// Tool point positions each tick, m.
-    tool_m: [[f32; 3]; TOOL_POINTS],
+    /// The tool points each tick (positions, actions, blades).
+    tools: ToolInputs,
     /// Non-zero: `reset` before the tick; a physics update after it.
     reset: u8,
     update: u8,
@@ -315,9 +397,12 @@ struct DynamicInputs {
 static mut DYNAMIC_INPUTS: DynamicInputs = DynamicInputs {
     surface_lengths: [
         VERTICES,
-        SURFACE,
+        TRIANGLES - 1,
+        TRIANGLES - 1,
+        TRIANGLES - 1,
+        TRIANGLES - 1,
         VERTICES + 1,
-        3 * SURFACE,
+        3 * (TRIANGLES - 1),
         CELLS + 1,
         VERTICES,
         VERTICES,
@@ -326,20 +411,30 @@ static mut DYNAMIC_INPUTS: DynamicInputs = DynamicInputs {
     extrapolation: 0,
     dt_s: 1e-3,
     substeps: 1,
+    cut_capacity_tets: 8,
+    tearing: 0,
+    tear_on: [0; 3],
+    tear_thresholds: [0.0; 3],
+    tear_capacity_tets: 8,
     config: [0.002, 1e-3, 4.0, 2000.0],
     ticks: 1,
-    tool_m: [[0.0; 3]; TOOL_POINTS],
+    tools: TOOLS_AT_REST,
     reset: 0,
     update: 1,
 };
 
 /// The deforming surface's storage (fixed capacity, sliced to the volatile
-/// lengths).
+/// lengths). The per-face buffers hold one more entry than the table's 378
+/// mesh triangles (as `TRIANGLES`), so a too-long buffer is reachable as well
+/// as a too-short one.
 struct SurfaceState {
     positions_m: [[f32; 3]; VERTICES],
-    planes: [[f32; 4]; SURFACE],
+    triangles: [[u32; 3]; TRIANGLES],
+    face_slot: [u32; TRIANGLES],
+    slot_tet: [u32; TRIANGLES],
+    planes: [[f32; 4]; TRIANGLES],
     vertex_triangle_start: [u32; VERTICES + 1],
-    vertex_triangle: [u32; 3 * SURFACE],
+    vertex_triangle: [u32; 3 * TRIANGLES],
     cell_start: [u32; CELLS + 1],
     grid_vertex: [u32; VERTICES],
     forces_n: [[f32; 3]; VERTICES],
@@ -349,9 +444,12 @@ impl SurfaceState {
     fn new() -> Self {
         Self {
             positions_m: [[0.0; 3]; VERTICES],
-            planes: [[0.0; 4]; SURFACE],
+            triangles: [[0; 3]; TRIANGLES],
+            face_slot: [0; TRIANGLES],
+            slot_tet: [0; TRIANGLES],
+            planes: [[0.0; 4]; TRIANGLES],
             vertex_triangle_start: [0; VERTICES + 1],
-            vertex_triangle: [0; 3 * SURFACE],
+            vertex_triangle: [0; 3 * TRIANGLES],
             cell_start: [0; CELLS + 1],
             grid_vertex: [0; VERTICES],
             forces_n: [[0.0; 3]; VERTICES],
@@ -359,8 +457,11 @@ impl SurfaceState {
     }
 }
 
-/// Load, model, dynamic tissue and loop on volatile inputs, then ticks with
-/// physics updates and resets on volatile flags, publishing every output.
+/// Load, model, dynamic tissue and loop on volatile inputs (surface buffer
+/// lengths, physics configuration with cut capacity and tearing), then
+/// ticks on volatile tool positions and actions (touch, grip, cut) with
+/// physics updates (cuts, tearing, exposed faces) and resets on volatile
+/// flags, publishing every output and the tets each update removed.
 fn dynamic_haptic_step(
     tensor: &TensorInputs,
     inputs: &DynamicInputs,
@@ -377,10 +478,13 @@ fn dynamic_haptic_step(
         refused();
         return;
     };
-    let [p, t, vs, vt, c, g, f] = inputs.surface_lengths;
+    let [p, tr, fs, st, pl, vs, vt, c, g, f] = inputs.surface_lengths;
     let buffers = SurfaceBuffers {
         positions_m: prefix(&mut surface.positions_m, p),
-        planes: prefix(&mut surface.planes, t),
+        triangles: prefix(&mut surface.triangles, tr),
+        face_slot: prefix(&mut surface.face_slot, fs),
+        slot_tet: prefix(&mut surface.slot_tet, st),
+        planes: prefix(&mut surface.planes, pl),
         vertex_triangle_start: prefix(&mut surface.vertex_triangle_start, vs),
         vertex_triangle: prefix(&mut surface.vertex_triangle, vt),
         cell_start: prefix(&mut surface.cell_start, c),
@@ -395,6 +499,11 @@ fn dynamic_haptic_step(
         integrator: integrator(inputs.integrator),
         dt_s: inputs.dt_s,
         substeps: inputs.substeps,
+        cut_capacity_tets: inputs.cut_capacity_tets,
+        tearing: (inputs.tearing != 0).then_some(Tearing {
+            thresholds: tear_thresholds(inputs.tear_on, inputs.tear_thresholds),
+            capacity_tets: inputs.tear_capacity_tets,
+        }),
     };
     let forces = prefix(&mut surface.forces_n, f);
     let Ok(tissue) = DynamicTissue::<f32, TOOL_POINTS>::new(model, buffers, forces, physics) else {
@@ -413,10 +522,25 @@ fn dynamic_haptic_step(
         if tick.reset != 0 {
             haptic.reset();
         }
-        let out = haptic.tick(&tick.tool_m.map(Vector3::from));
+        let out = haptic.tick_tools(&tick.tools.inputs());
         publish_tick(&out, haptic.counters().solves);
         if tick.update != 0 && haptic.physics_update().is_err() {
             refused();
+        }
+        publish_removed(haptic.tissue().removed());
+    }
+}
+
+/// Writes the tets the last physics update removed to `HAPTIC_OUTPUTS`
+/// (volatile): their count and the list.
+fn publish_removed(removed: &[u32]) {
+    let o = addr_of_mut!(HAPTIC_OUTPUTS);
+    // SAFETY: single-threaded; plain-old-data fields of a live static.
+    unsafe {
+        write_volatile(addr_of_mut!((*o).removed_count), removed.len() as u32);
+        let list = &mut *addr_of_mut!((*o).removed);
+        for (t, slot) in removed.iter().zip(list.iter_mut()) {
+            write_volatile(slot, *t);
         }
     }
 }
@@ -790,6 +914,19 @@ fn option(on: u8, value: f32) -> Option<f32> {
     (on != 0).then_some(value)
 }
 
+/// Tearing thresholds: each criterion (volume change, mean elongation, max
+/// elongation) on where its flag is non-zero, with its value.
+fn tear_thresholds(
+    [volume_on, mean_on, max_on]: [u8; 3],
+    [volume, mean, max]: [f32; 3],
+) -> TearThresholds<f32> {
+    TearThresholds {
+        volume_change: option(volume_on, volume),
+        mean_elongation: option(mean_on, mean),
+        max_elongation: option(max_on, max),
+    }
+}
+
 /// The integrator a byte names.
 fn integrator(code: u8) -> Integrator {
     match code % 4 {
@@ -907,13 +1044,7 @@ fn tensor_mass_round(model: &mut TensorMassModel<'_, '_, f32>, inputs: &TensorIn
         inputs.tool_radius_m,
         inputs.cut_capacity,
     );
-    let [volume, mean, max] = inputs.tear_thresholds;
-    let [volume_on, mean_on, max_on] = inputs.tear_on;
-    let thresholds = TearThresholds {
-        volume_change: option(volume_on, volume),
-        mean_elongation: option(mean_on, mean),
-        max_elongation: option(max_on, max),
-    };
+    let thresholds = tear_thresholds(inputs.tear_on, inputs.tear_thresholds);
     let tear = model.tear(&thresholds, inputs.tear_capacity);
     // SAFETY: see above.
     unsafe {
