@@ -11,8 +11,12 @@ mod host {
     mod mesh;
     mod robustness;
     mod session;
+    mod session_generate_tools;
     mod session_run;
+    mod session_scene_tools;
+    mod session_stability;
     mod session_tools;
+    mod session_trajectory_tools;
     mod stability;
 }
 

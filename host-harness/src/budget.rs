@@ -9,7 +9,8 @@
 //!
 //! Bound (instructions): `BASE + P · (TRIANGLE · D + WALK · MAX_WALK_STEPS +
 //! TRACK) + (P + 1) · SOLVE · M³`, with `D = 2 · max_query_triangles` the
-//! worst-case triangle tests of one detection (two point queries; the
+//! worst-case triangle tests of one detection (two point queries, the
+//! sweep's and the penetration test's sharing the one at the tool; the
 //! table-declared maximum over all grid cells, computed at load), `P` tool
 //! points, `M` the contact capacity and `P + 1` the most solves a tick can
 //! do. The unit costs are the largest per-unit costs callgrind measured on
@@ -24,8 +25,10 @@
 //! measured function) has the bound `BASE + P · (TRIANGLE · 6T + WALK ·
 //! MAX_WALK_STEPS + DYNAMIC_TRACK) + (P + 1) · DYNAMIC_SOLVE · M`: a
 //! detection on the re-binned grid tests at most every triangle reference
-//! twice (`T` surface triangles), since compression can crowd a bucket, and
-//! a solve is linear in the contacts (no factorization). Measured on
+//! twice (`3F` references for the `F` faces a cut can expose), since compression can crowd a bucket, and
+//! a solve is linear in the contacts (no factorization). The tick is the
+//! same with grips and blades (a held contact skips the walk; a blade cuts
+//! at the physics update, outside the tick). Measured on
 //! `palpate budget built-in-dynamic`: a tracked contact with its solve
 //! 1192 Ir over the idle 680, an edge crossed ≤ 564 Ir, a triangle tested
 //! ≤ 113 Ir; the worst tick 12 939 Ir.
@@ -80,10 +83,11 @@ pub const DYNAMIC_SOLVE_IR: u64 = 1500;
 /// The static per-tick bound (instructions) of the dynamic model's tick,
 /// between physics updates, for `points` tool points and capacity
 /// `capacity` over `table`. A detection tests at most every triangle
-/// reference of the surface twice (`2 × 3T`): the re-binned grid's buckets
+/// reference of the surface twice (`2 × 3F`, `F` the mesh's faces,
+/// every one of which a cut may expose): the re-binned grid's buckets
 /// depend on the deformation, so no tighter bound holds for any state.
 pub fn dynamic_tick_bound(table: &TensorMassTable<'_, f32>, points: u64, capacity: u64) -> u64 {
-    let detection = 2 * 3 * table.surface_triangles().len() as u64;
+    let detection = 2 * 3 * table.mesh_triangles().len() as u64;
     BASE_IR
         + points
             * (TRIANGLE_IR * detection + WALK_IR * u64::from(MAX_WALK_STEPS) + DYNAMIC_TRACK_IR)

@@ -2,7 +2,7 @@
 //! error), trajectory files (round trip, interpolation values, every validation error, the lenient
 //! reader) and the trajectory generators (poke, press-and-hold, slide, pinch, strike).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use palpate::session::generate::MAX_GENERATED_SAMPLES;
 use palpate::session::{
@@ -13,7 +13,9 @@ use palpate::session::{
 use palpate_kernel::haptic::SafetyLimits;
 use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
-use palpate_tests::reference_dir;
+use palpate_tests::{
+    BASE_SCENE, assert_scene_errors, csv, keyframe, reference_dir, scene, scene_err, traj, traj_err,
+};
 
 /// A fresh folder for this test's files.
 fn temp_dir(name: &str) -> PathBuf {
@@ -22,20 +24,6 @@ fn temp_dir(name: &str) -> PathBuf {
         .join(name);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn scene(text: &str) -> Scene {
-    match Scene::from_toml_str_named(text, "scene.toml", Path::new("/scenes")) {
-        Ok(s) => s,
-        Err(e) => panic!("{e}"),
-    }
-}
-
-fn scene_err(text: &str) -> String {
-    match Scene::from_toml_str_named(text, "bad.toml", Path::new("/scenes")) {
-        Ok(s) => panic!("expected an error, got {s:?}"),
-        Err(e) => e.to_string(),
-    }
 }
 
 // ---------------------------------------------------------------- scenes
@@ -312,11 +300,7 @@ fn scene_file_resolves_the_mesh_next_to_it() {
     );
 }
 
-/// Mesh, fix and material: a valid pre-computed scene ending inside `[material]`, 5 lines.
-const BASE: &str =
-    "mesh = \"a.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = 3000\npoisson = 0.45\n";
-
-/// `BASE` with `young_pa`/`poisson` replaced.
+/// `BASE_SCENE` with `young_pa`/`poisson` replaced.
 fn with_material(young: &str, poisson: &str) -> String {
     format!(
         "mesh = \"a.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = {young}\npoisson = {poisson}\n"
@@ -325,23 +309,23 @@ fn with_material(young: &str, poisson: &str) -> String {
 
 #[test]
 fn every_scene_error_names_the_file_and_what_is_wrong() {
-    let dynamic = |keys: &str| format!("{BASE}[model]\nkind = \"dynamic\"\n{keys}");
+    let dynamic = |keys: &str| format!("{BASE_SCENE}[model]\nkind = \"dynamic\"\n{keys}");
     let cases: Vec<(String, &str)> = vec![
         // Syntax, unknown keys, types: the parser's message with the line.
         (
-            format!("colour = 1\n{BASE}"),
+            format!("colour = 1\n{BASE_SCENE}"),
             "bad.toml: line 1: unknown field `colour`, expected one of `mesh`, `generated`, `fix`, `material`, `model`, `tool`, `cutting`, `tearing`, `rates`, `safety`",
         ),
         (
-            format!("{BASE}[tool]\nradius = 0.002\n"),
+            format!("{BASE_SCENE}[tool]\nradius = 0.002\n"),
             "bad.toml: line 7: unknown field `radius`, expected one of `points`, `radius_m`, `kind`, `jaw_axis`, `grip_opening_m`, `blade_m`",
         ),
         (
-            format!("{BASE}[tool]\npoints = \"one\"\n"),
+            format!("{BASE_SCENE}[tool]\npoints = \"one\"\n"),
             "bad.toml: line 7: invalid type: string \"one\", expected usize",
         ),
         (
-            format!("{BASE}[model]\nkind = \"hybrid\"\n"),
+            format!("{BASE_SCENE}[model]\nkind = \"hybrid\"\n"),
             "bad.toml: line 7: unknown variant `hybrid`, expected `precomputed` or `dynamic`",
         ),
         (
@@ -349,7 +333,7 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
             "bad.toml: line 8: unknown variant `neo-hookean`, expected one of `linear`, `stvk`, `stvk-incompressible`",
         ),
         (
-            format!("{BASE}density = 1000\n"),
+            format!("{BASE_SCENE}density = 1000\n"),
             "bad.toml: line 6: unknown field `density`, expected one of `young_pa`, `poisson`, `density_kg_m3`",
         ),
         (
@@ -367,7 +351,7 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
         ("mesh = \"a.msh\"\nmesh = \"b.msh\"\n".into(), "bad.toml: line 2: duplicate key"),
         // Mesh.
         (
-            format!("{BASE}[generated]\nbox_m = [1, 1, 1]\ncells = [1, 1, 1]\n"),
+            format!("{BASE_SCENE}[generated]\nbox_m = [1, 1, 1]\ncells = [1, 1, 1]\n"),
             "bad.toml: mesh: give either `mesh = \"<file>\"` or a [generated] table, not both",
         ),
         (
@@ -405,46 +389,46 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
         (with_material("3000", "0.5"), "bad.toml: [material] poisson = 0.5: must satisfy 0 <= nu < 0.5"),
         (with_material("3000", "-0.1"), "bad.toml: [material] poisson = -0.1: must satisfy 0 <= nu < 0.5"),
         (
-            format!("{BASE}density_kg_m3 = -1\n"),
+            format!("{BASE_SCENE}density_kg_m3 = -1\n"),
             "bad.toml: [material] density_kg_m3 = -1: must be finite and > 0 kg/m3",
         ),
         // Tool.
         (
-            format!("{BASE}[tool]\npoints = 0\n"),
+            format!("{BASE_SCENE}[tool]\npoints = 0\n"),
             "bad.toml: [tool] points = 0: must be in 1..=4 (the kernel's contact capacity)",
         ),
         (
-            format!("{BASE}[tool]\npoints = 5\n"),
+            format!("{BASE_SCENE}[tool]\npoints = 5\n"),
             "bad.toml: [tool] points = 5: must be in 1..=4 (the kernel's contact capacity)",
         ),
-        (format!("{BASE}[tool]\nradius_m = 0\n"), "bad.toml: [tool] radius_m = 0: must be finite and > 0 m"),
-        (format!("{BASE}[tool]\nradius_m = inf\n"), "bad.toml: [tool] radius_m = inf: must be finite and > 0 m"),
+        (format!("{BASE_SCENE}[tool]\nradius_m = 0\n"), "bad.toml: [tool] radius_m = 0: must be finite and > 0 m"),
+        (format!("{BASE_SCENE}[tool]\nradius_m = inf\n"), "bad.toml: [tool] radius_m = inf: must be finite and > 0 m"),
         // Rates.
-        (format!("{BASE}[rates]\nhaptic_hz = 0\n"), "bad.toml: [rates] haptic_hz = 0: must be finite and > 0 Hz"),
+        (format!("{BASE_SCENE}[rates]\nhaptic_hz = 0\n"), "bad.toml: [rates] haptic_hz = 0: must be finite and > 0 Hz"),
         (
-            format!("{BASE}[rates]\nhaptic_hz = -1000.0\n"),
+            format!("{BASE_SCENE}[rates]\nhaptic_hz = -1000.0\n"),
             "bad.toml: [rates] haptic_hz = -1000: must be finite and > 0 Hz",
         ),
         (
-            format!("{BASE}[rates]\nphysics_every = 0\n"),
+            format!("{BASE_SCENE}[rates]\nphysics_every = 0\n"),
             "bad.toml: [rates] physics_every = 0: must be >= 1 (a physics update every this many ticks)",
         ),
         // Safety.
         (
-            format!("{BASE}[safety]\nmax_force_n = 0\n"),
+            format!("{BASE_SCENE}[safety]\nmax_force_n = 0\n"),
             "bad.toml: [safety] max_force_n = 0: must be finite and > 0 N",
         ),
         (
-            format!("{BASE}[safety]\nmax_slew_n_per_s = nan\n"),
+            format!("{BASE_SCENE}[safety]\nmax_slew_n_per_s = nan\n"),
             "bad.toml: [safety] max_slew_n_per_s = NaN: must be finite and > 0 N/s",
         ),
         // Model.
         (
-            format!("{BASE}[model]\nlaw = \"stvk\"\n"),
+            format!("{BASE_SCENE}[model]\nlaw = \"stvk\"\n"),
             "bad.toml: [model] law: applies to kind = \"dynamic\" only (this scene is \"precomputed\")",
         ),
         (
-            format!("{BASE}[model]\nkind = \"precomputed\"\ndt_s = 0.001\n"),
+            format!("{BASE_SCENE}[model]\nkind = \"precomputed\"\ndt_s = 0.001\n"),
             "bad.toml: [model] dt_s: applies to kind = \"dynamic\" only (this scene is \"precomputed\")",
         ),
         (
@@ -484,31 +468,10 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
             "bad.toml: [model] dt_s = 0.002: the physics period (0.001 s = physics_every / haptic_hz) must be a whole number of steps, 1 to 10000",
         ),
     ];
-    for (text, expected) in cases {
-        let msg = scene_err(&text);
-        assert!(
-            msg == expected,
-            "\n   got: {msg}\nwanted: {expected}\n  text:\n{text}"
-        );
-        assert!(!msg.contains('\n'), "one line: {msg}");
-    }
+    assert_scene_errors(&cases);
 }
 
 // ---------------------------------------------------------------- trajectories
-
-fn traj(text: &str, tools: usize) -> Trajectory {
-    match Trajectory::from_csv_str(text, "traj.csv", tools) {
-        Ok(t) => t,
-        Err(e) => panic!("{e}"),
-    }
-}
-
-fn traj_err(text: &str, tools: usize) -> String {
-    match Trajectory::from_csv_str(text, "traj.csv", tools) {
-        Ok(t) => panic!("expected an error, got {} samples", t.samples().len()),
-        Err(e) => e.to_string(),
-    }
-}
 
 /// Two tool points; tool 0 jumps at t = 3 (two samples at the same time).
 const TWO_POINTS: &str = "\
@@ -610,9 +573,7 @@ fn trajectory_round_trips_through_write_csv() {
         },
     ];
     let t = Trajectory::from_samples(samples.clone(), 2).unwrap();
-    let mut bytes = Vec::new();
-    t.write_csv(&mut bytes).unwrap();
-    let text = String::from_utf8(bytes).unwrap();
+    let text = csv(&t);
     assert!(
         text.starts_with("t,tool,x,y,z\n0,0,0.1,-0,0.0000001\n"),
         "{text}"
@@ -851,9 +812,7 @@ fn unchecked_reader_keeps_bad_values_and_reports_them() {
     let (t, findings) = Trajectory::read_unchecked(&path, 1).unwrap();
     assert_eq!((t.samples().len(), findings.len()), (4, 3));
     // write_csv writes NaN and inf so that the lenient reader reads them back.
-    let mut bytes = Vec::new();
-    t.write_csv(&mut bytes).unwrap();
-    assert_eq!(String::from_utf8(bytes).unwrap(), text);
+    assert_eq!(csv(&t), text);
 }
 
 // ---------------------------------------------------------------- generators
@@ -868,13 +827,6 @@ fn exact_press() -> Press {
         approach_speed_m_s: 0.0625,
         withdraw_speed_m_s: 0.03125,
     }
-}
-
-fn key(keys: &[Keyframe], tool: usize, label: &str) -> Keyframe {
-    *keys
-        .iter()
-        .find(|k| k.tool == tool && k.label == label)
-        .unwrap_or_else(|| panic!("no {label} keyframe for tool {tool}"))
 }
 
 #[test]
@@ -937,10 +889,10 @@ fn poke_reaches_exactly_the_depth_at_the_requested_time() {
 fn press_and_hold_stays_at_the_depth() {
     let hold = PressHold::default();
     let keys = hold.keyframes().unwrap();
-    let deepest = key(&keys, 0, "deepest");
-    let held = key(&keys, 0, "held");
+    let deepest = keyframe(&keys, 0, "deepest");
+    let held = keyframe(&keys, 0, "held");
     assert!((deepest.t_s - 0.5).abs() < 1e-12 && (held.t_s - 1.5).abs() < 1e-12);
-    assert!((key(&keys, 0, "end").t_s - 2.0).abs() < 1e-12);
+    assert!((keyframe(&keys, 0, "end").t_s - 2.0).abs() < 1e-12);
     assert!((deepest.position_m[2] - 0.055).abs() < 1e-15);
     let t = hold.trajectory().unwrap();
     let during: Vec<&Sample> = t
@@ -967,11 +919,11 @@ fn slide_moves_along_the_surface_at_the_depth() {
         rate_hz: 1000.0,
     };
     let keys = slide.keyframes().unwrap();
-    let slid = key(&keys, 0, "slid");
+    let slid = keyframe(&keys, 0, "slid");
     assert_eq!(slid.t_s, 0.4375);
     assert_eq!(slid.position_m, [0.078125, 0.0625, 0.05859375]);
     assert_eq!(
-        key(&keys, 0, "end").position_m,
+        keyframe(&keys, 0, "end").position_m,
         [0.078125, 0.0625, 0.0703125]
     );
     let t = slide.trajectory().unwrap();
@@ -1002,24 +954,24 @@ fn pinch_points_approach_each_other_while_pressed() {
     };
     let keys = pinch.keyframes().unwrap();
     assert_eq!(
-        key(&keys, 0, "start").position_m,
+        keyframe(&keys, 0, "start").position_m,
         [0.0625, 0.046875, 0.0703125]
     );
     assert_eq!(
-        key(&keys, 1, "start").position_m,
+        keyframe(&keys, 1, "start").position_m,
         [0.0625, 0.078125, 0.0703125]
     );
     // Closing 11.71875 mm each at 11.71875 mm/s: 1 s after reaching the depth at 0.1875 s.
-    assert_eq!(key(&keys, 0, "closed").t_s, 1.1875);
+    assert_eq!(keyframe(&keys, 0, "closed").t_s, 1.1875);
     assert_eq!(
-        key(&keys, 0, "closed").position_m,
+        keyframe(&keys, 0, "closed").position_m,
         [0.0625, 0.05859375, 0.05859375]
     );
     assert_eq!(
-        key(&keys, 1, "closed").position_m,
+        keyframe(&keys, 1, "closed").position_m,
         [0.0625, 0.06640625, 0.05859375]
     );
-    assert_eq!(key(&keys, 1, "held").t_s, 1.25);
+    assert_eq!(keyframe(&keys, 1, "held").t_s, 1.25);
     let t = pinch.trajectory().unwrap();
     assert_eq!(t.tool_count(), 2);
     let gap = |time: f64| {
@@ -1059,9 +1011,9 @@ fn strike_hits_at_its_speed() {
     let strike = Strike::default();
     let t = strike.trajectory().unwrap();
     let keys = strike.keyframes().unwrap();
-    let deepest = key(&keys, 0, "deepest");
+    let deepest = keyframe(&keys, 0, "deepest");
     assert!((deepest.t_s - 0.03).abs() < 1e-15);
-    assert!((key(&keys, 0, "contact").t_s - 0.02).abs() < 1e-15);
+    assert!((keyframe(&keys, 0, "contact").t_s - 0.02).abs() < 1e-15);
     assert!((t.end_s() - 0.98).abs() < 1e-12);
     // 0.5 m/s: 0.5 mm per 1 kHz sample, through the surface without slowing down.
     let approach: Vec<&Sample> = t
@@ -1106,8 +1058,8 @@ fn two_probes_by_concatenating_keyframes() {
     assert_eq!(t.tool_count(), 2);
     assert_eq!(t.samples().len(), 2 * 2001);
     let p = t.positions_at(1.0);
-    assert_eq!(p[0], key(&keys, 0, "deepest").position_m);
-    assert_eq!(p[1], key(&keys, 1, "deepest").position_m);
+    assert_eq!(p[0], keyframe(&keys, 0, "deepest").position_m);
+    assert_eq!(p[1], keyframe(&keys, 1, "deepest").position_m);
     // Tool point 1 alone has no tool point 0.
     assert_eq!(
         second.trajectory().unwrap_err().to_string(),

@@ -3,11 +3,18 @@
 //! tears reproducibly, writes its removed tets and shows the cut in its VTK
 //! frames; a grasper without jaw columns, a blade on the pre-computed model
 //! and a step above the stable one are each refused or reported.
+//! Also `palpate::session::tools::kernel_tools` alone: a grasper's two jaws
+//! and a cutter's blade tip as kernel tool points.
 
+use nalgebra::Vector3;
+use palpate::session::ToolSpec;
 use palpate::session::generate::surgery;
 use palpate::session::run::{SessionSummary, removed_path, run_session, run_session_to_files};
 use palpate::session::scene::ToolKind;
+use palpate::session::tools::kernel_tools;
 use palpate::session::{DynamicSpec, Generator, ModelSpec, Poke, Scene};
+use palpate_kernel::haptic::{ToolAction, ToolInput};
+use palpate_tests::tool_state;
 
 fn temp_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("palpate-{name}-{}", std::process::id()));
@@ -162,4 +169,42 @@ fn a_step_above_the_stable_one_is_refused_at_load() {
         message.contains("dt_s = 0.005") && message.contains("largest stable step"),
         "{message}"
     );
+}
+
+/// A grasper then a cutter: the jaws either side along the axis,
+/// gripping at and below the opening; the cutter's sphere at the blade
+/// tip, its blade back up to the tool point, cutting only when enabled.
+#[test]
+fn grasper_and_cutter_expand_in_trajectory_order() {
+    let mut spec = ToolSpec::probes(2, 0.002);
+    spec.kinds = vec![ToolKind::Grasper, ToolKind::Cutter];
+    spec.grip_opening_m = 0.005;
+    let tools: [ToolInput<f32>; 3] = kernel_tools(
+        &spec,
+        &[
+            tool_state([0.1, 0.2, 0.3], 0.005, false),
+            tool_state([0.0, 0.0, 0.05], 0.0, true),
+        ],
+    );
+    assert_eq!(tools[0].position_m, Vector3::new(0.0975, 0.2, 0.3));
+    assert_eq!(tools[1].position_m, Vector3::new(0.1025, 0.2, 0.3));
+    assert_eq!([tools[0].action, tools[1].action], [ToolAction::Grip; 2]);
+    assert_eq!(tools[2].position_m, Vector3::new(0.0, 0.0, 0.04));
+    assert_eq!(
+        tools[2].action,
+        ToolAction::Cut {
+            blade_m: Vector3::new(0.0, 0.0, 0.01)
+        }
+    );
+    let open: [ToolInput<f32>; 3] = kernel_tools(
+        &spec,
+        &[
+            tool_state([0.1, 0.2, 0.3], 0.0051, false),
+            tool_state([0.0; 3], 0.0, false),
+        ],
+    );
+    assert_eq!([open[0].action, open[2].action], [ToolAction::Touch; 2]);
+    // A missing trajectory tool point: NaN, which the loop faults on.
+    let short: [ToolInput<f32>; 3] = kernel_tools(&spec, &[tool_state([0.0; 3], 0.01, false)]);
+    assert!(short[2].position_m.x.is_nan());
 }

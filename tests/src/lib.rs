@@ -1,7 +1,10 @@
 //! Shared helpers for the workspace integration tests: where the independent
-//! reference data lives and how to read it.
+//! reference data lives and how to read it, and the session tests' readers of
+//! scene and trajectory text.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use palpate::session::{Keyframe, Scene, ToolState, Trajectory};
 
 /// The independent reference data committed with the tests
 /// (`tests/reference/`, see its README for how each file was computed).
@@ -282,4 +285,84 @@ pub fn static_reaction(
         .zip(held)
         .map(|(g, (_, _, s))| -g * *s)
         .sum()
+}
+
+/// Mesh, fix and material: a valid pre-computed scene ending inside
+/// `[material]`, 5 lines, without tool, cutting or tearing keys.
+pub const BASE_SCENE: &str =
+    "mesh = \"a.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = 3000\npoisson = 0.45\n";
+
+/// The scene of TOML `text` named `scene.toml` in the folder `/scenes`;
+/// panics with the error's message if it does not validate.
+pub fn scene(text: &str) -> Scene {
+    match Scene::from_toml_str_named(text, "scene.toml", Path::new("/scenes")) {
+        Ok(s) => s,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The error message of the scene of TOML `text` named `bad.toml` in the
+/// folder `/scenes`; panics if it validates.
+pub fn scene_err(text: &str) -> String {
+    match Scene::from_toml_str_named(text, "bad.toml", Path::new("/scenes")) {
+        Ok(s) => panic!("expected an error, got {s:?}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Each `(text, expected)` of `cases`: the scene of TOML `text` is refused
+/// ([`scene_err`]) with exactly the one-line message `expected`.
+pub fn assert_scene_errors(cases: &[(String, &str)]) {
+    for (text, expected) in cases {
+        let msg = scene_err(text);
+        assert!(
+            msg == *expected,
+            "\n   got: {msg}\nwanted: {expected}\n  text:\n{text}"
+        );
+        assert!(!msg.contains('\n'), "one line: {msg}");
+    }
+}
+
+/// The trajectory of CSV `text` named `traj.csv` for `tools` tool points;
+/// panics with the error's message if it is refused.
+pub fn traj(text: &str, tools: usize) -> Trajectory {
+    match Trajectory::from_csv_str(text, "traj.csv", tools) {
+        Ok(t) => t,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The error message of the trajectory of CSV `text` named `traj.csv` for
+/// `tools` tool points; panics if it is read.
+pub fn traj_err(text: &str, tools: usize) -> String {
+    match Trajectory::from_csv_str(text, "traj.csv", tools) {
+        Ok(t) => panic!("expected an error, got {} samples", t.samples().len()),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The trajectory file `t` writes (`Trajectory::write_csv`), as text.
+pub fn csv(t: &Trajectory) -> String {
+    let mut bytes = Vec::new();
+    t.write_csv(&mut bytes).expect("write to memory");
+    String::from_utf8(bytes).expect("UTF-8")
+}
+
+/// A trajectory tool point's state: at `position_m` with the jaw opening
+/// `jaw_m`, the blade enabled if `cut`.
+pub fn tool_state(position_m: [f64; 3], jaw_m: f64, cut: bool) -> ToolState {
+    ToolState {
+        position_m,
+        jaw_m,
+        cut,
+    }
+}
+
+/// The first keyframe of tool point `tool` labelled `label`; panics if there
+/// is none.
+pub fn keyframe(keys: &[Keyframe], tool: usize, label: &str) -> Keyframe {
+    *keys
+        .iter()
+        .find(|k| k.tool == tool && k.label == label)
+        .unwrap_or_else(|| panic!("no {label} keyframe for tool {tool}"))
 }

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use palpate::budget::{BudgetRow, M4F_IPS, budget_table, measure, probe, trajectories};
 use palpate::session::run::check_scene_table;
+use palpate::session::stability::check_stable_step;
 use palpate::session::{MeshSource, Scene, Trajectory};
 use palpate::table::load::TableFile;
 
@@ -97,6 +98,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         sized.mesh = source.clone();
         let (mesh, report) = sized.load_mesh()?;
         check_scene_table(&sized, &mesh, &report)?;
+        check_stable_step(&sized, &mesh, &report)?;
     }
     let mut rows: Vec<BudgetRow> = Vec::new();
     for (s, source) in sizes.into_iter().enumerate() {

@@ -201,24 +201,56 @@ pub fn critical_dt_of_mesh(
     damping_per_s: f64,
     integrator: Integrator,
 ) -> anyhow::Result<CriticalDt> {
+    with_moving_model(mesh, report, options, damping_per_s, |model| {
+        let young_pa = options.material.young_pa;
+        // Checked before the bisection, which would run its every trial on
+        // a bracket of NaN or zero.
+        let omega = checked_omega(omega_max(model), young_pa)?;
+        let amplitude = 1e-3 * diagonal(&mesh.positions);
+        let result = critical_dt(model, integrator, amplitude);
+        if !(result.critical_dt.is_finite() && result.critical_dt > 0.0) {
+            bail!(
+                "no stable step found: {} is unstable even at {:e} s (2/omega_max = {:e} s): the \
+                 energies overflow f64 with E = {young_pa:e} Pa on this mesh; give E in Pa, the \
+                 density in kg/m3 and the mesh in metres (SI units)",
+                result.integrator,
+                8.0 / omega / f64::from(1u32 << BISECTIONS),
+                result.estimate_2_over_omega_max
+            );
+        }
+        Ok(result)
+    })
+}
+
+/// Builds the f64 model of `mesh` (the tensor-mass table `options`,
+/// damping `damping_per_s`, 1/s) and runs `body` on it; an error when no
+/// vertex can move (every one fixed or in no tet): nothing is unstable.
+fn with_moving_model<R>(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    damping_per_s: f64,
+    body: impl FnOnce(&mut TensorMassModel<'_, '_, f64>) -> anyhow::Result<R>,
+) -> anyhow::Result<R> {
     let file = f64_table(mesh, report, options)?;
     let table = palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes())?;
     let mut state = OwnedState::for_table(&table);
     let params = host_params(&mesh.positions, damping_per_s);
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     let moving = (0..model.modes().len())
-        .filter(|&v| model.modes()[v] == VertexMode::Free && model.masses_kg()[v] > 0.0)
-        .count();
-    if moving == 0 {
+        .any(|v| model.modes()[v] == VertexMode::Free && model.masses_kg()[v] > 0.0);
+    if !moving {
         bail!(
-            "every vertex is fixed (by --fix, or unreferenced by any tet): nothing moves, \
-             so no step is unstable and there is no critical step"
+            "every vertex is fixed (by the fix predicates, or unreferenced by any tet): nothing \
+             moves, so no step is unstable and there is no critical step"
         );
     }
-    let young_pa = options.material.young_pa;
-    // Checked before the bisection, which would run its every trial on a
-    // bracket of NaN or zero.
-    let omega = omega_max(&mut model);
+    body(&mut model)
+}
+
+/// `omega` (rad/s) if finite and positive, else the error naming the units
+/// to check (E `young_pa`, Pa).
+fn checked_omega(omega: f64, young_pa: f64) -> anyhow::Result<f64> {
     if !(omega.is_finite() && omega > 0.0) {
         bail!(
             "the largest eigenfrequency of M^-1 K is {omega} rad/s (f64 overflow or underflow \
@@ -226,19 +258,7 @@ pub fn critical_dt_of_mesh(
              kg/m3 and the mesh in metres (SI units)"
         );
     }
-    let amplitude = 1e-3 * diagonal(&mesh.positions);
-    let result = critical_dt(&mut model, integrator, amplitude);
-    if !(result.critical_dt.is_finite() && result.critical_dt > 0.0) {
-        bail!(
-            "no stable step found: {} is unstable even at {:e} s (2/omega_max = {:e} s): the \
-             energies overflow f64 with E = {young_pa:e} Pa on this mesh; give E in Pa, the \
-             density in kg/m3 and the mesh in metres (SI units)",
-            result.integrator,
-            8.0 / omega / f64::from(1u32 << BISECTIONS),
-            result.estimate_2_over_omega_max
-        );
-    }
-    Ok(result)
+    Ok(omega)
 }
 
 /// The largest stable step of an integrator on a mesh, from `ω_max`
@@ -310,33 +330,14 @@ pub fn stable_step_limit(
     if !(damping_per_s.is_finite() && damping_per_s >= 0.0) {
         bail!("the damping must be finite and >= 0 1/s, got {damping_per_s}");
     }
-    let file = f64_table(mesh, report, options)?;
-    let table = palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes())?;
-    let mut state = OwnedState::for_table(&table);
-    let params = host_params(&mesh.positions, damping_per_s);
-    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
-    let moving = (0..model.modes().len())
-        .any(|v| model.modes()[v] == VertexMode::Free && model.masses_kg()[v] > 0.0);
-    if !moving {
-        bail!(
-            "every vertex is fixed (by the fix predicates, or unreferenced by any tet): nothing \
-             moves, so there is no stable step to find"
-        );
-    }
-    let omega = lanczos_omega_max(&mut model);
-    if !(omega.is_finite() && omega > 0.0) {
-        let young_pa = options.material.young_pa;
-        bail!(
-            "the largest eigenfrequency of M^-1 K is {omega} rad/s (f64 overflow or underflow \
-             with E = {young_pa:e} Pa and this mesh and density): give E in Pa, the density in \
-             kg/m3 and the mesh in metres (SI units)"
-        );
-    }
-    let (limit_dt_s, rule) = integrator_limit(integrator, omega, damping_per_s);
-    Ok(StableStep {
-        omega_max: omega,
-        limit_dt_s,
-        rule,
+    with_moving_model(mesh, report, options, damping_per_s, |model| {
+        let omega = checked_omega(lanczos_omega_max(model), options.material.young_pa)?;
+        let (limit_dt_s, rule) = integrator_limit(integrator, omega, damping_per_s);
+        Ok(StableStep {
+            omega_max: omega,
+            limit_dt_s,
+            rule,
+        })
     })
 }
 

@@ -32,6 +32,13 @@ use crate::table::{
 /// walk; a contact that would slide further stops at the last triangle).
 pub const MAX_WALK_STEPS: u32 = 8;
 
+/// How far, in radii, a plane may lie from a tool sphere's centre for the
+/// penetration test to look at its triangle ([`SurfaceGeometry::detect`]):
+/// a sphere up to its diameter into the surface is found (its centre one
+/// radius behind it), and a tool hovering clear of the surface costs one
+/// dot product per candidate triangle.
+pub const PENETRATION_DEPTH_RADII: f64 = 2.0;
+
 /// Work done by detection and tracking (per-stage counters for the timing
 /// budget).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -221,20 +228,31 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// The contact of a sphere of radius `radius_m` whose centre moved from
     /// `from_m` (`None`: no earlier position) to `to_m` (m): the first
     /// surface triangle the motion hits from outside, else the triangle it
-    /// penetrates where it stands ([`Self::penetration`]); triangles with
-    /// all three vertices fixed (a rigid support, no compliance) are not
-    /// touchable. Sweep candidates: the triangles around the surface
-    /// vertices in the 27 grid cells around `to_m` and around `from_m`
-    /// (once when both are in the same cell; none for a point more than a
-    /// cell plus the radius outside the grid). Bounded by
-    /// `3 × max_query_triangles` triangle tests, most rejected by two dot
-    /// products with the stored plane.
+    /// penetrates where it stands; triangles with all three vertices fixed
+    /// (a rigid support, no compliance) are not touchable.
     ///
-    /// An end outside that reach is first moved along the segment to where
-    /// the segment leaves it ([`clip_towards`], computed from the end inside):
-    /// no triangle can be hit beyond it, and a far end (a tool sample at
-    /// 1e10 m) would otherwise swamp the intersection's arithmetic, in f32
-    /// every digit of the part near the surface.
+    /// Candidates: the triangles around the surface vertices in the 27 grid
+    /// cells around `to_m` and, for the sweep, around `from_m` (once when
+    /// both are in the same cell; none for a point more than a cell plus
+    /// the radius outside the grid). Bounded by `2 × max_query_triangles`
+    /// triangle tests, most rejected by two dot products with the stored
+    /// plane; the sweep and the penetration test share the visit of the
+    /// cells around `to_m`.
+    ///
+    /// Sweep: an end outside that reach is first moved along the segment to
+    /// where the segment leaves it ([`clip_towards`], computed from the end
+    /// inside): no triangle can be hit beyond it, and a far end (a tool
+    /// sample at 1e10 m) would otherwise swamp the intersection's
+    /// arithmetic, in f32 every digit of the part near the surface.
+    ///
+    /// Penetration (the surface moved onto the tool): among the triangles
+    /// around `to_m` whose plane lies within [`PENETRATION_DEPTH_RADII`]
+    /// radii of the centre and has the centre's projection inside the
+    /// triangle, the one with the nearest plane (the lowest index of
+    /// equals) decides; if the sphere reaches behind it (signed gap < 0)
+    /// that is the contact, pushed out along its outward normal, with
+    /// [`Contact::entry_gap_m`] its penetration; else there is none (also
+    /// when the nearest is a rigid support).
     pub fn detect(
         &self,
         tool: usize,
@@ -243,115 +261,48 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         radius_m: T,
         work: &mut ContactWork,
     ) -> Option<Contact<T>> {
-        from_m
-            .and_then(|from_m| self.sweep(tool, from_m, to_m, radius_m, work))
-            .or_else(|| self.penetration(tool, to_m, radius_m, work))
-    }
-
-    /// The first surface triangle a sphere moving from `from_m` to `to_m`
-    /// hits from outside ([`Self::detect`]'s sweep).
-    fn sweep(
-        &self,
-        tool: usize,
-        from_m: &Vector3<T>,
-        to_m: &Vector3<T>,
-        radius_m: T,
-        work: &mut ContactWork,
-    ) -> Option<Contact<T>> {
-        let tolerance = T::WEIGHT_TOLERANCE;
-        // A start exactly touching the surface may round to just inside it.
-        let slack_m = tolerance * self.index.cell_m();
-        let mut best: Option<(T, TriangleIndex, [T; 3])> = None;
-        let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
         let reach = self.index.reach(radius_m);
-        let (to_in, from_in) = (within(to_m, &reach), within(from_m, &reach));
-        let (near_to, near_from) = (to_in, !same_cell && from_in);
-        // The swept segment, clipped to the reach of the grid when exactly
-        // one end lies outside it (both outside: no candidate is tested).
-        let (start_m, end_m) = match (from_in, to_in) {
-            (false, true) => (clip_towards(to_m, from_m, &reach), *to_m),
-            (true, false) => (*from_m, clip_towards(from_m, to_m, &reach)),
-            _ => (*from_m, *to_m),
+        let to_in = within(to_m, &reach);
+        let sweep = from_m.map(|from_m| {
+            let from_in = within(from_m, &reach);
+            let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
+            // The swept segment, clipped to the reach of the grid when
+            // exactly one end lies outside it (both outside: no candidate).
+            let (start_m, end_m) = match (from_in, to_in) {
+                (false, true) => (clip_towards(to_m, from_m, &reach), *to_m),
+                (true, false) => (*from_m, clip_towards(from_m, to_m, &reach)),
+                _ => (*from_m, *to_m),
+            };
+            (start_m, end_m, (!same_cell && from_in).then_some(*from_m))
+        });
+        let mut hit = None;
+        let mut nearest = None;
+        let mut visit = |around: &Vector3<T>, penetration: bool, work: &mut ContactWork| {
+            for v in self.index.vertices_near(around) {
+                for t in self.index.triangles_of(v) {
+                    work.triangles_tested = work.triangles_tested.saturating_add(1);
+                    let Some((normal, offset)) = self.index.plane(t) else {
+                        continue;
+                    };
+                    if let Some((start_m, end_m, _)) = &sweep {
+                        let segment = [*start_m, *end_m];
+                        self.sweep_test(t, normal, offset, &segment, radius_m, &mut hit);
+                    }
+                    if penetration {
+                        self.nearest_test(t, normal, offset, to_m, radius_m, &mut nearest);
+                    }
+                }
+            }
         };
-        let candidates = self
-            .index
-            .vertices_near(to_m)
-            .take_while(|_| near_to)
-            .chain(self.index.vertices_near(from_m).take_while(|_| near_from));
-        for v in candidates {
-            for t in self.index.triangles_of(v) {
-                work.triangles_tested = work.triangles_tested.saturating_add(1);
-                // The stored plane first: two dot products reject almost all.
-                let Some((normal, offset)) = self.index.plane(t) else {
-                    continue;
-                };
-                let s0 = normal.dot(&start_m) - offset - radius_m;
-                let s1 = normal.dot(&end_m) - offset - radius_m;
-                if !(s0 >= -slack_m && s1 < T::zero()) {
-                    continue;
-                }
-                let s0 = s0.max(T::zero());
-                let along = s0 / (s0 - s1);
-                if best.as_ref().is_some_and(|(b, _, _)| *b <= along) {
-                    continue;
-                }
-                let Some(f) = self.corners(t) else { continue };
-                if f.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
-                    continue;
-                }
-                let x = start_m + (end_m - start_m) * along - normal * radius_m;
-                let w = barycentric(&f.corners, &normal, &x);
-                if w.iter().all(|&wi| wi >= -tolerance) {
-                    best = Some((along, t, clamp_weights(w)));
-                }
-            }
+        if to_in {
+            visit(to_m, true, work);
         }
-        let (_, triangle, weights) = best?;
-        let face = self.face(triangle)?;
-        Some(self.contact(tool, triangle, &face, weights, to_m, radius_m))
-    }
-
-    /// The contact of a sphere (centre `tip_m`, radius `radius_m`, m) found
-    /// already inside the tissue: among the candidate triangles around the
-    /// 27 cells of `tip_m` whose plane has the centre's projection inside
-    /// the triangle, the one with the nearest plane (the lowest index of
-    /// equals) decides; if the sphere reaches behind it (signed gap < 0)
-    /// that is the contact, pushed out along its outward normal (its
-    /// [`Contact::entry_gap_m`] the penetration), else there is none (also
-    /// when the nearest is a rigid support). Bounded by
-    /// `max_query_triangles` triangle tests.
-    pub fn penetration(
-        &self,
-        tool: usize,
-        tip_m: &Vector3<T>,
-        radius_m: T,
-        work: &mut ContactWork,
-    ) -> Option<Contact<T>> {
-        if !within(tip_m, &self.index.reach(radius_m)) {
-            return None;
+        if let Some((_, _, Some(from_m))) = &sweep {
+            visit(from_m, false, work);
         }
-        let tolerance = T::WEIGHT_TOLERANCE;
-        let mut nearest: Option<(T, TriangleIndex, [T; 3])> = None;
-        for v in self.index.vertices_near(tip_m) {
-            for t in self.index.triangles_of(v) {
-                work.triangles_tested = work.triangles_tested.saturating_add(1);
-                let Some((normal, offset)) = self.index.plane(t) else {
-                    continue;
-                };
-                let distance = normal.dot(tip_m) - offset;
-                if normal == Vector3::zeros()
-                    || nearest
-                        .as_ref()
-                        .is_some_and(|(d, _, _)| d.abs() <= distance.abs())
-                {
-                    continue;
-                }
-                let Some(f) = self.corners(t) else { continue };
-                let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance));
-                if w.iter().all(|&wi| wi >= -tolerance) {
-                    nearest = Some((distance, t, clamp_weights(w)));
-                }
-            }
+        if let Some((_, triangle, weights)) = hit {
+            let face = self.face(triangle)?;
+            return Some(self.contact(tool, triangle, &face, weights, to_m, radius_m));
         }
         let (distance, triangle, weights) = nearest?;
         let face = self.face(triangle)?;
@@ -360,11 +311,80 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         {
             return None;
         }
-        let contact = self.contact(tool, triangle, &face, weights, tip_m, radius_m);
+        let contact = self.contact(tool, triangle, &face, weights, to_m, radius_m);
         Some(Contact {
             entry_gap_m: contact.gap_m,
             ..contact
         })
+    }
+
+    /// The sweep's test of triangle `t` (plane `normal`, `offset`) against
+    /// the sphere moving along `segment`: keeps in `best` the earliest hit
+    /// from outside, as `(along, triangle, weights)`.
+    fn sweep_test(
+        &self,
+        t: TriangleIndex,
+        normal: Vector3<T>,
+        offset: T,
+        segment: &[Vector3<T>; 2],
+        radius_m: T,
+        best: &mut Option<(T, TriangleIndex, [T; 3])>,
+    ) {
+        let tolerance = T::WEIGHT_TOLERANCE;
+        // A start exactly touching the surface may round to just inside it.
+        let slack_m = tolerance * self.index.cell_m();
+        let [start_m, end_m] = segment;
+        // The stored plane first: two dot products reject almost all.
+        let s0 = normal.dot(start_m) - offset - radius_m;
+        let s1 = normal.dot(end_m) - offset - radius_m;
+        if !(s0 >= -slack_m && s1 < T::zero()) {
+            return;
+        }
+        let s0 = s0.max(T::zero());
+        let along = s0 / (s0 - s1);
+        if best.as_ref().is_some_and(|(b, _, _)| *b <= along) {
+            return;
+        }
+        let Some(f) = self.corners(t) else { return };
+        if f.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
+            return;
+        }
+        let x = start_m + (end_m - start_m) * along - normal * radius_m;
+        let w = barycentric(&f.corners, &normal, &x);
+        if w.iter().all(|&wi| wi >= -tolerance) {
+            *best = Some((along, t, clamp_weights(w)));
+        }
+    }
+
+    /// The penetration test of triangle `t` (plane `normal`, `offset`)
+    /// against a sphere centred at `tip_m`: keeps in `nearest` the triangle
+    /// with the nearest plane under the centre, as `(signed distance of the
+    /// centre, triangle, weights)`.
+    fn nearest_test(
+        &self,
+        t: TriangleIndex,
+        normal: Vector3<T>,
+        offset: T,
+        tip_m: &Vector3<T>,
+        radius_m: T,
+        nearest: &mut Option<(T, TriangleIndex, [T; 3])>,
+    ) {
+        let distance = normal.dot(tip_m) - offset;
+        // Beyond the depth reach either way: neither a penetration to find
+        // nor nearer than one (one dot product, the cheap reject).
+        if distance.abs() > radius_m * T::of_f64(PENETRATION_DEPTH_RADII)
+            || normal == Vector3::zeros()
+            || nearest
+                .as_ref()
+                .is_some_and(|(d, _, _)| d.abs() <= distance.abs())
+        {
+            return;
+        }
+        let Some(f) = self.corners(t) else { return };
+        let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance));
+        if w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE) {
+            *nearest = Some((distance, t, clamp_weights(w)));
+        }
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of

@@ -13,6 +13,8 @@ pub mod grid;
 mod set;
 mod tissue;
 
-pub use geometry::{ContactWork, MAX_WALK_STEPS, Supports, SurfaceGeometry};
+pub use geometry::{
+    ContactWork, MAX_WALK_STEPS, PENETRATION_DEPTH_RADII, Supports, SurfaceGeometry,
+};
 pub use set::{Contact, ContactSet};
 pub use tissue::{Refusal, Tissue};
