@@ -36,6 +36,7 @@ const PHYSICS: PhysicsConfig<f32> = PhysicsConfig {
     dt_s: 5e-4,
     substeps: 1,
     cut_capacity_tets: 8,
+    cut_force_n: 0.2,
     tearing: None,
 };
 

@@ -3,7 +3,7 @@
 //! `host::session`).
 
 use palpate::session::scene::{
-    CuttingSpec, MAX_TOOL_POINTS, Scene, TearingSpec, ToolKind, ToolSpec,
+    CuttingSpec, DEFAULT_CUT_FORCE_N, MAX_TOOL_POINTS, Scene, TearingSpec, ToolKind, ToolSpec,
 };
 use palpate_tests::{BASE_SCENE, assert_scene_errors, scene, scene_err};
 
@@ -24,6 +24,7 @@ fn tool_kinds_cutting_and_tearing_with_every_key() {
          blade_m = [0.0, 0.005, -0.02]\n\
          [cutting]\n\
          capacity_tets = 16\n\
+         force_n = 0.5\n\
          [tearing]\n\
          volume_change = 0.5\n\
          mean_elongation = 0.4\n\
@@ -42,7 +43,13 @@ fn tool_kinds_cutting_and_tearing_with_every_key() {
         }
     );
     assert_eq!(s.tool.kernel_points(), 3);
-    assert_eq!(s.cutting, CuttingSpec { capacity_tets: 16 });
+    assert_eq!(
+        s.cutting,
+        CuttingSpec {
+            capacity_tets: 16,
+            force_n: 0.5
+        }
+    );
     assert_eq!(
         s.tearing,
         Some(TearingSpec {
@@ -66,7 +73,13 @@ fn tool_kinds_cutting_and_tearing_defaults() {
     assert_eq!(s.tool.grip_opening_m, 2.5 * 0.002);
     assert_eq!(s.tool.blade_m, [0.0, 0.0, -0.01]);
     assert_eq!(s.tool.kernel_points(), 1);
-    assert_eq!(s.cutting, CuttingSpec { capacity_tets: 8 });
+    assert_eq!(
+        s.cutting,
+        CuttingSpec {
+            capacity_tets: 8,
+            force_n: DEFAULT_CUT_FORCE_N
+        }
+    );
     assert_eq!(s.tearing, None);
 
     // One kind for every point; the grip opening follows the radius; one tearing criterion.
@@ -106,7 +119,10 @@ fn tool_kinds_cutting_and_tearing_defaults() {
     // `[cutting]` is accepted on the pre-computed model (which has nothing to cut).
     assert_eq!(
         scene(&format!("{BASE_SCENE}[cutting]\ncapacity_tets = 64\n")).cutting,
-        CuttingSpec { capacity_tets: 64 }
+        CuttingSpec {
+            capacity_tets: 64,
+            force_n: DEFAULT_CUT_FORCE_N
+        }
     );
 }
 
@@ -133,7 +149,13 @@ fn built_in_scenes_have_one_probe_and_no_tearing() {
     for s in [Scene::built_in(), Scene::built_in_dynamic()] {
         s.validate().unwrap();
         assert_eq!(s.tool, ToolSpec::probes(1, 0.002));
-        assert_eq!(s.cutting, CuttingSpec { capacity_tets: 8 });
+        assert_eq!(
+            s.cutting,
+            CuttingSpec {
+                capacity_tets: 8,
+                force_n: DEFAULT_CUT_FORCE_N
+            }
+        );
         assert_eq!(s.tearing, None);
     }
 }
@@ -161,7 +183,7 @@ fn every_tool_cutting_and_tearing_error_names_the_key() {
         ),
         (
             format!("{BASE_SCENE}[cutting]\ncapacity = 8\n"),
-            "bad.toml: line 7: unknown field `capacity`, expected `capacity_tets`",
+            "bad.toml: line 7: unknown field `capacity`, expected `capacity_tets` or `force_n`",
         ),
         (
             format!("{BASE_SCENE}[cutting]\ncapacity_tets = -1\n"),
@@ -291,6 +313,10 @@ fn every_tool_cutting_and_tearing_error_names_the_key() {
         (
             format!("{DYNAMIC}[tearing]\nmax_elongation = inf\n"),
             "bad.toml: [tearing] max_elongation = inf: must be finite and > 0",
+        ),
+        (
+            format!("{DYNAMIC}[cutting]\nforce_n = 0\n"),
+            "bad.toml: [cutting] force_n = 0: must be finite, > 0 N and fit f32",
         ),
     ];
     assert_scene_errors(&cases);

@@ -28,7 +28,8 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 /// listed once; the last VTK frame holds exactly the live tets (the 5184
 /// of the block less those removed); the grasp pulls the hand down while
 /// held (the grasper's 8 mm pull at 1.75–2.25 s: the force's z below
-/// −0.5 N, measured −1.2 N); no fault.
+/// −0.5 N, measured −1.2 N); the cutter feels the tissue ahead of its blade
+/// while it cuts; no fault.
 #[test]
 fn surgery_cuts_and_grasps_reproducibly() {
     let scene = Scene::named("built-in-tools").expect("built-in");
@@ -87,6 +88,33 @@ fn surgery_cuts_and_grasps_reproducibly() {
         !pulled.is_empty() && pulled.iter().all(|&fz| fz < -0.5),
         "pulled down"
     );
+    // The cutter alone (3–6 s, the grasper gone): the sphere at the blade's
+    // tip touches the tissue ahead almost throughout and pushes back, up to
+    // the 0.2 N at which a tet gives way (measured: in contact 2977 of 3001
+    // ticks, mean 0.114 N, peak 0.284 N).
+    let cutting: Vec<(f64, u32)> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let t: f64 = f[0].parse().ok()?;
+            let force: f64 = f[1..4]
+                .iter()
+                .map(|x| x.parse::<f64>().expect("force").powi(2))
+                .sum::<f64>()
+                .sqrt();
+            (3.0..=6.0)
+                .contains(&t)
+                .then(|| (force, f[4].parse().expect("contacts")))
+        })
+        .collect();
+    let touching = cutting.iter().filter(|(_, c)| *c > 0).count();
+    let mean = cutting.iter().map(|(f, _)| f).sum::<f64>() / cutting.len() as f64;
+    println!(
+        "cutting: {touching} of {} ticks in contact, mean {mean:.3} N",
+        cutting.len()
+    );
+    assert!(touching * 10 >= cutting.len() * 9 && mean > 0.05);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -359,7 +359,8 @@ fn press_the_wall(haptic: &mut DynamicLoop<'_, '_, f64, 1, 1>) -> Vec<Vector3<f6
 /// deep (its sphere at the tip, the blade 2 cm up from it) drawn across the
 /// block along y at x = 31.3 mm removes the tets with a corner (where the
 /// blade has pushed it) within the sphere's radius of the blade, at most 8
-/// per physics update, while the hand feels the tissue ahead of the blade;
+/// per physics update, while the hand feels the tissue ahead of the blade
+/// (at least the 0.2 N cut force at which the tet ahead gives way);
 /// the trench it leaves lies in the cells `x ∈ [0.02, 0.04]`,
 /// `z ∈ [0.01, 0.03]` and takes at least 3/4 of them (126 of 144). Then a
 /// probe presses into the trench's wall: its force equals, tick by tick,
@@ -399,7 +400,9 @@ fn faces_a_cut_exposes_feel_like_a_fresh_mesh() {
         run(haptic, 100, &|s| blade(0.065, 0.018 + 0.05 * s, false));
         run(haptic, 1500, &|_| blade(0.065, 0.07, false));
         println!("largest force while cutting {felt:.4} N");
-        assert!(felt > 0.0, "the blade met tissue");
+        // The tissue ahead of the blade resists up to the cut force (0.2 N)
+        // before it gives way: measured 0.57 N at 20 mm/s.
+        assert!(felt >= 0.2, "the blade felt the tissue ahead: {felt} N");
         let alive = haptic.tissue().model().tet_alive().to_vec();
         (alive, press_the_wall(haptic), removed, most)
     });

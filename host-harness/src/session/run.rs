@@ -448,6 +448,7 @@ impl<'t> DynamicSetup<'t> {
                     .dynamic_substeps()
                     .context("physics period is not a whole number of dt_s")?,
                 cut_capacity_tets: scene.cutting.capacity_tets,
+                cut_force_n: scene.cutting.force_n as f32,
                 tearing: scene.tearing.map(|t| Tearing {
                     thresholds: TearThresholds {
                         volume_change: t.volume_change.map(|x| x as f32),

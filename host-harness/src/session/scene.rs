@@ -40,6 +40,8 @@
 //! [cutting]                    # optional; only meaningful for the dynamic model
 //! capacity_tets = 8            # tets one physics update removes at most (the rest on the next
 //!                              # updates); 1..=64, default 8
+//! force_n = 0.2                # the blade sphere's push, N, at which the tissue ahead of it
+//!                              # gives way (its tet is cut); finite, > 0; default 0.2
 //!
 //! [tearing]                    # optional, dynamic model only; absent: no tearing
 //! volume_change = 0.5          # tear a tet past |V - V0|/V0 ...
@@ -275,12 +277,19 @@ impl ToolSpec {
 }
 
 /// Cutting by the scene's cutters (`[cutting]`; only the dynamic model can be cut).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CuttingSpec {
     /// Tets one physics update removes at most (the rest on the next updates), in
     /// `1..=MAX_CAPACITY_TETS`.
     pub capacity_tets: u32,
+    /// The push of a blade's sphere, N, at which the tet it presses into is cut (the resistance
+    /// the hand feels ahead of the blade); finite, > 0 and fits f32.
+    pub force_n: f64,
 }
+
+/// Default [`CuttingSpec::force_n`], N: about what a scalpel needs through soft parenchyma,
+/// and under the 0.3 N of the built-in press on the 3 kPa block.
+pub const DEFAULT_CUT_FORCE_N: f64 = 0.2;
 
 /// Tearing by thresholds (`[tearing]`, dynamic model only): the kernel's
 /// [`palpate_kernel::tensor_mass::TearThresholds`] and a per-update capacity.
@@ -486,6 +495,8 @@ impl<'de> Deserialize<'de> for KindsFile {
 struct CuttingFile {
     #[serde(default = "default_capacity_tets")]
     capacity_tets: u32,
+    #[serde(default = "default_cut_force")]
+    force_n: f64,
 }
 
 #[derive(Deserialize)]
@@ -553,6 +564,9 @@ fn default_points() -> usize {
 fn default_radius() -> f64 {
     DEFAULT_TOOL_RADIUS_M
 }
+fn default_cut_force() -> f64 {
+    DEFAULT_CUT_FORCE_N
+}
 fn default_capacity_tets() -> u32 {
     DEFAULT_CAPACITY_TETS
 }
@@ -586,6 +600,7 @@ impl Default for CuttingFile {
     fn default() -> Self {
         Self {
             capacity_tets: DEFAULT_CAPACITY_TETS,
+            force_n: DEFAULT_CUT_FORCE_N,
         }
     }
 }
@@ -631,6 +646,7 @@ impl Scene {
             tool: ToolSpec::probes(DEFAULT_TOOL_POINTS, DEFAULT_TOOL_RADIUS_M),
             cutting: CuttingSpec {
                 capacity_tets: DEFAULT_CAPACITY_TETS,
+                force_n: DEFAULT_CUT_FORCE_N,
             },
             tearing: None,
             rates: Rates {
@@ -800,6 +816,7 @@ impl Scene {
             tool,
             cutting: CuttingSpec {
                 capacity_tets: raw.cutting.capacity_tets,
+                force_n: raw.cutting.force_n,
             },
             tearing: raw.tearing.map(|t| TearingSpec {
                 volume_change: t.volume_change,
@@ -1271,6 +1288,13 @@ fn check_removal(
         }
     };
     capacity("cutting", cutting.capacity_tets)?;
+    let force = cutting.force_n;
+    if !(force.is_finite() && force > 0.0 && force <= f64::from(f32::MAX)) {
+        return Err((
+            format!("[cutting] force_n = {force}"),
+            "must be finite, > 0 N and fit f32".into(),
+        ));
+    }
     let Some(tearing) = tearing else {
         return Ok(());
     };

@@ -339,7 +339,7 @@ impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
                         from_m: *tip,
                         to_m: tip + blade_m,
                         radius_m: self.config.radius_m,
-                        pressing: contact.filter(|c| c.gap_m < T::zero()).map(|c| c.triangle),
+                        pressing: contact.map(|c| c.triangle),
                     });
                 }
             }

@@ -244,7 +244,7 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         let axis = b_m - a_m;
         let length2 = axis.norm_squared();
         let r2 = radius_m * radius_m;
-        let touches = |p: Vector3<T>| {
+        let touches = |p: &Vector3<T>| {
             let t = if length2 > T::zero() {
                 ((p - a_m).dot(&axis) / length2)
                     .max(T::zero())
@@ -254,13 +254,25 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
             };
             (p - (a_m + axis * t)).norm_squared() <= r2
         };
+        // The blade's box grown by the radius: a tet whose box misses it is
+        // rejected on its 4 positions alone, the cheap test of the scan.
+        let reach = [
+            a_m.inf(&b_m).add_scalar(-radius_m),
+            a_m.sup(&b_m).add_scalar(radius_m),
+        ];
         self.remove_where(
             capacity,
             |model, tet| {
-                tet.iter().any(|&v| model.position(v).is_some_and(touches))
-                    || model
-                        .corners(tet)
-                        .is_some_and(|(now, _)| crosses(&now, &a_m, &b_m))
+                let Some(now) = model.positions_of(tet) else {
+                    return false;
+                };
+                let lo = now.iter().fold(now[0], |m, p| m.inf(p));
+                let hi = now.iter().fold(now[0], |m, p| m.sup(p));
+                let [r_lo, r_hi] = &reach;
+                if (lo - r_hi).max() > T::zero() || (r_lo - hi).max() > T::zero() {
+                    return false;
+                }
+                now.iter().any(touches) || crosses(&now, &a_m, &b_m)
             },
             removed,
         )
@@ -291,16 +303,23 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         )
     }
 
+    /// Current corner positions of `tet`, m.
+    fn positions_of(&self, tet: [VertexIndex; 4]) -> Option<Corners<T>> {
+        let mut now = [Vector3::zeros(); 4];
+        for (n, &v) in now.iter_mut().zip(&tet) {
+            *n = self.position(v)?;
+        }
+        Some(now)
+    }
+
     /// Current and rest corner positions of `tet`, m.
     fn corners(&self, tet: [VertexIndex; 4]) -> Option<(Corners<T>, Corners<T>)> {
-        let mut now = [Vector3::zeros(); 4];
         let mut rest = [Vector3::zeros(); 4];
-        for ((n, r), &v) in now.iter_mut().zip(rest.iter_mut()).zip(&tet) {
-            *n = self.position(v)?;
+        for (r, &v) in rest.iter_mut().zip(&tet) {
             let p = self.table.rest_positions().get(v.get())?;
             *r = Vector3::new(p[0], p[1], p[2]);
         }
-        Some((now, rest))
+        Some((self.positions_of(tet)?, rest))
     }
 
     /// Scans the live tets in index order and removes those `qualifies`

@@ -53,7 +53,9 @@
 //!
 //! Cutting and tearing (Picinbono 2001 §3.1; MODELS.md §3): at each update,
 //! first each enabled [`Blade`] removes the tets it touches, and the tet
-//! its sphere presses into, at most [`Tearing::capacity_tets`]-like
+//! its sphere presses into once it pushes with
+//! [`PhysicsConfig::cut_force_n`] (until then the sphere is a probe: the
+//! resistance the hand feels ahead of the blade), at most
 //! [`PhysicsConfig::cut_capacity_tets`] per update over all blades (the
 //! rest at the next updates: nothing is lost, the scan finds them again);
 //! after the steps, tets past the [`Tearing`] thresholds are removed, at
@@ -117,8 +119,9 @@ pub struct Blade<T> {
     /// The blade's half-thickness (the tool sphere's radius), m: tets with
     /// a vertex this close to the segment are cut.
     pub radius_m: T,
-    /// The surface triangle the tool sphere presses into (negative gap),
-    /// if any: its tet is cut too (the tissue ahead of the blade).
+    /// The surface triangle the tool sphere touches, if any: its tet is cut
+    /// too once the sphere pushes it with [`PhysicsConfig::cut_force_n`]
+    /// (the tissue ahead of the blade).
     pub pressing: Option<TriangleIndex>,
 }
 
@@ -160,6 +163,11 @@ pub struct PhysicsConfig<T> {
     /// Most tets the blades remove per update, over all blades (in
     /// `1..=MAX_REMOVAL_CAPACITY`).
     pub cut_capacity_tets: u32,
+    /// The push of a blade's sphere, N, at which the tet it presses into
+    /// gives way (finite, > 0): below it the sphere is a probe, so the hand
+    /// feels the tissue ahead of the blade build up to this force, then
+    /// give.
+    pub cut_force_n: T,
     /// Tearing, or none.
     pub tearing: Option<Tearing<T>>,
 }
@@ -175,6 +183,7 @@ impl<T: Real> PhysicsConfig<T> {
             dt_s,
             substeps,
             cut_capacity_tets: 8,
+            cut_force_n: T::of_f64(0.2),
             tearing: None,
         }
     }
@@ -193,8 +202,8 @@ pub enum DynamicTissueError {
         found: usize,
     },
     /// `dt_s` not finite and positive, `substeps` not in
-    /// `1..=MAX_SUBSTEPS`, or a removal capacity not in
-    /// `1..=MAX_REMOVAL_CAPACITY`.
+    /// `1..=MAX_SUBSTEPS`, a removal capacity not in
+    /// `1..=MAX_REMOVAL_CAPACITY`, or a cut force not finite and > 0.
     BadPhysics,
 }
 
@@ -206,7 +215,7 @@ impl fmt::Display for DynamicTissueError {
                 write!(f, "force buffer: length {found}, expected {expected}")
             }
             Self::BadPhysics => {
-                f.write_str("physics dt_s must be finite and > 0, substeps in 1..=MAX_SUBSTEPS, removal capacities in 1..=MAX_REMOVAL_CAPACITY")
+                f.write_str("physics dt_s must be finite and > 0, substeps in 1..=MAX_SUBSTEPS, removal capacities in 1..=MAX_REMOVAL_CAPACITY, the cut force finite and > 0")
             }
         }
     }
@@ -303,6 +312,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             && physics.dt_s > T::zero()
             && (1..=MAX_SUBSTEPS).contains(&physics.substeps)
             && capacity.contains(&physics.cut_capacity_tets)
+            && physics.cut_force_n.finite()
+            && physics.cut_force_n > T::zero()
             && physics
                 .tearing
                 .is_none_or(|t| capacity.contains(&t.capacity_tets)))
@@ -524,7 +535,20 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             if left == 0 {
                 break;
             }
-            let pressed = blade.pressing.and_then(|t| self.surface.tet_of(t));
+            // The tissue ahead gives way once the sphere pushes it with the
+            // cut force (the last update's held force along the normal).
+            let pushing = self
+                .held
+                .get(blade.tool)
+                .copied()
+                .flatten()
+                .is_some_and(|h| {
+                    -h.contact.force_n.dot(&h.contact.normal) >= self.physics.cut_force_n
+                });
+            let pressed = blade
+                .pressing
+                .filter(|_| pushing)
+                .and_then(|t| self.surface.tet_of(t));
             if let Some(t) = pressed.filter(|&t| self.model.is_alive(t)) {
                 let n = self.model.remove(t, &mut record).unwrap_or(0);
                 left = left.saturating_sub(n);

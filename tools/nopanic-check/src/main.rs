@@ -375,6 +375,8 @@ struct DynamicInputs {
     substeps: u32,
     /// Most tets the blades remove per update.
     cut_capacity_tets: u32,
+    /// The blade sphere's push at which the tissue ahead gives way, N.
+    cut_force_n: f32,
     /// Non-zero: tearing on, with each criterion (volume change, mean
     /// elongation, max elongation) on where `tear_on` is non-zero, with its
     /// threshold, and the capacity.
@@ -412,6 +414,7 @@ static mut DYNAMIC_INPUTS: DynamicInputs = DynamicInputs {
     dt_s: 1e-3,
     substeps: 1,
     cut_capacity_tets: 8,
+    cut_force_n: 0.2,
     tearing: 0,
     tear_on: [0; 3],
     tear_thresholds: [0.0; 3],
@@ -500,6 +503,7 @@ fn dynamic_haptic_step(
         dt_s: inputs.dt_s,
         substeps: inputs.substeps,
         cut_capacity_tets: inputs.cut_capacity_tets,
+        cut_force_n: inputs.cut_force_n,
         tearing: (inputs.tearing != 0).then_some(Tearing {
             thresholds: tear_thresholds(inputs.tear_on, inputs.tear_thresholds),
             capacity_tets: inputs.tear_capacity_tets,
