@@ -34,8 +34,8 @@ pub const MAX_WALK_STEPS: u32 = 8;
 
 /// How far, in radii, a plane may lie from a tool sphere's centre for the
 /// penetration test to look at its triangle ([`SurfaceGeometry::detect`]):
-/// a sphere up to its diameter into the surface is found (its centre one
-/// radius behind it), and a tool hovering clear of the surface costs one
+/// a sphere whose centre is up to two radii behind the surface (three radii
+/// into it) is found, and a tool hovering clear of the surface costs one
 /// dot product per candidate triangle.
 pub const PENETRATION_DEPTH_RADII: f64 = 2.0;
 

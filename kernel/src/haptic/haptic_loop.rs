@@ -344,6 +344,14 @@ impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
                 }
             }
         }
-        self.tissue.update(&set, &blades)
+        let result = self.tissue.update(&set, &blades);
+        if result.is_ok() {
+            // The update imposed every gap, a found-inside contact's too:
+            // from now on its gap counts from touching.
+            for c in self.contacts.iter_mut().flatten() {
+                c.entry_gap_m = T::zero();
+            }
+        }
+        result
     }
 }

@@ -454,7 +454,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         let Some(h) = carried(&self.held, t) else {
             let k = self.contact_stiffness(&t.vertices, shares);
             return match t.grip_offset_m {
-                Some(_) => -(k * t.displacement_m()),
+                Some(_) => -(k * (t.displacement_m() - t.normal * t.entry_gap_m)),
                 None => t.normal * (-t.normal.dot(&(k * t.normal)) * (t.gap_m - t.entry_gap_m)),
             };
         };
@@ -588,6 +588,8 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         set: &ContactSet<T, M>,
         blades: &Blades<T>,
     ) -> Result<StepReport<T>, PhysicsError> {
+        // A faulted update removes nothing (the log is this update's).
+        self.removed.clear();
         if let Some(fault) = self.fault {
             return Err(fault);
         }
@@ -600,7 +602,6 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 *x = self.extrapolate(&t, &self.shares(&t)).dot(&t.normal);
             }
         }
-        self.removed.clear();
         self.cut(blades);
         self.expose(0);
         // Each contact still on the surface, in the rest frame with its
