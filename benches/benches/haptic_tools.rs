@@ -44,30 +44,19 @@ use std::time::Instant;
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use palpate::fem::material::Material;
-use palpate::mesh::MeshReport;
 use palpate::mesh::generate::{ORGAN_CUBE_M, organ_mesh};
-use palpate::table::build::{BuildOptions, build};
-use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate::tensor_mass::{OwnedState, OwnedSurface};
 use palpate_benches::{TOOL_RADIUS_M, haptic_config};
 use palpate_kernel::haptic::{DynamicLoop, ForceOutput, OutputStatus, ToolAction, ToolInput};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, Extrapolation, Integrator, PhysicsConfig, SurfaceBuffers,
-    TensorMassModel,
+    DynamicParams, DynamicTissue, Integrator, PhysicsConfig, SurfaceBuffers, TensorMassModel,
 };
 
-const PHYSICS: PhysicsConfig<f32> = PhysicsConfig {
-    extrapolation: Extrapolation::Secant,
-    integrator: Integrator::SymplecticEuler,
-    dt_s: 5e-4,
-    substeps: 1,
-    cut_capacity_tets: 8,
-    cut_force_n: 0.2,
-    tearing: None,
-};
+fn physics() -> PhysicsConfig<f32> {
+    PhysicsConfig::new(Integrator::SymplecticEuler, 5e-4, 1)
+}
 
 fn params() -> DynamicParams<f32> {
     DynamicParams::linear(30.0, 0.2)
@@ -79,20 +68,7 @@ type Loop<'a, 's> = DynamicLoop<'a, 's, f32, 3, 3>;
 /// The organ's f32 tensor-mass table (E = 5 kPa, ν = 0.4, 1000 kg/m³), its
 /// lowest vertices fixed, as `stvk_step` builds it.
 fn organ_table() -> TableFile {
-    let mesh = organ_mesh(ORGAN_CUBE_M);
-    let z_min = mesh
-        .positions
-        .iter()
-        .map(|p| p[2])
-        .fold(f64::INFINITY, f64::min);
-    let options = BuildOptions::tensor_mass(
-        Material::new(5000.0, 0.4).expect("material"),
-        1000.0,
-        vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")],
-        Precision::F32,
-    );
-    let built = build(&mesh, &MeshReport::default(), &options).expect("table");
-    TableFile::from_bytes(&built.bytes)
+    palpate_benches::base_fixed_table(&organ_mesh(ORGAN_CUBE_M))
 }
 
 /// Height of the table's rest surface over `(x, y)`, m: the highest
@@ -315,7 +291,7 @@ fn with_loop<R>(table: TensorMassTable<'_, f32>, body: impl FnOnce(&mut Loop<'_,
     let model = TensorMassModel::new(table, state.buffers(), params()).expect("model");
     let mut owned = OwnedSurface::for_model(&model);
     let (buffers, forces) = owned.buffers();
-    let tissue = DynamicTissue::<f32, 3>::new(model, buffers, forces, PHYSICS).expect("tissue");
+    let tissue = DynamicTissue::<f32, 3>::new(model, buffers, forces, physics()).expect("tissue");
     let mut haptic = Loop::new(tissue, haptic_config()).expect("loop");
     body(&mut haptic)
 }

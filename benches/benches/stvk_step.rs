@@ -19,11 +19,8 @@ use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use palpate::fem::material::Material;
+use palpate::mesh::TetMesh;
 use palpate::mesh::generate::{ORGAN_CUBE_M, box_mesh, cylinder_mesh, organ_mesh};
-use palpate::mesh::{MeshReport, TetMesh};
-use palpate::table::build::{BuildOptions, build};
-use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate::tensor_mass::OwnedState;
 use palpate_kernel::table::TensorMassTable;
@@ -60,19 +57,7 @@ fn meshes() -> Vec<(&'static str, TetMesh)> {
 }
 
 fn table(mesh: &TetMesh) -> TableFile {
-    let z_min = mesh
-        .positions
-        .iter()
-        .map(|p| p[2])
-        .fold(f64::INFINITY, f64::min);
-    let options = BuildOptions::tensor_mass(
-        Material::new(5000.0, 0.4).expect("material"),
-        1000.0,
-        vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")],
-        Precision::F32,
-    );
-    let built = build(mesh, &MeshReport::default(), &options).expect("table");
-    TableFile::from_bytes(&built.bytes)
+    palpate_benches::base_fixed_table(mesh)
 }
 
 fn params(law: ElasticLaw, incompressibility_n: Option<f32>) -> DynamicParams<f32> {

@@ -81,3 +81,22 @@ pub fn haptic_tool(p: usize, depth_m: f32) -> Vector3<f32> {
     ][p % 4];
     Vector3::new(x, y, 0.1 + TOOL_RADIUS_M - depth_m)
 }
+
+/// The f32 tensor-mass table of `mesh` with its lowest vertices fixed
+/// (E = 5 kPa, ν = 0.4, 1000 kg/m³): the St Venant-Kirchhoff and tools
+/// benches' meshes resting on their base.
+pub fn base_fixed_table(mesh: &TetMesh) -> palpate::table::load::TableFile {
+    let z_min = mesh
+        .positions
+        .iter()
+        .map(|p| p[2])
+        .fold(f64::INFINITY, f64::min);
+    let options = BuildOptions::tensor_mass(
+        Material::new(5000.0, 0.4).expect("material"),
+        1000.0,
+        vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")],
+        Precision::F32,
+    );
+    let built = build(mesh, &MeshReport::default(), &options).expect("table");
+    palpate::table::load::TableFile::from_bytes(&built.bytes)
+}

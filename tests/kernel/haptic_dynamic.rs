@@ -45,14 +45,7 @@ fn params(max_displacement_m: f64) -> DynamicParams<f64> {
 }
 
 fn loop_config() -> LoopConfig<f64> {
-    LoopConfig {
-        radius_m: RADIUS_M,
-        dt_s: TICK_S,
-        limits: SafetyLimits {
-            max_force_n: 1e3,
-            max_slew_n_per_s: 1e9,
-        },
-    }
+    palpate_tests::unclamped_loop_config(RADIUS_M, TICK_S)
 }
 
 /// Symplectic Euler in steps of `dt_s`, `substeps` per physics update.

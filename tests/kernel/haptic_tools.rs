@@ -46,14 +46,7 @@ fn table_of(mesh: &TetMesh, fix: &str) -> TableFile {
 }
 
 fn loop_config() -> LoopConfig<f64> {
-    LoopConfig {
-        radius_m: RADIUS_M,
-        dt_s: TICK_S,
-        limits: SafetyLimits {
-            max_force_n: 1e3,
-            max_slew_n_per_s: 1e9,
-        },
-    }
+    palpate_tests::unclamped_loop_config(RADIUS_M, TICK_S)
 }
 
 /// Runs `body` on a `P`-point loop over `file`'s table: damping 30/s,

@@ -366,3 +366,20 @@ pub fn keyframe(keys: &[Keyframe], tool: usize, label: &str) -> Keyframe {
         .find(|k| k.tool == tool && k.label == label)
         .unwrap_or_else(|| panic!("no {label} keyframe for tool {tool}"))
 }
+
+/// A haptic loop configuration (f64) that never clamps: tool spheres of
+/// `radius_m` (m), ticks of `tick_s` (s), force and slew limits of 1e3 N and
+/// 1e9 N/s, so a test sees the tissue's own force.
+pub fn unclamped_loop_config(
+    radius_m: f64,
+    tick_s: f64,
+) -> palpate_kernel::haptic::LoopConfig<f64> {
+    palpate_kernel::haptic::LoopConfig {
+        radius_m,
+        dt_s: tick_s,
+        limits: palpate_kernel::haptic::SafetyLimits {
+            max_force_n: 1e3,
+            max_slew_n_per_s: 1e9,
+        },
+    }
+}
