@@ -5,7 +5,8 @@
 mod common;
 
 use common::{
-    assert_one_line_error, build_cube_table, palpate, palpate_with_stdin, reference, stderr, temp,
+    assert_one_line_error, build_cube, build_cube_table, build_table, palpate, palpate_with_stdin,
+    stderr, temp,
 };
 use core::time::Duration;
 use std::process::Command;
@@ -125,23 +126,7 @@ fn session_run_refuses_unbounded_trajectories_and_rates() {
 fn tables_build_prints_the_estimate_and_honours_max_table_bytes() {
     let table = temp("limited.tbl");
     let _ = std::fs::remove_file(&table);
-    let mesh = reference("meshes/cube.msh");
-    let table_arg = table.display().to_string();
-    let mut args = vec![
-        "tables",
-        "build",
-        &mesh,
-        "--young",
-        "5000",
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "--quiet",
-        "-o",
-        &table_arg,
-    ];
-    let out = palpate(&args);
+    let out = build_cube(&table, "5000", &[]);
     assert!(out.status.success(), "{}", stderr(&out));
     let err = stderr(&out);
     assert!(
@@ -150,15 +135,12 @@ fn tables_build_prints_the_estimate_and_honours_max_table_bytes() {
     );
     let built = std::fs::metadata(&table).expect("table").len();
     std::fs::remove_file(&table).expect("remove");
-    args.extend(["--max-table-bytes", "100000"]);
-    let out = palpate(&args);
+    let out = build_cube(&table, "5000", &["--max-table-bytes", "100000"]);
     assert_one_line_error(&out, &["the table is above --max-table-bytes 100000 bytes"]);
     assert!(!table.exists(), "no table written");
     // At the real size plus the estimate's slack it builds.
     let limit = (built + 32 * 152 + 16).to_string();
-    let last = args.len() - 1;
-    args[last] = &limit;
-    let out = palpate(&args);
+    let out = build_cube(&table, "5000", &["--max-table-bytes", &limit]);
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
@@ -261,19 +243,12 @@ fn oversized_mesh_file_is_refused_before_reading() {
     let file = std::fs::File::create(&mesh).expect("create");
     file.set_len((2 << 30) + 1).expect("sparse file");
     drop(file);
-    let out = palpate(&[
-        "tables",
-        "build",
+    let out = build_table(
         &mesh.display().to_string(),
-        "--young",
-        "5000",
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "-o",
         &temp("big.tbl").display().to_string(),
-    ]);
+        "5000",
+        &[],
+    );
     assert_one_line_error(&out, &["the limit for a mesh file (MAX_MESH_FILE_BYTES)"]);
     std::fs::remove_file(&mesh).expect("remove");
 }

@@ -8,7 +8,8 @@
 mod common;
 
 use common::{
-    assert_one_line_error, build_cube_table, fresh_dir, palpate, palpate_command, reference, stderr,
+    assert_one_line_error, build_cube_table, build_table, fresh_dir, palpate, palpate_command,
+    reference, stderr,
 };
 use core::time::Duration;
 use std::io::{BufRead, BufReader};
@@ -171,20 +172,7 @@ fn an_output_that_is_an_input_is_refused() {
         .map(|p| std::fs::read(p).expect("input"))
         .collect();
     for (input, output) in [(&mesh, &mesh), (&node, &ele)] {
-        let out = palpate(&[
-            "tables",
-            "build",
-            s(input),
-            "--young",
-            "5000",
-            "--poisson",
-            "0.45",
-            "--fix",
-            "z<0.001",
-            "--quiet",
-            "-o",
-            s(output),
-        ]);
+        let out = build_table(s(input), s(output), "5000", &[]);
         assert_one_line_error(
             &out,
             &[&format!(

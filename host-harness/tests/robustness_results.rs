@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{build_cube, build_cube_table, palpate, reference, temp, text};
+use common::{build_cube, build_cube_table, build_table, palpate, reference, temp, text};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -293,19 +293,7 @@ fn an_msh_node_id_of_zero_is_named_as_written() {
     )
     .unwrap();
     let table = temp("zero-node.tbl").display().to_string();
-    let out = palpate(&[
-        "tables",
-        "build",
-        &msh.display().to_string(),
-        "--young",
-        "5000",
-        "--poisson",
-        "0.45",
-        "--fix",
-        "z<0.001",
-        "-o",
-        &table,
-    ]);
+    let out = build_table(&msh.display().to_string(), &table, "5000", &[]);
     assert_one_line_error(
         &out,
         &["zero-node.msh", "element id 7", "node id 0 is not defined"],

@@ -110,17 +110,13 @@ pub fn assert_one_line_error(out: &Output, needles: &[&str]) {
     }
 }
 
-/// Runs `tables build` of the reference cube (`meshes/cube.msh`, base
-/// fixed: `z<0.001`) with Young's modulus `young` (Pa), ν = 0.45,
-/// `--quiet`, into `table`, then `extra` arguments; does not check the
-/// outcome.
-pub fn build_cube(table: &Path, young: &str, extra: &[&str]) -> Output {
-    let mesh = reference("meshes/cube.msh");
-    let table_str = table.display().to_string();
+/// Runs `tables build MESH --young YOUNG --poisson 0.45 --fix z<0.001
+/// --quiet -o TABLE`, then `extra` arguments; does not check the outcome.
+pub fn build_table(mesh: &str, table: &str, young: &str, extra: &[&str]) -> Output {
     let mut args = vec![
         "tables",
         "build",
-        &mesh,
+        mesh,
         "--young",
         young,
         "--poisson",
@@ -129,10 +125,21 @@ pub fn build_cube(table: &Path, young: &str, extra: &[&str]) -> Output {
         "z<0.001",
         "--quiet",
         "-o",
-        &table_str,
+        table,
     ];
     args.extend_from_slice(extra);
     palpate(&args)
+}
+
+/// [`build_table`] of the reference cube (`meshes/cube.msh`, base fixed:
+/// `z<0.001`) into `table`.
+pub fn build_cube(table: &Path, young: &str, extra: &[&str]) -> Output {
+    build_table(
+        &reference("meshes/cube.msh"),
+        &table.display().to_string(),
+        young,
+        extra,
+    )
 }
 
 /// Builds the reference cube's table (E = 5000 Pa, f32 unless `extra` says
