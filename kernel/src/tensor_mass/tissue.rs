@@ -593,27 +593,30 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         if let Some(fault) = self.fault {
             return Err(fault);
         }
+        // Each contact in the rest frame with its shares, computed once.
+        let mut set_now: ContactSet<T, M> = ContactSet::new();
+        let mut shares = [[T::zero(); 3]; M];
+        for (t, s) in set.iter().zip(shares.iter_mut()) {
+            let t = self.in_rest_frame(t);
+            *s = self.shares(&t);
+            let _ = set_now.push(t);
+        }
         // What the last tick sent, per tool point (the corrections'
         // reference), before a cut changes the tensors.
         let mut sent = [T::zero(); P];
-        for t in set {
-            let t = self.in_rest_frame(t);
+        for (t, s) in set_now.iter().zip(&shares) {
             if let Some(x) = sent.get_mut(t.tool) {
-                *x = self.extrapolate(&t, &self.shares(&t)).dot(&t.normal);
+                *x = self.extrapolate(t, s).dot(&t.normal);
             }
         }
         self.cut(blades);
         self.expose(0);
-        // Each contact still on the surface, in the rest frame with its
-        // shares, computed once.
-        let mut set_now: ContactSet<T, M> = ContactSet::new();
-        let mut shares = [[T::zero(); 3]; M];
-        for t in set.iter().filter(|t| self.on_surface(t)) {
-            let t = self.in_rest_frame(t);
-            if let Some(s) = shares.get_mut(set_now.len()) {
-                *s = self.shares(&t);
+        // A contact whose triangle the cut took holds nothing from now on:
+        // its vertices are released below and nothing is imposed for it.
+        for (t, s) in set_now.iter().zip(shares.iter_mut()) {
+            if !self.on_surface(t) {
+                *s = [T::zero(); 3];
             }
-            let _ = set_now.push(t);
         }
         let now = || set_now.iter().zip(&shares);
         let previous = self.held;
