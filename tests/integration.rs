@@ -24,6 +24,7 @@ mod kernel {
     mod haptic;
     mod haptic_dynamic;
     mod haptic_tools;
+    mod hybrid;
     mod layers;
     mod precomputed;
     mod stvk;

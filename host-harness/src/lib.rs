@@ -12,6 +12,7 @@ pub mod demo;
 pub mod experiment;
 pub mod fem;
 pub mod fix;
+pub mod hybrid;
 pub mod limits;
 pub mod mesh;
 pub mod output;

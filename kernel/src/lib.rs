@@ -37,6 +37,7 @@
 
 pub mod contact;
 pub mod haptic;
+pub mod hybrid;
 pub mod math;
 pub mod precomputed;
 pub mod table;

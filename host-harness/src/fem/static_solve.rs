@@ -34,7 +34,29 @@ pub fn solve_prescribed(
     fixed: &[bool],
     prescribed: &[(u32, [f64; 3])],
 ) -> anyhow::Result<(VertexVectors, VertexVectors)> {
+    solve_loaded(positions, tets, m, fixed, prescribed, &[])
+}
+
+/// [`solve_prescribed`] with nodal loads as well: `loads_n` (N, one per
+/// vertex, or empty for none) acts on the unknown DOFs, so it solves
+/// `K_UU u_U = f_U − K_UP u_P`; the reactions are `(K u)_p − f_p`, the force
+/// the constraint applies. The reference of the hybrid model's steady
+/// states (gravity as lumped nodal loads `ρ V/4 g`, point loads).
+pub fn solve_loaded(
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    m: &Material,
+    fixed: &[bool],
+    prescribed: &[(u32, [f64; 3])],
+    loads_n: &[[f64; 3]],
+) -> anyhow::Result<(VertexVectors, VertexVectors)> {
     let n = positions.len();
+    ensure!(
+        loads_n.is_empty() || loads_n.len() == n,
+        "loads has {} entries for {n} vertices",
+        loads_n.len()
+    );
+    let load = |v: usize| loads_n.get(v).copied().unwrap_or([0.0; 3]);
     ensure!(
         fixed.len() == n,
         "fixed has {} flags for {n} vertices",
@@ -78,7 +100,7 @@ pub fn solve_prescribed(
         let mut rhs = Mat::<f64>::zeros(3 * unknown.len(), 1);
         for (s, &v) in unknown.iter().enumerate() {
             for c in 0..3 {
-                rhs[(3 * s + c, 0)] = -ku[v][c];
+                rhs[(3 * s + c, 0)] = load(v)[c] - ku[v][c];
             }
         }
         llt.solve_in_place(rhs.as_mut());
@@ -89,7 +111,13 @@ pub fn solve_prescribed(
         }
     }
     let f = sparse_mul(&k, &u);
-    let reactions = prescribed.iter().map(|&(v, _)| f[v as usize]).collect();
+    let reactions = prescribed
+        .iter()
+        .map(|&(v, _)| {
+            let (kv, fv) = (f[v as usize], load(v as usize));
+            [kv[0] - fv[0], kv[1] - fv[1], kv[2] - fv[2]]
+        })
+        .collect();
     Ok((u, reactions))
 }
 

@@ -295,7 +295,7 @@ fn build_unchecked(
 
 /// The pre-computed stages: the free/touchable ordering, the compliance,
 /// the collision index of `surface`, the writer.
-fn precomputed(
+pub(crate) fn precomputed(
     mesh: &TetMesh,
     report: &MeshReport,
     options: &BuildOptions,

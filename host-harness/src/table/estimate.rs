@@ -65,6 +65,9 @@ pub struct TableCounts {
     pub surface_triangles: u64,
     /// Distinct vertices of the boundary surface triangles (`Vs`).
     pub surface_vertices: u64,
+    /// Connection nodes (`c`) of an interface table (RR-3510 §6.2); zero
+    /// for the other kinds.
+    pub connections: u64,
 }
 
 impl TableCounts {
@@ -89,6 +92,7 @@ impl TableCounts {
             touchable: count(free_surface),
             surface_triangles: count(surface.triangles.len()),
             surface_vertices: count(surface.vertices.len()),
+            connections: 0,
         }
     }
 }
@@ -162,6 +166,20 @@ impl TableEstimate {
                     .saturating_add(per_vertex);
                 (table, peak)
             }
+            TableKind::Interface => {
+                let table = file_bytes(kind, precision, &c);
+                // The dense right-hand sides of the condensation: 3F rows of
+                // f64, 3c + 1 columns, plus the f64 blocks before rounding.
+                let rhs = c
+                    .free
+                    .saturating_mul(3 * 8)
+                    .saturating_mul(c.connections.saturating_mul(3).saturating_add(1));
+                let peak = rhs
+                    .saturating_mul(2)
+                    .saturating_add(table.saturating_mul(2))
+                    .saturating_add(per_vertex);
+                (table, peak)
+            }
         };
         Self {
             kind,
@@ -192,6 +210,12 @@ impl TableEstimate {
                 "the tensor-mass table ({} vertices, {} tets, {})",
                 c.vertices,
                 c.tets,
+                precision_name(self.precision)
+            ),
+            TableKind::Interface => format!(
+                "the interface table ({} connection nodes x {} free pre-computed vertices, {})",
+                c.connections,
+                c.free,
                 precision_name(self.precision)
             ),
         };
@@ -248,6 +272,11 @@ fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Optio
                 .saturating_sub(c.tets.checked_add(1)?);
             header.edge_count = u32_of(edges)?;
             header.mesh_triangle_count = mesh_triangles;
+        }
+        TableKind::Interface => {
+            header.free_count = u32_of(c.free)?;
+            header.touchable_count = u32_of(c.touchable)?;
+            header.connection_count = u32_of(c.connections)?;
         }
     }
     let sizes = kind
@@ -326,6 +355,9 @@ impl SizeLimits {
                 "use the tensor-mass model (tables build --kind tensor-mass, or [model] kind = \"dynamic\" in a scene), a coarser mesh, or fix more of the surface (fewer touchable vertices)"
             }
             TableKind::TensorMass => "use a coarser mesh",
+            TableKind::Interface => {
+                "make the dynamic zones smaller or simpler (fewer connection nodes), or use a coarser mesh"
+            }
         };
         anyhow::bail!(
             "{source}{}; {reason}: refused before building; {instead}",

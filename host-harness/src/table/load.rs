@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use palpate_kernel::table::format::{CRC_LEN, CRC32, HEADER_LEN, RawHeader, TableKind};
-use palpate_kernel::table::{LoadError, TensorMassTable};
+use palpate_kernel::table::{InterfaceTable, LoadError, TensorMassTable};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
 use crate::limits::{MAX_TABLE_FILE_BYTES, read_bounded};
@@ -172,6 +172,7 @@ impl TableFile {
         match self.raw_header()?.table_kind {
             k if k == TableKind::Precomputed as u32 => Some(TableKind::Precomputed),
             k if k == TableKind::TensorMass as u32 => Some(TableKind::TensorMass),
+            k if k == TableKind::Interface as u32 => Some(TableKind::Interface),
             _ => None,
         }
     }
@@ -185,6 +186,8 @@ impl TableFile {
         match (self.kind(), f64_table) {
             (Some(TableKind::TensorMass), true) => TensorMassTable::<f64>::load(bytes).map(drop),
             (Some(TableKind::TensorMass), false) => TensorMassTable::<f32>::load(bytes).map(drop),
+            (Some(TableKind::Interface), true) => InterfaceTable::<f64>::load(bytes).map(drop),
+            (Some(TableKind::Interface), false) => InterfaceTable::<f32>::load(bytes).map(drop),
             _ => self.model().map(drop),
         }
     }
@@ -206,6 +209,7 @@ impl TableFile {
         let kind_name = match kind {
             Some(TableKind::Precomputed) => "pre-computed (compliance)",
             Some(TableKind::TensorMass) => "tensor-mass (dynamic)",
+            Some(TableKind::Interface) => "interface (hybrid model)",
             None => "unknown",
         };
         let _ = writeln!(out, "table kind: {kind_name}");
@@ -223,6 +227,9 @@ impl TableFile {
             h.vertex_count.saturating_sub(h.free_count)
         );
         let _ = writeln!(out, "free vertices: {}", h.free_count);
+        if kind == Some(TableKind::Interface) {
+            let _ = writeln!(out, "connection nodes: {}", h.connection_count);
+        }
         if kind == Some(TableKind::TensorMass) {
             let _ = writeln!(out, "edges: {}", h.edge_count);
             let _ = writeln!(out, "mesh triangles: {}", h.mesh_triangle_count);

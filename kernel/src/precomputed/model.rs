@@ -55,7 +55,7 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
             .fold(Vector3::zeros(), |acc, g| acc - g)
     }
 
-    fn resolved(&self) -> impl Iterator<Item = (&ResolvedPoint<T>, &Vector3<T>)> {
+    pub(crate) fn resolved(&self) -> impl Iterator<Item = (&ResolvedPoint<T>, &Vector3<T>)> {
         self.points.iter().zip(self.forces_n.iter()).take(self.len)
     }
 }

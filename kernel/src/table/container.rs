@@ -110,7 +110,7 @@ fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result
         || header_len.is_some_and(|len| len > body_len)
         || h.free_count > h.vertex_count
         || h.touchable_count > h.free_count
-        || h.reserved != 0
+        || (h.connection_count != 0) != (kind == TableKind::Interface)
     {
         return Err(LoadError::InconsistentHeader);
     }

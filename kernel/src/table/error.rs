@@ -47,7 +47,8 @@ pub enum LoadError {
         found: u32,
     },
     /// Header counts contradict each other (free > vertices, touchable > free,
-    /// directory length, reserved field not zero, mesh triangle count above
+    /// directory length, a connection count in a table that is not an
+    /// interface table or none in one, mesh triangle count above
     /// `u32::MAX` or not the number of distinct tet faces).
     InconsistentHeader,
     /// Material out of range (E ≤ 0, ν outside [0, 0.5), density < 0,
@@ -154,6 +155,14 @@ pub enum LoadError {
         /// Vertex index.
         vertex: u32,
     },
+    /// A connection node of an interface table is malformed: its mesh vertex
+    /// is out of range or not after the previous one, its tensor-mass vertex
+    /// is not the `dynamic-vertex` entry of its mesh vertex, or a diagonal
+    /// entry of its condensed stiffness block is not positive.
+    BadConnection {
+        /// Connection index `j`.
+        connection: u32,
+    },
     /// A diagonal compliance block `C_kk` is not symmetric positive definite.
     NotPositiveDefinite {
         /// Touchable index `k` (free index; the vertex is `free-vertex[k]`).
@@ -184,6 +193,10 @@ impl fmt::Display for LoadError {
             LoadError::WrongTableKind { found } => {
                 write!(f, "table kind {found} is not the kind requested")
             }
+            LoadError::BadConnection { connection } => write!(
+                f,
+                "connection node {connection}: bad vertex numbers or condensed stiffness"
+            ),
             LoadError::InconsistentHeader => f.write_str("inconsistent header counts"),
             LoadError::BadMaterial => f.write_str("material out of range in header"),
             LoadError::UnknownSection { kind } => write!(f, "unknown section kind {kind}"),

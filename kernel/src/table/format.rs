@@ -78,8 +78,10 @@ pub struct RawHeader {
     pub triangle_count: u32,
     /// Mesh edges (tensor-mass tables; zero otherwise).
     pub edge_count: u32,
-    /// Zero (keeps the floats 8-byte aligned).
-    pub reserved: u32,
+    /// Connection nodes (`c`) of an interface table (RR-3510 §6.2): the
+    /// vertices shared by the pre-computed and the tensor-mass region. Zero
+    /// in the other kinds (and it keeps the floats 8-byte aligned).
+    pub connection_count: u32,
     /// Young's modulus the table was built with, Pa.
     pub young_pa: f64,
     /// Poisson ratio the table was built with, dimensionless.
@@ -134,6 +136,11 @@ pub enum TableKind {
     /// The dynamic tensor-mass model (RR-3510 §5): stiffness on vertices and
     /// edges, lumped masses, per-tet rest data for local removal.
     TensorMass = 2,
+    /// The interface of the hybrid model (RR-3510 §6.2): how a pre-computed
+    /// region answers the displacements of its connection nodes, condensed
+    /// offline. Read with the region's pre-computed table (connection nodes
+    /// fixed in it) and the tensor-mass table of the dynamic region.
+    Interface = 3,
 }
 
 impl TableKind {
@@ -174,6 +181,14 @@ impl TableKind {
                 SectionKind::TriangleTerms,
                 SectionKind::TetTriangle,
                 SectionKind::TetTerms,
+            ],
+            TableKind::Interface => &[
+                SectionKind::ConnectionVertex,
+                SectionKind::CondensedStiffness,
+                SectionKind::ConnectionResponse,
+                SectionKind::LoadDisplacement,
+                SectionKind::LoadForce,
+                SectionKind::DynamicVertex,
             ],
         }
     }
@@ -279,6 +294,31 @@ pub enum SectionKind {
     /// `[scalar; 3]` × tet_count: the quartic terms owned by each tet (local
     /// positions in the tet's own vertex order), N/m³.
     TetTerms = 30,
+    /// `[u32; 2]` × c: each connection node `j` of an interface table, as
+    /// `[mesh vertex, tensor-mass vertex]` (its number in the dynamic
+    /// region's table); mesh vertices strictly ascending.
+    ConnectionVertex = 40,
+    /// `[scalar; 9]` × c²: the condensed stiffness of the pre-computed
+    /// region on its connection nodes (the Schur complement
+    /// `S = K_cc − K_ci K_ii⁻¹ K_ic`, N/m), block `S_jk` row-major at index
+    /// `j·c + k`. Symmetric; both halves stored so a row is contiguous.
+    CondensedStiffness = 41,
+    /// `[scalar; 9]` × F·c: the response `H = −K_ii⁻¹ K_ic` of every free
+    /// vertex of the pre-computed region (free index `n` of its table, the
+    /// connection nodes fixed there) to the connection nodes'
+    /// displacements, dimensionless (m/m), block `H_nj` at `n·c + j`.
+    ConnectionResponse = 42,
+    /// `[scalar; 3]` × F: the displacement (m) of each free vertex of the
+    /// pre-computed region under its built-in load (gravity and point loads
+    /// given at build time) with the connection nodes held at rest,
+    /// `K_ii⁻¹ f_i`; zero without load.
+    LoadDisplacement = 43,
+    /// `[scalar; 3]` × c: the force (N) that built-in load passes to each
+    /// connection node, `Hᵀ f_i`.
+    LoadForce = 44,
+    /// `u32` × N: the tensor-mass vertex of each mesh vertex, or
+    /// [`FIXED_SLOT`] for a vertex of the pre-computed region only.
+    DynamicVertex = 45,
 }
 
 /// The vertex pairs of a tet's six edges, in [`SectionKind::TetEdge`] order:
@@ -313,7 +353,7 @@ pub const TET_TERMS_LEN: usize = 3;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 28] = [
+    pub const ALL: [SectionKind; 34] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -342,6 +382,12 @@ impl SectionKind {
         SectionKind::TriangleTerms,
         SectionKind::TetTriangle,
         SectionKind::TetTerms,
+        SectionKind::ConnectionVertex,
+        SectionKind::CondensedStiffness,
+        SectionKind::ConnectionResponse,
+        SectionKind::LoadDisplacement,
+        SectionKind::LoadForce,
+        SectionKind::DynamicVertex,
     ];
 
     /// Bytes per element for a table whose floats have `scalar_bytes` bytes.
@@ -350,7 +396,11 @@ impl SectionKind {
             SectionKind::VertexSlot
             | SectionKind::FreeVertex
             | SectionKind::EdgeRowStart
-            | SectionKind::EdgeColumn => 4,
+            | SectionKind::EdgeColumn
+            | SectionKind::DynamicVertex => 4,
+            SectionKind::ConnectionVertex => 8,
+            SectionKind::CondensedStiffness | SectionKind::ConnectionResponse => 9 * scalar_bytes,
+            SectionKind::LoadDisplacement | SectionKind::LoadForce => 3 * scalar_bytes,
             SectionKind::RestPositions => 3 * scalar_bytes,
             SectionKind::SurfaceTriangles | SectionKind::MeshTriangle | SectionKind::GridDims => 12,
             SectionKind::SurfaceGrid => 4 * scalar_bytes,
@@ -381,7 +431,13 @@ impl SectionKind {
         let s = u64::from(h.touchable_count);
         let tets = u64::from(h.tet_count);
         let edges = u64::from(h.edge_count);
+        let c = u64::from(h.connection_count);
         match self {
+            SectionKind::ConnectionVertex | SectionKind::LoadForce => Some(c),
+            SectionKind::CondensedStiffness => c.checked_mul(c),
+            SectionKind::ConnectionResponse => f.checked_mul(c),
+            SectionKind::LoadDisplacement => Some(f),
+            SectionKind::DynamicVertex => Some(n),
             SectionKind::VertexSlot
             | SectionKind::RestPositions
             | SectionKind::LumpedMass
@@ -442,6 +498,12 @@ impl SectionKind {
             SectionKind::TriangleTerms => "triangle-terms",
             SectionKind::TetTriangle => "tet-triangle",
             SectionKind::TetTerms => "tet-terms",
+            SectionKind::ConnectionVertex => "connection-vertex",
+            SectionKind::CondensedStiffness => "condensed-stiffness",
+            SectionKind::ConnectionResponse => "connection-response",
+            SectionKind::LoadDisplacement => "load-displacement",
+            SectionKind::LoadForce => "load-force",
+            SectionKind::DynamicVertex => "dynamic-vertex",
         }
     }
 }

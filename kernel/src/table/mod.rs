@@ -15,6 +15,7 @@ mod container;
 mod error;
 pub mod format;
 mod index;
+mod interface;
 mod precomputed;
 mod tensor_mass;
 
@@ -23,6 +24,7 @@ pub use collision::{DEAD_TRIANGLE, Grid, SurfaceIndex, max_row, within};
 pub use error::LoadError;
 pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};
+pub use interface::InterfaceTable;
 pub use precomputed::PrecomputedTable;
 pub use tensor_mass::TensorMassTable;
 

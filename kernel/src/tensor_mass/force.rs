@@ -4,6 +4,7 @@
 
 use nalgebra::Vector3;
 
+use super::coupling::CouplingForces;
 use super::law::{ElasticLaw, StvkForm};
 use super::stvk::TetPass;
 use super::stvk_terms::NonLinearTerms;
@@ -23,11 +24,14 @@ pub(crate) struct InternalForces<'b, 'a, T: Real> {
     pub(crate) lame: (T, T),
     /// Penalty `γ` (N) of Picinbono 2001 §3.2, `None` when off.
     pub(crate) incompressibility_n: Option<T>,
+    /// The pre-computed region of a hybrid model, `None` for a model alone.
+    pub(crate) coupling: Option<CouplingForces<'b, 'a, T>>,
 }
 
 impl<T: Real> InternalForces<'_, '_, T> {
     /// Overwrites `f` with the internal forces (N) of displacements `u` (m):
-    /// the elastic force of the law, plus the incompressibility penalty.
+    /// the elastic force of the law, plus the incompressibility penalty, plus
+    /// the coupled pre-computed region's force on the connection nodes.
     pub(crate) fn forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
         let (lambda, mu) = self.lame;
         match self.law {
@@ -44,9 +48,13 @@ impl<T: Real> InternalForces<'_, '_, T> {
         if let Some(gamma_n) = self.incompressibility_n {
             self.tets.add_incompressibility(gamma_n, u, f);
         }
+        if let Some(coupling) = &self.coupling {
+            coupling.add_forces(u, f);
+        }
     }
 
-    /// The elastic energy (J) of displacements `u` (m) under the law; the
+    /// The elastic energy (J) of displacements `u` (m) under the law, plus
+    /// a coupled pre-computed region's ([`CouplingForces::energy_j`]); the
     /// incompressibility penalty has no energy (its force is not a gradient)
     /// and is not included. `scratch` (N entries) receives the linear
     /// forces where the law needs them.
@@ -62,15 +70,17 @@ impl<T: Real> InternalForces<'_, '_, T> {
                 .fold(T::zero(), |sum, x| sum + x);
             -twice / T::of_f64(2.0)
         };
-        match self.law {
-            ElasticLaw::Linear => quadratic(),
-            ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
-                self.tets.stvk_energy_j(lambda, mu, u)
+        let coupled = self.coupling.map_or(T::zero(), |c| c.energy_j(u));
+        coupled
+            + match self.law {
+                ElasticLaw::Linear => quadratic(),
+                ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
+                    self.tets.stvk_energy_j(lambda, mu, u)
+                }
+                ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
+                    quadratic() + self.terms.energy_j(u)
+                }
             }
-            ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
-                quadratic() + self.terms.energy_j(u)
-            }
-        }
     }
 }
 

@@ -17,6 +17,7 @@
 //! model as a tissue). Depends on [`crate::math`], [`crate::table`] and
 //! [`crate::contact`].
 
+mod coupling;
 mod cut;
 mod force;
 mod integrator;

@@ -4,6 +4,7 @@ use core::fmt;
 
 use nalgebra::Vector3;
 
+use super::coupling::Coupling;
 use super::force::{InternalForces, Stiffness, vec3};
 use super::integrator::{Integrator, Loads};
 use super::law::{ElasticLaw, StvkForm};
@@ -12,7 +13,7 @@ use super::state::{Fault, StateBuffers, StateError, VertexMode};
 use super::stvk::TetPass;
 use super::stvk_terms::{NonLinearTerms, TermArraysMut};
 use crate::Real;
-use crate::table::TensorMassTable;
+use crate::table::{InterfaceTable, TensorMassTable};
 
 /// Parameters of the dynamics that are not in the table.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -161,6 +162,7 @@ pub struct TensorMassModel<'a, 's, T: Real> {
     params: DynamicParams<T>,
     previous_valid: bool,
     fault: Option<Fault>,
+    coupling: Option<Coupling<'a, 's, T>>,
 }
 
 impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
@@ -210,6 +212,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             params,
             previous_valid: false,
             fault: None,
+            coupling: None,
         };
         model.reset();
         Ok(model)
@@ -411,6 +414,30 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         self.internal_forces().energy_j(u, scratch)
     }
 
+    /// Couples the model to the pre-computed region that `interface`
+    /// condenses (the hybrid model, RR-3510 §6.2): from now on every force
+    /// evaluation adds that region's force on the connection nodes, the
+    /// condensed stiffness on their displacements plus `passed_force_n` (one
+    /// entry per connection node, N, which the caller updates between
+    /// steps). The caller has checked that `interface` belongs to this
+    /// model's table and that `passed_force_n` has `c` entries.
+    pub(crate) fn couple(
+        &mut self,
+        interface: InterfaceTable<'a, T>,
+        passed_force_n: &'s mut [[T; 3]],
+    ) {
+        self.coupling = Some(Coupling {
+            interface,
+            passed_force_n,
+        });
+    }
+
+    /// The forces passed to the connection nodes by a coupled region (N),
+    /// `None` for a model alone.
+    pub(crate) fn passed_force_mut(&mut self) -> Option<&mut [[T; 3]]> {
+        self.coupling.as_mut().map(|c| &mut *c.passed_force_n)
+    }
+
     fn internal_forces(&self) -> InternalForces<'_, 'a, T> {
         let s = &self.state;
         internal_forces(
@@ -420,6 +447,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             s.tet_alive,
             &s.stvk_terms,
             &self.params,
+            self.coupling.as_ref(),
         )
     }
 
@@ -457,7 +485,12 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// Forward (`symplectic == false`) or semi-implicit Euler: one force
     /// pass, then one pass over the vertices that updates and checks each.
     fn step_euler(&mut self, dt: T, symplectic: bool) -> Result<T, Fault> {
-        let (forces, loads, s) = split(&self.table, &mut self.state, &self.params);
+        let (forces, loads, s) = split(
+            &self.table,
+            &mut self.state,
+            &self.params,
+            self.coupling.as_ref(),
+        );
         let (u, v, f) = (s.displacement_m, s.velocity_m_s, s.force_n);
         forces.forces(u, f);
         let c = self.params.damping_per_s;
@@ -486,7 +519,12 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// RK4 scratch.
     fn step_rk4(&mut self, dt: T) -> Option<Result<T, Fault>> {
         let n = self.state.displacement_m.len();
-        let (forces, loads, s) = split(&self.table, &mut self.state, &self.params);
+        let (forces, loads, s) = split(
+            &self.table,
+            &mut self.state,
+            &self.params,
+            self.coupling.as_ref(),
+        );
         let mut chunks = s.rk4_scratch.chunks_exact_mut(n.max(1));
         let (Some(su), Some(sv), Some(du), Some(dv)) =
             (chunks.next(), chunks.next(), chunks.next(), chunks.next())
@@ -544,7 +582,12 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// Picinbono 2001 eq. (19), MODELS.md damping sign (see [`Integrator::CentralDifference`]).
     fn step_central(&mut self, dt: T) -> Result<T, Fault> {
         let first = !self.previous_valid;
-        let (forces, loads, s) = split(&self.table, &mut self.state, &self.params);
+        let (forces, loads, s) = split(
+            &self.table,
+            &mut self.state,
+            &self.params,
+            self.coupling.as_ref(),
+        );
         let (u, v, prev, f) = (
             s.displacement_m,
             s.velocity_m_s,
@@ -600,6 +643,7 @@ fn split<'b, 'a, T: Real>(
     table: &'b TensorMassTable<'a, T>,
     state: &'b mut StateBuffers<'_, T>,
     params: &DynamicParams<T>,
+    coupling: Option<&'b Coupling<'a, '_, T>>,
 ) -> (InternalForces<'b, 'a, T>, Loads<'b, T>, Writable<'b, T>) {
     let forces = internal_forces(
         table,
@@ -608,6 +652,7 @@ fn split<'b, 'a, T: Real>(
         state.tet_alive,
         &state.stvk_terms,
         params,
+        coupling,
     );
     let loads = Loads {
         masses_kg: state.masses_kg,
@@ -633,6 +678,7 @@ fn internal_forces<'b, 'a, T: Real>(
     tet_alive: &'b [bool],
     terms: &'b TermArraysMut<'_, T>,
     params: &DynamicParams<T>,
+    coupling: Option<&'b Coupling<'a, '_, T>>,
 ) -> InternalForces<'b, 'a, T> {
     let terms = NonLinearTerms {
         vertex_terms: terms.vertex,
@@ -657,6 +703,7 @@ fn internal_forces<'b, 'a, T: Real>(
         law: params.law,
         lame: table.lame(),
         incompressibility_n: params.incompressibility_n,
+        coupling: coupling.map(Coupling::forces),
     }
 }
 

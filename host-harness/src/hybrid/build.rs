@@ -1,0 +1,255 @@
+//! The three tables of a hybrid model (RR-3510 §6.2): the pre-computed
+//! region's (connection nodes fixed), the tensor-mass region's (its own
+//! vertex numbering) and the interface that condenses the former onto the
+//! connection nodes.
+
+use anyhow::{Context, bail};
+use bytemuck::Zeroable;
+use palpate_kernel::table::format::{FIXED_SLOT, RawHeader, SectionKind, TableKind};
+use palpate_kernel::table::{InterfaceTable, TensorMassTable};
+use palpate_kernel::{PrecomputedTable, Real};
+
+use super::condense::{Condensed, condense};
+use super::split::RegionSplit;
+use crate::fem::assembly::FreeOrdering;
+use crate::fem::element::shape_gradients;
+use crate::fem::material::Material;
+use crate::fix::{FixPredicate, fixed_vertices};
+use crate::mesh::{MeshReport, TetMesh, boundary_surface};
+use crate::table::build::{BuildOptions, BuiltTable, precomputed};
+use crate::table::compliance::Solver;
+use crate::table::file::{Precision, Section, write_container};
+use crate::table::load::TableFile;
+use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+
+/// What a hybrid build needs besides the mesh and the split.
+#[derive(Clone, Debug)]
+pub struct HybridOptions {
+    /// Young's modulus and Poisson ratio of both regions.
+    pub material: Material,
+    /// Mass density, kg/m³ (the tensor-mass region's masses and the
+    /// pre-computed region's gravity load).
+    pub density_kg_m3: f64,
+    /// A vertex matching any predicate is fixed.
+    pub fix: Vec<FixPredicate>,
+    /// Stored float width.
+    pub precision: Precision,
+    /// Gravity on the pre-computed region, m/s² (built into its load; the
+    /// tensor-mass region takes it as a run parameter).
+    pub gravity_m_s2: [f64; 3],
+    /// Point loads `(mesh vertex, force N)` on free vertices of the
+    /// pre-computed region, built into its load (a point load on the
+    /// tensor-mass region is an external force of its model).
+    pub point_loads: Vec<(u32, [f64; 3])>,
+}
+
+/// The three tables and how the mesh was split.
+pub struct HybridTables {
+    /// The pre-computed region's table, connection nodes fixed, mesh numbering.
+    pub precomputed: TableFile,
+    /// The tensor-mass region's table, [`RegionSplit::dynamic_vertex`] numbering.
+    pub dynamic: TableFile,
+    /// The interface table.
+    pub interface: TableFile,
+    /// The split.
+    pub split: RegionSplit,
+    /// The pre-computed table's build summary.
+    pub precomputed_summary: BuiltTable,
+}
+
+/// Builds the hybrid tables of `mesh` with the tets flagged in
+/// `dynamic_tet` in the tensor-mass region.
+///
+/// The connection nodes carry the lumped mass of all their tets (both
+/// regions): the pre-computed region is massless in its model, so the mass
+/// its tets lump onto the connection nodes is given to the tensor-mass
+/// region, which keeps the whole mesh's lumped mass matrix on the vertices
+/// it integrates (and the whole mesh's gravity load with the pre-computed
+/// region's built in). This also keeps the stable step of the hybrid no
+/// smaller than the all-tensor-mass model's: the condensed stiffness is
+/// bounded by the pre-computed tets' own stiffness on the connection
+/// nodes, and the mass is the same (README, "The hybrid model").
+pub fn build_hybrid(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    dynamic_tet: &[bool],
+    options: &HybridOptions,
+) -> anyhow::Result<HybridTables> {
+    let source = &report.source;
+    let n = mesh.positions.len();
+    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
+    let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
+
+    // The pre-computed region: connection nodes and vertices outside it fixed.
+    let pmesh = split.precomputed_mesh(mesh);
+    let mut pfixed = fixed.clone();
+    for (v, f) in pfixed.iter_mut().enumerate() {
+        *f |= !split.in_precomputed[v] || split.dynamic_index[v].is_some();
+    }
+    if pfixed.iter().all(|&f| f) {
+        bail!(
+            "{source}: the pre-computed region has no free vertex (every one is fixed or connects)"
+        );
+    }
+    let surface = boundary_surface(&pmesh);
+    let build = BuildOptions::precomputed(
+        options.material,
+        options.fix.clone(),
+        Solver::Cholesky,
+        options.precision,
+    );
+    let summary = BuiltTable {
+        bytes: Vec::new(),
+        fixed_by_predicate: fixed.iter().filter(|&&f| f).count(),
+        fixed_unreferenced: report.unreferenced_vertices.len(),
+        free_count: pfixed.iter().filter(|&&f| !f).count(),
+        touchable_count: 0,
+        edge_count: 0,
+        arrays_time: core::time::Duration::ZERO,
+    };
+    let preport = MeshReport {
+        source: format!("{source} (pre-computed region)"),
+        ..MeshReport::default()
+    };
+    let precomputed_summary = precomputed(
+        &pmesh,
+        &preport,
+        &build,
+        Solver::Cholesky,
+        &pfixed,
+        &surface,
+        summary,
+    )?;
+    let ordering = FreeOrdering::new(n, &pfixed, &surface.vertices);
+
+    // Lumped masses of each region's tets, and the pre-computed load.
+    let mass_of = |dynamic: bool| {
+        let mut m = vec![0.0f64; n];
+        for (tet, &d) in mesh.tets.iter().zip(&split.dynamic_tet) {
+            if d == dynamic {
+                let (_, volume) = shape_gradients(&tet.map(|v| mesh.positions[v as usize]));
+                for &v in tet {
+                    m[v as usize] += options.density_kg_m3 * volume / 4.0;
+                }
+            }
+        }
+        m
+    };
+    let precomputed_mass = mass_of(false);
+    let mut load_n: Vec<[f64; 3]> = precomputed_mass
+        .iter()
+        .map(|&m| options.gravity_m_s2.map(|g| m * g))
+        .collect();
+    for &(v, force) in &options.point_loads {
+        let Some(load) = load_n.get_mut(v as usize).filter(|_| !pfixed[v as usize]) else {
+            bail!(
+                "{source}: point load on vertex {v}, not a free vertex of the pre-computed region"
+            );
+        };
+        for (l, f) in load.iter_mut().zip(force) {
+            *l += f;
+        }
+    }
+    let condensed = condense(
+        &mesh.positions,
+        &pmesh.tets,
+        &options.material,
+        &ordering,
+        &split.connection,
+        &load_n,
+    )
+    .with_context(|| format!("{source}: condensing the pre-computed region"))?;
+
+    // The tensor-mass region, the connection nodes carrying both regions' mass.
+    let dmesh = split.dynamic_mesh(mesh);
+    let dfixed: Vec<bool> = split
+        .dynamic_vertex
+        .iter()
+        .map(|&v| fixed[v as usize])
+        .collect();
+    let mut arrays =
+        TensorMassArrays::new(&dmesh, &options.material, options.density_kg_m3, dfixed);
+    for &v in &split.connection {
+        if let Some(d) = split.dynamic_index[v as usize] {
+            arrays.masses_kg[d as usize] += precomputed_mass[v as usize];
+        }
+    }
+    let dsurface = boundary_surface(&dmesh);
+    let dynamic = write_tensor_mass_table(&dmesh, &dsurface.triangles, &arrays, options.precision);
+    let interface = write_interface_table(mesh, &split, &ordering, &condensed, options);
+    let tables = HybridTables {
+        precomputed: TableFile::from_bytes(&precomputed_summary.bytes),
+        dynamic: TableFile::from_bytes(&dynamic),
+        interface: TableFile::from_bytes(&interface),
+        split,
+        precomputed_summary: BuiltTable {
+            bytes: Vec::new(),
+            ..precomputed_summary
+        },
+    };
+    let loaded = match options.precision {
+        Precision::F32 => tables.check::<f32>(),
+        Precision::F64 => tables.check::<f64>(),
+    };
+    loaded.with_context(|| {
+        format!("{source}: the built hybrid tables fail Palpate's own load check")
+    })?;
+    Ok(tables)
+}
+
+impl HybridTables {
+    /// Loads the three tables with the kernel's loaders.
+    pub fn check<T: Real>(&self) -> anyhow::Result<()> {
+        PrecomputedTable::<T>::load(self.precomputed.bytes()).context("pre-computed region")?;
+        TensorMassTable::<T>::load(self.dynamic.bytes()).context("tensor-mass region")?;
+        InterfaceTable::<T>::load(self.interface.bytes()).context("interface")?;
+        Ok(())
+    }
+}
+
+/// Serializes the interface table (`TableKind::Interface`).
+fn write_interface_table(
+    mesh: &TetMesh,
+    split: &RegionSplit,
+    ordering: &FreeOrdering,
+    condensed: &Condensed,
+    options: &HybridOptions,
+) -> Vec<u8> {
+    let header = RawHeader {
+        table_kind: TableKind::Interface as u32,
+        vertex_count: mesh.positions.len() as u32,
+        tet_count: mesh.tets.len() as u32,
+        free_count: ordering.free_count() as u32,
+        touchable_count: ordering.touchable_count as u32,
+        connection_count: split.connection.len() as u32,
+        young_pa: options.material.young_pa,
+        poisson: options.material.poisson,
+        density_kg_m3: options.density_kg_m3,
+        mesh_hash: mesh.content_hash(),
+        ..RawHeader::zeroed()
+    };
+    let connections: Vec<[u32; 2]> = split
+        .connection
+        .iter()
+        .map(|&v| [v, split.dynamic_index[v as usize].unwrap_or(FIXED_SLOT)])
+        .collect();
+    let dynamic_vertex: Vec<u32> = split
+        .dynamic_index
+        .iter()
+        .map(|d| d.unwrap_or(FIXED_SLOT))
+        .collect();
+    let p = options.precision;
+    let sections = [
+        Section::ints(SectionKind::ConnectionVertex, &connections),
+        Section::floats(SectionKind::CondensedStiffness, &condensed.condensed, p),
+        Section::floats(SectionKind::ConnectionResponse, &condensed.response, p),
+        Section::floats(
+            SectionKind::LoadDisplacement,
+            &condensed.load_displacement,
+            p,
+        ),
+        Section::floats(SectionKind::LoadForce, &condensed.load_force, p),
+        Section::ints(SectionKind::DynamicVertex, &dynamic_vertex),
+    ];
+    write_container(header, p, &sections)
+}

@@ -1,0 +1,15 @@
+//! The hybrid model's offline side (RR-3510 §6.2; the kernel's
+//! `palpate_kernel::hybrid`): a mesh and the tets chosen dynamic →
+//! [`split::RegionSplit`] (the two regions and their connection nodes) →
+//! [`condense::condense`] (the pre-computed region condensed onto the
+//! connection nodes) → [`build::build_hybrid`] (the three tables) →
+//! [`owned::with_hybrid`] (the kernel model over heap buffers, for the
+//! harness's runs).
+
+pub mod build;
+pub mod condense;
+pub mod owned;
+pub mod split;
+
+pub use build::{HybridOptions, HybridTables, build_hybrid};
+pub use split::RegionSplit;

@@ -1,0 +1,138 @@
+//! The validated, zero-copy view of an interface table: the pre-computed
+//! region of a hybrid model condensed onto its connection nodes (RR-3510
+//! §6.2, MODELS.md §2 for the linear elasticity it condenses).
+
+use super::LoadError;
+use super::container::{Container, check_finite};
+use super::format::{FIXED_SLOT, RawHeader, SectionKind, TableKind};
+use crate::Real;
+
+/// An interface table that passed every load-time check.
+///
+/// Invariants established by [`InterfaceTable::load`]:
+/// - `c ≥ 1` connection nodes; their mesh vertices are `< N` and strictly
+///   ascending, and each one's tensor-mass vertex is the `dynamic-vertex`
+///   entry of its mesh vertex (not [`FIXED_SLOT`]);
+/// - every float is finite, and every diagonal entry of the condensed
+///   stiffness is positive (a Schur complement of a positive definite
+///   stiffness is positive definite);
+/// - section lengths match the header's counts: `c²` condensed blocks,
+///   `F·c` response blocks, `F` load displacements and `c` load forces,
+///   `N` dynamic-vertex entries.
+///
+/// That the table belongs with a given pre-computed and tensor-mass table
+/// is checked where the three meet ([`crate::hybrid::HybridModel::new`]).
+#[derive(Clone, Copy, Debug)]
+pub struct InterfaceTable<'a, T: Real> {
+    header: RawHeader,
+    connections: &'a [[u32; 2]],
+    condensed: &'a [[T; 9]],
+    response: &'a [[T; 9]],
+    load_displacement: &'a [[T; 3]],
+    load_force: &'a [[T; 3]],
+    dynamic_vertex: &'a [u32],
+}
+
+impl<'a, T: Real> InterfaceTable<'a, T> {
+    /// Validates `bytes` once and returns the view (format in
+    /// [`super::format`]). Cost: linear in the table size. Not for the step
+    /// path.
+    pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
+        let c = Container::parse::<T>(bytes, TableKind::Interface)?;
+        let table = Self {
+            header: c.header,
+            connections: c.section(SectionKind::ConnectionVertex)?,
+            condensed: c.section(SectionKind::CondensedStiffness)?,
+            response: c.section(SectionKind::ConnectionResponse)?,
+            load_displacement: c.section(SectionKind::LoadDisplacement)?,
+            load_force: c.section(SectionKind::LoadForce)?,
+            dynamic_vertex: c.section(SectionKind::DynamicVertex)?,
+        };
+        check_finite(SectionKind::CondensedStiffness, table.condensed)?;
+        check_finite(SectionKind::ConnectionResponse, table.response)?;
+        check_finite(SectionKind::LoadDisplacement, table.load_displacement)?;
+        check_finite(SectionKind::LoadForce, table.load_force)?;
+        let mut previous: Option<u32> = None;
+        for (j, &[vertex, dynamic]) in table.connections.iter().enumerate() {
+            let ascending = previous.is_none_or(|p| vertex > p);
+            let mapped = table.dynamic_vertex.get(vertex as usize) == Some(&dynamic);
+            let diagonal = table
+                .condensed
+                .get(j * table.connection_count() + j)
+                .is_some_and(|s| [s[0], s[4], s[8]].iter().all(|&d| d > T::zero()));
+            if !(ascending && mapped && dynamic != FIXED_SLOT && diagonal) {
+                return Err(LoadError::BadConnection {
+                    connection: j as u32,
+                });
+            }
+            previous = Some(vertex);
+        }
+        Ok(table)
+    }
+
+    /// The header as stored.
+    pub fn header(&self) -> &RawHeader {
+        &self.header
+    }
+
+    /// Vertices of the whole mesh (`N`).
+    pub fn vertex_count(&self) -> usize {
+        self.dynamic_vertex.len()
+    }
+
+    /// Connection nodes (`c`).
+    pub fn connection_count(&self) -> usize {
+        self.connections.len()
+    }
+
+    /// Free vertices of the pre-computed region's table (`F`), the rows of
+    /// the response.
+    pub fn free_count(&self) -> usize {
+        self.load_displacement.len()
+    }
+
+    /// Each connection node as `[mesh vertex, tensor-mass vertex]`.
+    pub fn connections(&self) -> &'a [[u32; 2]] {
+        self.connections
+    }
+
+    /// Row `j` of the condensed stiffness: the blocks `S_jk`, `k = 0..c`,
+    /// N/m, row-major 3×3; empty out of range.
+    pub fn condensed_row(&self, j: usize) -> &'a [[T; 9]] {
+        let c = self.connection_count();
+        self.condensed.get(j * c..(j + 1) * c).unwrap_or(&[])
+    }
+
+    /// Row `n` (free index of the pre-computed table) of the response: the
+    /// blocks `H_nj`, `j = 0..c`, m/m; empty out of range.
+    pub fn response_row(&self, n: usize) -> &'a [[T; 9]] {
+        let c = self.connection_count();
+        self.response.get(n * c..(n + 1) * c).unwrap_or(&[])
+    }
+
+    /// The built-in load's displacement of each free vertex of the
+    /// pre-computed region with the connection nodes at rest, m.
+    pub fn load_displacement_m(&self) -> &'a [[T; 3]] {
+        self.load_displacement
+    }
+
+    /// The force the built-in load passes to each connection node, N.
+    pub fn load_force_n(&self) -> &'a [[T; 3]] {
+        self.load_force
+    }
+
+    /// The tensor-mass vertex of mesh vertex `vertex`; `None` for a vertex of
+    /// the pre-computed region only, or out of range.
+    pub fn dynamic_vertex(&self, vertex: u32) -> Option<u32> {
+        self.dynamic_vertex
+            .get(vertex as usize)
+            .copied()
+            .filter(|&d| d != FIXED_SLOT)
+    }
+
+    /// The `dynamic-vertex` section as stored ([`FIXED_SLOT`] for a vertex
+    /// of the pre-computed region only).
+    pub fn dynamic_vertices(&self) -> &'a [u32] {
+        self.dynamic_vertex
+    }
+}
