@@ -41,6 +41,42 @@ pub struct HybridOptions {
     /// pre-computed region, built into its load (a point load on the
     /// tensor-mass region is an external force of its model).
     pub point_loads: Vec<(u32, [f64; 3])>,
+    /// Which tets' mass the connection nodes carry.
+    pub connection_mass: ConnectionMass,
+}
+
+/// The lumped mass of the connection nodes in the tensor-mass region.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ConnectionMass {
+    /// Both regions' tets (the default): the whole mesh's lumped mass, so
+    /// the coupling does not lower the stable step (README, "The hybrid
+    /// model": measured, and bounded by the all-tensor-mass model's).
+    #[default]
+    AllTets,
+    /// The tensor-mass region's tets only, as the region alone would have:
+    /// the condensed stiffness then stiffens the connection nodes without
+    /// their mass, which lowers the stable step (kept to measure it).
+    DynamicTetsOnly,
+}
+
+impl HybridOptions {
+    /// Options with no load and the default connection mass.
+    pub fn new(
+        material: Material,
+        density_kg_m3: f64,
+        fix: Vec<FixPredicate>,
+        precision: Precision,
+    ) -> Self {
+        Self {
+            material,
+            density_kg_m3,
+            fix,
+            precision,
+            gravity_m_s2: [0.0; 3],
+            point_loads: Vec::new(),
+            connection_mass: ConnectionMass::AllTets,
+        }
+    }
 }
 
 /// The three tables and how the mesh was split.
@@ -169,9 +205,11 @@ pub fn build_hybrid(
         .collect();
     let mut arrays =
         TensorMassArrays::new(&dmesh, &options.material, options.density_kg_m3, dfixed);
-    for &v in &split.connection {
-        if let Some(d) = split.dynamic_index[v as usize] {
-            arrays.masses_kg[d as usize] += precomputed_mass[v as usize];
+    if options.connection_mass == ConnectionMass::AllTets {
+        for &v in &split.connection {
+            if let Some(d) = split.dynamic_index[v as usize] {
+                arrays.masses_kg[d as usize] += precomputed_mass[v as usize];
+            }
         }
     }
     let dsurface = boundary_surface(&dmesh);

@@ -4,12 +4,14 @@
 //! [`condense::condense`] (the pre-computed region condensed onto the
 //! connection nodes) → [`build::build_hybrid`] (the three tables) →
 //! [`owned::with_hybrid`] (the kernel model over heap buffers, for the
-//! harness's runs).
+//! harness's runs) and [`stability::critical_dt_of_hybrid`] (its stable
+//! step next to its tensor-mass region's alone).
 
 pub mod build;
 pub mod condense;
 pub mod owned;
 pub mod split;
+pub mod stability;
 
-pub use build::{HybridOptions, HybridTables, build_hybrid};
+pub use build::{ConnectionMass, HybridOptions, HybridTables, build_hybrid};
 pub use split::RegionSplit;
