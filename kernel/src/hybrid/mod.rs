@@ -26,5 +26,7 @@
 //! [`crate::tensor_mass`].
 
 mod model;
+mod region;
 
-pub use model::{FieldError, HybridBuffers, HybridError, HybridModel};
+pub use model::HybridModel;
+pub use region::{CondensedRegion, FieldError, HybridBuffers, HybridError};

@@ -1,194 +1,32 @@
-//! [`HybridModel`]: the tensor-mass region coupled to the condensed
-//! pre-computed region, and the pre-computed region's contacts and field.
-
-use core::fmt;
-
-use nalgebra::{Matrix3, Vector3};
+//! [`HybridModel`]: the tensor-mass region and the condensed pre-computed
+//! region together, for scripted runs (steady states, stable steps); the
+//! haptic loop's tissue is [`super::HybridTissue`].
 
 use crate::Real;
-use crate::precomputed::{
-    AsConstraint, Constraint, ContactError, ContactPoint, ContactSolution, DisplacementError,
-    PrecomputedModel,
-};
-use crate::table::{InterfaceTable, PrecomputedTable, VertexSlot};
-use crate::tensor_mass::{Fault, Integrator, StepError, StepReport, TensorMassModel, VertexMode};
+use crate::precomputed::{AsConstraint, ContactError, ContactSolution};
+use crate::table::{InterfaceTable, PrecomputedTable};
+use crate::tensor_mass::{Fault, Integrator, StepError, StepReport, TensorMassModel};
 
-/// The hybrid model's own buffers (static arrays on firmware).
-pub struct HybridBuffers<'s, T> {
-    /// One per connection node (`c`): the force the pre-computed region's
-    /// load and contacts pass to it, N.
-    pub passed_force_n: &'s mut [[T; 3]],
-    /// One per free vertex of the pre-computed table (`F`, its free index
-    /// order): the displacement the connection nodes and the load give it,
-    /// m ([`HybridModel::update_background`]).
-    pub background_m: &'s mut [[T; 3]],
-}
-
-/// The three tables or the buffers of a hybrid model do not belong together.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum HybridError {
-    /// A buffer has the wrong length.
-    Buffer {
-        /// Which buffer.
-        name: &'static str,
-        /// Entries the tables require.
-        expected: usize,
-        /// Entries given.
-        found: usize,
-    },
-    /// The tables disagree: what, at which mesh vertex.
-    Mismatch {
-        /// What disagrees.
-        what: &'static str,
-        /// Mesh vertex (0 for a count).
-        vertex: u32,
-    },
-}
-
-impl fmt::Display for HybridError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            HybridError::Buffer {
-                name,
-                expected,
-                found,
-            } => write!(
-                f,
-                "buffer {name} holds {found} entries, the tables need {expected}"
-            ),
-            HybridError::Mismatch { what, vertex } => write!(
-                f,
-                "the interface table does not belong with the region tables: {what} (vertex {vertex})"
-            ),
-        }
-    }
-}
-
-impl core::error::Error for HybridError {}
-
-/// Why [`HybridModel::displacements`] wrote nothing.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FieldError {
-    /// The output buffer does not hold one entry per mesh vertex.
-    Length(DisplacementError),
-    /// The tensor-mass region is faulted: its state cannot be read.
-    Faulted(Fault),
-}
-
-impl fmt::Display for FieldError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            FieldError::Length(e) => e.fmt(f),
-            FieldError::Faulted(fault) => write!(f, "dynamic region faulted: {fault}"),
-        }
-    }
-}
-
-impl core::error::Error for FieldError {}
+use super::region::{CondensedRegion, FieldError, HybridBuffers, HybridError};
 
 /// The hybrid model over three validated tables: the tensor-mass region's
-/// (in its model), the pre-computed region's (the connection nodes fixed in
-/// it, numbered as the whole mesh), and the interface that condenses the
-/// latter onto the connection nodes (module docs: [`crate::hybrid`]).
-///
-/// Per step: the tensor-mass step, with `9c²` more multiply-adds per force
-/// evaluation. Per physics update, for contacts on the pre-computed region:
-/// [`Self::update_background`] over the touchable rows (`9·S·c`) and
-/// [`Self::pass_contact_forces`] (`27·c` per contact). Per tick:
-/// [`Self::contact_forces`], the pre-computed solve (`O(m³)`).
+/// (in its model), the pre-computed region's and the interface
+/// ([`CondensedRegion::couple`] checks they belong together).
 pub struct HybridModel<'a, 's, T: Real> {
     dynamic: TensorMassModel<'a, 's, T>,
-    precomputed: PrecomputedModel<'a, T>,
-    interface: InterfaceTable<'a, T>,
-    background_m: &'s mut [[T; 3]],
+    region: CondensedRegion<'a, 's, T>,
 }
 
 impl<'a, 's, T: Real> HybridModel<'a, 's, T> {
-    /// Couples `dynamic` to the pre-computed region of `precomputed` through
-    /// `interface`, after checking that the three belong together: one
-    /// vertex numbering (the interface's and the pre-computed table's vertex
-    /// counts, free counts and touchable counts agree), every vertex of the
-    /// tensor-mass table mapped from exactly one mesh vertex at the same
-    /// rest position and fixed in the pre-computed table, every connection
-    /// node free in the tensor-mass model, and the buffers' lengths. The
-    /// background starts at the load's displacement with the connection
-    /// nodes at rest.
-    ///
-    /// Cost: linear in the tables' vertices. Not for the step path.
+    /// Couples `dynamic` to the pre-computed region ([`CondensedRegion::couple`]).
     pub fn new(
         mut dynamic: TensorMassModel<'a, 's, T>,
         precomputed: PrecomputedTable<'a, T>,
         interface: InterfaceTable<'a, T>,
         buffers: HybridBuffers<'s, T>,
     ) -> Result<Self, HybridError> {
-        let mismatch = |what, vertex| HybridError::Mismatch { what, vertex };
-        let n = precomputed.vertex_count();
-        if interface.vertex_count() != n {
-            return Err(mismatch("vertex count", 0));
-        }
-        if interface.free_count() != precomputed.free_count()
-            || interface.header().touchable_count as usize != precomputed.touchable_count()
-        {
-            return Err(mismatch(
-                "free or touchable count of the pre-computed region",
-                0,
-            ));
-        }
-        let dynamic_table = *dynamic.table();
-        let mut mapped = 0usize;
-        for (v, p) in precomputed.rest_positions().iter().enumerate() {
-            let vertex = v as u32;
-            let Some(d) = interface.dynamic_vertex(vertex) else {
-                continue;
-            };
-            mapped += 1;
-            let same_place = dynamic_table.rest_positions().get(d as usize) == Some(p);
-            if !same_place {
-                return Err(mismatch("rest position of a dynamic vertex", vertex));
-            }
-            if !matches!(precomputed.slot(vertex), Some(VertexSlot::Fixed)) {
-                return Err(mismatch(
-                    "dynamic vertex free in the pre-computed region",
-                    vertex,
-                ));
-            }
-        }
-        if mapped != dynamic_table.vertex_count() {
-            return Err(mismatch("dynamic vertex count", 0));
-        }
-        for &[vertex, d] in interface.connections() {
-            if dynamic.modes().get(d as usize) != Some(&VertexMode::Free) {
-                return Err(mismatch(
-                    "connection node not free in the dynamic region",
-                    vertex,
-                ));
-            }
-        }
-        let c = interface.connection_count();
-        let check = |name, expected: usize, found: usize| {
-            (expected == found)
-                .then_some(())
-                .ok_or(HybridError::Buffer {
-                    name,
-                    expected,
-                    found,
-                })
-        };
-        check("passed_force_n", c, buffers.passed_force_n.len())?;
-        check(
-            "background_m",
-            interface.free_count(),
-            buffers.background_m.len(),
-        )?;
-        copy(buffers.passed_force_n, interface.load_force_n());
-        copy(buffers.background_m, interface.load_displacement_m());
-        dynamic.couple(interface, buffers.passed_force_n);
-        Ok(Self {
-            dynamic,
-            precomputed: PrecomputedModel::new(precomputed),
-            interface,
-            background_m: buffers.background_m,
-        })
+        let region = CondensedRegion::couple(&mut dynamic, precomputed, interface, buffers)?;
+        Ok(Self { dynamic, region })
     }
 
     /// The tensor-mass region (state, fault, tensors).
@@ -201,14 +39,14 @@ impl<'a, 's, T: Real> HybridModel<'a, 's, T> {
         &mut self.dynamic
     }
 
-    /// The pre-computed region's model (connection nodes fixed in it).
-    pub fn precomputed(&self) -> &PrecomputedModel<'a, T> {
-        &self.precomputed
+    /// The condensed pre-computed region.
+    pub fn region(&self) -> &CondensedRegion<'a, 's, T> {
+        &self.region
     }
 
     /// The interface table.
     pub fn interface(&self) -> &InterfaceTable<'a, T> {
-        &self.interface
+        self.region.interface()
     }
 
     /// Advances the tensor-mass region by `dt_s` with `integrator`, the
@@ -218,192 +56,36 @@ impl<'a, 's, T: Real> HybridModel<'a, 's, T> {
         self.dynamic.step(integrator, dt_s)
     }
 
-    /// Back to rest: the tensor-mass region reset, no contact force passed,
-    /// the background at the load's displacement.
+    /// Back to rest: both regions.
     pub fn reset(&mut self) {
         self.dynamic.reset();
-        self.pass_contact_forces::<1>(None);
-        copy(self.background_m, self.interface.load_displacement_m());
+        self.region.reset(&mut self.dynamic);
     }
 
-    /// Recomputes the background of the pre-computed free rows `0..rows`
-    /// (all of them for `rows ≥ F`; the touchable ones, which contacts
-    /// read, for `rows = S`): `b_n = K_ii⁻¹ f_n + Σ_j H_nj u_j`, m, from the
-    /// tensor-mass region's connection displacements. `9c` multiply-adds per
-    /// row. A faulted region leaves the background as it was.
+    /// [`CondensedRegion::update_background`].
     pub fn update_background(&mut self, rows: usize) -> Result<(), Fault> {
-        let u = self.dynamic.displacements_m()?;
-        let interface = &self.interface;
-        let backgrounds = self
-            .background_m
-            .iter_mut()
-            .zip(interface.load_displacement_m())
-            .enumerate()
-            .take(rows);
-        for (n, (b, load)) in backgrounds {
-            *b = (Vector3::from(*load) + response(interface, n, u)).into();
-        }
-        Ok(())
+        self.region.update_background(&self.dynamic, rows)
     }
 
-    /// The background of each pre-computed free vertex (see
-    /// [`Self::update_background`]), m, by free index.
-    pub fn background_m(&self) -> &[[T; 3]] {
-        self.background_m
+    /// [`CondensedRegion::pass_contact_forces`].
+    pub fn pass_contact_forces<const M: usize>(&mut self, solution: Option<&ContactSolution<T, M>>) {
+        self.region.pass_contact_forces(&mut self.dynamic, solution);
     }
 
-    /// Sets the force the pre-computed region passes to the connection nodes
-    /// to that of its load plus the contacts of `solution` (`None`: no
-    /// contact): `p_j = Hᵀ f_load + Σ_q Σ_a β_a H_{a j}ᵀ g_q` (N). Takes
-    /// effect at the next force evaluation. `27c` multiply-adds per
-    /// contact.
-    pub fn pass_contact_forces<const M: usize>(
-        &mut self,
-        solution: Option<&ContactSolution<T, M>>,
-    ) {
-        let interface = self.interface;
-        let Some(passed) = self.dynamic.passed_force_mut() else {
-            return;
-        };
-        copy(passed, interface.load_force_n());
-        let Some(solution) = solution else {
-            return;
-        };
-        for (point, g) in solution.resolved() {
-            for (k, beta) in point.terms() {
-                let weighted = g * beta;
-                for (p, h) in passed.iter_mut().zip(interface.response_row(k.get())) {
-                    *p = (Vector3::from(*p) + Matrix3::from_row_slice(h).transpose() * weighted)
-                        .into();
-                }
-            }
-        }
-    }
-
-    /// Contact forces for contacts on the pre-computed region (MODELS.md §2
-    /// with the connection nodes held): each contact's imposed displacement
-    /// less the background at its point (the displacement the connection
-    /// nodes and the load give it) is solved with the compliance `C⁰`.
-    /// Reads the background of the touchable rows: call
-    /// [`Self::update_background`] with at least `S` rows after each
-    /// physics update. Bounded: `O(M³)` like [`PrecomputedModel::contact_forces`].
+    /// [`CondensedRegion::contact_forces`].
     pub fn contact_forces<const M: usize>(
         &self,
         contacts: &[impl AsConstraint<T>],
     ) -> Result<ContactSolution<T, M>, ContactError> {
-        if contacts.len() > M {
-            return Err(ContactError::TooManyContacts {
-                given: contacts.len(),
-                capacity: M,
-            });
-        }
-        let mut relative = [Constraint::at_vertex(0, Vector3::zeros()); M];
-        for (r, contact) in relative.iter_mut().zip(contacts) {
-            let point = contact.point();
-            *r = Constraint {
-                point,
-                displacement_m: contact.displacement_m() - self.background_at(point),
-            };
-        }
-        let relative = relative.get(..contacts.len()).unwrap_or(&[]);
-        self.precomputed.contact_forces::<M>(relative)
+        self.region.contact_forces(&self.dynamic, contacts)
     }
 
-    /// The displacement of every mesh vertex (m, mesh vertex order): the
-    /// tensor-mass region's own, and in the pre-computed region the
-    /// background plus the response to the contacts of `solution` (`None`:
-    /// no contact). `9c` multiply-adds per pre-computed free vertex, plus
-    /// [`PrecomputedModel::displacements`]. Not needed by the haptic path.
+    /// [`CondensedRegion::displacements`].
     pub fn displacements<const M: usize>(
         &self,
         solution: Option<&ContactSolution<T, M>>,
         out: &mut [[T; 3]],
     ) -> Result<(), FieldError> {
-        let u = self
-            .dynamic
-            .displacements_m()
-            .map_err(FieldError::Faulted)?;
-        match solution {
-            Some(s) => self.precomputed.displacements(s, out),
-            None => {
-                let expected = self.interface.vertex_count();
-                if out.len() == expected {
-                    out.fill([T::zero(); 3]);
-                    Ok(())
-                } else {
-                    Err(DisplacementError {
-                        expected,
-                        found: out.len(),
-                    })
-                }
-            }
-        }
-        .map_err(FieldError::Length)?;
-        let table = self.precomputed.table();
-        for (n, (&v, load)) in table
-            .free_vertices()
-            .iter()
-            .zip(self.interface.load_displacement_m())
-            .enumerate()
-        {
-            if let Some(o) = out.get_mut(v as usize) {
-                let b = Vector3::from(*load) + response(&self.interface, n, u);
-                *o = (Vector3::from(*o) + b).into();
-            }
-        }
-        for (o, &d) in out.iter_mut().zip(self.interface.dynamic_vertices()) {
-            if let Some(ud) = u.get(d as usize) {
-                *o = *ud;
-            }
-        }
-        Ok(())
-    }
-
-    /// The background at a contact point: `Σ_a β_a b(v_a)` with `b` the
-    /// background of a pre-computed free vertex, the tensor-mass
-    /// displacement of a connection node, zero for a fixed vertex (and
-    /// zero for a faulted region, whose contacts the caller drops).
-    fn background_at(&self, point: ContactPoint<T>) -> Vector3<T> {
-        let (vertices, weights) = match point {
-            ContactPoint::Vertex(v) => ([v, v, v], [T::one(), T::zero(), T::zero()]),
-            ContactPoint::Triangle { vertices, weights } => (vertices, weights),
-        };
-        let u = self.dynamic.displacements_m().unwrap_or(&[]);
-        let table = self.precomputed.table();
-        let mut sum = Vector3::zeros();
-        for (&v, &w) in vertices.iter().zip(&weights) {
-            let b = match (table.slot(v), self.interface.dynamic_vertex(v)) {
-                (Some(VertexSlot::Free(n)), _) => self.background_m.get(n.get()),
-                (_, Some(d)) => u.get(d as usize),
-                _ => None,
-            };
-            if let Some(b) = b {
-                sum += Vector3::from(*b) * w;
-            }
-        }
-        sum
-    }
-}
-
-/// `Σ_j H_nj u_{d_j}` (m): row `n` of the response applied to the
-/// connection displacements read from the tensor-mass displacements `u`.
-fn response<T: Real>(interface: &InterfaceTable<'_, T>, n: usize, u: &[[T; 3]]) -> Vector3<T> {
-    let mut sum = Vector3::zeros();
-    for (h, &[_, d]) in interface
-        .response_row(n)
-        .iter()
-        .zip(interface.connections())
-    {
-        if let Some(ud) = u.get(d as usize) {
-            sum += Matrix3::from_row_slice(h) * Vector3::from(*ud);
-        }
-    }
-    sum
-}
-
-/// Copies the common prefix of `src` into `dst`.
-fn copy<E: Copy>(dst: &mut [E], src: &[E]) {
-    for (d, s) in dst.iter_mut().zip(src) {
-        *d = *s;
+        self.region.displacements(&self.dynamic, solution, out)
     }
 }
