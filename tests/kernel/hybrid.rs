@@ -106,10 +106,7 @@ fn settle(
 /// Calls `step` until the field it writes (every 100th call, when given
 /// `Some`) changes by less than `tolerance` of its size over 100 calls;
 /// at most 40 000 calls.
-fn settle_with(
-    tolerance: f64,
-    mut step: impl FnMut(Option<&mut Vec<[f64; 3]>>),
-) -> Vec<[f64; 3]> {
+fn settle_with(tolerance: f64, mut step: impl FnMut(Option<&mut Vec<[f64; 3]>>)) -> Vec<[f64; 3]> {
     let mut previous: Vec<[f64; 3]> = Vec::new();
     let mut field = Vec::new();
     for call in 0..40_000 {
@@ -286,8 +283,15 @@ fn coupling_with_the_whole_mass_keeps_the_stable_step() {
             connection_mass,
             ..options([0.0; 3], Vec::new())
         };
-        critical_dt_of_hybrid(&mesh, &report, &dynamic, &options, 0.0, Integrator::SymplecticEuler)
-            .expect("critical dt")
+        critical_dt_of_hybrid(
+            &mesh,
+            &report,
+            &dynamic,
+            &options,
+            0.0,
+            Integrator::SymplecticEuler,
+        )
+        .expect("critical dt")
     };
     let naive = measure(ConnectionMass::DynamicTetsOnly);
     let whole = measure(ConnectionMass::AllTets);
@@ -345,7 +349,13 @@ fn stvk_in_the_dynamic_region_against_all_stvk_under_a_large_rotation() {
     let dynamic: Vec<bool> = mesh
         .tets
         .iter()
-        .map(|t| t.iter().map(|&v| mesh.positions[v as usize][0]).sum::<f64>() / 4.0 > 0.04)
+        .map(|t| {
+            t.iter()
+                .map(|&v| mesh.positions[v as usize][0])
+                .sum::<f64>()
+                / 4.0
+                > 0.04
+        })
         .collect();
     let stvk = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
     let (dt, damping, tolerance) = (2e-4, 40.0, 1e-10);
@@ -362,7 +372,9 @@ fn stvk_in_the_dynamic_region_against_all_stvk_under_a_large_rotation() {
     let hybrid = with_hybrid(&tables, params(stvk), |hybrid| {
         let mut field = vec![[0.0; 3]; mesh.positions.len()];
         settle_with(tolerance, |f| {
-            hybrid.step(Integrator::SymplecticEuler, dt).expect("stable step");
+            hybrid
+                .step(Integrator::SymplecticEuler, dt)
+                .expect("stable step");
             if let Some(f) = f {
                 hybrid.displacements::<1>(None, &mut field).expect("field");
                 f.clone_from(&field);
@@ -382,7 +394,9 @@ fn stvk_in_the_dynamic_region_against_all_stvk_under_a_large_rotation() {
         let mut state = OwnedState::for_table(&table);
         let mut model = TensorMassModel::new(table, state.buffers(), params(law)).expect("model");
         settle_with(tolerance, |f| {
-            model.step(Integrator::SymplecticEuler, dt).expect("stable step");
+            model
+                .step(Integrator::SymplecticEuler, dt)
+                .expect("stable step");
             if let Some(f) = f {
                 f.clone_from(&model.displacements_m().expect("field").to_vec());
             }
@@ -390,7 +404,10 @@ fn stvk_in_the_dynamic_region_against_all_stvk_under_a_large_rotation() {
     };
     let all_stvk = whole(stvk);
     let all_linear = whole(ElasticLaw::Linear);
-    let tip = all_stvk.iter().map(|u| Vector3::from(*u).norm()).fold(0.0, f64::max);
+    let tip = all_stvk
+        .iter()
+        .map(|u| Vector3::from(*u).norm())
+        .fold(0.0, f64::max);
     let hybrid_difference = relative_error(&hybrid, &all_stvk);
     let linear_difference = relative_error(&all_linear, &all_stvk);
     println!(

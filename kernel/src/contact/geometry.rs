@@ -25,7 +25,8 @@ use nalgebra::Vector3;
 use super::Contact;
 use crate::Real;
 use crate::table::{
-    PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex, within,
+    InterfaceTable, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex,
+    within,
 };
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
@@ -57,6 +58,17 @@ pub enum Supports<'a, T: Real> {
     Precomputed(&'a PrecomputedTable<'a, T>),
     /// The fixed vertices of a tensor-mass table.
     TensorMass(&'a TensorMassTable<'a, T>),
+    /// The fixed vertices of a hybrid mesh (RR-3510 §6.2): a vertex of the
+    /// tensor-mass region as its table says, any other as the pre-computed
+    /// table says.
+    Hybrid {
+        /// The pre-computed region's table (mesh numbering).
+        precomputed: &'a PrecomputedTable<'a, T>,
+        /// The tensor-mass region's table.
+        dynamic: &'a TensorMassTable<'a, T>,
+        /// Their interface (the vertex map).
+        interface: &'a InterfaceTable<'a, T>,
+    },
 }
 
 impl<T: Real> Supports<'_, T> {
@@ -64,6 +76,14 @@ impl<T: Real> Supports<'_, T> {
         match self {
             Self::Precomputed(t) => t.is_fixed_vertex(vertex),
             Self::TensorMass(t) => t.is_fixed_vertex(vertex),
+            Self::Hybrid {
+                precomputed,
+                dynamic,
+                interface,
+            } => match interface.dynamic_vertex(vertex.as_u32()) {
+                Some(d) => dynamic.is_fixed(d),
+                None => precomputed.is_fixed_vertex(vertex),
+            },
         }
     }
 }

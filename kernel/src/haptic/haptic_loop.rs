@@ -20,6 +20,7 @@ use nalgebra::Vector3;
 use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
 use super::tool::{ToolAction, ToolInput};
 use crate::contact::{Contact, ContactSet, ContactWork, Refusal, Tissue};
+use crate::hybrid::HybridTissue;
 use crate::precomputed::{ContactSolution, PrecomputedTissue};
 use crate::tensor_mass::{Blade, Blades, DynamicTissue, PhysicsError, StepReport};
 use crate::{MAX_CONTACTS, Real};
@@ -100,6 +101,10 @@ pub type PrecomputedLoop<'a, T, const P: usize, const M: usize> =
 /// The loop over the dynamic tensor-mass model.
 pub type DynamicLoop<'a, 's, T, const P: usize, const M: usize> =
     HapticLoop<T, DynamicTissue<'a, 's, T, P>, P, M>;
+
+/// The loop over the hybrid model.
+pub type HybridLoop<'a, 's, T, const P: usize, const M: usize> =
+    HapticLoop<T, HybridTissue<'a, 's, T, P, M>, P, M>;
 
 impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, P, M> {
     /// A loop at rest (no contact, zero force) over `tissue`.
@@ -317,7 +322,42 @@ impl<'a, T: Real, const P: usize, const M: usize> PrecomputedLoop<'a, T, P, M> {
     }
 }
 
-impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
+/// A tissue stepped at the physics rate, between ticks: the tensor-mass
+/// model ([`DynamicTissue`]) and the hybrid ([`HybridTissue`]).
+pub trait PhysicsTissue<T: Real, const M: usize>: Tissue<T, M> {
+    /// The physics update for contact set `set` (the loop's current
+    /// contacts at the last tick's tool positions) and the enabled
+    /// `blades`. Bounded; on failure the tissue is faulted.
+    fn update(
+        &mut self,
+        set: &ContactSet<T, M>,
+        blades: &Blades<T>,
+    ) -> Result<StepReport<T>, PhysicsError>;
+}
+
+impl<T: Real, const P: usize, const M: usize> PhysicsTissue<T, M> for DynamicTissue<'_, '_, T, P> {
+    fn update(
+        &mut self,
+        set: &ContactSet<T, M>,
+        blades: &Blades<T>,
+    ) -> Result<StepReport<T>, PhysicsError> {
+        DynamicTissue::update(self, set, blades)
+    }
+}
+
+impl<T: Real, const P: usize, const M: usize> PhysicsTissue<T, M>
+    for HybridTissue<'_, '_, T, P, M>
+{
+    fn update(
+        &mut self,
+        set: &ContactSet<T, M>,
+        blades: &Blades<T>,
+    ) -> Result<StepReport<T>, PhysicsError> {
+        HybridTissue::update(self, set, blades)
+    }
+}
+
+impl<T: Real, B: PhysicsTissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, P, M> {
     /// One physics update of the dynamic model with the current contacts at
     /// the last tick's tool positions and the last tick's enabled blades
     /// (call it every `physics_every` ticks, after the tick). On failure the
@@ -344,7 +384,7 @@ impl<T: Real, const P: usize, const M: usize> DynamicLoop<'_, '_, T, P, M> {
                 }
             }
         }
-        let result = self.tissue.update(&set, &blades);
+        let result = PhysicsTissue::update(&mut self.tissue, &set, &blades);
         if result.is_ok() {
             // The update imposed every gap, a found-inside contact's too:
             // from now on its gap counts from touching.

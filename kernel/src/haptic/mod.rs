@@ -10,7 +10,8 @@ mod safety;
 mod tool;
 
 pub use haptic_loop::{
-    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, LoopError, PrecomputedLoop, TickCounters,
+    DynamicLoop, ForceOutput, HapticLoop, HybridLoop, LoopConfig, LoopError, PhysicsTissue,
+    PrecomputedLoop, TickCounters,
 };
 pub use safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
 pub use tool::{ToolAction, ToolInput};

@@ -27,6 +27,10 @@
 
 mod model;
 mod region;
+mod surface;
+mod tissue;
 
 pub use model::HybridModel;
 pub use region::{CondensedRegion, FieldError, HybridBuffers, HybridError};
+pub use surface::{HybridSurface, HybridSurfaceBuffers, HybridSurfaceLengths, SlotRegion};
+pub use tissue::{HybridTissue, HybridTissueError};

@@ -68,7 +68,10 @@ impl<'a, 's, T: Real> HybridModel<'a, 's, T> {
     }
 
     /// [`CondensedRegion::pass_contact_forces`].
-    pub fn pass_contact_forces<const M: usize>(&mut self, solution: Option<&ContactSolution<T, M>>) {
+    pub fn pass_contact_forces<const M: usize>(
+        &mut self,
+        solution: Option<&ContactSolution<T, M>>,
+    ) {
         self.region.pass_contact_forces(&mut self.dynamic, solution);
     }
 

@@ -130,7 +130,10 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
         if interface.free_count() != precomputed.free_count()
             || interface.header().touchable_count as usize != precomputed.touchable_count()
         {
-            return Err(mismatch("free or touchable count of the pre-computed region", 0));
+            return Err(mismatch(
+                "free or touchable count of the pre-computed region",
+                0,
+            ));
         }
         let dynamic_table = *dynamic.table();
         let mut mapped = 0usize;
@@ -145,7 +148,10 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
                 return Err(mismatch("rest position of a dynamic vertex", vertex));
             }
             if !matches!(precomputed.slot(vertex), Some(VertexSlot::Fixed)) {
-                return Err(mismatch("dynamic vertex free in the pre-computed region", vertex));
+                return Err(mismatch(
+                    "dynamic vertex free in the pre-computed region",
+                    vertex,
+                ));
             }
         }
         if mapped != dynamic_table.vertex_count() {
@@ -153,7 +159,10 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
         }
         for &[vertex, d] in interface.connections() {
             if dynamic.modes().get(d as usize) != Some(&VertexMode::Free) {
-                return Err(mismatch("connection node not free in the dynamic region", vertex));
+                return Err(mismatch(
+                    "connection node not free in the dynamic region",
+                    vertex,
+                ));
             }
         }
         let c = interface.connection_count();
@@ -167,7 +176,11 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
                 })
         };
         check("passed_force_n", c, buffers.passed_force_n.len())?;
-        check("background_m", interface.free_count(), buffers.background_m.len())?;
+        check(
+            "background_m",
+            interface.free_count(),
+            buffers.background_m.len(),
+        )?;
         copy(buffers.passed_force_n, interface.load_force_n());
         copy(buffers.background_m, interface.load_displacement_m());
         dynamic.couple(interface, buffers.passed_force_n);
@@ -338,7 +351,10 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     /// touchable vertex's background, zero otherwise (fixed, or an
     /// interior vertex of this region, which no contact touches).
     pub fn surface_displacement<'u>(&'u self, u: &'u [[T; 3]], v: u32) -> Option<&'u [T; 3]> {
-        match (self.interface.dynamic_vertex(v), self.precomputed.table().slot(v)) {
+        match (
+            self.interface.dynamic_vertex(v),
+            self.precomputed.table().slot(v),
+        ) {
             (Some(d), _) => u.get(d as usize),
             (None, Some(VertexSlot::Free(n))) => self.background_m.get(n.get()),
             _ => None,

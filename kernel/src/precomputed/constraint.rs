@@ -186,6 +186,25 @@ pub enum ContactError {
     NonFiniteResult,
 }
 
+impl ContactError {
+    /// The index of the contact this error names (the one to drop), if
+    /// any.
+    pub fn contact(&self) -> Option<usize> {
+        match *self {
+            ContactError::VertexOutOfRange { contact, .. }
+            | ContactError::FixedVertex { contact, .. }
+            | ContactError::NotOnSurface { contact, .. }
+            | ContactError::RepeatedVertex { contact, .. }
+            | ContactError::NotSurfaceTriangle { contact, .. }
+            | ContactError::BadWeights { contact }
+            | ContactError::NonFiniteInput { contact }
+            | ContactError::IllConditioned { contact } => Some(contact),
+            ContactError::DuplicateContact { second, .. } => Some(second),
+            ContactError::TooManyContacts { .. } | ContactError::NonFiniteResult => None,
+        }
+    }
+}
+
 impl fmt::Display for ContactError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {

@@ -5,7 +5,7 @@
 
 use nalgebra::Vector3;
 
-use super::{ContactError, ContactSolution, PrecomputedModel};
+use super::{ContactSolution, PrecomputedModel};
 use crate::contact::{ContactSet, Refusal, SurfaceGeometry, Tissue};
 use crate::table::PrecomputedTable;
 use crate::{MAX_CONTACTS, Real};
@@ -56,7 +56,7 @@ impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
         let solution = self
             .model
             .contact_forces::<M>(set.as_slice())
-            .map_err(|e| contact_index(&e).map_or(Refusal::Fault, Refusal::Contact))?;
+            .map_err(|e| e.contact().map_or(Refusal::Fault, Refusal::Contact))?;
         for (c, g) in set.iter_mut().zip(solution.contact_forces_n()) {
             c.force_n = *g;
         }
@@ -71,21 +71,5 @@ impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
 
     fn reset(&mut self) {
         self.solution = None;
-    }
-}
-
-/// The index of the contact a [`ContactError`] names, if any.
-fn contact_index(e: &ContactError) -> Option<usize> {
-    match *e {
-        ContactError::VertexOutOfRange { contact, .. }
-        | ContactError::FixedVertex { contact, .. }
-        | ContactError::NotOnSurface { contact, .. }
-        | ContactError::RepeatedVertex { contact, .. }
-        | ContactError::NotSurfaceTriangle { contact, .. }
-        | ContactError::BadWeights { contact }
-        | ContactError::NonFiniteInput { contact }
-        | ContactError::IllConditioned { contact } => Some(contact),
-        ContactError::DuplicateContact { second, .. } => Some(second),
-        ContactError::TooManyContacts { .. } | ContactError::NonFiniteResult => None,
     }
 }

@@ -341,6 +341,12 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         &self.removed
     }
 
+    /// The dynamic model, to pass it a coupled region's forces (the
+    /// hybrid tissue).
+    pub(crate) fn model_mut(&mut self) -> &mut TensorMassModel<'a, 's, T> {
+        &mut self.model
+    }
+
     /// The model.
     pub fn model(&self) -> &TensorMassModel<'a, 's, T> {
         &self.model

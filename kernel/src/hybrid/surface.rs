@@ -1,0 +1,301 @@
+//! The surface of a hybrid tissue for the haptic loop: the whole mesh's
+//! boundary at the current positions (RR-3510 §6.2; MODELS.md §6),
+//! re-binned at every physics update like the tensor-mass model's
+//! ([`crate::tensor_mass::DeformingSurface`], Cotin 1999 §4).
+//!
+//! Slots: `0..B` hold the pre-computed table's boundary triangles in its
+//! order, the faces it shares with the tensor-mass region left empty
+//! ([`DEAD_TRIANGLE`]: they are inside the organ); `B..B + F` the
+//! tensor-mass region's surface slots (its
+//! [`crate::tensor_mass::DeformingSurface::triangles`], faces a cut exposes
+//! included) in mesh vertex numbers. Positions: a tensor-mass vertex at its
+//! displacement, a touchable pre-computed vertex at its background (the
+//! displacement the connection nodes and the load give it; a contact's own
+//! dimple is the contact's), every other vertex at rest.
+
+use nalgebra::Vector3;
+
+use super::region::CondensedRegion;
+use crate::Real;
+use crate::contact::grid::{self, BinBuffers, Binned};
+use crate::contact::{Supports, SurfaceGeometry};
+use crate::table::{
+    BuiltLists, DEAD_TRIANGLE, Grid, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex,
+};
+use crate::tensor_mass::{NonFinitePosition, SurfaceBufferError, TensorMassModel};
+
+/// The caller's buffers of a hybrid surface (static arrays on firmware);
+/// lengths from [`HybridSurfaceBuffers::lengths`].
+pub struct HybridSurfaceBuffers<'s, T> {
+    /// Current position of every mesh vertex, m: `N`.
+    pub positions_m: &'s mut [[T; 3]],
+    /// The triangle in each slot (module docs): `B + F`.
+    pub triangles: &'s mut [[u32; 3]],
+    /// Plane of every slot's triangle: `B + F`.
+    pub planes: &'s mut [[T; 4]],
+    /// Start of each vertex's triangle list: `N + 1`.
+    pub vertex_triangle_start: &'s mut [u32],
+    /// The triangles around each vertex: `3 (B + F)`.
+    pub vertex_triangle: &'s mut [u32],
+    /// Start of each grid cell's vertex list: the grid's capacity in cells
+    /// plus one, at least 2.
+    pub cell_start: &'s mut [u32],
+    /// Surface vertices filed by cell: `N`.
+    pub grid_vertex: &'s mut [u32],
+    /// The mesh vertex of each tensor-mass vertex: `N_d`.
+    pub mesh_vertex: &'s mut [u32],
+}
+
+/// Buffer lengths of a hybrid surface (see [`HybridSurfaceBuffers`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HybridSurfaceLengths {
+    /// `positions_m` and `grid_vertex` (`N`).
+    pub vertices: usize,
+    /// `triangles` and `planes` (`B + F`).
+    pub triangles: usize,
+    /// `cell_start`.
+    pub cell_start: usize,
+    /// `mesh_vertex` (`N_d`).
+    pub dynamic_vertices: usize,
+}
+
+impl<T> HybridSurfaceBuffers<'_, T> {
+    /// The lengths for the region tables with room for `cells` grid cells.
+    pub fn lengths<R: Real>(
+        precomputed: &PrecomputedTable<'_, R>,
+        dynamic: &TensorMassTable<'_, R>,
+        cells: usize,
+    ) -> HybridSurfaceLengths {
+        HybridSurfaceLengths {
+            vertices: precomputed.vertex_count(),
+            triangles: precomputed.surface_triangles().len() + dynamic.mesh_triangles().len(),
+            cell_start: cells.max(1) + 1,
+            dynamic_vertices: dynamic.vertex_count(),
+        }
+    }
+}
+
+/// Where a surface slot lies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlotRegion {
+    /// A boundary triangle of the pre-computed region.
+    Precomputed,
+    /// The tensor-mass region's surface slot of this index.
+    Dynamic(TriangleIndex),
+}
+
+/// The hybrid tissue's surface at the positions of the last
+/// [`Self::rebuild`].
+pub struct HybridSurface<'s, T: Real> {
+    buffers: HybridSurfaceBuffers<'s, T>,
+    /// First slot of the tensor-mass region (`B`).
+    dynamic_first: usize,
+    grid: Grid<T>,
+    cells: usize,
+    filed: usize,
+    max_bucket: u32,
+    max_valence: u32,
+}
+
+impl<'s, T: Real> HybridSurface<'s, T> {
+    /// Checks the buffer lengths, fills the pre-computed slots (a face
+    /// shared with a tensor-mass tet left empty: its sorted tensor-mass
+    /// vertices are one of that table's mesh triangles) and the
+    /// tensor-mass vertices' mesh numbers, and builds the surface over
+    /// `dynamic`'s surface slots `dynamic_triangles` ([`Self::rebuild`]).
+    /// Cost: one pass over the pre-computed boundary (a binary search
+    /// each) and one over the mesh vertices. Not for the step path.
+    pub fn new(
+        region: &CondensedRegion<'_, '_, T>,
+        dynamic: &TensorMassModel<'_, '_, T>,
+        dynamic_triangles: &[[u32; 3]],
+        buffers: HybridSurfaceBuffers<'s, T>,
+    ) -> Result<Self, SurfaceBufferError> {
+        let precomputed = region.precomputed().table();
+        let need = HybridSurfaceBuffers::<T>::lengths(precomputed, dynamic.table(), 1);
+        let checks = [
+            ("positions_m", need.vertices, buffers.positions_m.len()),
+            ("triangles", need.triangles, buffers.triangles.len()),
+            ("planes", need.triangles, buffers.planes.len()),
+            (
+                "vertex_triangle_start",
+                need.vertices + 1,
+                buffers.vertex_triangle_start.len(),
+            ),
+            (
+                "vertex_triangle",
+                3 * need.triangles,
+                buffers.vertex_triangle.len(),
+            ),
+            ("grid_vertex", need.vertices, buffers.grid_vertex.len()),
+            (
+                "mesh_vertex",
+                need.dynamic_vertices,
+                buffers.mesh_vertex.len(),
+            ),
+        ];
+        if let Some(&(buffer, expected, found)) = checks.iter().find(|(_, e, f)| e != f) {
+            return Err(SurfaceBufferError {
+                buffer,
+                expected,
+                found,
+            });
+        }
+        if buffers.cell_start.len() < need.cell_start {
+            return Err(SurfaceBufferError {
+                buffer: "cell_start",
+                expected: need.cell_start,
+                found: buffers.cell_start.len(),
+            });
+        }
+        let interface = region.interface();
+        for (v, &d) in interface.dynamic_vertices().iter().enumerate() {
+            if let Some(m) = buffers.mesh_vertex.get_mut(d as usize) {
+                *m = v as u32;
+            }
+        }
+        let inside = dynamic.table().mesh_triangles();
+        for (slot, tri) in buffers
+            .triangles
+            .iter_mut()
+            .zip(precomputed.surface_triangles())
+        {
+            let shared = match tri.map(|v| interface.dynamic_vertex(v)) {
+                [Some(a), Some(b), Some(c)] => {
+                    let mut sorted = [a, b, c];
+                    sorted.sort_unstable();
+                    inside.binary_search(&sorted).is_ok()
+                }
+                _ => false,
+            };
+            *slot = if shared { DEAD_TRIANGLE } else { *tri };
+        }
+        let mut surface = Self {
+            buffers,
+            dynamic_first: precomputed.surface_triangles().len(),
+            grid: Grid {
+                origin_m: Vector3::zeros(),
+                cell_m: T::one(),
+                dims: [1; 3],
+            },
+            cells: 1,
+            filed: 0,
+            max_bucket: 0,
+            max_valence: 0,
+        };
+        // The rest state is finite (validated tables), so this bins.
+        surface
+            .rebuild(region, dynamic, dynamic_triangles)
+            .map_err(|_| SurfaceBufferError {
+                buffer: "positions_m",
+                expected: need.vertices,
+                found: 0,
+            })?;
+        Ok(surface)
+    }
+
+    /// Moves the surface to the current state (module docs): the
+    /// tensor-mass slots from `dynamic_triangles` (its surface slots,
+    /// renumbered), the positions, the vertex-to-triangle lists, planes and
+    /// a new grid. One pass over the slots and three over the vertices,
+    /// plus the grid builder's ([`crate::contact::grid::bin`]). A
+    /// non-finite position is refused and leaves the grid as it was.
+    pub fn rebuild(
+        &mut self,
+        region: &CondensedRegion<'_, '_, T>,
+        dynamic: &TensorMassModel<'_, '_, T>,
+        dynamic_triangles: &[[u32; 3]],
+    ) -> Result<(), NonFinitePosition> {
+        let b = &mut self.buffers;
+        let mesh_vertex = &*b.mesh_vertex;
+        let slots = b.triangles.get_mut(self.dynamic_first..).unwrap_or(&mut []);
+        for (slot, tri) in slots.iter_mut().zip(dynamic_triangles) {
+            *slot = if *tri == DEAD_TRIANGLE {
+                DEAD_TRIANGLE
+            } else {
+                tri.map(|d| mesh_vertex.get(d as usize).copied().unwrap_or(u32::MAX))
+            };
+        }
+        let u = dynamic.displacements_m().unwrap_or(&[]);
+        let zero = [T::zero(); 3];
+        let rest = region.precomputed().table().rest_positions();
+        for (v, (x, p)) in b.positions_m.iter_mut().zip(rest).enumerate() {
+            let d = region.surface_displacement(u, v as u32).unwrap_or(&zero);
+            *x = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
+            if !x.iter().all(|c| c.finite()) {
+                return Err(NonFinitePosition { vertex: v as u32 });
+            }
+        }
+        self.max_valence =
+            grid::vertex_triangles(b.triangles, b.vertex_triangle_start, b.vertex_triangle);
+        let Binned {
+            grid,
+            cells,
+            filed,
+            max_bucket,
+        } = grid::bin(
+            b.positions_m,
+            b.triangles,
+            b.vertex_triangle_start,
+            BinBuffers {
+                planes: b.planes,
+                cell_start: b.cell_start,
+                grid_vertex: b.grid_vertex,
+            },
+        );
+        (self.grid, self.cells, self.filed, self.max_bucket) = (grid, cells, filed, max_bucket);
+        Ok(())
+    }
+
+    /// Where slot `t` lies; `None` beyond the slots.
+    pub fn region_of(&self, t: TriangleIndex) -> Option<SlotRegion> {
+        let slots = self.buffers.triangles.len();
+        match t.get() {
+            s if s < self.dynamic_first => Some(SlotRegion::Precomputed),
+            s if s < slots => {
+                let d = (s - self.dynamic_first) as u32;
+                TriangleIndex::new(d, slots - self.dynamic_first).map(SlotRegion::Dynamic)
+            }
+            _ => None,
+        }
+    }
+
+    /// The slot of the tensor-mass region's surface slot `d`.
+    pub fn slot_of_dynamic(&self, d: TriangleIndex) -> Option<TriangleIndex> {
+        TriangleIndex::new(
+            (self.dynamic_first + d.get()) as u32,
+            self.buffers.triangles.len(),
+        )
+    }
+
+    /// The mesh vertex of each tensor-mass vertex.
+    pub fn mesh_vertices(&self) -> &[u32] {
+        self.buffers.mesh_vertex
+    }
+
+    /// The current vertex positions, m.
+    pub fn positions_m(&self) -> &[[T; 3]] {
+        self.buffers.positions_m
+    }
+
+    /// The surface at the last rebuild, for detection and tracking.
+    pub fn geometry<'g>(&'g self, supports: Supports<'g, T>) -> SurfaceGeometry<'g, T> {
+        SurfaceGeometry::of_parts(
+            self.buffers.positions_m,
+            SurfaceIndex::assembled(
+                self.grid,
+                BuiltLists {
+                    triangles: self.buffers.triangles,
+                    cell_start: self.buffers.cell_start.get(..=self.cells).unwrap_or(&[]),
+                    grid_vertex: self.buffers.grid_vertex.get(..self.filed).unwrap_or(&[]),
+                    vertex_triangle_start: self.buffers.vertex_triangle_start,
+                    vertex_triangle: self.buffers.vertex_triangle,
+                    planes: self.buffers.planes,
+                    max_bucket: self.max_bucket,
+                    max_valence: self.max_valence,
+                },
+            ),
+            supports,
+        )
+    }
+}
