@@ -422,3 +422,157 @@ fn stvk_in_the_dynamic_region_against_all_stvk_under_a_large_rotation() {
     assert!(tip > 0.1 * 0.08, "not a large deformation: {tip} m");
     assert!(hybrid_difference < linear_difference);
 }
+
+/// The hybrid in the haptic loop (`HybridLoop`): a probe lowered onto a
+/// top vertex of either region and held 2 mm below it. After the physics
+/// updates settle, each contact's force is the global solve's for the
+/// constraint the loop's contact model imposes there, at the displacements
+/// the hybrid reached: on the pre-computed region the contact point's
+/// displacement (the global compliance table's solve at that point, its
+/// gap taken from the moving surface); on the tensor-mass region the held
+/// vertices' displacements (the global Dirichlet solve, the reactions
+/// weighted by the contact's shares). Bound 1e-6 relative; the press is
+/// also checked to reach the probe's depth (within 1e-3).
+#[test]
+fn haptic_loop_press_on_either_region_settles_to_the_global_equilibrium() {
+    use palpate::hybrid::owned::OwnedHybridBuffers;
+    use palpate::table::build::{BuildOptions, build};
+    use palpate::table::compliance::Solver;
+    use palpate::table::load::TableFile;
+    use palpate::tensor_mass::{OwnedState, OwnedSurface};
+    use palpate_kernel::haptic::HybridLoop;
+    use palpate_kernel::hybrid::HybridTissue;
+    use palpate_kernel::table::{InterfaceTable, TensorMassTable};
+    use palpate_kernel::tensor_mass::{PhysicsConfig, TensorMassModel};
+    use palpate_kernel::{PrecomputedModel, PrecomputedTable};
+    use palpate_tests::unclamped_loop_config;
+
+    let (mesh, report) = block();
+    let built = tables(&mesh, &report, &options([0.0; 3], Vec::new()));
+    let precomputed = PrecomputedTable::<f64>::load(built.precomputed.bytes()).expect("table");
+    let dynamic = TensorMassTable::<f64>::load(built.dynamic.bytes()).expect("table");
+    let interface = InterfaceTable::<f64>::load(built.interface.bytes()).expect("table");
+    let global_file = TableFile::from_bytes(
+        &build(
+            &mesh,
+            &report,
+            &BuildOptions::precomputed(
+                material(),
+                vec!["z<0.0001".parse().expect("predicate")],
+                Solver::Cholesky,
+                Precision::F64,
+            ),
+        )
+        .expect("global table")
+        .bytes,
+    );
+    let global = PrecomputedModel::new(
+        PrecomputedTable::<f64>::load(global_file.bytes()).expect("global table"),
+    );
+    let (radius, depth) = (0.002, 0.002);
+    for (vertex, region) in [
+        (4 * 25 + 2 * 5 + 1, "pre-computed"),
+        (4 * 25 + 2 * 5 + 3, "dynamic"),
+    ] {
+        let mut state = OwnedState::for_table(&dynamic);
+        let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
+        let mut surface = OwnedSurface::for_model(&model);
+        let (surface_buffers, forces) = surface.buffers();
+        let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
+        let (coupling, hybrid_surface) = owned.buffers();
+        let tissue = HybridTissue::<f64, 1, 1>::new(
+            model,
+            surface_buffers,
+            forces,
+            PhysicsConfig::new(Integrator::SymplecticEuler, 2e-4, 5),
+            precomputed,
+            interface,
+            coupling,
+            hybrid_surface,
+        )
+        .expect("hybrid tissue");
+        let mut haptic = HybridLoop::<f64, 1, 1>::new(tissue, unclamped_loop_config(radius, 1e-3))
+            .expect("loop");
+        let top = Vector3::from(mesh.positions[vertex as usize]);
+        for tick in 0..6000 {
+            // From 1 mm above the surface down to the press over 100 ticks.
+            let lowered = (f64::from(tick) / 100.0).min(1.0);
+            let height = radius + 0.001 - (0.001 + depth) * lowered;
+            haptic.tick(&[top + Vector3::new(0.0, 0.0, height)]);
+            haptic.physics_update().expect("physics update");
+        }
+        let tissue = haptic.tissue();
+        let contact = haptic.contacts()[0].expect("contact held");
+        let mut field = vec![[0.0; 3]; mesh.positions.len()];
+        tissue
+            .region()
+            .displacements(tissue.dynamic().model(), tissue.solution(), &mut field)
+            .expect("field");
+        let at = |v: u32| Vector3::from(field[v as usize]);
+        let (ours, reference) = match tissue.solution() {
+            Some(solution) => {
+                let vertices = contact.vertices.map(|v| v.as_u32());
+                let point: Vector3<f64> = vertices
+                    .iter()
+                    .zip(contact.weights)
+                    .map(|(&v, w)| at(v) * w)
+                    .sum();
+                // The sphere touches the tilted surface a little off its
+                // lowest point: measured 5e-5 of the depth.
+                assert!(
+                    (point.z + depth).abs() < 1e-3 * depth,
+                    "{region}: {point:?}"
+                );
+                let reference = global
+                    .contact_forces::<1>(&[Constraint::on_triangle(
+                        vertices,
+                        contact.weights,
+                        point,
+                    )])
+                    .expect("global solve");
+                (
+                    solution.contact_forces_n()[0],
+                    reference.contact_forces_n()[0],
+                )
+            }
+            None => {
+                let held = tissue.dynamic().held()[0].expect("held");
+                let mesh_vertex = tissue.surface().mesh_vertices();
+                let vertices: Vec<(u32, f64)> = held
+                    .contact
+                    .vertices
+                    .iter()
+                    .zip(held.shares)
+                    .filter(|(_, s)| *s != 0.0)
+                    .map(|(v, s)| (mesh_vertex[v.get()], s))
+                    .collect();
+                let prescribed: Vec<(u32, [f64; 3])> = vertices
+                    .iter()
+                    .map(|&(v, _)| (v, field[v as usize]))
+                    .collect();
+                let (_, reactions) = solve_loaded(
+                    &mesh.positions,
+                    &mesh.tets,
+                    &material(),
+                    &fixed(&mesh),
+                    &prescribed,
+                    &[],
+                )
+                .expect("global solve");
+                let reference: Vector3<f64> = vertices
+                    .iter()
+                    .zip(&reactions)
+                    .map(|(&(_, s), r)| Vector3::from(*r) * s)
+                    .sum();
+                (held.contact.force_n, reference)
+            }
+        };
+        let error = (ours - reference).norm() / reference.norm();
+        println!(
+            "haptic press on the {region} region: contact force {:.6e} N, global {:.6e} N, error {error:.2e}",
+            ours.norm(),
+            reference.norm()
+        );
+        assert!(error <= 1e-6, "{region}: relative force error {error:e}");
+    }
+}

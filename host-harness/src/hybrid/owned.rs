@@ -2,7 +2,7 @@
 //! tests (firmware keeps the same buffers in static arrays).
 
 use anyhow::{Context, anyhow};
-use palpate_kernel::hybrid::{HybridBuffers, HybridModel};
+use palpate_kernel::hybrid::{HybridBuffers, HybridModel, HybridSurfaceBuffers};
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 use palpate_kernel::tensor_mass::{DynamicParams, TensorMassModel};
 use palpate_kernel::{PrecomputedTable, Real};
@@ -23,14 +23,71 @@ pub fn with_hybrid<T: Real, R>(
         TensorMassTable::<T>::load(tables.dynamic.bytes()).context("tensor-mass region")?;
     let interface = InterfaceTable::<T>::load(tables.interface.bytes()).context("interface")?;
     let mut state = OwnedState::for_table(&dynamic);
-    let mut passed = vec![[T::zero(); 3]; interface.connection_count()];
-    let mut background = vec![[T::zero(); 3]; interface.free_count()];
+    let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
     let model = TensorMassModel::new(dynamic, state.buffers(), params)
         .map_err(|e| anyhow!("tensor-mass region: {e}"))?;
-    let buffers = HybridBuffers {
-        passed_force_n: &mut passed,
-        background_m: &mut background,
-    };
+    let (buffers, _) = owned.buffers();
     let mut hybrid = HybridModel::new(model, precomputed, interface, buffers)?;
     Ok(run(&mut hybrid))
+}
+
+/// Heap storage for a hybrid tissue's own buffers: the coupling's
+/// ([`HybridBuffers`]) and the whole surface's ([`HybridSurfaceBuffers`]).
+pub struct OwnedHybridBuffers<T> {
+    passed_force_n: Vec<[T; 3]>,
+    background_m: Vec<[T; 3]>,
+    positions_m: Vec<[T; 3]>,
+    triangles: Vec<[u32; 3]>,
+    planes: Vec<[T; 4]>,
+    vertex_triangle_start: Vec<u32>,
+    vertex_triangle: Vec<u32>,
+    cell_start: Vec<u32>,
+    grid_vertex: Vec<u32>,
+    mesh_vertex: Vec<u32>,
+}
+
+impl<T: Real> OwnedHybridBuffers<T> {
+    /// Buffers for the three tables, with a grid of up to one cell per
+    /// mesh vertex.
+    pub fn for_tables(
+        precomputed: &PrecomputedTable<'_, T>,
+        dynamic: &TensorMassTable<'_, T>,
+        interface: &InterfaceTable<'_, T>,
+    ) -> Self {
+        let n =
+            HybridSurfaceBuffers::<T>::lengths(precomputed, dynamic, precomputed.vertex_count());
+        let zero = [T::zero(); 3];
+        Self {
+            passed_force_n: vec![zero; interface.connection_count()],
+            background_m: vec![zero; interface.free_count()],
+            positions_m: vec![zero; n.vertices],
+            triangles: vec![[0; 3]; n.triangles],
+            planes: vec![[T::zero(); 4]; n.triangles],
+            vertex_triangle_start: vec![0; n.vertices + 1],
+            vertex_triangle: vec![0; 3 * n.triangles],
+            cell_start: vec![0; n.cell_start],
+            grid_vertex: vec![0; n.vertices],
+            mesh_vertex: vec![0; n.dynamic_vertices],
+        }
+    }
+
+    /// The kernel's views of the coupling and surface buffers.
+    pub fn buffers(&mut self) -> (HybridBuffers<'_, T>, HybridSurfaceBuffers<'_, T>) {
+        (
+            HybridBuffers {
+                passed_force_n: &mut self.passed_force_n,
+                background_m: &mut self.background_m,
+            },
+            HybridSurfaceBuffers {
+                positions_m: &mut self.positions_m,
+                triangles: &mut self.triangles,
+                planes: &mut self.planes,
+                vertex_triangle_start: &mut self.vertex_triangle_start,
+                vertex_triangle: &mut self.vertex_triangle,
+                cell_start: &mut self.cell_start,
+                grid_vertex: &mut self.grid_vertex,
+                mesh_vertex: &mut self.mesh_vertex,
+            },
+        )
+    }
 }

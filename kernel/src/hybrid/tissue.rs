@@ -2,9 +2,12 @@
 //! MODELS.md §6): contacts on the tensor-mass region are held and imposed
 //! at the physics rate, their force extrapolated in between
 //! ([`crate::tensor_mass::DynamicTissue`], which this wraps); contacts on
-//! the pre-computed region are solved every tick against the background
-//! the connection nodes give them ([`CondensedRegion::contact_forces`]),
-//! and their forces reach the connection nodes at the next physics update.
+//! the pre-computed region are solved every tick with the compliance `C⁰`
+//! (connection nodes held) for their gap beyond the surface, which stands
+//! at the background the connection nodes give it (so the gap is the
+//! displacement [`CondensedRegion::contact_forces`] solves for a scripted
+//! constraint given from rest), and their forces reach the connection
+//! nodes at the next physics update.
 //! Both touch one surface, the whole mesh's ([`HybridSurface`]).
 
 use core::fmt;
@@ -252,9 +255,12 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
         }
         self.solution = None;
         if !precomputed_set.is_empty() {
+            // The surface stands at the background: a contact's gap is
+            // already the displacement beyond it, what `C⁰` answers.
             let solution = self
                 .region
-                .contact_forces::<M>(self.dynamic.model(), precomputed_set.as_slice())
+                .precomputed()
+                .contact_forces::<M>(precomputed_set.as_slice())
                 .map_err(|e| {
                     e.contact().map_or(Refusal::Fault, |i| {
                         remap(Refusal::Contact(i), &precomputed_index)
