@@ -9,6 +9,7 @@
 //! jaws), and [`tool_points`] turns their count into the kernel's const generic.
 
 pub mod generate;
+pub mod hybrid;
 pub mod run;
 pub mod scene;
 pub mod stability;

@@ -29,15 +29,17 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{
-    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits, ToolInput,
+    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue,
+    PrecomputedLoop, SafetyLimits, ToolInput,
 };
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, ElasticLaw, PhysicsConfig, StvkForm, TearThresholds, Tearing,
-    TensorMassModel,
+    DynamicParams, DynamicTissue, ElasticLaw, PhysicsConfig, StvkForm, SurfaceBuffers,
+    TearThresholds, Tearing, TensorMassModel,
 };
 
+use super::hybrid::HybridSetup;
 use super::scene::{ToolKind, ToolSpec};
 use super::stability::check_stable_step;
 use super::tool_points::{ForToolPoints, with_tool_points};
@@ -389,6 +391,7 @@ pub fn run_session_into(
 enum SessionTissue<'t> {
     Precomputed(PrecomputedTable<'t, f32>, LoopConfig<f32>),
     Dynamic(DynamicSetup<'t>),
+    Hybrid(HybridSetup<'t>),
 }
 
 /// A session's ticks on its tissue, run with the scene's tool points.
@@ -407,6 +410,7 @@ impl ForToolPoints for SessionTicks<'_, '_, '_, '_> {
                 self.ticks.precomputed::<P>(table, *config, self.session)
             }
             SessionTissue::Dynamic(setup) => self.ticks.dynamic::<P>(setup, self.session),
+            SessionTissue::Hybrid(setup) => self.ticks.hybrid::<P>(setup, self.session),
         }
     }
 }
@@ -468,7 +472,27 @@ impl<'t> DynamicSetup<'t> {
         &self,
         body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P>) -> anyhow::Result<R>,
     ) -> anyhow::Result<R> {
-        // The split-term buffers only for the form that reads them.
+        self.with_parts(|model, buffers, forces| {
+            let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, self.physics)
+                .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?;
+            let mut haptic = DynamicLoop::<f32, P, P>::new(tissue, self.config)
+                .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+            body(&mut haptic)
+        })
+    }
+
+    /// Builds the model at rest and its surface buffers and force scratch
+    /// on the heap (the split-term buffers only for the form that reads
+    /// them), and runs `body` on them: what a dynamic or hybrid tissue is
+    /// built from.
+    pub fn with_parts<R>(
+        &self,
+        body: impl FnOnce(
+            TensorMassModel<'_, '_, f32>,
+            SurfaceBuffers<'_, f32>,
+            &mut [[f32; 3]],
+        ) -> anyhow::Result<R>,
+    ) -> anyhow::Result<R> {
         let state = OwnedState::for_table(&self.table);
         let mut state = if self.params.law == ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) {
             state
@@ -479,11 +503,22 @@ impl<'t> DynamicSetup<'t> {
             .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
         let mut surface = OwnedSurface::for_model(&model);
         let (buffers, forces) = surface.buffers();
-        let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, self.physics)
-            .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?;
-        let mut haptic = DynamicLoop::<f32, P, P>::new(tissue, self.config)
-            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
-        body(&mut haptic)
+        body(model, buffers, forces)
+    }
+
+    /// The tensor-mass table.
+    pub fn table(&self) -> TensorMassTable<'t, f32> {
+        self.table
+    }
+
+    /// The physics settings.
+    pub fn physics(&self) -> PhysicsConfig<f32> {
+        self.physics
+    }
+
+    /// The haptic loop settings.
+    pub fn config(&self) -> LoopConfig<f32> {
+        self.config
     }
 }
 
@@ -526,13 +561,25 @@ impl Ticks<'_> {
         setup: &DynamicSetup<'_>,
         session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
-        setup.with_loop::<P, _>(|haptic| self.dynamic_ticks(haptic, session))
+        setup.with_loop::<P, _>(|haptic| self.physics_ticks(haptic, session, &DynamicView))
     }
 
-    fn dynamic_ticks<const P: usize>(
+    fn hybrid<const P: usize>(
         &self,
-        haptic: &mut DynamicLoop<'_, '_, f32, P, P>,
+        setup: &HybridSetup<'_>,
         session: &mut Session<'_, '_>,
+    ) -> anyhow::Result<()> {
+        let view = setup.view();
+        setup.with_loop::<P, _>(|haptic| self.physics_ticks(haptic, session, &view))
+    }
+
+    /// The ticks of a tissue stepped at the physics rate: a physics update
+    /// every `every` ticks, its removed tets and VTK frame through `view`.
+    fn physics_ticks<const P: usize, B: PhysicsTissue<f32, P>>(
+        &self,
+        haptic: &mut HapticLoop<f32, B, P, P>,
+        session: &mut Session<'_, '_>,
+        view: &impl PhysicsView<B>,
     ) -> anyhow::Result<()> {
         for (k, (t, tool)) in ticks::<P>(self.trajectory, self.tick_s, self.tools)?.enumerate() {
             session.record(t, &haptic.tick_tools(&tool))?;
@@ -544,14 +591,40 @@ impl Ticks<'_> {
             {
                 session.summary.physics_error = Some(format!("t = {t} s: {e}"));
             }
-            session.removed(t, haptic.tissue().removed())?;
+            session.removed(t, &view.removed(haptic.tissue()))?;
             if session.dir.is_some() {
-                let model = haptic.tissue().model();
-                let u = model.displacements_m().unwrap_or(&[]);
-                session.frame(t, u, Some(model.tet_alive()))?;
+                let (u, alive) = view.frame(haptic.tissue())?;
+                session.frame(t, &u, Some(&alive))?;
             }
         }
         Ok(())
+    }
+}
+
+/// What a session reads of a tissue stepped at the physics rate, in the
+/// mesh's numbering.
+pub trait PhysicsView<B> {
+    /// The mesh tets the last physics update removed, in removal order.
+    fn removed(&self, tissue: &B) -> Vec<u32>;
+    /// The displacement of every mesh vertex (m) and which tets live.
+    fn frame(&self, tissue: &B) -> anyhow::Result<(Vec<[f32; 3]>, Vec<bool>)>;
+}
+
+/// The tensor-mass tissue is the whole mesh.
+struct DynamicView;
+
+impl<const P: usize> PhysicsView<DynamicTissue<'_, '_, f32, P>> for DynamicView {
+    fn removed(&self, tissue: &DynamicTissue<'_, '_, f32, P>) -> Vec<u32> {
+        tissue.removed().to_vec()
+    }
+
+    fn frame(
+        &self,
+        tissue: &DynamicTissue<'_, '_, f32, P>,
+    ) -> anyhow::Result<(Vec<[f32; 3]>, Vec<bool>)> {
+        let model = tissue.model();
+        let u = model.displacements_m().unwrap_or(&[]).to_vec();
+        Ok((u, model.tet_alive().to_vec()))
     }
 }
 

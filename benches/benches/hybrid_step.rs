@@ -1,0 +1,244 @@
+//! The hybrid model (`kernel/src/hybrid`, RR-3510 §6.2) on the liver-like
+//! organ (5868 tets, E = 5 kPa, ν = 0.4, 1000 kg/m³, lowest vertices fixed),
+//! f32, with dynamic fractions of about 10, 20 and 40 % of the tets (the
+//! tets with the lowest centroid x: the left lobe first).
+//!
+//! - `step`: one symplectic-Euler step of the hybrid, of its tensor-mass
+//!   region alone (its table, uncoupled), of the organ all tensor-mass; and
+//!   `interface`: the coupling's share of a force pass (the coupled force
+//!   pass minus the uncoupled one, `9c²` multiply-adds). Targets: hybrid ≤
+//!   1.3 × (region alone + interface), and ≥ 3× faster than all
+//!   tensor-mass at 20 %.
+//! - `tick`: one haptic tick of the hybrid loop with a probe held on the
+//!   pre-computed region, one on the tensor-mass region, and both (2 + 2
+//!   contacts: 4), at each fraction. Target ≤ 2 µs, independent of the
+//!   pre-computed region's size.
+//! - Printed after the groups: per fraction the regions' tets, the
+//!   connection nodes, the three tables' sizes and build time, next to the
+//!   organ's pure pre-computed table.
+//!
+//! Run: `RUSTFLAGS="-C target-cpu=native" cargo bench -p palpate-benches --bench hybrid_step`.
+
+use core::hint::black_box;
+use std::time::Instant;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use nalgebra::Vector3;
+use palpate::fem::material::Material;
+use palpate::hybrid::owned::OwnedHybridBuffers;
+use palpate::hybrid::{HybridOptions, HybridTables, build_hybrid};
+use palpate::mesh::generate::{ORGAN_CUBE_M, organ_mesh};
+use palpate::mesh::{MeshReport, TetMesh};
+use palpate::table::build::{BuildOptions, build};
+use palpate::table::compliance::Solver;
+use palpate::table::file::Precision;
+use palpate::tensor_mass::{OwnedState, OwnedSurface};
+use palpate_benches::haptic_config;
+use palpate_kernel::PrecomputedTable;
+use palpate_kernel::haptic::HybridLoop;
+use palpate_kernel::hybrid::{HybridModel, HybridTissue};
+use palpate_kernel::table::{InterfaceTable, TensorMassTable};
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator, PhysicsConfig, TensorMassModel};
+
+const FRACTIONS: [f64; 3] = [0.1, 0.2, 0.4];
+const DT_S: f32 = 1e-5;
+
+fn material() -> Material {
+    Material::new(5000.0, 0.4).expect("material")
+}
+
+fn fix(mesh: &TetMesh) -> Vec<palpate::fix::FixPredicate> {
+    let z_min = mesh.positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")]
+}
+
+fn params() -> DynamicParams<f32> {
+    DynamicParams::linear(30.0, 0.2)
+}
+
+/// The `fraction` of the tets with the lowest centroid x.
+fn dynamic_tets(mesh: &TetMesh, fraction: f64) -> Vec<bool> {
+    let x = |t: &[u32; 4]| t.iter().map(|&v| mesh.positions[v as usize][0]).sum::<f64>();
+    let mut order: Vec<usize> = (0..mesh.tets.len()).collect();
+    order.sort_by(|&a, &b| x(&mesh.tets[a]).total_cmp(&x(&mesh.tets[b])));
+    let mut dynamic = vec![false; mesh.tets.len()];
+    for &t in order.iter().take((fraction * mesh.tets.len() as f64).round() as usize) {
+        dynamic[t] = true;
+    }
+    dynamic
+}
+
+struct Built {
+    fraction: f64,
+    tables: HybridTables,
+    build_s: f64,
+}
+
+fn build_all(mesh: &TetMesh) -> Vec<Built> {
+    FRACTIONS
+        .iter()
+        .map(|&fraction| {
+            let options =
+                HybridOptions::new(material(), 1000.0, fix(mesh), Precision::F32);
+            let start = Instant::now();
+            let tables =
+                build_hybrid(mesh, &MeshReport::default(), &dynamic_tets(mesh, fraction), &options)
+                    .expect("hybrid tables");
+            Built {
+                fraction,
+                tables,
+                build_s: start.elapsed().as_secs_f64(),
+            }
+        })
+        .collect()
+}
+
+/// A touchable vertex of the top of each region: the highest vertex of the
+/// pre-computed table's touchable ones, and of the tensor-mass region's
+/// surface that is no connection node (mesh numbers).
+fn top_vertices(built: &HybridTables, mesh: &TetMesh) -> (u32, u32) {
+    let table = PrecomputedTable::<f32>::load(built.precomputed.bytes()).expect("table");
+    let z = |v: &u32| mesh.positions[*v as usize][2];
+    let touchable = &table.free_vertices()[..table.touchable_count()];
+    let p = *touchable.iter().max_by(|a, b| z(a).total_cmp(&z(b))).expect("touchable");
+    let surface = palpate::mesh::boundary_surface(mesh);
+    let d = *surface
+        .vertices
+        .iter()
+        .filter(|&&v| built.split.dynamic_index[v as usize].is_some() && !built.split.in_precomputed[v as usize])
+        .max_by(|a, b| z(a).total_cmp(&z(b)))
+        .expect("dynamic surface vertex");
+    (p, d)
+}
+
+fn step(c: &mut Criterion) {
+    let mesh = organ_mesh(ORGAN_CUBE_M);
+    let built = build_all(&mesh);
+    let mut group = c.benchmark_group("hybrid_step");
+    let whole_file = palpate_benches::base_fixed_table(&mesh);
+    let whole = TensorMassTable::<f32>::load(whole_file.bytes()).expect("table");
+    let mut whole_state = OwnedState::for_table(&whole);
+    let mut whole_model = TensorMassModel::new(whole, whole_state.buffers(), params()).expect("model");
+    group.bench_function("all_tensor_mass", |b| {
+        b.iter(|| whole_model.step(black_box(Integrator::SymplecticEuler), DT_S))
+    });
+    for b in &built {
+        let label = format!("{:.0}%", b.fraction * 100.0);
+        let precomputed = PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
+        let dynamic = TensorMassTable::<f32>::load(b.tables.dynamic.bytes()).expect("table");
+        let interface = InterfaceTable::<f32>::load(b.tables.interface.bytes()).expect("table");
+        let n = dynamic.vertex_count();
+        let mut alone_state = OwnedState::for_table(&dynamic);
+        let mut alone = TensorMassModel::new(dynamic, alone_state.buffers(), params()).expect("model");
+        group.bench_function(BenchmarkId::new("region_alone", &label), |bench| {
+            bench.iter(|| alone.step(black_box(Integrator::SymplecticEuler), DT_S))
+        });
+        let mut forces = vec![[0.0f32; 3]; n];
+        let u = vec![[1e-4f32; 3]; n];
+        group.bench_function(BenchmarkId::new("force_pass_alone", &label), |bench| {
+            bench.iter(|| alone.elastic_forces_of(black_box(&u), &mut forces))
+        });
+        let mut state = OwnedState::for_table(&dynamic);
+        let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
+        let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
+        let (coupling, _) = owned.buffers();
+        let mut hybrid = HybridModel::new(model, precomputed, interface, coupling).expect("hybrid");
+        group.bench_function(BenchmarkId::new("hybrid", &label), |bench| {
+            bench.iter(|| hybrid.step(black_box(Integrator::SymplecticEuler), DT_S))
+        });
+        group.bench_function(BenchmarkId::new("force_pass_coupled", &label), |bench| {
+            bench.iter(|| hybrid.dynamic().elastic_forces_of(black_box(&u), &mut forces))
+        });
+    }
+    group.finish();
+    let start = Instant::now();
+    let pure = build(
+        &mesh,
+        &MeshReport::default(),
+        &BuildOptions::precomputed(material(), fix(&mesh), Solver::Cholesky, Precision::F32),
+    )
+    .expect("pre-computed table");
+    let pure_s = start.elapsed().as_secs_f64();
+    println!("\norgan tables (f32): fraction, dynamic tets, connection nodes, pre-computed + tensor-mass + interface bytes, build s");
+    for b in &built {
+        let s = &b.tables.split;
+        println!(
+            "{:4.0}% {:5} {:4} {:9} + {:8} + {:9} = {:9} bytes {:6.2} s",
+            b.fraction * 100.0,
+            s.dynamic_tet_count(),
+            s.connection.len(),
+            b.tables.precomputed.bytes().len(),
+            b.tables.dynamic.bytes().len(),
+            b.tables.interface.bytes().len(),
+            b.tables.precomputed.bytes().len()
+                + b.tables.dynamic.bytes().len()
+                + b.tables.interface.bytes().len(),
+            b.build_s
+        );
+    }
+    println!("pure pre-computed: {} bytes {pure_s:.2} s", pure.bytes.len());
+}
+
+fn tick(c: &mut Criterion) {
+    let mesh = organ_mesh(ORGAN_CUBE_M);
+    let built = build_all(&mesh);
+    let mut group = c.benchmark_group("hybrid_tick");
+    for b in &built {
+        let label = format!("{:.0}%", b.fraction * 100.0);
+        let precomputed = PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
+        let dynamic = TensorMassTable::<f32>::load(b.tables.dynamic.bytes()).expect("table");
+        let interface = InterfaceTable::<f32>::load(b.tables.interface.bytes()).expect("table");
+        let (p, d) = top_vertices(&b.tables, &mesh);
+        let at = |v: u32, dx: f32| {
+            let x = mesh.positions[v as usize].map(|c| c as f32);
+            Vector3::new(x[0] + dx, x[1], x[2] + palpate_benches::TOOL_RADIUS_M - 0.0005)
+        };
+        for (name, tools) in [
+            ("precomputed_1", [at(p, 0.0), at(p, 0.0), at(p, 0.0), at(p, 0.0)]),
+            ("dynamic_1", [at(d, 0.0), at(d, 0.0), at(d, 0.0), at(d, 0.0)]),
+            ("both_4", [at(p, 0.0), at(p, 0.004), at(d, 0.0), at(d, 0.004)]),
+        ] {
+            let mut state = OwnedState::for_table(&dynamic);
+            let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
+            let mut surface = OwnedSurface::for_model(&model);
+            let (surface_buffers, forces) = surface.buffers();
+            let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
+            let (coupling, hybrid_surface) = owned.buffers();
+            let tissue = HybridTissue::<f32, 4, 4>::new(
+                model,
+                surface_buffers,
+                forces,
+                PhysicsConfig::new(Integrator::SymplecticEuler, DT_S, 1),
+                precomputed,
+                interface,
+                coupling,
+                hybrid_surface,
+            )
+            .expect("tissue");
+            let mut haptic = HybridLoop::<f32, 4, 4>::new(tissue, haptic_config()).expect("loop");
+            let points = if name == "both_4" { 4 } else { 1 };
+            let lifted = tools.map(|t| t + Vector3::new(0.0, 0.0, 0.01));
+            let mut input = lifted;
+            input[..points].copy_from_slice(&tools[..points]);
+            // Descend from 1 cm above, then hold with a physics update.
+            for k in 0..=20 {
+                let s = k as f32 / 20.0;
+                let mut at_k = lifted;
+                for (t, (a, b)) in at_k.iter_mut().zip(lifted.iter().zip(&input)) {
+                    *t = a + (b - a) * s;
+                }
+                haptic.tick(&at_k);
+            }
+            haptic.physics_update().expect("update");
+            let contacts = haptic.tick(&input).contacts as usize;
+            assert_eq!(contacts, points, "{name} at {label}: contacts made");
+            group.bench_function(BenchmarkId::new(name, &label), |bench| {
+                bench.iter(|| haptic.tick(black_box(&input)))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, step, tick);
+criterion_main!(benches);
