@@ -15,6 +15,7 @@ pub mod fix;
 pub mod limits;
 pub mod mesh;
 pub mod output;
+pub mod partition;
 pub mod precomputed;
 pub mod replay;
 pub mod session;

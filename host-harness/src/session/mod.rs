@@ -15,6 +15,7 @@ pub mod stability;
 pub mod tool_points;
 pub mod tools;
 pub mod trajectory;
+pub mod zones;
 
 pub use generate::{
     CutLine, GenerateError, Generator, GraspPull, Keyframe, Pinch, Poke, Press, PressHold, Slide,
@@ -25,3 +26,4 @@ pub use scene::{
     ToolSpec,
 };
 pub use trajectory::{FileProblem, LineProblem, Sample, ToolState, Trajectory, TrajectoryError};
+pub use zones::{PartitionSpec, Zone, ZoneKind, ZoneShape};
