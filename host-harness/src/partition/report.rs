@@ -161,9 +161,8 @@ impl PlanReport {
             );
             let _ = writeln!(
                 s,
-                "  table {} ({} bytes), step cost {:.3e} s, critical dt {}",
+                "  table {}, step cost {:.3e} s, critical dt {}",
                 human_bytes(r.table_bytes),
-                r.table_bytes,
                 r.step_cost_s,
                 r.critical_dt_s.map_or("none (unconditionally stable)".into(), |dt| format!(
                     "{dt:.3e} s ({})",
@@ -176,11 +175,10 @@ impl PlanReport {
         if i.connection_nodes > 0 {
             let _ = writeln!(
                 s,
-                "interface: {} connection nodes, {} free pre-computed vertices, table {} ({} bytes), update {:.3e} s",
+                "interface: {} connection nodes, {} free pre-computed vertices, table {}, update {:.3e} s",
                 i.connection_nodes,
                 i.precomputed_free,
                 human_bytes(i.table_bytes),
-                i.table_bytes,
                 i.update_s
             );
         } else {
