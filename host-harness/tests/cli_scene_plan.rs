@@ -70,7 +70,13 @@ fn plan_json_has_the_contract_keys_and_counts() {
             p[0] <= 0.01 + 1e-9 && p[1] <= 0.02 + 1e-9 && p[2] >= 0.02 - 1e-9
         })
     };
-    let zone_vertices: Vec<u32> = mesh.tets.iter().filter(|t| inside(t)).flatten().copied().collect();
+    let zone_vertices: Vec<u32> = mesh
+        .tets
+        .iter()
+        .filter(|t| inside(t))
+        .flatten()
+        .copied()
+        .collect();
     let dynamic: Vec<bool> = mesh
         .tets
         .iter()
@@ -82,7 +88,12 @@ fn plan_json_has_the_contract_keys_and_counts() {
     );
     let connection = (0..mesh.positions.len() as u32)
         .filter(|&v| {
-            let uses = |d: bool| mesh.tets.iter().zip(&dynamic).any(|(t, &x)| x == d && t.contains(&v));
+            let uses = |d: bool| {
+                mesh.tets
+                    .iter()
+                    .zip(&dynamic)
+                    .any(|(t, &x)| x == d && t.contains(&v))
+            };
             uses(true) && uses(false)
         })
         .count() as u64;
@@ -93,7 +104,10 @@ fn plan_json_has_the_contract_keys_and_counts() {
     let out = plan(&scene, &[]);
     assert!(out.status.success(), "{}", stderr(&out));
     let t = text(&out.stdout);
-    assert!(t.contains("region 1: tensor-mass (linear)") && t.contains("why: "), "{t}");
+    assert!(
+        t.contains("region 1: tensor-mass (linear)") && t.contains("why: "),
+        "{t}"
+    );
 }
 
 #[test]
@@ -155,7 +169,9 @@ fn bad_zones_are_one_line_errors_naming_the_key() {
             vec!["[[zone]] 1 max_m: missing"],
         ),
         (
-            zone("shape = \"box\"\nmin_m = [0.0, 0.0, 0.0]\nmax_m = [0.01, 0.01, 0.01]\nradius_m = 1\n"),
+            zone(
+                "shape = \"box\"\nmin_m = [0.0, 0.0, 0.0]\nmax_m = [0.01, 0.01, 0.01]\nradius_m = 1\n",
+            ),
             vec!["[[zone]] 1 radius_m: does not apply to shape = \"box\""],
         ),
         (
@@ -190,12 +206,18 @@ fn bad_zones_are_one_line_errors_naming_the_key() {
         &scene,
         format!(
             "{}{}",
-            BLOCK.replace("fix = [\"z<0.0001\"]\n", "[model]\nkind = \"dynamic\"\ndamping_per_s = 2\n"),
+            BLOCK.replace(
+                "fix = [\"z<0.0001\"]\n",
+                "[model]\nkind = \"dynamic\"\ndamping_per_s = 2\n"
+            ),
             zone("shape = \"box\"\nmin_m = [-1.0, -1.0, -1.0]\nmax_m = [1.0, 1.0, 1.0]\n")
         ),
     )
     .unwrap();
-    assert_one_line_error(&plan(&scene, &[]), &["dynamic region 1 (648 tets", "it floats"]);
+    assert_one_line_error(
+        &plan(&scene, &[]),
+        &["dynamic region 1 (648 tets", "it floats"],
+    );
 }
 
 #[test]

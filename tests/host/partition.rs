@@ -30,7 +30,12 @@ fn cut(shape: ZoneShape) -> Zone {
     }
 }
 
-fn planned(mesh: &TetMesh, zones: &[Zone], rings: u32, poisson: f64) -> Result<Partition, PlanError> {
+fn planned(
+    mesh: &TetMesh,
+    zones: &[Zone],
+    rings: u32,
+    poisson: f64,
+) -> Result<Partition, PlanError> {
     let fixed = base_fixed(mesh);
     plan(&PlanInput {
         mesh,
@@ -72,7 +77,10 @@ fn a_box_on_the_grid_takes_its_cells_and_nothing_that_only_touches_it() {
     })];
     let p = planned(&mesh, &zones, 0, 0.3).unwrap();
     assert_eq!(dynamic_count(&p), 12);
-    assert_eq!(p.connection_nodes, brute_connection_nodes(&mesh, &p.dynamic));
+    assert_eq!(
+        p.connection_nodes,
+        brute_connection_nodes(&mesh, &p.dynamic)
+    );
     // The 2 × 1 × 1 block's 12 vertices are all shared with pre-computed tets.
     assert_eq!(p.connection_nodes.len(), 12);
     // A box inside one cell takes the tets of that cell it meets: all 6 share the cell's
@@ -96,11 +104,7 @@ fn a_sphere_at_a_vertex_takes_the_tets_around_it() {
         dynamic_count(&planned(&mesh, &zones, 0, 0.3).unwrap())
     };
     assert_eq!(around(0.001), 24);
-    let v = mesh
-        .positions
-        .iter()
-        .position(|p| *p == [0.02; 3])
-        .unwrap() as u32;
+    let v = mesh.positions.iter().position(|p| *p == [0.02; 3]).unwrap() as u32;
     assert_eq!(mesh.tets.iter().filter(|t| t.contains(&v)).count(), 24);
     // A sphere of one cell's half diagonal and more takes more.
     assert!(around(0.009) > 24);
@@ -127,7 +131,11 @@ fn a_capsule_and_a_path_along_a_grid_line_take_the_same_tets() {
     assert_eq!((dynamic_count(&p), expected), (72, 72));
     let path = [cut(ZoneShape::Path {
         trajectory: "line.csv".into(),
-        polylines: vec![vec![[0.02, 0.02, -0.01], [0.02, 0.02, 0.02], [0.02, 0.02, 0.05]]],
+        polylines: vec![vec![
+            [0.02, 0.02, -0.01],
+            [0.02, 0.02, 0.02],
+            [0.02, 0.02, 0.05],
+        ]],
         radius_m: 0.001,
     })];
     assert_eq!(planned(&mesh, &path, 0, 0.3).unwrap().dynamic, p.dynamic);
@@ -195,7 +203,11 @@ fn the_law_follows_the_zones_and_the_poisson_ratio() {
             incompressibility: true
         }
     ));
-    assert!(p.regions[2].why.contains("large-deformation"), "{}", p.regions[2].why);
+    assert!(
+        p.regions[2].why.contains("large-deformation"),
+        "{}",
+        p.regions[2].why
+    );
     // Below ν = 0.45 no penalty.
     let p = planned(&mesh, &[large], 0, 0.3).unwrap();
     assert_eq!(p.regions[1].model.law_name(), "stvk");
@@ -249,7 +261,10 @@ fn bad_partitions_are_refused_naming_the_zone_or_region() {
     })
     .unwrap_err()
     .to_string();
-    assert!(err.starts_with("scene.toml: dynamic region 1 (384 tets"), "{err}");
+    assert!(
+        err.starts_with("scene.toml: dynamic region 1 (384 tets"),
+        "{err}"
+    );
     assert!(err.contains("it floats") && !err.contains('\n'), "{err}");
     // A slab across the block (it meets the cell layers z in [0.01, 0.03]) splits the
     // pre-computed region in two pieces; the top one is held by its connection nodes only:
@@ -265,8 +280,12 @@ fn bad_partitions_are_refused_naming_the_zone_or_region() {
     let mut two = block();
     let shifted = box_mesh([4, 4, 4], [0.04; 3]);
     let offset = two.positions.len() as u32;
-    two.positions
-        .extend(shifted.positions.iter().map(|p| [p[0] + 0.1, p[1], p[2] + 0.01]));
+    two.positions.extend(
+        shifted
+            .positions
+            .iter()
+            .map(|p| [p[0] + 0.1, p[1], p[2] + 0.01]),
+    );
     two.tets
         .extend(shifted.tets.iter().map(|t| t.map(|v| v + offset)));
     let err = planned(&two, &[], 0, 0.3).unwrap_err().to_string();
@@ -338,7 +357,13 @@ fn margin_default_is_where_a_pulled_cut_is_back_in_the_linear_range() {
             .fold(0.0, f64::max)
     };
     let largest: Vec<f64> = (0..=DEFAULT_MARGIN_RINGS).map(outside).collect();
-    eprintln!("largest |grad u| outside the slit + k rings, k = 0..={DEFAULT_MARGIN_RINGS}: {largest:.4?}");
+    eprintln!(
+        "largest |grad u| outside the slit + k rings, k = 0..={DEFAULT_MARGIN_RINGS}: {largest:.4?}"
+    );
     let first_below = largest.iter().position(|&g| g < 0.1);
-    assert_eq!(first_below, Some(DEFAULT_MARGIN_RINGS as usize), "{largest:?}");
+    assert_eq!(
+        first_below,
+        Some(DEFAULT_MARGIN_RINGS as usize),
+        "{largest:?}"
+    );
 }

@@ -45,7 +45,11 @@ fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
     }
     let scene = Scene::named(name)?;
     if let MeshSource::File(mesh) = &scene.mesh {
-        inputs.extend(mesh_files(mesh).into_iter().map(|f| ("the scene's mesh", f)));
+        inputs.extend(
+            mesh_files(mesh)
+                .into_iter()
+                .map(|f| ("the scene's mesh", f)),
+        );
     }
     for zone in &scene.zones {
         if let palpate::session::ZoneShape::Path { trajectory, .. } = &zone.shape {
@@ -61,7 +65,12 @@ fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
     let plan = PlanReport::new(&scene, &mesh, &report, &partition)
         .with_context(|| format!("{}: costing the partition", scene.source))?;
     if let Some(out) = vtk {
-        write_regions(out, &mesh.positions, &mesh.tets, &partition.region_of_tets())?;
+        write_regions(
+            out,
+            &mesh.positions,
+            &mesh.tets,
+            &partition.region_of_tets(),
+        )?;
     }
     if json {
         stdout::println(&serde_json::to_string_pretty(&plan)?)?;

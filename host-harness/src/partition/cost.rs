@@ -108,12 +108,19 @@ pub struct InterfaceCost {
 /// connection displacements (`F_P·c` blocks), the pre-computed free displacements (`3F_P`) and
 /// the connection forces (`3c`) in scalars of `scalar_bytes`, and one 8-byte slot per mesh
 /// vertex (`8N`). `u64::MAX` when a length overflows.
-pub fn interface_table_bytes(c: u64, free_precomputed: u64, vertices: u64, scalar_bytes: u64) -> u64 {
+pub fn interface_table_bytes(
+    c: u64,
+    free_precomputed: u64,
+    vertices: u64,
+    scalar_bytes: u64,
+) -> u64 {
     let sections = (|| {
         let block = 9 * scalar_bytes;
         Some([
             c.checked_mul(12)?,
-            c.checked_mul(c.checked_add(1)?)?.checked_div(2)?.checked_mul(block)?,
+            c.checked_mul(c.checked_add(1)?)?
+                .checked_div(2)?
+                .checked_mul(block)?,
             free_precomputed.checked_mul(c)?.checked_mul(block)?,
             free_precomputed.checked_mul(3 * scalar_bytes)?,
             c.checked_mul(3 * scalar_bytes)?,
@@ -134,7 +141,10 @@ pub fn sub_mesh(mesh: &TetMesh, tets: &[u32]) -> (TetMesh, Vec<u32>) {
         new_id[v as usize] = i as u32;
     }
     let sub = TetMesh {
-        positions: vertices.iter().map(|&v| mesh.positions[v as usize]).collect(),
+        positions: vertices
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .collect(),
         tets: tets
             .iter()
             .map(|&t| mesh.tets[t as usize].map(|v| new_id[v as usize]))
@@ -181,15 +191,20 @@ pub fn costs(
                 law,
                 incompressibility,
             } => {
-                let arrays =
-                    TensorMassArrays::new(&sub, &options.material, options.density_kg_m3, sub_fixed);
+                let arrays = TensorMassArrays::new(
+                    &sub,
+                    &options.material,
+                    options.density_kg_m3,
+                    sub_fixed,
+                );
                 let gamma = incompressibility.then(|| {
-                    options
-                        .incompressibility_n
-                        .unwrap_or_else(|| crate::experiment::scenes::penalty_n(&sub, &options.material))
+                    options.incompressibility_n.unwrap_or_else(|| {
+                        crate::experiment::scenes::penalty_n(&sub, &options.material)
+                    })
                 });
-                let step_s = tensor_mass_step_s(&sub, &surface.triangles, &arrays, options, law, gamma)
-                    .with_context(|| format!("timing dynamic region {}", region.id))?;
+                let step_s =
+                    tensor_mass_step_s(&sub, &surface.triangles, &arrays, options, law, gamma)
+                        .with_context(|| format!("timing dynamic region {}", region.id))?;
                 RegionCost {
                     table_bytes: TableEstimate::new(TableKind::TensorMass, PRECISION, counts)
                         .table_bytes,
@@ -238,10 +253,13 @@ fn tensor_mass_step_s(
     let bytes = write_tensor_mass_table(sub, triangles, arrays, Precision::F32);
     let table = TensorMassTable::<f32>::load(&bytes)?;
     let mut state = OwnedState::for_table(&table);
-    let params = DynamicParams::linear(options.damping_per_s as f32, diagonal(&sub.positions) as f32)
-        .with_law(law)
-        .with_incompressibility(gamma.map(|g| g as f32))
-        .with_gravity(Vector3::new(0.0, 0.0, -9.81));
+    let params = DynamicParams::linear(
+        options.damping_per_s as f32,
+        diagonal(&sub.positions) as f32,
+    )
+    .with_law(law)
+    .with_incompressibility(gamma.map(|g| g as f32))
+    .with_gravity(Vector3::new(0.0, 0.0, -9.81));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     // A step the region is stable at: a tenth of a millisecond is far below the limit of any
     // mesh the real-time loop runs, and the cost of a step does not depend on its length.

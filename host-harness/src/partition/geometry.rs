@@ -49,11 +49,17 @@ impl<'a> TetGrid<'a> {
         let extent = hi - lo;
         let diagonal = extent.norm();
         // Cells of about one tet's volume, at least the mean tet's size on the flat axes.
-        let volume = extent.iter().map(|e| e.max(diagonal * 1e-3)).product::<f64>();
-        let cell_m = (volume / mesh.tets.len().max(1) as f64).cbrt().max(f64::MIN_POSITIVE);
+        let volume = extent
+            .iter()
+            .map(|e| e.max(diagonal * 1e-3))
+            .product::<f64>();
+        let cell_m = (volume / mesh.tets.len().max(1) as f64)
+            .cbrt()
+            .max(f64::MIN_POSITIVE);
         let dims = [0, 1, 2].map(|i| ((extent[i] / cell_m).ceil() as usize).clamp(1, 1 << 10));
         let cell_of = |p: &V3| -> [usize; 3] {
-            [0, 1, 2].map(|i| (((p[i] - lo[i]) / cell_m).floor().max(0.0) as usize).min(dims[i] - 1))
+            [0, 1, 2]
+                .map(|i| (((p[i] - lo[i]) / cell_m).floor().max(0.0) as usize).min(dims[i] - 1))
         };
         let ranges: Vec<([usize; 3], [usize; 3])> = mesh
             .tets
@@ -98,10 +104,17 @@ impl<'a> TetGrid<'a> {
         match shape {
             ZoneShape::Box { min_m, max_m } => {
                 let (lo, hi) = (V3::from(*min_m), V3::from(*max_m));
-                self.visit(lo, hi, &mut met, |p| box_meets_tet(lo, hi, p, self.tolerance_m));
+                self.visit(lo, hi, &mut met, |p| {
+                    box_meets_tet(lo, hi, p, self.tolerance_m)
+                });
             }
             ZoneShape::Sphere { center_m, radius_m } => {
-                self.capsule(V3::from(*center_m), V3::from(*center_m), *radius_m, &mut met);
+                self.capsule(
+                    V3::from(*center_m),
+                    V3::from(*center_m),
+                    *radius_m,
+                    &mut met,
+                );
             }
             ZoneShape::Capsule { a_m, b_m, radius_m } => {
                 self.capsule(V3::from(*a_m), V3::from(*b_m), *radius_m, &mut met);
@@ -146,21 +159,23 @@ impl<'a> TetGrid<'a> {
     /// it accepts.
     fn visit(&self, lo: V3, hi: V3, met: &mut [bool], meets: impl Fn(&TetPoints) -> bool) {
         let cell = |p: &V3, i: usize| ((p[i] - self.origin[i]) / self.cell_m).floor();
-        let mut range = [[0usize; 3]; 2];
-        for i in 0..3 {
+        // Per axis, the cells `[lo, hi]` overlaps; `None` outside the grid.
+        let span = [0, 1, 2].map(|i| {
             let (a, b) = (cell(&lo, i), cell(&hi, i));
             let last = (self.dims[i] - 1) as f64;
-            if b < 0.0 || a > last {
-                return; // outside the grid on this axis
-            }
-            range[0][i] = a.max(0.0) as usize;
-            range[1][i] = b.min(last) as usize;
-        }
+            (b >= 0.0 && a <= last).then(|| (a.max(0.0) as usize, b.min(last) as usize))
+        });
+        let [Some(x), Some(y), Some(z)] = span else {
+            return;
+        };
+        let range = [[x.0, y.0, z.0], [x.1, y.1, z.1]];
         let index = |c: [usize; 3]| c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2]);
         for_cells(range[0], range[1], |c| {
             let i = index(c);
             for &t in &self.tets[self.start[i] as usize..self.start[i + 1] as usize] {
-                if !met[t as usize] && meets(&self.mesh.tets[t as usize].map(|v| point(self.mesh, v))) {
+                if !met[t as usize]
+                    && meets(&self.mesh.tets[t as usize].map(|v| point(self.mesh, v)))
+                {
                     met[t as usize] = true;
                 }
             }
@@ -197,7 +212,14 @@ fn for_cells(a: [usize; 3], b: [usize; 3], mut f: impl FnMut([usize; 3])) {
 pub fn box_meets_tet(lo: V3, hi: V3, p: &TetPoints, eps: f64) -> bool {
     let center = (lo + hi) / 2.0;
     let half = (hi - lo) / 2.0;
-    let edges = [p[1] - p[0], p[2] - p[0], p[3] - p[0], p[2] - p[1], p[3] - p[1], p[3] - p[2]];
+    let edges = [
+        p[1] - p[0],
+        p[2] - p[0],
+        p[3] - p[0],
+        p[2] - p[1],
+        p[3] - p[1],
+        p[3] - p[2],
+    ];
     let faces = [
         edges[3].cross(&edges[4]),
         edges[1].cross(&edges[2]),

@@ -261,7 +261,11 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
             }
         }
     }
-    let connection: Vec<bool> = on_dynamic.iter().zip(&on_static).map(|(a, b)| *a && *b).collect();
+    let connection: Vec<bool> = on_dynamic
+        .iter()
+        .zip(&on_static)
+        .map(|(a, b)| *a && *b)
+        .collect();
     let connection_nodes: Vec<u32> = (0..connection.len() as u32)
         .filter(|&v| connection[v as usize])
         .collect();
@@ -291,7 +295,11 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
         for (i, piece) in static_pieces.iter().enumerate() {
             if !held(piece) {
                 let region = if several {
-                    format!("piece {} of {} of the pre-computed region", i + 1, static_pieces.len())
+                    format!(
+                        "piece {} of {} of the pre-computed region",
+                        i + 1,
+                        static_pieces.len()
+                    )
                 } else {
                     "the pre-computed region".to_owned()
                 };
@@ -311,7 +319,10 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
             why,
         });
     }
-    for (i, tets) in components(mesh, &adjacency, &dynamic, true).into_iter().enumerate() {
+    for (i, tets) in components(mesh, &adjacency, &dynamic, true)
+        .into_iter()
+        .enumerate()
+    {
         let id = i as u32 + 1;
         if !held(&tets) {
             return Err(floating(format!("dynamic region {id}"), &tets));
@@ -372,7 +383,12 @@ fn grow_rings(mesh: &TetMesh, adjacency: &VertexTets, set: &mut [bool], rings: u
 
 /// The vertex-connected components of the tets whose `dynamic` flag equals `which`, each
 /// ascending, in order of their lowest tet.
-fn components(mesh: &TetMesh, adjacency: &VertexTets, dynamic: &[bool], which: bool) -> Vec<Vec<u32>> {
+fn components(
+    mesh: &TetMesh,
+    adjacency: &VertexTets,
+    dynamic: &[bool],
+    which: bool,
+) -> Vec<Vec<u32>> {
     let mut seen: Vec<bool> = dynamic.iter().map(|&d| d != which).collect();
     let mut out = Vec::new();
     for first in 0..dynamic.len() {
@@ -410,7 +426,12 @@ pub fn distinct_vertices(mesh: &TetMesh, tets: &[u32]) -> Vec<u32> {
 /// The centroid of tet `t`, m.
 fn centroid(mesh: &TetMesh, t: u32) -> [f64; 3] {
     let tet = mesh.tets[t as usize];
-    core::array::from_fn(|i| tet.iter().map(|&v| mesh.positions[v as usize][i]).sum::<f64>() / 4.0)
+    core::array::from_fn(|i| {
+        tet.iter()
+            .map(|&v| mesh.positions[v as usize][i])
+            .sum::<f64>()
+            / 4.0
+    })
 }
 
 /// Why the pre-computed region is pre-computed.

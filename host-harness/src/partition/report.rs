@@ -164,10 +164,11 @@ impl PlanReport {
                 "  table {}, step cost {:.3e} s, critical dt {}",
                 human_bytes(r.table_bytes),
                 r.step_cost_s,
-                r.critical_dt_s.map_or("none (unconditionally stable)".into(), |dt| format!(
-                    "{dt:.3e} s ({})",
-                    self.integrator
-                ))
+                r.critical_dt_s
+                    .map_or("none (unconditionally stable)".into(), |dt| format!(
+                        "{dt:.3e} s ({})",
+                        self.integrator
+                    ))
             );
             let _ = writeln!(s, "  why: {}", r.why);
         }

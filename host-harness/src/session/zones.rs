@@ -282,7 +282,10 @@ fn zone(
         if r.is_finite() && r > 0.0 {
             Ok(r)
         } else {
-            Err((key(&format!("radius_m = {r}")), "must be finite and > 0 m".into()))
+            Err((
+                key(&format!("radius_m = {r}")),
+                "must be finite and > 0 m".into(),
+            ))
         }
     };
     let shape = match z.shape.as_str() {
@@ -310,7 +313,10 @@ fn zone(
             let trajectory = base_dir.join(z.trajectory.clone().unwrap_or_default());
             let read = Trajectory::read(&trajectory, tool_points).map_err(|e| {
                 (
-                    key(&format!("trajectory = {:?}", trajectory.display().to_string())),
+                    key(&format!(
+                        "trajectory = {:?}",
+                        trajectory.display().to_string()
+                    )),
                     e.to_string().replace('\n', "; "),
                 )
             })?;
