@@ -9,7 +9,7 @@ use clap::Subcommand;
 use palpate::output::atomic;
 use palpate::output::vtk::write_regions;
 use palpate::partition::{Partition, PlanReport};
-use palpate::session::{MeshSource, Scene};
+use palpate::session::{MeshSource, Scene, ZoneShape};
 
 use super::mesh_files;
 use super::stdout;
@@ -52,7 +52,7 @@ fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
         );
     }
     for zone in &scene.zones {
-        if let palpate::session::ZoneShape::Path { trajectory, .. } = &zone.shape {
+        if let ZoneShape::Path { trajectory, .. } = &zone.shape {
             inputs.push(("a [[zone]] trajectory", trajectory.clone()));
         }
     }
