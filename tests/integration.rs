@@ -9,6 +9,7 @@ mod host {
     mod experiment;
     mod fem;
     mod mesh;
+    mod partition;
     mod robustness;
     mod session;
     mod session_generate_tools;

@@ -16,6 +16,7 @@ pub mod hybrid;
 pub mod limits;
 pub mod mesh;
 pub mod output;
+pub mod partition;
 pub mod precomputed;
 pub mod replay;
 pub mod session;

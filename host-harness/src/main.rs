@@ -11,7 +11,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod commands;
 
-use commands::{budget, demo, dynamic, experiment, precomputed, session, stvk, tables};
+use commands::{budget, demo, dynamic, experiment, precomputed, scene, session, stvk, tables};
 
 #[derive(Parser)]
 #[command(
@@ -44,6 +44,9 @@ enum Command {
     /// Haptic sessions: the kernel's fixed-timestep loop driven by a trajectory.
     #[command(subcommand)]
     Session(session::SessionCommand),
+    /// What a scene asks of the models: the hybrid partition of its zones (`scene plan`).
+    #[command(subcommand)]
+    Scene(scene::SceneCommand),
     /// Per-tick instruction counts (callgrind) of every generated trajectory
     /// against the static bound from the table sizes and capacities.
     Budget(budget::BudgetArgs),
@@ -81,6 +84,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
         Command::Stvk(command) => stvk::run(command),
         Command::Experiment(command) => experiment::run(command),
         Command::Session(command) => session::run(command),
+        Command::Scene(command) => scene::run(command),
         Command::Budget(args) => budget::run(&args),
         Command::Demo(args) => demo::run(&args),
     }

@@ -5,9 +5,12 @@
 //! rejected by future Rust versions.
 
 use core::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+
+use super::atomic::AtomicFile;
 
 /// Writes one frame: the deformed mesh (`rest + displacement`, m) with the
 /// displacement as point data.
@@ -17,14 +20,54 @@ pub fn write_frame(
     tets: &[[u32; 4]],
     displacement_m: &[[f64; 3]],
 ) -> anyhow::Result<()> {
+    let points: Vec<[f64; 3]> = rest
+        .iter()
+        .zip(displacement_m)
+        .map(|(p, u)| [p[0] + u[0], p[1] + u[1], p[2] + u[2]])
+        .collect();
+    let mut s = unstructured_grid("palpate frame", &points, tets);
+    let _ = writeln!(s, "POINT_DATA {}\nVECTORS displacement double", rest.len());
+    for u in displacement_m {
+        let _ = writeln!(s, "{} {} {}", u[0], u[1], u[2]);
+    }
+    std::fs::write(path, s).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Writes the rest mesh with the integer cell field `region` (one value per
+/// tet: the hybrid partition's region ids, `palpate scene plan --vtk`),
+/// atomically ([`AtomicFile`]).
+pub fn write_regions(
+    path: &Path,
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    region: &[u32],
+) -> anyhow::Result<()> {
+    let mut s = unstructured_grid("palpate regions", positions, tets);
+    let _ = writeln!(
+        s,
+        "CELL_DATA {}\nSCALARS region int 1\nLOOKUP_TABLE default",
+        region.len()
+    );
+    for r in region {
+        let _ = writeln!(s, "{r}");
+    }
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(s.as_bytes())?;
+    file.commit()?;
+    Ok(())
+}
+
+/// A legacy ASCII unstructured grid of linear tets (VTK cell type 10) at
+/// `points` (m), titled `title`, before any point or cell data.
+fn unstructured_grid(title: &str, points: &[[f64; 3]], tets: &[[u32; 4]]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# vtk DataFile Version 3.0\npalpate frame\nASCII\nDATASET UNSTRUCTURED_GRID"
+        "# vtk DataFile Version 3.0\n{title}\nASCII\nDATASET UNSTRUCTURED_GRID"
     );
-    let _ = writeln!(s, "POINTS {} double", rest.len());
-    for (p, u) in rest.iter().zip(displacement_m) {
-        let _ = writeln!(s, "{} {} {}", p[0] + u[0], p[1] + u[1], p[2] + u[2]);
+    let _ = writeln!(s, "POINTS {} double", points.len());
+    for p in points {
+        let _ = writeln!(s, "{} {} {}", p[0], p[1], p[2]);
     }
     let _ = writeln!(s, "CELLS {} {}", tets.len(), tets.len() * 5);
     for t in tets {
@@ -34,11 +77,7 @@ pub fn write_frame(
     for _ in tets {
         s.push_str("10\n");
     }
-    let _ = writeln!(s, "POINT_DATA {}\nVECTORS displacement double", rest.len());
-    for u in displacement_m {
-        let _ = writeln!(s, "{} {} {}", u[0], u[1], u[2]);
-    }
-    std::fs::write(path, s).with_context(|| format!("{}: cannot write", path.display()))
+    s
 }
 
 /// Writes a ParaView collection listing `frames` as `(time in s, file)`.

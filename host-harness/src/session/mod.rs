@@ -16,6 +16,7 @@ pub mod stability;
 pub mod tool_points;
 pub mod tools;
 pub mod trajectory;
+pub mod zones;
 
 pub use generate::{
     CutLine, GenerateError, Generator, GraspPull, Keyframe, Pinch, Poke, Press, PressHold, Slide,
@@ -26,3 +27,4 @@ pub use scene::{
     ToolSpec,
 };
 pub use trajectory::{FileProblem, LineProblem, Sample, ToolState, Trajectory, TrajectoryError};
+pub use zones::{PartitionSpec, Zone, ZoneKind, ZoneShape};

@@ -57,6 +57,8 @@
 //! [safety]
 //! max_force_n = 4.0            # default 4
 //! max_slew_n_per_s = 2000.0    # default 2000
+//!
+//! # [[zone]] and [partition]: where the hybrid model must be dynamic (crate::session::zones)
 //! ```
 //!
 //! Unknown keys are refused, so a typo is an error, not a silently ignored setting. TOML integers
@@ -76,6 +78,7 @@ use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
 
+use super::zones::{PartitionFile, PartitionSpec, Zone, ZoneFile, zones_spec};
 use crate::fem::material::{Material, MaterialError};
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_HAPTIC_HZ, MAX_SCENE_FILE_BYTES, read_bounded};
@@ -347,6 +350,10 @@ pub struct Scene {
     /// Limits of the safety supervisor on the device force (N, N/s), each finite and > 0;
     /// the loop takes them in f32 ([`crate::session::run::loop_config`]).
     pub safety: SafetyLimits<f64>,
+    /// Where the tissue must be dynamic (`[[zone]]`, [`crate::session::zones`]).
+    pub zones: Vec<Zone>,
+    /// How the zones become tets (`[partition]`).
+    pub partition: PartitionSpec,
 }
 
 // ---- The file as written (serde), before validation. ----
@@ -370,6 +377,9 @@ struct SceneFile {
     rates: RatesFile,
     #[serde(default)]
     safety: SafetyFile,
+    #[serde(default)]
+    zone: Vec<ZoneFile>,
+    partition: Option<PartitionFile>,
 }
 
 #[derive(Deserialize)]
@@ -657,6 +667,8 @@ impl Scene {
                 max_force_n: DEFAULT_MAX_FORCE_N,
                 max_slew_n_per_s: DEFAULT_MAX_SLEW_N_PER_S,
             },
+            zones: Vec::new(),
+            partition: PartitionSpec::default(),
         }
     }
 
@@ -803,6 +815,9 @@ impl Scene {
         let model = model_spec(&raw.model, raw.rates.haptic_hz, raw.rates.physics_every)
             .map_err(|(key, msg)| invalid(&key, msg))?;
         let tool = tool_spec(&raw.tool).map_err(|(key, msg)| invalid(&key, msg))?;
+        let (zones, partition) =
+            zones_spec(&raw.zone, raw.partition.as_ref(), base_dir, raw.tool.points)
+                .map_err(|(key, msg)| invalid(&key, msg))?;
         let scene = Scene {
             source: source.to_owned(),
             mesh,
@@ -832,6 +847,8 @@ impl Scene {
                 max_force_n: raw.safety.max_force_n,
                 max_slew_n_per_s: raw.safety.max_slew_n_per_s,
             },
+            zones,
+            partition,
         };
         scene.validate()?;
         Ok(scene)
