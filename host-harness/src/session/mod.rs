@@ -10,6 +10,7 @@
 
 pub mod generate;
 pub mod hybrid;
+pub mod model;
 pub mod run;
 pub mod scene;
 pub mod stability;

@@ -40,6 +40,7 @@ use palpate_kernel::tensor_mass::{
 };
 
 use super::hybrid::HybridSetup;
+use super::model::{SceneModel, SceneTables};
 use super::scene::{ToolKind, ToolSpec};
 use super::stability::check_stable_step;
 use super::tool_points::{ForToolPoints, with_tool_points};
@@ -57,7 +58,6 @@ use crate::table::build::{BuildOptions, build};
 use crate::table::compliance::Solver;
 use crate::table::estimate::{SizeLimits, TableEstimate};
 use crate::table::file::Precision;
-use crate::table::load::TableFile;
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::{OwnedState, OwnedSurface};
 
@@ -65,16 +65,32 @@ use crate::tensor_mass::{OwnedState, OwnedSurface};
 /// supports, f32 (the firmware precision), quiet; a pre-computed table
 /// solved by sparse Cholesky, a tensor-mass table of the scene's density.
 pub fn table_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
+    match scene.model {
+        ModelSpec::Precomputed => precomputed_options(scene),
+        ModelSpec::Dynamic(_) => tensor_mass_options(scene),
+    }
+}
+
+/// The pre-computed table options of `scene` (see [`table_options`]).
+pub fn precomputed_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
     let material = scene.elastic_material()?;
-    let fix = scene.fix.clone();
-    Ok(match scene.model {
-        ModelSpec::Precomputed => {
-            BuildOptions::precomputed(material, fix, Solver::Cholesky, Precision::F32)
-        }
-        ModelSpec::Dynamic(_) => {
-            BuildOptions::tensor_mass(material, scene.material.density_kg_m3, fix, Precision::F32)
-        }
-    })
+    Ok(BuildOptions::precomputed(
+        material,
+        scene.fix.clone(),
+        Solver::Cholesky,
+        Precision::F32,
+    ))
+}
+
+/// The tensor-mass table options of `scene` (see [`table_options`]).
+pub fn tensor_mass_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
+    let material = scene.elastic_material()?;
+    Ok(BuildOptions::tensor_mass(
+        material,
+        scene.material.density_kg_m3,
+        scene.fix.clone(),
+        Precision::F32,
+    ))
 }
 
 /// The f32 table of `scene` (pre-computed or tensor-mass, by its model),
@@ -190,8 +206,8 @@ pub fn removed_path(out: &Path) -> std::path::PathBuf {
 /// `true` for a dynamic scene with a cutter or tearing: its session
 /// removes tets.
 pub fn removes_tets(scene: &Scene) -> bool {
-    matches!(scene.model, ModelSpec::Dynamic(_))
-        && (scene.tool.kinds.contains(&ToolKind::Cutter) || scene.tearing.is_some())
+    let dynamic = matches!(scene.model, ModelSpec::Dynamic(_)) || !scene.zones.is_empty();
+    dynamic && (scene.tool.kinds.contains(&ToolKind::Cutter) || scene.tearing.is_some())
 }
 
 /// What a session did.
@@ -364,15 +380,19 @@ pub fn run_session_into(
         tick_s: scene.tick_s(),
         every: scene.rates.physics_every.max(1) as usize,
     };
-    let file = TableFile::from_bytes(&scene_table(scene, &mesh, &report)?);
-    let tissue = match scene.model {
-        ModelSpec::Precomputed => SessionTissue::Precomputed(
-            PrecomputedTable::<f32>::load(file.bytes()).context("session table")?,
+    let tables = SceneModel::of(scene, &mesh, &report)?.tables(scene, &mesh, &report)?;
+    let load = |e| anyhow::anyhow!("session table: {e}");
+    let tissue = match &tables {
+        SceneTables::Precomputed(file) => SessionTissue::Precomputed(
+            PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?,
             loop_config(scene),
         ),
-        ModelSpec::Dynamic(spec) => {
-            let table = TensorMassTable::<f32>::load(file.bytes()).context("session table")?;
-            SessionTissue::Dynamic(DynamicSetup::of(scene, &spec, table)?)
+        SceneTables::Dynamic(file, spec) => {
+            let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
+            SessionTissue::Dynamic(DynamicSetup::of(scene, spec, table)?)
+        }
+        SceneTables::Hybrid(tables, spec) => {
+            SessionTissue::Hybrid(HybridSetup::of(scene, spec, tables)?)
         }
     };
     with_tool_points(

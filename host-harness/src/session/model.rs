@@ -1,0 +1,131 @@
+//! How a scene's tissue is modelled (MODELS.md §5, RR-3510 §6.2): without
+//! zones, as its `[model]` says; with zones, as their partition
+//! ([`crate::partition`]) says: no dynamic tet → pre-computed, every tet
+//! dynamic → tensor-mass, both → the hybrid. The dynamic region's law is
+//! the plan's (St Venant-Kirchhoff where a large-deformation zone asks for
+//! it, the penalty when ν ≥ 0.45) or `[model]`'s, whichever is the more
+//! demanding; its step, integrator and damping are `[model]`'s.
+
+use anyhow::{Context, anyhow, bail};
+use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
+
+use super::{DynamicSpec, ModelSpec, Scene};
+use crate::experiment::scenes::penalty_n;
+use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
+use crate::mesh::{MeshReport, TetMesh};
+use crate::partition::{Partition, RegionModel, cost::sub_mesh};
+use crate::table::build::build;
+use crate::table::file::Precision;
+use crate::table::load::TableFile;
+use super::run::{precomputed_options, tensor_mass_options};
+
+/// A scene's model, resolved.
+pub enum SceneModel {
+    /// The pre-computed model of the whole mesh.
+    Precomputed,
+    /// The tensor-mass model of the whole mesh.
+    Dynamic(DynamicSpec),
+    /// The hybrid: the tensor-mass region's settings and the partition.
+    Hybrid {
+        /// The tensor-mass region's settings.
+        spec: DynamicSpec,
+        /// The partition the zones chose.
+        partition: Partition,
+    },
+}
+
+impl SceneModel {
+    /// The model of `scene` on its loaded `mesh` (module docs). A scene
+    /// whose zones make tets dynamic needs `[model] kind = "dynamic"` for
+    /// their step: otherwise a one-line error naming the scene.
+    pub fn of(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Self> {
+        if scene.zones.is_empty() {
+            return Ok(match scene.model {
+                ModelSpec::Precomputed => Self::Precomputed,
+                ModelSpec::Dynamic(spec) => Self::Dynamic(spec),
+            });
+        }
+        let partition = Partition::of_scene(scene, mesh, report).map_err(|e| anyhow!("{e}"))?;
+        let dynamic: Vec<u32> = (0..mesh.tets.len() as u32)
+            .filter(|&t| partition.dynamic[t as usize])
+            .collect();
+        if dynamic.is_empty() {
+            return Ok(Self::Precomputed);
+        }
+        let ModelSpec::Dynamic(spec) = scene.model else {
+            bail!(
+                "{}: the zones make {} tets dynamic: give their step in [model] (kind = \"dynamic\", dt_s, integrator, damping_per_s)",
+                scene.source,
+                dynamic.len()
+            );
+        };
+        let stvk = partition.regions.iter().any(|r| {
+            matches!(r.model, RegionModel::TensorMass { law: ElasticLaw::StVenantKirchhoff(_), .. })
+        });
+        let penalty = partition
+            .regions
+            .iter()
+            .any(|r| matches!(r.model, RegionModel::TensorMass { incompressibility: true, .. }));
+        let law = match (spec.law, stvk) {
+            (ElasticLaw::Linear, true) => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
+            (law, _) => law,
+        };
+        let incompressibility_n = match (spec.incompressibility_n, penalty) {
+            (None, true) => {
+                let (region, _) = sub_mesh(mesh, &dynamic);
+                Some(penalty_n(&region, &scene.elastic_material()?))
+            }
+            (given, _) => given,
+        };
+        let spec = DynamicSpec {
+            law,
+            incompressibility_n,
+            ..spec
+        };
+        Ok(if dynamic.len() == mesh.tets.len() {
+            Self::Dynamic(spec)
+        } else {
+            Self::Hybrid { spec, partition }
+        })
+    }
+
+    /// The f32 tables of the model (the scene's material, density and
+    /// supports), built in memory with the pipeline of `palpate tables
+    /// build`.
+    pub fn tables(
+        self,
+        scene: &Scene,
+        mesh: &TetMesh,
+        report: &MeshReport,
+    ) -> anyhow::Result<SceneTables> {
+        let single = |options| -> anyhow::Result<TableFile> {
+            let built = build(mesh, report, &options).with_context(|| scene.source.clone())?;
+            Ok(TableFile::from_bytes(&built.bytes))
+        };
+        Ok(match self {
+            Self::Precomputed => SceneTables::Precomputed(single(precomputed_options(scene)?)?),
+            Self::Dynamic(spec) => SceneTables::Dynamic(single(tensor_mass_options(scene)?)?, spec),
+            Self::Hybrid { spec, partition } => {
+                let options = HybridOptions::new(
+                    scene.elastic_material()?,
+                    scene.material.density_kg_m3,
+                    scene.fix.clone(),
+                    Precision::F32,
+                );
+                let tables = build_hybrid(mesh, report, &partition.dynamic, &options)
+                    .with_context(|| scene.source.clone())?;
+                SceneTables::Hybrid(tables, spec)
+            }
+        })
+    }
+}
+
+/// A scene's tables, by its model.
+pub enum SceneTables {
+    /// The pre-computed table.
+    Precomputed(TableFile),
+    /// The tensor-mass table and the model's settings.
+    Dynamic(TableFile, DynamicSpec),
+    /// The hybrid's three tables and its tensor-mass region's settings.
+    Hybrid(HybridTables, DynamicSpec),
+}
