@@ -48,7 +48,11 @@ fn material() -> Material {
 }
 
 fn fix(mesh: &TetMesh) -> Vec<palpate::fix::FixPredicate> {
-    let z_min = mesh.positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    let z_min = mesh
+        .positions
+        .iter()
+        .map(|p| p[2])
+        .fold(f64::INFINITY, f64::min);
     vec![format!("z<{}", z_min + 1e-6).parse().expect("predicate")]
 }
 
@@ -58,11 +62,18 @@ fn params() -> DynamicParams<f32> {
 
 /// The `fraction` of the tets with the lowest centroid x.
 fn dynamic_tets(mesh: &TetMesh, fraction: f64) -> Vec<bool> {
-    let x = |t: &[u32; 4]| t.iter().map(|&v| mesh.positions[v as usize][0]).sum::<f64>();
+    let x = |t: &[u32; 4]| {
+        t.iter()
+            .map(|&v| mesh.positions[v as usize][0])
+            .sum::<f64>()
+    };
     let mut order: Vec<usize> = (0..mesh.tets.len()).collect();
     order.sort_by(|&a, &b| x(&mesh.tets[a]).total_cmp(&x(&mesh.tets[b])));
     let mut dynamic = vec![false; mesh.tets.len()];
-    for &t in order.iter().take((fraction * mesh.tets.len() as f64).round() as usize) {
+    for &t in order
+        .iter()
+        .take((fraction * mesh.tets.len() as f64).round() as usize)
+    {
         dynamic[t] = true;
     }
     dynamic
@@ -78,12 +89,15 @@ fn build_all(mesh: &TetMesh) -> Vec<Built> {
     FRACTIONS
         .iter()
         .map(|&fraction| {
-            let options =
-                HybridOptions::new(material(), 1000.0, fix(mesh), Precision::F32);
+            let options = HybridOptions::new(material(), 1000.0, fix(mesh), Precision::F32);
             let start = Instant::now();
-            let tables =
-                build_hybrid(mesh, &MeshReport::default(), &dynamic_tets(mesh, fraction), &options)
-                    .expect("hybrid tables");
+            let tables = build_hybrid(
+                mesh,
+                &MeshReport::default(),
+                &dynamic_tets(mesh, fraction),
+                &options,
+            )
+            .expect("hybrid tables");
             Built {
                 fraction,
                 tables,
@@ -100,12 +114,18 @@ fn top_vertices(built: &HybridTables, mesh: &TetMesh) -> (u32, u32) {
     let table = PrecomputedTable::<f32>::load(built.precomputed.bytes()).expect("table");
     let z = |v: &u32| mesh.positions[*v as usize][2];
     let touchable = &table.free_vertices()[..table.touchable_count()];
-    let p = *touchable.iter().max_by(|a, b| z(a).total_cmp(&z(b))).expect("touchable");
+    let p = *touchable
+        .iter()
+        .max_by(|a, b| z(a).total_cmp(&z(b)))
+        .expect("touchable");
     let surface = palpate::mesh::boundary_surface(mesh);
     let d = *surface
         .vertices
         .iter()
-        .filter(|&&v| built.split.dynamic_index[v as usize].is_some() && !built.split.in_precomputed[v as usize])
+        .filter(|&&v| {
+            built.split.dynamic_index[v as usize].is_some()
+                && !built.split.in_precomputed[v as usize]
+        })
         .max_by(|a, b| z(a).total_cmp(&z(b)))
         .expect("dynamic surface vertex");
     (p, d)
@@ -118,18 +138,21 @@ fn step(c: &mut Criterion) {
     let whole_file = palpate_benches::base_fixed_table(&mesh);
     let whole = TensorMassTable::<f32>::load(whole_file.bytes()).expect("table");
     let mut whole_state = OwnedState::for_table(&whole);
-    let mut whole_model = TensorMassModel::new(whole, whole_state.buffers(), params()).expect("model");
+    let mut whole_model =
+        TensorMassModel::new(whole, whole_state.buffers(), params()).expect("model");
     group.bench_function("all_tensor_mass", |b| {
         b.iter(|| whole_model.step(black_box(Integrator::SymplecticEuler), DT_S))
     });
     for b in &built {
         let label = format!("{:.0}%", b.fraction * 100.0);
-        let precomputed = PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
+        let precomputed =
+            PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
         let dynamic = TensorMassTable::<f32>::load(b.tables.dynamic.bytes()).expect("table");
         let interface = InterfaceTable::<f32>::load(b.tables.interface.bytes()).expect("table");
         let n = dynamic.vertex_count();
         let mut alone_state = OwnedState::for_table(&dynamic);
-        let mut alone = TensorMassModel::new(dynamic, alone_state.buffers(), params()).expect("model");
+        let mut alone =
+            TensorMassModel::new(dynamic, alone_state.buffers(), params()).expect("model");
         group.bench_function(BenchmarkId::new("region_alone", &label), |bench| {
             bench.iter(|| alone.step(black_box(Integrator::SymplecticEuler), DT_S))
         });
@@ -147,7 +170,11 @@ fn step(c: &mut Criterion) {
             bench.iter(|| hybrid.step(black_box(Integrator::SymplecticEuler), DT_S))
         });
         group.bench_function(BenchmarkId::new("force_pass_coupled", &label), |bench| {
-            bench.iter(|| hybrid.dynamic().elastic_forces_of(black_box(&u), &mut forces))
+            bench.iter(|| {
+                hybrid
+                    .dynamic()
+                    .elastic_forces_of(black_box(&u), &mut forces)
+            })
         });
     }
     group.finish();
@@ -159,7 +186,9 @@ fn step(c: &mut Criterion) {
     )
     .expect("pre-computed table");
     let pure_s = start.elapsed().as_secs_f64();
-    println!("\norgan tables (f32): fraction, dynamic tets, connection nodes, pre-computed + tensor-mass + interface bytes, build s");
+    println!(
+        "\norgan tables (f32): fraction, dynamic tets, connection nodes, pre-computed + tensor-mass + interface bytes, build s"
+    );
     for b in &built {
         let s = &b.tables.split;
         println!(
@@ -176,7 +205,10 @@ fn step(c: &mut Criterion) {
             b.build_s
         );
     }
-    println!("pure pre-computed: {} bytes {pure_s:.2} s", pure.bytes.len());
+    println!(
+        "pure pre-computed: {} bytes {pure_s:.2} s",
+        pure.bytes.len()
+    );
 }
 
 fn tick(c: &mut Criterion) {
@@ -185,18 +217,32 @@ fn tick(c: &mut Criterion) {
     let mut group = c.benchmark_group("hybrid_tick");
     for b in &built {
         let label = format!("{:.0}%", b.fraction * 100.0);
-        let precomputed = PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
+        let precomputed =
+            PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
         let dynamic = TensorMassTable::<f32>::load(b.tables.dynamic.bytes()).expect("table");
         let interface = InterfaceTable::<f32>::load(b.tables.interface.bytes()).expect("table");
         let (p, d) = top_vertices(&b.tables, &mesh);
         let at = |v: u32, dx: f32| {
             let x = mesh.positions[v as usize].map(|c| c as f32);
-            Vector3::new(x[0] + dx, x[1], x[2] + palpate_benches::TOOL_RADIUS_M - 0.0005)
+            Vector3::new(
+                x[0] + dx,
+                x[1],
+                x[2] + palpate_benches::TOOL_RADIUS_M - 0.0005,
+            )
         };
         for (name, tools) in [
-            ("precomputed_1", [at(p, 0.0), at(p, 0.0), at(p, 0.0), at(p, 0.0)]),
-            ("dynamic_1", [at(d, 0.0), at(d, 0.0), at(d, 0.0), at(d, 0.0)]),
-            ("both_4", [at(p, 0.0), at(p, 0.004), at(d, 0.0), at(d, 0.004)]),
+            (
+                "precomputed_1",
+                [at(p, 0.0), at(p, 0.0), at(p, 0.0), at(p, 0.0)],
+            ),
+            (
+                "dynamic_1",
+                [at(d, 0.0), at(d, 0.0), at(d, 0.0), at(d, 0.0)],
+            ),
+            (
+                "both_4",
+                [at(p, 0.0), at(p, 0.004), at(d, 0.0), at(d, 0.004)],
+            ),
         ] {
             let mut state = OwnedState::for_table(&dynamic);
             let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");

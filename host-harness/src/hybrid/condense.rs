@@ -18,10 +18,14 @@ use crate::fem::material::Material;
 /// (on its free vertices) `u_load = K_ii⁻¹ f`, `p_load = Hᵀ f`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Condensed {
-    /// `S_jk` row-major, N/m, at `j·c + k` (symmetrized: `(S + Sᵀ)/2`).
-    pub condensed: Vec<[f64; 9]>,
-    /// `H_nj` row-major, m/m, at `n·c + j` (`n` the free index).
-    pub response: Vec<[f64; 9]>,
+    /// `S` (N/m) as the `3c × 3c` matrix, row-major in triples: row
+    /// `3j + a` is `c` triples at `(3j + a)·c`, triple `k` holding columns
+    /// `3k..3k+3` (the interface table's layout); symmetrized,
+    /// `(S + Sᵀ)/2`.
+    pub condensed: Vec<[f64; 3]>,
+    /// `H` (m/m) as the `3F × 3c` matrix in the same layout (row `3n + a`,
+    /// `n` the free index).
+    pub response: Vec<[f64; 3]>,
     /// `u_load` per free index, m.
     pub load_displacement: Vec<[f64; 3]>,
     /// `p_load` per connection node, N.
@@ -72,15 +76,10 @@ pub fn condense(
     }
     llt.solve_in_place(rhs.as_mut());
 
-    let mut response = vec![[0.0; 9]; f * c];
-    for n in 0..f {
-        for j in 0..c {
-            let block = &mut response[n * c + j];
-            for a in 0..3 {
-                for b in 0..3 {
-                    block[3 * a + b] = rhs[(3 * n + a, 3 * j + b)];
-                }
-            }
+    let mut response = vec![[0.0; 3]; 3 * f * c];
+    for (r, row) in response.chunks_exact_mut(c).enumerate() {
+        for (j, triple) in row.iter_mut().enumerate() {
+            *triple = core::array::from_fn(|b| rhs[(r, 3 * j + b)]);
         }
     }
     // S = K_cc + K_ci H, column (k, b) by column: K times (H column on the
@@ -89,13 +88,14 @@ pub fn condense(
     for (j, &v) in connection.iter().enumerate() {
         connection_slot[v as usize] = Some(j);
     }
-    let mut s = vec![[0.0; 9]; c * c];
+    // Dense 3c × 3c, row-major in scalars.
+    let mut s = vec![0.0f64; 9 * c * c];
     for (kk, &vk) in connection.iter().enumerate() {
         for b in 0..3 {
             let mut add_column = |dof: usize, x: f64| {
                 for (row, value) in column(dof) {
                     if let Some(j) = connection_slot[row / 3] {
-                        s[j * c + kk][3 * (row % 3) + b] += value * x;
+                        s[(3 * j + row % 3) * 3 * c + 3 * kk + b] += value * x;
                     }
                 }
             };
@@ -114,13 +114,16 @@ pub fn condense(
     let load_displacement = (0..f)
         .map(|n| core::array::from_fn(|a| rhs[(3 * n + a, 3 * c)]))
         .collect::<Vec<[f64; 3]>>();
+    // p = Hᵀ f: row 3n + a of H scaled by f_n[a].
     let mut load_force = vec![[0.0; 3]; c];
     for n in 0..f {
         let fv = load_n[ordering.free_vertex[n] as usize];
-        for (j, p) in load_force.iter_mut().enumerate() {
-            let h = &response[n * c + j];
-            for b in 0..3 {
-                p[b] += h[b] * fv[0] + h[3 + b] * fv[1] + h[6 + b] * fv[2];
+        for (a, &fa) in fv.iter().enumerate() {
+            let row = &response[(3 * n + a) * c..(3 * n + a + 1) * c];
+            for (p, h) in load_force.iter_mut().zip(row) {
+                for (pb, hb) in p.iter_mut().zip(h) {
+                    *pb += hb * fa;
+                }
             }
         }
     }
@@ -132,18 +135,14 @@ pub fn condense(
     })
 }
 
-/// `(S + Sᵀ)/2` of `c × c` row-major blocks.
-fn symmetrized(s: &[[f64; 9]], c: usize) -> Vec<[f64; 9]> {
-    let mut out = s.to_vec();
-    for j in 0..c {
-        for k in 0..c {
-            for a in 0..3 {
-                for b in 0..3 {
-                    out[j * c + k][3 * a + b] =
-                        0.5 * (s[j * c + k][3 * a + b] + s[k * c + j][3 * b + a]);
-                }
-            }
-        }
-    }
-    out
+/// `(S + Sᵀ)/2` of the `n × n` row-major `s` (`n = 3c`), as rows of `c`
+/// triples.
+fn symmetrized(s: &[f64], c: usize) -> Vec<[f64; 3]> {
+    let n = 3 * c;
+    (0..n)
+        .flat_map(|r| (0..c).map(move |k| (r, k)))
+        .map(|(r, k)| {
+            core::array::from_fn(|b| 0.5 * (s[r * n + 3 * k + b] + s[(3 * k + b) * n + r]))
+        })
+        .collect()
 }

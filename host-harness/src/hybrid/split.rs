@@ -8,9 +8,11 @@ use crate::mesh::TetMesh;
 /// The two regions of a hybrid mesh.
 ///
 /// Invariants: every tet is in exactly one region; both regions have tets;
-/// the tensor-mass region's vertices are numbered compactly in ascending
-/// mesh order; the connection nodes are the vertices of both regions that
-/// are not fixed, in ascending mesh order, and there is at least one.
+/// the connection nodes are the vertices of both regions that are not
+/// fixed, in ascending mesh order, and there is at least one; the
+/// tensor-mass region numbers its vertices compactly, the connection nodes
+/// first (connection `j` is tensor-mass vertex `j`), then the others in
+/// ascending mesh order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RegionSplit {
     /// Per mesh tet: `true` in the tensor-mass region.
@@ -54,19 +56,18 @@ impl RegionSplit {
                 region[v as usize] = true;
             }
         }
-        let dynamic_vertex: Vec<u32> = (0..n as u32).filter(|&v| in_dynamic[v as usize]).collect();
+        let connects = |v: usize| in_dynamic[v] && in_precomputed[v] && !fixed[v];
+        let connection: Vec<u32> = (0..n as u32).filter(|&v| connects(v as usize)).collect();
+        if connection.is_empty() {
+            bail!("the regions share no free vertex: nothing connects them");
+        }
+        // The connection nodes first: their displacements and forces are
+        // then one contiguous run of the tensor-mass arrays.
+        let others = (0..n as u32).filter(|&v| in_dynamic[v as usize] && !connects(v as usize));
+        let dynamic_vertex: Vec<u32> = connection.iter().copied().chain(others).collect();
         let mut dynamic_index = vec![None; n];
         for (d, &v) in dynamic_vertex.iter().enumerate() {
             dynamic_index[v as usize] = Some(d as u32);
-        }
-        let connection: Vec<u32> = (0..n as u32)
-            .filter(|&v| {
-                let v = v as usize;
-                in_dynamic[v] && in_precomputed[v] && !fixed[v]
-            })
-            .collect();
-        if connection.is_empty() {
-            bail!("the regions share no free vertex: nothing connects them");
         }
         Ok(Self {
             dynamic_tet: dynamic_tet.to_vec(),

@@ -94,7 +94,9 @@ pub struct HybridView<'v> {
 impl<const P: usize> PhysicsView<HybridTissue<'_, '_, f32, P, P>> for HybridView<'_> {
     fn removed(&self, tissue: &HybridTissue<'_, '_, f32, P, P>) -> Vec<u32> {
         let removed = tissue.dynamic().removed().iter();
-        removed.filter_map(|&t| self.mesh_tet.get(t as usize).copied()).collect()
+        removed
+            .filter_map(|&t| self.mesh_tet.get(t as usize).copied())
+            .collect()
     }
 
     fn frame(
@@ -104,7 +106,9 @@ impl<const P: usize> PhysicsView<HybridTissue<'_, '_, f32, P, P>> for HybridView
         let model = tissue.dynamic().model();
         let mut u = vec![[0.0f32; 3]; tissue.region().interface().vertex_count()];
         // A faulted region's field is not read: the frame shows rest.
-        let _ = tissue.region().displacements(model, tissue.solution(), &mut u);
+        let _ = tissue
+            .region()
+            .displacements(model, tissue.solution(), &mut u);
         let mut alive = vec![true; self.tet_count];
         for (&t, &a) in self.mesh_tet.iter().zip(model.tet_alive()) {
             alive[t as usize] = a;

@@ -9,6 +9,7 @@
 use anyhow::{Context, anyhow, bail};
 use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 
+use super::run::{precomputed_options, tensor_mass_options};
 use super::{DynamicSpec, ModelSpec, Scene};
 use crate::experiment::scenes::penalty_n;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
@@ -17,7 +18,6 @@ use crate::partition::{Partition, RegionModel, cost::sub_mesh};
 use crate::table::build::build;
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
-use super::run::{precomputed_options, tensor_mass_options};
 
 /// A scene's model, resolved.
 pub enum SceneModel {
@@ -60,12 +60,23 @@ impl SceneModel {
             );
         };
         let stvk = partition.regions.iter().any(|r| {
-            matches!(r.model, RegionModel::TensorMass { law: ElasticLaw::StVenantKirchhoff(_), .. })
+            matches!(
+                r.model,
+                RegionModel::TensorMass {
+                    law: ElasticLaw::StVenantKirchhoff(_),
+                    ..
+                }
+            )
         });
-        let penalty = partition
-            .regions
-            .iter()
-            .any(|r| matches!(r.model, RegionModel::TensorMass { incompressibility: true, .. }));
+        let penalty = partition.regions.iter().any(|r| {
+            matches!(
+                r.model,
+                RegionModel::TensorMass {
+                    incompressibility: true,
+                    ..
+                }
+            )
+        });
         let law = match (spec.law, stvk) {
             (ElasticLaw::Linear, true) => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
             (law, _) => law,

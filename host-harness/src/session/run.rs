@@ -29,8 +29,8 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{
-    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue,
-    PrecomputedLoop, SafetyLimits, ToolInput,
+    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop,
+    SafetyLimits, ToolInput,
 };
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;

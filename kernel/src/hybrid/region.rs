@@ -4,9 +4,10 @@
 
 use core::fmt;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 use crate::Real;
+use crate::math::dense::{axpy, dot};
 use crate::precomputed::{
     AsConstraint, Constraint, ContactError, ContactPoint, ContactSolution, DisplacementError,
     PrecomputedModel,
@@ -256,12 +257,13 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
         let Some(solution) = solution else {
             return;
         };
+        let passed = passed.as_flattened_mut();
         for (point, g) in solution.resolved() {
             for (k, beta) in point.terms() {
-                let weighted = g * beta;
-                for (p, h) in passed.iter_mut().zip(interface.response_row(k.get())) {
-                    *p = (Vector3::from(*p) + Matrix3::from_row_slice(h).transpose() * weighted)
-                        .into();
+                // p += H_kᵀ (β g): row 3k + a of H scaled by β g_a.
+                for (a, &ga) in g.iter().enumerate() {
+                    let row = interface.response_row(3 * k.get() + a);
+                    axpy(ga * beta, row.as_flattened(), passed);
                 }
             }
         }
@@ -379,20 +381,15 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     }
 }
 
-/// `Σ_j H_nj u_{d_j}` (m): row `n` of the response applied to the
-/// connection displacements read from the tensor-mass displacements `u`.
+/// `Σ_j H_nj u_j` (m): row `n` of the response applied to the connection
+/// displacements (the first `c` of the tensor-mass displacements `u`).
 fn response<T: Real>(interface: &InterfaceTable<'_, T>, n: usize, u: &[[T; 3]]) -> Vector3<T> {
-    let mut sum = Vector3::zeros();
-    for (h, &[_, d]) in interface
-        .response_row(n)
-        .iter()
-        .zip(interface.connections())
-    {
-        if let Some(ud) = u.get(d as usize) {
-            sum += Matrix3::from_row_slice(h) * Vector3::from(*ud);
-        }
-    }
-    sum
+    let uc = u
+        .get(..interface.connection_count())
+        .unwrap_or(&[])
+        .as_flattened();
+    let row = |a: usize| dot(interface.response_row(3 * n + a).as_flattened(), uc);
+    Vector3::new(row(0), row(1), row(2))
 }
 
 /// Copies the common prefix of `src` into `dst`.

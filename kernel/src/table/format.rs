@@ -295,18 +295,23 @@ pub enum SectionKind {
     /// positions in the tet's own vertex order), N/m³.
     TetTerms = 30,
     /// `[u32; 2]` × c: each connection node `j` of an interface table, as
-    /// `[mesh vertex, tensor-mass vertex]` (its number in the dynamic
-    /// region's table); mesh vertices strictly ascending.
+    /// `[mesh vertex, tensor-mass vertex]`; mesh vertices strictly
+    /// ascending, and connection node `j` is tensor-mass vertex `j` (the
+    /// dynamic region numbers its connection nodes first, so their
+    /// displacements and forces are one contiguous run of `3c` scalars).
     ConnectionVertex = 40,
-    /// `[scalar; 9]` × c²: the condensed stiffness of the pre-computed
+    /// `[scalar; 3]` × 3c²: the condensed stiffness of the pre-computed
     /// region on its connection nodes (the Schur complement
-    /// `S = K_cc − K_ci K_ii⁻¹ K_ic`, N/m), block `S_jk` row-major at index
-    /// `j·c + k`. Symmetric; both halves stored so a row is contiguous.
+    /// `S = K_cc − K_ci K_ii⁻¹ K_ic`, N/m) as the `3c × 3c` matrix, row
+    /// major: row `r = 3j + a` (connection `j`, component `a`) is the `c`
+    /// triples at `r·c .. (r + 1)·c`, triple `k` holding columns `3k..3k+3`.
+    /// Symmetric; both halves stored so every row is contiguous.
     CondensedStiffness = 41,
-    /// `[scalar; 9]` × F·c: the response `H = −K_ii⁻¹ K_ic` of every free
+    /// `[scalar; 3]` × 3F·c: the response `H = −K_ii⁻¹ K_ic` of every free
     /// vertex of the pre-computed region (free index `n` of its table, the
     /// connection nodes fixed there) to the connection nodes'
-    /// displacements, dimensionless (m/m), block `H_nj` at `n·c + j`.
+    /// displacements, dimensionless (m/m), as the `3F × 3c` matrix in the
+    /// same row-major layout (row `3n + a`).
     ConnectionResponse = 42,
     /// `[scalar; 3]` × F: the displacement (m) of each free vertex of the
     /// pre-computed region under its built-in load (gravity and point loads
@@ -399,8 +404,10 @@ impl SectionKind {
             | SectionKind::EdgeColumn
             | SectionKind::DynamicVertex => 4,
             SectionKind::ConnectionVertex => 8,
-            SectionKind::CondensedStiffness | SectionKind::ConnectionResponse => 9 * scalar_bytes,
-            SectionKind::LoadDisplacement | SectionKind::LoadForce => 3 * scalar_bytes,
+            SectionKind::CondensedStiffness
+            | SectionKind::ConnectionResponse
+            | SectionKind::LoadDisplacement
+            | SectionKind::LoadForce => 3 * scalar_bytes,
             SectionKind::RestPositions => 3 * scalar_bytes,
             SectionKind::SurfaceTriangles | SectionKind::MeshTriangle | SectionKind::GridDims => 12,
             SectionKind::SurfaceGrid => 4 * scalar_bytes,
@@ -434,8 +441,8 @@ impl SectionKind {
         let c = u64::from(h.connection_count);
         match self {
             SectionKind::ConnectionVertex | SectionKind::LoadForce => Some(c),
-            SectionKind::CondensedStiffness => c.checked_mul(c),
-            SectionKind::ConnectionResponse => f.checked_mul(c),
+            SectionKind::CondensedStiffness => c.checked_mul(c)?.checked_mul(3),
+            SectionKind::ConnectionResponse => f.checked_mul(c)?.checked_mul(3),
             SectionKind::LoadDisplacement => Some(f),
             SectionKind::DynamicVertex => Some(n),
             SectionKind::VertexSlot

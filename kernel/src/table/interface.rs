@@ -11,14 +11,14 @@ use crate::Real;
 ///
 /// Invariants established by [`InterfaceTable::load`]:
 /// - `c ≥ 1` connection nodes; their mesh vertices are `< N` and strictly
-///   ascending, and each one's tensor-mass vertex is the `dynamic-vertex`
-///   entry of its mesh vertex (not [`FIXED_SLOT`]);
+///   ascending, connection node `j` is tensor-mass vertex `j`, and that is
+///   the `dynamic-vertex` entry of its mesh vertex;
 /// - every float is finite, and every diagonal entry of the condensed
 ///   stiffness is positive (a Schur complement of a positive definite
 ///   stiffness is positive definite);
-/// - section lengths match the header's counts: `c²` condensed blocks,
-///   `F·c` response blocks, `F` load displacements and `c` load forces,
-///   `N` dynamic-vertex entries.
+/// - section lengths match the header's counts: the `3c × 3c` condensed
+///   stiffness and `3F × 3c` response, `F` load displacements and `c` load
+///   forces, `N` dynamic-vertex entries.
 ///
 /// That the table belongs with a given pre-computed and tensor-mass table
 /// is checked where the three meet ([`crate::hybrid::HybridModel::new`]).
@@ -26,8 +26,8 @@ use crate::Real;
 pub struct InterfaceTable<'a, T: Real> {
     header: RawHeader,
     connections: &'a [[u32; 2]],
-    condensed: &'a [[T; 9]],
-    response: &'a [[T; 9]],
+    condensed: &'a [[T; 3]],
+    response: &'a [[T; 3]],
     load_displacement: &'a [[T; 3]],
     load_force: &'a [[T; 3]],
     dynamic_vertex: &'a [u32],
@@ -56,11 +56,14 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         for (j, &[vertex, dynamic]) in table.connections.iter().enumerate() {
             let ascending = previous.is_none_or(|p| vertex > p);
             let mapped = table.dynamic_vertex.get(vertex as usize) == Some(&dynamic);
-            let diagonal = table
-                .condensed
-                .get(j * table.connection_count() + j)
-                .is_some_and(|s| [s[0], s[4], s[8]].iter().all(|&d| d > T::zero()));
-            if !(ascending && mapped && dynamic != FIXED_SLOT && diagonal) {
+            let diagonal = (0..3).all(|a| {
+                table
+                    .condensed_row(3 * j + a)
+                    .get(j)
+                    .and_then(|s| s.get(a))
+                    .is_some_and(|&d| d > T::zero())
+            });
+            if !(ascending && mapped && dynamic == j as u32 && diagonal) {
                 return Err(LoadError::BadConnection {
                     connection: j as u32,
                 });
@@ -96,18 +99,19 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         self.connections
     }
 
-    /// Row `j` of the condensed stiffness: the blocks `S_jk`, `k = 0..c`,
-    /// N/m, row-major 3×3; empty out of range.
-    pub fn condensed_row(&self, j: usize) -> &'a [[T; 9]] {
+    /// Row `r = 3j + a` of the `3c × 3c` condensed stiffness (N/m), as `c`
+    /// triples (columns `3k..3k+3` in triple `k`); empty out of range.
+    pub fn condensed_row(&self, r: usize) -> &'a [[T; 3]] {
         let c = self.connection_count();
-        self.condensed.get(j * c..(j + 1) * c).unwrap_or(&[])
+        self.condensed.get(r * c..(r + 1) * c).unwrap_or(&[])
     }
 
-    /// Row `n` (free index of the pre-computed table) of the response: the
-    /// blocks `H_nj`, `j = 0..c`, m/m; empty out of range.
-    pub fn response_row(&self, n: usize) -> &'a [[T; 9]] {
+    /// Row `r = 3n + a` (free index `n` of the pre-computed table, component
+    /// `a`) of the `3F × 3c` response (m/m), as `c` triples; empty out of
+    /// range.
+    pub fn response_row(&self, r: usize) -> &'a [[T; 3]] {
         let c = self.connection_count();
-        self.response.get(n * c..(n + 1) * c).unwrap_or(&[])
+        self.response.get(r * c..(r + 1) * c).unwrap_or(&[])
     }
 
     /// The built-in load's displacement of each free vertex of the

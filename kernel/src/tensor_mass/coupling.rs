@@ -3,10 +3,8 @@
 //! the condensed stiffness acting on the connection displacements, plus the
 //! constant forces of the region's load and contacts.
 
-use nalgebra::{Matrix3, Vector3};
-
-use super::force::vec3;
 use crate::Real;
+use crate::math::dense::dot;
 use crate::table::InterfaceTable;
 
 /// A tensor-mass model's coupling to a pre-computed region: the interface
@@ -36,23 +34,20 @@ impl<'a, 's, T: Real> Coupling<'a, 's, T> {
 }
 
 impl<T: Real> CouplingForces<'_, '_, T> {
-    /// `f_{d_j} += p_j − Σ_k S_jk u_{d_k}` for every connection node `j` (mesh
-    /// vertex of tensor-mass number `d_j`, passed force `p_j`): the force of
-    /// the pre-computed region, held at the connection displacements with
-    /// its interior at equilibrium (static condensation,
-    /// `S = K_cc − K_ci K_ii⁻¹ K_ic`). `9c²` multiply-adds.
+    /// `f_j += p_j − Σ_k S_jk u_k` for every connection node `j` (tensor-mass
+    /// vertex `j`, passed force `p_j`): the force of the pre-computed region,
+    /// held at the connection displacements with its interior at
+    /// equilibrium (static condensation, `S = K_cc − K_ci K_ii⁻¹ K_ic`).
+    /// `9c²` multiply-adds over contiguous rows.
     pub(crate) fn add_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
-        let connections = self.interface.connections();
-        for (j, (&[_, dj], passed)) in connections.iter().zip(self.passed_force_n).enumerate() {
-            let mut acc = vec3(passed);
-            for (s, &[_, dk]) in self.interface.condensed_row(j).iter().zip(connections) {
-                if let Some(uk) = u.get(dk as usize) {
-                    acc -= Matrix3::from_row_slice(s) * vec3(uk);
-                }
-            }
-            if let Some(fj) = f.get_mut(dj as usize) {
-                *fj = (vec3(fj) + acc).into();
-            }
+        let c = self.interface.connection_count();
+        let (Some(uc), Some(fc)) = (u.get(..c), f.get_mut(..c)) else {
+            return;
+        };
+        let uc = uc.as_flattened();
+        let passed = self.passed_force_n.as_flattened();
+        for (r, (fr, &p)) in fc.as_flattened_mut().iter_mut().zip(passed).enumerate() {
+            *fr += p - dot(self.interface.condensed_row(r).as_flattened(), uc);
         }
     }
 
@@ -60,17 +55,16 @@ impl<T: Real> CouplingForces<'_, '_, T> {
     /// connection displacements, less the work of the passed forces (so
     /// that [`Self::add_forces`] is minus its gradient).
     pub(crate) fn energy_j(&self, u: &[[T; 3]]) -> T {
-        let connections = self.interface.connections();
-        let at = |d: u32| u.get(d as usize).map_or(Vector3::zeros(), vec3);
-        let mut energy = T::zero();
-        for (j, (&[_, dj], passed)) in connections.iter().zip(self.passed_force_n).enumerate() {
-            let uj = at(dj);
-            let mut su = Vector3::zeros();
-            for (s, &[_, dk]) in self.interface.condensed_row(j).iter().zip(connections) {
-                su += Matrix3::from_row_slice(s) * at(dk);
-            }
-            energy += uj.dot(&su) / T::of_f64(2.0) - uj.dot(&vec3(passed));
-        }
-        energy
+        let c = self.interface.connection_count();
+        let uc = u.get(..c).unwrap_or(&[]).as_flattened();
+        let passed = self.passed_force_n.as_flattened();
+        let half = T::of_f64(0.5);
+        uc.iter()
+            .zip(passed)
+            .enumerate()
+            .fold(T::zero(), |e, (r, (&x, &p))| {
+                let su = dot(self.interface.condensed_row(r).as_flattened(), uc);
+                e + x * (half * su - p)
+            })
     }
 }
