@@ -83,22 +83,12 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     if !(options.dt_s.is_finite() && options.dt_s > 0.0) {
         bail!("--dt must be finite and > 0 s, got {}", options.dt_s);
     }
-    let mut last = model.displacements_m()?.to_vec();
-    let mut kinetic_energy = 0.0;
-    let mut fault = None;
-    for _ in 0..options.steps {
-        match model.step(options.integrator, options.dt_s) {
-            Ok(report) => {
-                kinetic_energy = report.kinetic_energy_j;
-                last.copy_from_slice(model.displacements_m()?);
-            }
-            Err(StepError::Faulted(f)) => {
-                fault = Some(f.to_string());
-                break;
-            }
-            Err(e) => bail!("{e}"),
-        }
-    }
+    let first = model.displacements_m()?.to_vec();
+    let (last, kinetic_energy, fault) = run_steps(options.steps, first, |last| {
+        let report = model.step(options.integrator, options.dt_s)?;
+        last.copy_from_slice(model.displacements_m().map_err(StepError::Faulted)?);
+        Ok(report)
+    })?;
     let alive = model.tet_alive();
     Ok(RunOutput {
         volume_change: volume_change(mesh, &last, alive),
@@ -109,6 +99,33 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
             .filter(|&t| !alive[t as usize])
             .collect(),
     })
+}
+
+/// Steps `steps` times with `step`, which steps and, on success, writes
+/// the field into its argument; stops at a fault. Returns the last good
+/// field (starting from `last`), its kinetic energy (J) and the fault, if
+/// any: the step loop of `dynamic run`, for the tensor-mass and the hybrid
+/// model.
+pub fn run_steps(
+    steps: usize,
+    mut last: Vec<[f64; 3]>,
+    mut step: impl FnMut(
+        &mut Vec<[f64; 3]>,
+    ) -> Result<palpate_kernel::tensor_mass::StepReport<f64>, StepError>,
+) -> anyhow::Result<(Vec<[f64; 3]>, f64, Option<String>)> {
+    let mut kinetic_energy = 0.0;
+    let mut field = last.clone();
+    for _ in 0..steps {
+        match step(&mut field) {
+            Ok(report) => {
+                kinetic_energy = report.kinetic_energy_j;
+                last.clone_from(&field);
+            }
+            Err(StepError::Faulted(f)) => return Ok((last, kinetic_energy, Some(f.to_string()))),
+            Err(e) => bail!("{e}"),
+        }
+    }
+    Ok((last, kinetic_energy, None))
 }
 
 /// The table of `mesh` that `options` describe (a tensor-mass kind) in f64:
