@@ -250,6 +250,15 @@ impl<'a> Cursor<'a> {
     }
 }
 
+/// A region id read as a number (an MSH tag, a VTK cell value, a TetGen attribute): an integer
+/// in `0..=u32::MAX`, else `None`.
+pub(crate) fn region_id(value: f64) -> Option<u32> {
+    (value.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&value)).then_some(value as u32)
+}
+
+/// The message of a value that is not a region id.
+pub(crate) const NOT_A_REGION: &str = "is not a region id (an integer from 0 to 4294967295)";
+
 /// Parse an ASCII token.
 pub(crate) fn parse_tok<T: FromStr>(tok: &[u8]) -> Option<T> {
     core::str::from_utf8(tok).ok()?.parse().ok()

@@ -9,6 +9,7 @@
 //! jaws), and [`tool_points`] turns their count into the kernel's const generic.
 
 pub mod generate;
+pub mod materials;
 pub mod run;
 pub mod scene;
 pub mod stability;
@@ -20,6 +21,7 @@ pub use generate::{
     CutLine, GenerateError, Generator, GraspPull, Keyframe, Pinch, Poke, Press, PressHold, Slide,
     Strike, sample_keyframes, sample_keyframes_with_tool_columns,
 };
+pub use materials::RegionSpec;
 pub use scene::{
     DynamicSpec, MAX_TOOL_POINTS, MaterialSpec, MeshSource, ModelSpec, Rates, Scene, SceneError,
     ToolSpec,

@@ -59,26 +59,33 @@ use crate::table::load::TableFile;
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::{OwnedState, OwnedSurface};
 
-/// The build options of `scene`'s table, by its model: its material and
+/// The build options of `scene`'s table on `mesh` (read with `report`), by
+/// its model: its materials per tet ([`Scene::tet_materials`]) and
 /// supports, f32 (the firmware precision), quiet; a pre-computed table
 /// solved by sparse Cholesky, a tensor-mass table of the scene's density.
-pub fn table_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
-    let material = scene.elastic_material()?;
+pub fn table_options(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<BuildOptions> {
+    let materials = scene.tet_materials(mesh, report)?;
+    let material = materials.default_material();
     let fix = scene.fix.clone();
-    Ok(match scene.model {
+    let options = match scene.model {
         ModelSpec::Precomputed => {
             BuildOptions::precomputed(material, fix, Solver::Cholesky, Precision::F32)
         }
         ModelSpec::Dynamic(_) => {
             BuildOptions::tensor_mass(material, scene.material.density_kg_m3, fix, Precision::F32)
         }
-    })
+    };
+    Ok(options.with_tet_materials(materials))
 }
 
 /// The f32 table of `scene` (pre-computed or tensor-mass, by its model),
 /// built in memory with the same pipeline as `palpate tables build`.
 pub fn scene_table(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Vec<u8>> {
-    let options = table_options(scene)?;
+    let options = table_options(scene, mesh, report)?;
     Ok(build(mesh, report, &options)
         .with_context(|| scene.source.clone())?
         .bytes)
@@ -94,7 +101,7 @@ pub fn check_scene_table(
     mesh: &TetMesh,
     report: &MeshReport,
 ) -> anyhow::Result<TableEstimate> {
-    let options = table_options(scene)?;
+    let options = table_options(scene, mesh, report)?;
     let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
     let surface = boundary_surface(mesh);
     let estimate = TableEstimate::of_build(mesh, report, &options, &fixed, &surface);
