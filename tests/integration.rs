@@ -8,7 +8,9 @@ mod host {
     mod compliance;
     mod experiment;
     mod fem;
+    mod materials;
     mod mesh;
+    mod mesh_regions;
     mod robustness;
     mod session;
     mod session_generate_tools;
