@@ -94,11 +94,8 @@ fn dense_stiffness(mesh: &TetMesh, lame: &[[f64; 2]]) -> DMatrix<f64> {
         let d = Matrix3::from_columns(&[p[1] - p[0], p[2] - p[0], p[3] - p[0]]);
         let volume = d.determinant().abs() / 6.0;
         let inv = d.try_inverse().unwrap();
-        let mut a = [Vector3::zeros(); 4];
-        for j in 1..4 {
-            a[j] = inv.row(j - 1).transpose();
-        }
-        a[0] = -(a[1] + a[2] + a[3]);
+        let [a1, a2, a3] = [0, 1, 2].map(|r| inv.row(r).transpose());
+        let a = [-(a1 + a2 + a3), a1, a2, a3];
         for j in 0..4 {
             for l in 0..4 {
                 let block = volume
@@ -517,12 +514,10 @@ fn scene_regions_map_to_tets_and_a_missing_region_is_named() {
             "[[region]] id = 2: young_pa = -1",
         ),
         (
-            NODULE_SCENE
-                .replace("poisson = 0.45\n[[", "poisson = 0.45\n[[")
-                .replace(
-                    "id = 2\nyoung_pa = 30000.0\npoisson = 0.45",
-                    "id = 2\nyoung_pa = 30000.0\npoisson = 0.5",
-                ),
+            NODULE_SCENE.replace(
+                "id = 2\nyoung_pa = 30000.0\npoisson = 0.45",
+                "id = 2\nyoung_pa = 30000.0\npoisson = 0.5",
+            ),
             "[[region]] id = 2: poisson = 0.5",
         ),
         (

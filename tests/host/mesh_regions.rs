@@ -25,7 +25,7 @@ fn msh_2_2_region_is_the_first_tag() {
     assert_eq!(mesh.tets.len(), 2);
     assert_eq!(report.tet_regions, Some(vec![1, 2]));
     // No tags: region 0.
-    let file = msh22(["1", "0"]).replace("3 4 0 2 3 4 5", "3 4 0 2 3 4 5");
+    let file = msh22(["1", "0"]);
     let (_, report) = read_mesh_bytes(file.as_bytes(), MeshFormat::Msh, "a.msh").expect("valid");
     assert_eq!(report.tet_regions, Some(vec![1, 0]));
     let err = read_mesh_bytes(msh22(["-3", "1 2"]).as_bytes(), MeshFormat::Msh, "a.msh")
@@ -114,9 +114,9 @@ fn binary_vtk_region_field() {
         }
     }
     file.extend_from_slice(b"\nCELLS 2 10\n");
-    for cell in [[4, 0, 1, 2, 3], [4, 1, 2, 3, 4]] {
+    for cell in [[4i32, 0, 1, 2, 3], [4, 1, 2, 3, 4]] {
         for v in cell {
-            file.extend_from_slice(&(v as i32).to_be_bytes());
+            file.extend_from_slice(&v.to_be_bytes());
         }
     }
     file.extend_from_slice(b"\nCELL_TYPES 2\n");
