@@ -58,9 +58,10 @@ fn msh_4_1_region_is_the_physical_tag_of_the_tets_entity() {
     // Without $Entities: no region ids.
     let (_, report) = read_mesh_bytes(msh41("").as_bytes(), MeshFormat::Msh, "b.msh").unwrap();
     assert_eq!(report.tet_regions, None);
-    // A truncated $Entities is an error, not a panic.
+    // A truncated $Entities gives no region ids; the mesh reads as before.
     let cut = "$Entities\n1 0 1 2\n1 0 0\n$EndEntities\n";
-    assert!(read_mesh_bytes(msh41(cut).as_bytes(), MeshFormat::Msh, "b.msh").is_err());
+    let (_, report) = read_mesh_bytes(msh41(cut).as_bytes(), MeshFormat::Msh, "b.msh").unwrap();
+    assert_eq!(report.tet_regions, None);
 }
 
 fn vtk(data: &str) -> String {
@@ -159,4 +160,63 @@ fn tetgen_region_is_the_first_attribute() {
         err.starts_with("e.ele: line 2: tet 0: region attribute -1 is not a region id"),
         "{err}"
     );
+}
+
+/// The binary 4.1 layout of `$Entities` (tags `int`, bounds `double`, counts `size_t`).
+#[test]
+fn binary_msh_4_1_region() {
+    let mut b = b"$MeshFormat\n4.1 1 8\n".to_vec();
+    b.extend_from_slice(&1i32.to_le_bytes());
+    b.extend_from_slice(b"\n$EndMeshFormat\n$Entities\n");
+    let size = |b: &mut Vec<u8>, v: u64| b.extend_from_slice(&v.to_le_bytes());
+    let int = |b: &mut Vec<u8>, v: i32| b.extend_from_slice(&v.to_le_bytes());
+    for n in [0u64, 0, 0, 2] {
+        size(&mut b, n);
+    }
+    for (tag, physical) in [(1, Some(4)), (2, None)] {
+        int(&mut b, tag);
+        for x in [0.0f64, 0.0, 0.0, 1.0, 1.0, 1.0] {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+        size(&mut b, u64::from(physical.is_some()));
+        if let Some(p) = physical {
+            int(&mut b, p);
+        }
+        size(&mut b, 1);
+        int(&mut b, 3);
+    }
+    b.extend_from_slice(b"\n$EndEntities\n$Nodes\n");
+    for v in [1u64, 5, 1, 5] {
+        size(&mut b, v);
+    }
+    for v in [3i32, 1, 0] {
+        int(&mut b, v);
+    }
+    size(&mut b, 5);
+    for id in 1..=5u64 {
+        size(&mut b, id);
+    }
+    for p in POINTS.lines() {
+        for x in p.split(' ') {
+            b.extend_from_slice(&x.parse::<f64>().unwrap().to_le_bytes());
+        }
+    }
+    b.extend_from_slice(b"\n$EndNodes\n$Elements\n");
+    for v in [2u64, 2, 1, 2] {
+        size(&mut b, v);
+    }
+    for (entity, id, nodes) in [(2, 1u64, [1u64, 2, 3, 4]), (1, 2, [2, 3, 4, 5])] {
+        for v in [3i32, entity, 4] {
+            int(&mut b, v);
+        }
+        size(&mut b, 1);
+        size(&mut b, id);
+        for n in nodes {
+            size(&mut b, n);
+        }
+    }
+    b.extend_from_slice(b"\n$EndElements\n");
+    let (mesh, report) = read_mesh_bytes(&b, MeshFormat::Msh, "f.msh").expect("valid");
+    assert_eq!(mesh.tets.len(), 2);
+    assert_eq!(report.tet_regions, Some(vec![0, 4]));
 }

@@ -63,6 +63,11 @@ impl<'a> Cursor<'a> {
         }
     }
 
+    /// The bytes not read yet.
+    pub(crate) fn rest(&self) -> &'a [u8] {
+        self.buf.get(self.pos..).unwrap_or(&[])
+    }
+
     pub(crate) fn at_end(&self) -> bool {
         self.pos >= self.buf.len()
     }

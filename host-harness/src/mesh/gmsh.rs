@@ -79,7 +79,8 @@ struct Acc {
     /// Per tet: its first tag (2.x: the physical tag, 0 without tags) or the tag of the entity
     /// of its element block (4.1).
     tet_keys: Vec<i64>,
-    /// 4.1 `$Entities`: volume entity tag → its first physical tag (0 without one).
+    /// 4.1 `$Entities`: volume entity tag → its first physical tag (0 without one); `None`
+    /// without the section or if it does not parse.
     volume_physical: Option<HashMap<i64, i64>>,
     skipped: usize,
     have_nodes: bool,
@@ -150,12 +151,16 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                 expect_end(&mut cur, b"$EndNodes")?;
             }
             b"Entities" if header.version == Version::V41 => {
-                if acc.volume_physical.is_some() {
-                    return Err(cur.err("second $Entities section"));
+                let body = cur.rest();
+                if !cur.skip_past(b"$EndEntities") {
+                    return Err(cur.eof("section $Entities"));
                 }
-                cur.section = "$Entities";
-                acc.volume_physical = Some(entities_v41(&mut cur, &header)?);
-                expect_end(&mut cur, b"$EndEntities")?;
+                let len = body.len() - cur.rest().len() - b"$EndEntities".len();
+                let mut entities = Cursor::new(body.get(..len).unwrap_or(&[]), file);
+                entities.section = "$Entities";
+                // Only the region ids need it: a section that does not parse gives none, and
+                // the mesh is read as before.
+                acc.volume_physical = entities_v41(&mut entities, &header).ok();
             }
             b"Elements" => {
                 if acc.have_elements {

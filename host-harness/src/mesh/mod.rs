@@ -55,7 +55,7 @@ pub struct MeshReport {
     /// The region id of each tet (same order as [`TetMesh::tets`]), where the file has them:
     /// MSH 2.2 the first tag of a tet element (its physical tag; 0 without tags), MSH 4.1 the
     /// first physical tag of the tet's volume entity in `$Entities` (0 for an entity without
-    /// one; `None` without an `$Entities` section), VTK the integer `CELL_DATA` field named
+    /// one; `None` without an `$Entities` section or with one that does not parse), VTK the integer `CELL_DATA` field named
     /// `region` (a `SCALARS` or `FIELD` array; `None` without it), TetGen the first region
     /// attribute of the `.ele` file (`None` without attributes). The scene's `[[region]]`
     /// materials are looked up here (heterogeneous tissue).
