@@ -7,7 +7,7 @@
 //! `VECTORS`, `NORMALS`, `TENSORS`); the search ends at any other keyword, without regions.
 
 use super::MeshError;
-use super::cursor::{Cursor, NOT_A_REGION, cap, region_id, show};
+use super::cursor::{Cursor, NOT_A_REGION, cap, parse_tok, region_id, show};
 use super::validate::{Numbering, RawMesh};
 
 /// VTK cell type of the linear tet.
@@ -298,6 +298,15 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// One attribute array's header.
+struct Array {
+    /// The cells' array named `region`.
+    is_region: bool,
+    ty: DataType,
+    components: usize,
+    tuples: usize,
+}
+
 /// The region id of every cell: the `CELL_DATA` array named `region` among the attribute data
 /// that starts at `keyword` (`POINT_DATA` or `CELL_DATA`, already read), `None` without one.
 /// Errors only on the `region` array itself: not one value per cell, not one component, or a
@@ -310,11 +319,12 @@ fn regions(
     r.cur.section = "CELL_DATA";
     let mut on_cells = false;
     let mut count = 0usize;
+    let number = |w: Option<&&[u8]>| w.and_then(|w| parse_tok::<usize>(w));
+    let data_type = |w: Option<&&[u8]>| w.and_then(|w| DataType::of(w));
     loop {
         let Some(tok) = keyword.take().or_else(|| r.cur.token()) else {
             return Ok(None);
         };
-        // (name, type, components, tuples) of one array, or a keyword read past.
         let array = match tok.to_ascii_uppercase().as_slice() {
             b"POINT_DATA" | b"CELL_DATA" => {
                 on_cells = tok.eq_ignore_ascii_case(b"CELL_DATA");
@@ -324,58 +334,64 @@ fn regions(
                 count = n;
                 continue;
             }
+            // SCALARS name type [components], then an optional LOOKUP_TABLE line.
             b"SCALARS" => {
                 let words = r.words();
-                let components = match words.get(2) {
-                    Some(w) => super::cursor::parse_tok::<usize>(w),
-                    None => Some(1),
+                let components = if words.len() > 2 {
+                    number(words.get(2))
+                } else {
+                    Some(1)
                 };
                 if matches!(r.cur.peek_token(), Some(t) if t.eq_ignore_ascii_case(b"LOOKUP_TABLE"))
                 {
                     r.cur.line();
                 }
-                let (Some(&name), Some(ty), Some(components)) = (
-                    words.first(),
-                    words.get(1).and_then(|t| DataType::of(t)),
-                    components,
-                ) else {
-                    return Ok(None);
-                };
-                vec![(name, ty, components, count)]
-            }
-            b"FIELD" => {
-                let words = r.words();
-                let Some(arrays) = words
-                    .get(1)
-                    .and_then(|w| super::cursor::parse_tok::<usize>(w))
+                let (Some(&name), Some(ty), Some(components)) =
+                    (words.first(), data_type(words.get(1)), components)
                 else {
                     return Ok(None);
                 };
-                let mut found = None;
+                Array {
+                    is_region: on_cells && name == b"region",
+                    ty,
+                    components,
+                    tuples: count,
+                }
+            }
+            // FIELD name arrays, then per array: name components tuples type, values.
+            b"FIELD" => {
+                let Some(arrays) = number(r.words().get(1)) else {
+                    return Ok(None);
+                };
+                let mut region = None;
                 for _ in 0..arrays {
                     let words = r.words();
-                    let parse = |k: usize| {
-                        words
-                            .get(k)
-                            .and_then(|w| super::cursor::parse_tok::<usize>(w))
-                    };
                     let (Some(&name), Some(components), Some(tuples), Some(ty)) = (
                         words.first(),
-                        parse(1),
-                        parse(2),
-                        words.get(3).and_then(|t| DataType::of(t)),
+                        number(words.get(1)),
+                        number(words.get(2)),
+                        data_type(words.get(3)),
                     ) else {
                         return Ok(None);
                     };
-                    if on_cells && name == b"region" {
-                        found = Some((name, ty, components, tuples));
+                    let array = Array {
+                        is_region: on_cells && name == b"region",
+                        ty,
+                        components,
+                        tuples,
+                    };
+                    if array.is_region {
+                        region = Some(array);
                         break;
                     }
                     if r.skip_values(ty, components.checked_mul(tuples)).is_none() {
                         return Ok(None);
                     }
                 }
-                found.into_iter().collect()
+                let Some(region) = region else {
+                    continue;
+                };
+                region
             }
             b"VECTORS" | b"NORMALS" | b"TENSORS" => {
                 let per = if tok.eq_ignore_ascii_case(b"TENSORS") {
@@ -383,8 +399,7 @@ fn regions(
                 } else {
                     3
                 };
-                let words = r.words();
-                let Some(ty) = words.get(1).and_then(|t| DataType::of(t)) else {
+                let Some(ty) = data_type(r.words().get(1)) else {
                     return Ok(None);
                 };
                 if r.skip_values(ty, count.checked_mul(per)).is_none() {
@@ -394,29 +409,35 @@ fn regions(
             }
             _ => return Ok(None),
         };
-        for (name, ty, components, tuples) in array {
-            if !(on_cells && name == b"region") {
-                if r.skip_values(ty, components.checked_mul(tuples)).is_none() {
-                    return Ok(None);
-                }
-                continue;
+        if !array.is_region {
+            if r.skip_values(array.ty, array.components.checked_mul(array.tuples))
+                .is_none()
+            {
+                return Ok(None);
             }
-            if components != 1 || tuples != cells {
-                return Err(r.cur.err(format_args!(
-                    "the region array has {tuples} values of {components} components for {cells} cells (expected one integer per cell)"
-                )));
-            }
-            let mut ids = Vec::with_capacity(cap(cells, r.cur.len()));
-            for i in 0..cells {
-                let what = format_args!("region of cell {i}");
-                let v = r.value(ty, &what)?;
-                ids.push(region_id(v).ok_or_else(|| {
-                    r.cur
-                        .err(format_args!("cell {i}: region {v} {NOT_A_REGION}"))
-                })?);
-            }
-            return Ok(Some(ids));
+            continue;
         }
+        let Array {
+            ty,
+            components,
+            tuples,
+            ..
+        } = array;
+        if components != 1 || tuples != cells {
+            return Err(r.cur.err(format_args!(
+                "the region array has {tuples} values of {components} components for {cells} cells (expected one integer per cell)"
+            )));
+        }
+        let mut ids = Vec::with_capacity(cap(cells, r.cur.len()));
+        for i in 0..cells {
+            let v = r.value(ty, &format_args!("region of cell {i}"))?;
+            let id = region_id(v).ok_or_else(|| {
+                r.cur
+                    .err(format_args!("cell {i}: region {v} {NOT_A_REGION}"))
+            })?;
+            ids.push(id);
+        }
+        return Ok(Some(ids));
     }
 }
 
