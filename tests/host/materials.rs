@@ -477,7 +477,11 @@ fn scene_regions_map_to_tets_and_a_missing_region_is_named() {
     let scene = Scene::from_toml_str_named(NODULE_SCENE, "nodule.toml", &dir).unwrap();
     let (read, report) = scene.load_mesh().unwrap();
     let per_tet = scene.tet_materials(&read, &report).unwrap();
-    assert_eq!(per_tet, materials(&mesh));
+    for (m, r) in per_tet.per_tet().iter().zip(regions(&mesh)) {
+        let want = if r == NODULE { NODULE_PA } else { SOFT_PA };
+        assert_eq!((m.young_pa, m.poisson), (want, POISSON));
+    }
+    assert_eq!(per_tet.default_material().young_pa, SOFT_PA);
 
     let absent = NODULE_SCENE.replace("id = 2", "id = 5");
     let scene = Scene::from_toml_str_named(&absent, "nodule.toml", &dir).unwrap();
