@@ -8,7 +8,9 @@ mod host {
     mod compliance;
     mod experiment;
     mod fem;
+    mod materials;
     mod mesh;
+    mod mesh_regions;
     mod partition;
     mod robustness;
     mod session;

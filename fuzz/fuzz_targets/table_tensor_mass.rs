@@ -33,7 +33,7 @@ fn check<T: Real>(table: &TensorMassTable<'_, T>) {
     let fixed = (0..n as u32).filter(|&v| table.is_fixed(v)).count();
     assert_eq!(n - fixed, header.free_count as usize);
     assert!(!table.is_fixed(n as u32));
-    let _ = (table.lame(), table.density_kg_m3());
+    let _ = (table.tet_materials(), table.density_kg_m3());
 
     // Per-vertex data.
     assert_eq!(table.rest_positions().len(), n);

@@ -46,7 +46,7 @@ pub fn run(out_dir: &Path, printed: &mut dyn Write) -> anyhow::Result<()> {
     };
     let (mesh, mut report) = scene.load_mesh()?;
     report.source = "built-in block".into();
-    let options = table_options(&scene)?;
+    let options = table_options(&scene, &mesh, &report)?;
     writeln!(
         out,
         "scene: {:.0}x{:.0}x{:.0} cm block, {} vertices, {} tets, E = {} Pa, nu = {}, base fixed",

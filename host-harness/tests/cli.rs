@@ -504,3 +504,48 @@ fn session_run_drives_both_models_through_the_cli() {
         assert!(rows.iter().filter(|r| r[4] == "1").count() > 100, "{scene}");
     }
 }
+
+#[test]
+fn session_run_refuses_a_region_absent_from_the_mesh() {
+    let dir = temp("session-region");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 2 x 2 x 2 cm block whose tets are all of region 1 (MSH 2.2 physical tag).
+    let mesh = palpate::mesh::generate::box_mesh([2, 2, 2], [0.02, 0.02, 0.02]);
+    let mut msh = format!(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n{}\n",
+        mesh.positions.len()
+    );
+    for (i, p) in mesh.positions.iter().enumerate() {
+        msh += &format!("{} {:?} {:?} {:?}\n", i + 1, p[0], p[1], p[2]);
+    }
+    msh += &format!("$EndNodes\n$Elements\n{}\n", mesh.tets.len());
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        let [a, b, c, d] = tet.map(|v| v + 1);
+        msh += &format!("{} 4 2 1 1 {a} {b} {c} {d}\n", t + 1);
+    }
+    msh += "$EndElements\n";
+    std::fs::write(dir.join("block.msh"), msh).unwrap();
+    let scene = dir.join("nodule.toml");
+    std::fs::write(
+        &scene,
+        "mesh = \"block.msh\"\nfix = [\"z<0.001\"]\n[material]\nyoung_pa = 3000.0\npoisson = 0.45\n\
+         [[region]]\nid = 9\nyoung_pa = 30000.0\npoisson = 0.45\n",
+    )
+    .unwrap();
+    let poke = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", poke.to_str().unwrap()]);
+    assert!(out.status.success());
+    let out = palpate(&[
+        "session",
+        "run",
+        scene.to_str().unwrap(),
+        "--trajectory",
+        poke.to_str().unwrap(),
+        "--out",
+        dir.join("forces.csv").to_str().unwrap(),
+    ]);
+    assert_one_line_error(
+        &out,
+        &["nodule.toml: [[region]] id = 9: ", "block.msh", "region 9"],
+    );
+}

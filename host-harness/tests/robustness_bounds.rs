@@ -177,7 +177,7 @@ fn generated_scene_too_large_for_a_table_is_refused_without_allocating() {
     assert_one_line_error(
         &out,
         &[
-            "the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+            "the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.1 GB",
         ],
     );
     assert!(stderr(&out).contains("tensor-mass"), "{}", stderr(&out));
@@ -191,7 +191,7 @@ fn generated_scene_too_large_for_a_table_is_refused_without_allocating() {
         "--work-dir",
         &temp("budget40").display().to_string(),
     ]);
-    assert_one_line_error(&out, &["would be 18.0 GB"]);
+    assert_one_line_error(&out, &["would be 18.1 GB"]);
     assert!(started.elapsed() < Duration::from_secs(5));
 }
 
@@ -228,7 +228,7 @@ fn tables_build_of_a_40_cubed_box_is_refused_without_allocating() {
     assert_one_line_error(
         &out,
         &[
-            "box40.node: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB",
+            "box40.node: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.1 GB",
         ],
     );
     assert!(started.elapsed() < Duration::from_secs(10));

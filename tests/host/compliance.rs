@@ -5,7 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use palpate::fem::assembly::FreeOrdering;
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::fem::static_solve::solve_prescribed;
 use palpate::table::compliance::{Compliance, Solver, compute_compliance};
 use palpate_kernel::table::format::surface_block_index;
@@ -15,6 +15,11 @@ use palpate_tests::{
 
 fn material() -> Material {
     Material::new(5000.0, 0.45).unwrap()
+}
+
+/// Every tet of `t` of [`material`].
+fn uniform(t: &[[u32; 4]]) -> TetMaterials {
+    TetMaterials::uniform(material(), t.len())
 }
 
 /// Base `z = 0` fixed, touchable = free boundary vertices.
@@ -56,7 +61,7 @@ fn check_against_reference(solver: Solver, tol: f64) {
     // 5x5x5 cube: 216 - 64 interior - 36 base = 116 touchable, 180 free.
     assert_eq!(o.free_count(), 180);
     assert_eq!(o.touchable_count, 116);
-    let c = compute_compliance(&p, &t, &material(), &o, solver, false).unwrap();
+    let c = compute_compliance(&p, &t, &uniform(&t), &o, solver, false).unwrap();
     assert_eq!(c.surface.len(), 116 * 117 / 2);
     assert_eq!(c.interior.len(), 64 * 116);
 
@@ -118,7 +123,7 @@ fn cg_compliance_matches_reference() {
 fn compliance_is_symmetric_and_consistent_with_static_solve() {
     let (p, t) = kuhn_box([3, 2, 4]);
     let (fixed, o) = box_ordering(&p, &t);
-    let c = compute_compliance(&p, &t, &material(), &o, Solver::Cholesky, false).unwrap();
+    let c = compute_compliance(&p, &t, &uniform(&t), &o, Solver::Cholesky, false).unwrap();
     let s = o.touchable_count;
     // Diagonal blocks symmetric.
     for k in 0..s {
@@ -133,7 +138,7 @@ fn compliance_is_symmetric_and_consistent_with_static_solve() {
     let k = s / 2;
     let v = o.free_vertex[k];
     let d = [0.002, -0.001, -0.004];
-    let (u, f) = solve_prescribed(&p, &t, &material(), &fixed, &[(v, d)]).unwrap();
+    let (u, f) = solve_prescribed(&p, &t, &uniform(&t), &fixed, &[(v, d)]).unwrap();
     let ckk = block(&c, &o, k, k);
     let inv = nalgebra::Matrix3::from_fn(|a, b| ckk[a][b])
         .try_inverse()
@@ -156,7 +161,7 @@ fn compliance_is_symmetric_and_consistent_with_static_solve() {
 #[test]
 fn compliance_rejects_bad_input() {
     let (p, t) = kuhn_box([2, 2, 2]);
-    let m = material();
+    let m = uniform(&t);
     // Nothing fixed: A singular.
     let none = FreeOrdering::new(
         p.len(),
@@ -167,13 +172,16 @@ fn compliance_rejects_bad_input() {
     // Ordering for another mesh.
     let (_, o) = box_ordering(&p, &t);
     assert!(compute_compliance(&p[1..], &t, &m, &o, Solver::Cholesky, false).is_err());
+    // Materials for another mesh.
+    let fewer = TetMaterials::uniform(material(), t.len() - 1);
+    assert!(compute_compliance(&p, &t, &fewer, &o, Solver::Cholesky, false).is_err());
 }
 
 fn time_box(cells: usize, solver: Solver) -> f64 {
     let (p, t) = kuhn_box([cells; 3]);
     let (_, o) = box_ordering(&p, &t);
     let start = std::time::Instant::now();
-    let c = compute_compliance(&p, &t, &material(), &o, solver, false).unwrap();
+    let c = compute_compliance(&p, &t, &uniform(&t), &o, solver, false).unwrap();
     let secs = start.elapsed().as_secs_f64();
     println!(
         "{cells}x{cells}x{cells} box, {solver:?}: {} vertices, {} free, {} touchable, {} blocks: {secs:.3} s",

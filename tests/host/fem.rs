@@ -6,7 +6,7 @@
 
 use palpate::fem::assembly::{FreeOrdering, assemble_stiffness};
 use palpate::fem::element::{element_stiffness, shape_gradients};
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::fem::static_solve::solve_prescribed;
 use palpate_tests::{
     max_entry_difference, read_reference_json, read_reference_stiffness, read_reference_tetgen,
@@ -195,7 +195,7 @@ fn element_matches_energy_finite_difference() {
 
 fn cube_k() -> faer::sparse::SparseColMat<usize, f64> {
     let (p, t) = read_reference_tetgen("cube");
-    assemble_stiffness(&p, &t, &material())
+    assemble_stiffness(&p, &t, &TetMaterials::uniform(material(), t.len()))
 }
 
 #[test]
@@ -278,7 +278,14 @@ fn static_solve_matches_reference_contacts() {
     let single = &r["single_contact"];
     let v = single["vertex"].as_u64().unwrap() as u32;
     let d = vec3s(&serde_json::json!([single["imposed_displacement"]]))[0];
-    let (u, f) = solve_prescribed(&p, &t, &material(), &fixed, &[(v, d)]).unwrap();
+    let (u, f) = solve_prescribed(
+        &p,
+        &t,
+        &TetMaterials::uniform(material(), t.len()),
+        &fixed,
+        &[(v, d)],
+    )
+    .unwrap();
     let ref_u = vec3s(&single["displacements"]);
     let ref_f = vec3s(&serde_json::json!([single["force"]]));
     let eu = rel_max_diff(&flat(&u), &flat(&ref_u));
@@ -296,7 +303,14 @@ fn static_solve_matches_reference_contacts() {
         .collect();
     let ds = vec3s(&two["imposed_displacements"]);
     let pres: Vec<(u32, [f64; 3])> = vs.iter().copied().zip(ds.iter().copied()).collect();
-    let (u, f) = solve_prescribed(&p, &t, &material(), &fixed, &pres).unwrap();
+    let (u, f) = solve_prescribed(
+        &p,
+        &t,
+        &TetMaterials::uniform(material(), t.len()),
+        &fixed,
+        &pres,
+    )
+    .unwrap();
     let eu = rel_max_diff(&flat(&u), &flat(&vec3s(&two["displacements"])));
     let ef = rel_max_diff(&flat(&f), &flat(&vec3s(&two["forces"])));
     println!("two contacts: displacement rel {eu:e}, force rel {ef:e}");
@@ -306,7 +320,7 @@ fn static_solve_matches_reference_contacts() {
 #[test]
 fn static_solve_rejects_bad_input() {
     let (p, t) = read_reference_tetgen("cube");
-    let m = material();
+    let m = TetMaterials::uniform(material(), t.len());
     let fixed: Vec<bool> = p.iter().map(|x| x[2] == 0.0).collect();
     assert!(
         solve_prescribed(&p, &t, &m, &fixed, &[(0, [0.0; 3])]).is_err(),
@@ -318,6 +332,9 @@ fn static_solve_rejects_bad_input() {
     // Nothing holds the body: singular.
     let none = vec![false; p.len()];
     assert!(solve_prescribed(&p, &t, &m, &none, &[]).is_err());
+    // Materials for another mesh.
+    let fewer = TetMaterials::uniform(material(), t.len() - 1);
+    assert!(solve_prescribed(&p, &t, &fewer, &fixed, &[]).is_err());
 }
 
 #[test]

@@ -4,7 +4,7 @@
 //! from a pulled cut the static deformation stays past the linear model's range.
 
 use palpate::fem::element::shape_gradients;
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::fem::static_solve::solve_prescribed;
 use palpate::mesh::TetMesh;
 use palpate::mesh::generate::box_mesh;
@@ -333,7 +333,14 @@ fn margin_default_is_where_a_pulled_cut_is_back_in_the_linear_range() {
         .zip(&used)
         .map(|(f, u)| *f || !u)
         .collect();
-    let (u, _) = solve_prescribed(&mesh.positions, &kept, &material, &fixed, &pull).unwrap();
+    let (u, _) = solve_prescribed(
+        &mesh.positions,
+        &kept,
+        &TetMaterials::uniform(material, kept.len()),
+        &fixed,
+        &pull,
+    )
+    .unwrap();
     // |∇u| of tet t: ∇u = Σ_j u_j ⊗ a_j (MODELS.md §1).
     let gradient = |t: &[u32; 4]| {
         let (a, _) = shape_gradients(&t.map(|v| mesh.positions[v as usize]));

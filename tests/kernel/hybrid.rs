@@ -7,7 +7,7 @@
 
 use nalgebra::Vector3;
 use palpate::fem::element::shape_gradients;
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::fem::static_solve::solve_loaded;
 use palpate::hybrid::owned::with_hybrid;
 use palpate::hybrid::{HybridOptions, HybridTables, build_hybrid};
@@ -25,6 +25,11 @@ const SIZE_M: f64 = 0.04;
 
 fn material() -> Material {
     Material::new(5000.0, 0.3).expect("material")
+}
+
+/// [`material`] on every tet of `mesh`, for the global solves.
+fn uniform(mesh: &TetMesh) -> TetMaterials {
+    TetMaterials::uniform(material(), mesh.tets.len())
 }
 
 fn block() -> (TetMesh, MeshReport) {
@@ -179,7 +184,7 @@ fn steady_state_under_gravity_and_point_loads_is_the_global_solve() {
     let (global, _) = solve_loaded(
         &mesh.positions,
         &mesh.tets,
-        &material(),
+        &uniform(&mesh),
         &fixed(&mesh),
         &[],
         &loads,
@@ -239,7 +244,7 @@ fn steady_state_under_a_press_on_either_region_is_the_global_solve() {
         let (global, reactions) = solve_loaded(
             &mesh.positions,
             &mesh.tets,
-            &material(),
+            &uniform(&mesh),
             &fixed(&mesh),
             &[(vertex, press)],
             &[],
@@ -553,7 +558,7 @@ fn haptic_loop_press_on_either_region_settles_to_the_global_equilibrium() {
                 let (_, reactions) = solve_loaded(
                     &mesh.positions,
                     &mesh.tets,
-                    &material(),
+                    &uniform(&mesh),
                     &fixed(&mesh),
                     &prescribed,
                     &[],

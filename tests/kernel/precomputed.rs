@@ -14,7 +14,7 @@
 #![allow(clippy::needless_range_loop)] // component loops mirror MODELS.md notation
 
 use nalgebra::Vector3;
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::fem::static_solve::solve_prescribed;
 use palpate::table::file::Precision;
 use palpate::table::load::{AnyModel, TableFile};
@@ -164,7 +164,7 @@ fn four_contacts_match_direct_dirichlet_solve() {
     let (u_direct, f_direct) = solve_prescribed(
         &mesh.positions,
         &mesh.tets,
-        &Material::new(5000.0, 0.45).unwrap(),
+        &TetMaterials::uniform(Material::new(5000.0, 0.45).unwrap(), mesh.tets.len()),
         &fixed,
         &contacts,
     )

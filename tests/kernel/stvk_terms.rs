@@ -10,7 +10,7 @@ use core::f64::consts::PI;
 use std::collections::HashMap;
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
 use palpate::table::build::{BuildOptions, build};
@@ -398,7 +398,6 @@ fn subtracting_tet_terms_equals_rebuild_without_the_tets() {
     let mesh = cube();
     let file = table_file(&mesh);
     let table = TensorMassTable::<f64>::load(file.bytes()).expect("valid table");
-    let (lambda, mu) = table.lame();
     // A corner tet, a few interior tets, and all 6 tets of one cell (so some
     // interior edges and triangles lose every tet).
     let removed: Vec<usize> = [0, 17, 100, 101, 374, 749]
@@ -418,6 +417,7 @@ fn subtracting_tet_terms_equals_rebuild_without_the_tets() {
     };
     for &t in &removed {
         let (a, volume) = table.tet_shape(t).unwrap();
+        let [lambda, mu] = table.tet_materials()[t];
         let place = TetPlace {
             tet: t as u32,
             vertices: table.tets()[t],
@@ -439,7 +439,7 @@ fn subtracting_tet_terms_equals_rebuild_without_the_tets() {
     };
     let rebuilt = TensorMassArrays::new(
         &live,
-        &options().material,
+        &TetMaterials::uniform(options().material, live.tets.len()),
         1000.0,
         vec![false; mesh.positions.len()],
     );
@@ -577,7 +577,7 @@ fn broken_triangle_sections_are_refused() {
     let opts = options();
     let arrays = TensorMassArrays::new(
         &mesh,
-        &opts.material,
+        &TetMaterials::uniform(opts.material, mesh.tets.len()),
         1000.0,
         vec![false; mesh.positions.len()],
     );

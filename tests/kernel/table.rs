@@ -123,7 +123,7 @@ impl Tiny {
     fn bytes(&self) -> Vec<u8> {
         write_table(
             &TableContents {
-                tet_count: 2,
+                tet_lame: &[[1.0, 1.0]; 2],
                 young_pa: self.young_pa,
                 poisson: 0.3,
                 mesh_hash: 7,

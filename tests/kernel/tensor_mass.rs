@@ -6,7 +6,7 @@
 //! conservation of the symplectic schemes, and the fault state.
 
 use nalgebra::{Matrix2, Vector2, Vector3};
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::file::Precision;
@@ -389,7 +389,12 @@ fn broken_edge_and_tet_references_are_refused() {
     let (mesh, _) = cube();
     let opts = options(&["z<0.001"], 5000.0, 0.45);
     let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 0.001).collect();
-    let arrays = TensorMassArrays::new(&mesh, &opts.material, DENSITY, fixed);
+    let arrays = TensorMassArrays::new(
+        &mesh,
+        &TetMaterials::uniform(opts.material, mesh.tets.len()),
+        DENSITY,
+        fixed,
+    );
     let load = |arrays: &TensorMassArrays| {
         let triangles = boundary_surface(&mesh).triangles;
         let bytes = write_tensor_mass_table(&mesh, &triangles, arrays, opts.precision);
@@ -450,7 +455,12 @@ fn removal_equals_rebuild_and_keeps_the_mesh_conformal() {
 
     let live = palpate_tests::live_mesh(&mesh, model.tet_alive());
     let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 0.001).collect();
-    let rebuilt = TensorMassArrays::new(&live, &opts.material, DENSITY, fixed);
+    let rebuilt = TensorMassArrays::new(
+        &live,
+        &TetMaterials::uniform(opts.material, live.tets.len()),
+        DENSITY,
+        fixed,
+    );
     let scale = rebuilt
         .vertex_tensors
         .iter()

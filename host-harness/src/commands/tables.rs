@@ -137,6 +137,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             let options = BuildOptions {
                 kind,
                 material: material.material()?,
+                tet_materials: None,
                 fix: fix.fix,
                 precision,
                 progress: !quiet,

@@ -21,7 +21,7 @@ use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, StvkForm, TensorMas
 use serde::Serialize;
 
 use super::relax::{Relaxation, relax};
-use crate::fem::material::Material;
+use crate::fem::material::{Material, TetMaterials};
 use crate::mesh::{TetMesh, boundary_surface};
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
@@ -215,7 +215,8 @@ pub fn run_scene(
 ) -> anyhow::Result<SceneResult> {
     // The fixed flags are the scene's own (no predicates): the arrays and
     // the writer of the table build, without its predicate stage.
-    let arrays = TensorMassArrays::new(&scene.mesh, &scene.material, 1000.0, scene.fixed.clone());
+    let materials = TetMaterials::uniform(scene.material, scene.mesh.tets.len());
+    let arrays = TensorMassArrays::new(&scene.mesh, &materials, 1000.0, scene.fixed.clone());
     let file = TableFile::from_bytes(&write_tensor_mass_table(
         &scene.mesh,
         &boundary_surface(&scene.mesh).triangles,

@@ -5,23 +5,25 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use palpate_kernel::table::format::FIXED_SLOT;
 
 use super::element::element_stiffness;
-use super::material::Material;
+use super::material::TetMaterials;
 
 /// Full global stiffness `K` (N/m), `3N × 3N` for `N = positions.len()`, with
 /// DOF `3 * vertex + component` (component 0 = x, 1 = y, 2 = z).
 ///
 /// `K = Σ_tets` of the element blocks of [`element_stiffness`]
-/// (`MODELS.md` §1), so `K u = f` gives the external nodal forces `f` (N)
+/// (`MODELS.md` §1), each tet with its own material `m.per_tet()[t]`, so
+/// `K u = f` gives the external nodal forces `f` (N)
 /// balancing displacements `u` (m). Every block `(i, j)` of an edge or vertex
 /// of the mesh is stored (both triangles, sorted row indices); vertices used
 /// by no tet get empty columns.
 ///
 /// # Panics
-/// If a tet references a vertex `>= positions.len()`.
+/// If a tet references a vertex `>= positions.len()` or `m` is not for
+/// `tets.len()` tets.
 pub fn assemble_stiffness(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
-    m: &Material,
+    m: &TetMaterials,
 ) -> SparseColMat<usize, f64> {
     let n = u32::try_from(positions.len()).expect("vertex count fits in u32");
     let slot: Vec<Option<u32>> = (0..n).map(Some).collect();
@@ -38,16 +40,18 @@ pub fn assemble_stiffness(
 /// the stiffness restricted to the free DOFs. Both triangles are stored.
 ///
 /// # Panics
-/// If `slot.len() != positions.len()`, a slot is `>= slot_count`, or a tet
-/// references a vertex `>= positions.len()`.
+/// If `slot.len() != positions.len()`, a slot is `>= slot_count`, a tet
+/// references a vertex `>= positions.len()`, or `m` is not for `tets.len()`
+/// tets.
 pub fn assemble_restricted(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
-    m: &Material,
+    m: &TetMaterials,
     slot: &[Option<u32>],
     slot_count: usize,
 ) -> SparseColMat<usize, f64> {
     assert_eq!(slot.len(), positions.len(), "one slot per vertex");
+    assert_eq!(m.len(), tets.len(), "one material per tet");
     assert!(
         slot.iter().flatten().all(|&s| (s as usize) < slot_count),
         "slot out of range"
@@ -78,13 +82,13 @@ pub fn assemble_restricted(
         }
     }
     let mut val = vec![0.0f64; row_idx.len()];
-    for t in tets {
+    for (t, material) in tets.iter().zip(m.per_tet()) {
         let s = t.map(|v| slot[v as usize]);
         if s.iter().all(Option::is_none) {
             continue;
         }
         let p = t.map(|v| positions[v as usize]);
-        let ke = element_stiffness(&p, m);
+        let ke = element_stiffness(&p, material);
         // Block (row j, column k) goes to column slot s[k], neighbour s[j].
         for (k, sk) in s.iter().enumerate() {
             let Some(sk) = *sk else { continue };

@@ -5,7 +5,7 @@ use faer::Mat;
 
 use super::assembly::{assemble_restricted, assemble_stiffness};
 use super::llt::SparseLlt;
-use super::material::Material;
+use super::material::TetMaterials;
 
 /// One 3-vector per vertex (or per prescribed vertex): displacements in m or
 /// forces in N. Plain `Vec<[f64; 3]>`.
@@ -24,13 +24,17 @@ pub type VertexVectors = Vec<[f64; 3]>;
 ///   `f_p = (K u)_p` (N): the force the constraint applies to the tissue
 ///   at that vertex (for a single contact, `f = C_kk⁻¹ u_p`).
 ///
-/// Errors if `fixed.len() != positions.len()`, a prescribed vertex is out of
-/// range, fixed or listed twice, a tet references a missing vertex, or the
-/// reduced system is not positive definite (e.g. nothing holds the body).
+/// Each tet has its own material `m.per_tet()[t]` ([`TetMaterials::uniform`]
+/// for a homogeneous body).
+///
+/// Errors if `fixed.len() != positions.len()`, `m` is not for `tets.len()`
+/// tets, a prescribed vertex is out of range, fixed or listed twice, a tet
+/// references a missing vertex, or the reduced system is not positive
+/// definite (e.g. nothing holds the body).
 pub fn solve_prescribed(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
-    m: &Material,
+    m: &TetMaterials,
     fixed: &[bool],
     prescribed: &[(u32, [f64; 3])],
 ) -> anyhow::Result<(VertexVectors, VertexVectors)> {
@@ -45,7 +49,7 @@ pub fn solve_prescribed(
 pub fn solve_loaded(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
-    m: &Material,
+    m: &TetMaterials,
     fixed: &[bool],
     prescribed: &[(u32, [f64; 3])],
     loads_n: &[[f64; 3]],
@@ -63,6 +67,7 @@ pub fn solve_loaded(
         fixed.len()
     );
     ensure!(u32::try_from(n).is_ok(), "too many vertices");
+    m.check_tet_count(tets.len())?;
     for (t, tet) in tets.iter().enumerate() {
         ensure!(
             tet.iter().all(|&v| (v as usize) < n),

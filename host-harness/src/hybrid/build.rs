@@ -13,10 +13,10 @@ use super::condense::{Condensed, condense};
 use super::split::RegionSplit;
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::element::shape_gradients;
-use crate::fem::material::Material;
+use crate::fem::material::{Material, TetMaterials};
 use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
-use crate::table::build::{BuildOptions, BuiltTable, precomputed};
+use crate::table::build::{BuildOptions, BuiltTable, Stages, precomputed};
 use crate::table::compliance::Solver;
 use crate::table::file::{Precision, Section, write_container};
 use crate::table::load::TableFile;
@@ -25,15 +25,12 @@ use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 /// What a hybrid build needs besides the mesh and the split.
 #[derive(Clone, Debug)]
 pub struct HybridOptions {
-    /// Young's modulus and Poisson ratio of both regions.
-    pub material: Material,
+    /// The materials (one, or one per tet of the whole mesh), the fixed
+    /// predicates and the precision, as a pre-computed build takes them.
+    pub build: BuildOptions,
     /// Mass density, kg/m³ (the tensor-mass region's masses and the
     /// pre-computed region's gravity load).
     pub density_kg_m3: f64,
-    /// A vertex matching any predicate is fixed.
-    pub fix: Vec<FixPredicate>,
-    /// Stored float width.
-    pub precision: Precision,
     /// Gravity on the pre-computed region, m/s² (built into its load; the
     /// tensor-mass region takes it as a run parameter).
     pub gravity_m_s2: [f64; 3],
@@ -60,7 +57,8 @@ pub enum ConnectionMass {
 }
 
 impl HybridOptions {
-    /// Options with no load and the default connection mass.
+    /// Options of one `material` with no load and the default connection
+    /// mass (per-tet materials: [`Self::with_tet_materials`]).
     pub fn new(
         material: Material,
         density_kg_m3: f64,
@@ -68,13 +66,19 @@ impl HybridOptions {
         precision: Precision,
     ) -> Self {
         Self {
-            material,
+            build: BuildOptions::precomputed(material, fix, Solver::Cholesky, precision),
             density_kg_m3,
-            fix,
-            precision,
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+        }
+    }
+
+    /// The same with one material per tet of the whole mesh.
+    pub fn with_tet_materials(self, materials: TetMaterials) -> Self {
+        Self {
+            build: self.build.with_tet_materials(materials),
+            ..self
         }
     }
 }
@@ -113,7 +117,9 @@ pub fn build_hybrid(
 ) -> anyhow::Result<HybridTables> {
     let source = &report.source;
     let n = mesh.positions.len();
-    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
+    let build = &options.build;
+    let materials = build.materials_for(mesh.tets.len())?;
+    let (fixed, _) = fixed_vertices(&mesh.positions, &build.fix, &report.unreferenced_vertices);
     let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
 
     // The pre-computed region: connection nodes and vertices outside it fixed.
@@ -128,12 +134,11 @@ pub fn build_hybrid(
         );
     }
     let surface = boundary_surface(&pmesh);
-    let build = BuildOptions::precomputed(
-        options.material,
-        options.fix.clone(),
-        Solver::Cholesky,
-        options.precision,
-    );
+    let region_tets = |dynamic: bool| {
+        let flags = &split.dynamic_tet;
+        (0..flags.len()).filter(move |&t| flags[t] == dynamic)
+    };
+    let pmaterials = materials.subset(region_tets(false));
     let summary = BuiltTable {
         bytes: Vec::new(),
         fixed_by_predicate: fixed.iter().filter(|&&f| f).count(),
@@ -147,15 +152,13 @@ pub fn build_hybrid(
         source: format!("{source} (pre-computed region)"),
         ..MeshReport::default()
     };
-    let precomputed_summary = precomputed(
-        &pmesh,
-        &preport,
-        &build,
-        Solver::Cholesky,
-        &pfixed,
-        &surface,
-        summary,
-    )?;
+    let stages = Stages {
+        fixed: &pfixed,
+        surface: &surface,
+        materials: &pmaterials,
+    };
+    let precomputed_summary =
+        precomputed(&pmesh, &preport, build, Solver::Cholesky, &stages, summary)?;
     let ordering = FreeOrdering::new(n, &pfixed, &surface.vertices);
 
     // Lumped masses of each region's tets, and the pre-computed load.
@@ -189,7 +192,7 @@ pub fn build_hybrid(
     let condensed = condense(
         &mesh.positions,
         &pmesh.tets,
-        &options.material,
+        &pmaterials,
         &ordering,
         &split.connection,
         &load_n,
@@ -203,8 +206,8 @@ pub fn build_hybrid(
         .iter()
         .map(|&v| fixed[v as usize])
         .collect();
-    let mut arrays =
-        TensorMassArrays::new(&dmesh, &options.material, options.density_kg_m3, dfixed);
+    let dmaterials = materials.subset(region_tets(true));
+    let mut arrays = TensorMassArrays::new(&dmesh, &dmaterials, options.density_kg_m3, dfixed);
     if options.connection_mass == ConnectionMass::AllTets {
         for &v in &split.connection {
             if let Some(d) = split.dynamic_index[v as usize] {
@@ -213,8 +216,8 @@ pub fn build_hybrid(
         }
     }
     let dsurface = boundary_surface(&dmesh);
-    let dynamic = write_tensor_mass_table(&dmesh, &dsurface.triangles, &arrays, options.precision);
-    let interface = write_interface_table(mesh, &split, &ordering, &condensed, options);
+    let dynamic = write_tensor_mass_table(&dmesh, &dsurface.triangles, &arrays, build.precision);
+    let interface = write_interface_table(mesh, &split, &ordering, &condensed, &materials, options);
     let tables = HybridTables {
         precomputed: TableFile::from_bytes(&precomputed_summary.bytes),
         dynamic: TableFile::from_bytes(&dynamic),
@@ -225,7 +228,7 @@ pub fn build_hybrid(
             ..precomputed_summary
         },
     };
-    let loaded = match options.precision {
+    let loaded = match build.precision {
         Precision::F32 => tables.check::<f32>(),
         Precision::F64 => tables.check::<f64>(),
     };
@@ -251,8 +254,10 @@ fn write_interface_table(
     split: &RegionSplit,
     ordering: &FreeOrdering,
     condensed: &Condensed,
+    materials: &TetMaterials,
     options: &HybridOptions,
 ) -> Vec<u8> {
+    let material = materials.default_material();
     let header = RawHeader {
         table_kind: TableKind::Interface as u32,
         vertex_count: mesh.positions.len() as u32,
@@ -260,8 +265,8 @@ fn write_interface_table(
         free_count: ordering.free_count() as u32,
         touchable_count: ordering.touchable_count as u32,
         connection_count: split.connection.len() as u32,
-        young_pa: options.material.young_pa,
-        poisson: options.material.poisson,
+        young_pa: material.young_pa,
+        poisson: material.poisson,
         density_kg_m3: options.density_kg_m3,
         mesh_hash: mesh.content_hash(),
         ..RawHeader::zeroed()
@@ -276,7 +281,7 @@ fn write_interface_table(
         .iter()
         .map(|d| d.unwrap_or(FIXED_SLOT))
         .collect();
-    let p = options.precision;
+    let p = options.build.precision;
     let sections = [
         Section::ints(SectionKind::ConnectionVertex, &connections),
         Section::floats(SectionKind::CondensedStiffness, &condensed.condensed, p),

@@ -7,7 +7,7 @@ use faer::Mat;
 
 use crate::fem::assembly::{FreeOrdering, assemble_restricted, assemble_stiffness};
 use crate::fem::llt::SparseLlt;
-use crate::fem::material::Material;
+use crate::fem::material::TetMaterials;
 
 /// The pre-computed region condensed onto `c` connection nodes, in f64.
 ///
@@ -32,7 +32,8 @@ pub struct Condensed {
     pub load_force: Vec<[f64; 3]>,
 }
 
-/// Condenses the region of `tets` (positions in m, material `m`) with the
+/// Condenses the region of `tets` (positions in m, one material per tet in
+/// `m`) with the
 /// free/fixed split of `ordering` (connection nodes fixed in it) onto the
 /// `connection` nodes (mesh vertices, ascending), under the nodal load
 /// `load_n` (N, one per mesh vertex; only free vertices' entries count).
@@ -42,7 +43,7 @@ pub struct Condensed {
 pub fn condense(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
-    m: &Material,
+    m: &TetMaterials,
     ordering: &FreeOrdering,
     connection: &[u32],
     load_n: &[[f64; 3]],

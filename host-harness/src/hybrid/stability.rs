@@ -37,10 +37,8 @@ pub fn critical_dt_of_hybrid(
     damping_per_s: f64,
     integrator: Integrator,
 ) -> anyhow::Result<HybridCriticalDt> {
-    let options = HybridOptions {
-        precision: Precision::F64,
-        ..options.clone()
-    };
+    let mut options = options.clone();
+    options.build.precision = Precision::F64;
     let tables = build_hybrid(mesh, report, dynamic_tet, &options)?;
     let amplitude = 1e-3 * diagonal(&mesh.positions);
     let params = host_params(&mesh.positions, damping_per_s);
@@ -48,11 +46,18 @@ pub fn critical_dt_of_hybrid(
         critical_dt(hybrid.dynamic_mut(), integrator, amplitude)
     })?;
     let region = tables.split.dynamic_mesh(mesh);
+    let build = &options.build;
     let alone = BuildOptions::tensor_mass(
-        options.material,
+        build.material,
         options.density_kg_m3,
-        options.fix.clone(),
+        build.fix.clone(),
         Precision::F64,
+    );
+    let flags = &tables.split.dynamic_tet;
+    let alone = alone.with_tet_materials(
+        build
+            .materials_for(mesh.tets.len())?
+            .subset((0..flags.len()).filter(|&t| flags[t])),
     );
     let region_alone = critical_dt_of_mesh(&region, report, &alone, damping_per_s, integrator)?;
     Ok(HybridCriticalDt {

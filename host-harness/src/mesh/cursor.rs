@@ -63,6 +63,11 @@ impl<'a> Cursor<'a> {
         }
     }
 
+    /// The bytes not read yet.
+    pub(crate) fn rest(&self) -> &'a [u8] {
+        self.buf.get(self.pos..).unwrap_or(&[])
+    }
+
     pub(crate) fn at_end(&self) -> bool {
         self.pos >= self.buf.len()
     }
@@ -249,6 +254,15 @@ impl<'a> Cursor<'a> {
         Ok(f64::from(f32::from_le_bytes(self.array(big, what)?)))
     }
 }
+
+/// A region id read as a number (an MSH tag, a VTK cell value, a TetGen attribute): an integer
+/// in `0..=u32::MAX`, else `None`.
+pub(crate) fn region_id(value: f64) -> Option<u32> {
+    (value.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&value)).then_some(value as u32)
+}
+
+/// The message of a value that is not a region id.
+pub(crate) const NOT_A_REGION: &str = "is not a region id (an integer from 0 to 4294967295)";
 
 /// Parse an ASCII token.
 pub(crate) fn parse_tok<T: FromStr>(tok: &[u8]) -> Option<T> {

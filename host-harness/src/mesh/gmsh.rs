@@ -1,8 +1,14 @@
 //! Gmsh MSH reader: versions 2.x and 4.1, ASCII and binary. Hand-written (no `mshio`) so that every
 //! input, however broken, gives an error rather than a panic.
+//!
+//! Region ids ([`super::MeshReport::tet_regions`]): in 2.x the first tag of a tet element (its
+//! physical tag), in 4.1 the first physical tag of the volume entity its element block names,
+//! read from `$Entities`.
+
+use std::collections::HashMap;
 
 use super::MeshError;
-use super::cursor::{Cursor, cap, parse_tok, show};
+use super::cursor::{Cursor, NOT_A_REGION, cap, parse_tok, show};
 use super::validate::{Numbering, RawMesh};
 
 /// Gmsh element type of the linear tet.
@@ -70,14 +76,21 @@ struct Acc {
     node_ids: Vec<i64>,
     tets: Vec<[i64; 4]>,
     elem_ids: Vec<i64>,
+    /// Per tet: its first tag (2.x: the physical tag, 0 without tags) or the tag of the entity
+    /// of its element block (4.1).
+    tet_keys: Vec<i64>,
+    /// 4.1 `$Entities`: volume entity tag → its first physical tag (0 without one); `None`
+    /// without the section or if it does not parse.
+    volume_physical: Option<HashMap<i64, i64>>,
     skipped: usize,
     have_nodes: bool,
     have_elements: bool,
 }
 
 impl Acc {
-    /// Record element `id` of type `ty` with nodes `nodes`.
-    fn element(&mut self, ty: i64, id: i64, nodes: &[i64]) {
+    /// Record element `id` of type `ty` with nodes `nodes` and region key `key` (see
+    /// [`Acc::tet_keys`]).
+    fn element(&mut self, ty: i64, id: i64, nodes: &[i64], key: i64) {
         if ty == TET4 || ty == TET10 {
             let mut t = [0i64; 4];
             for (s, n) in t.iter_mut().zip(nodes) {
@@ -85,9 +98,33 @@ impl Acc {
             }
             self.tets.push(t);
             self.elem_ids.push(id);
+            self.tet_keys.push(key);
         } else {
             self.skipped += 1;
         }
+    }
+
+    /// Each tet's region id: its key (2.x), or its entity's physical tag (4.1, `None` without
+    /// `$Entities`; an entity not listed there has none: 0). Errors on a tag outside `u32`.
+    fn tet_regions(&self, version: Version, file: &str) -> Result<Option<Vec<u32>>, MeshError> {
+        let entities = match (version, &self.volume_physical) {
+            (Version::V2, _) => None,
+            (Version::V41, Some(map)) => Some(map),
+            (Version::V41, None) => return Ok(None),
+        };
+        self.tet_keys
+            .iter()
+            .zip(&self.elem_ids)
+            .enumerate()
+            .map(|(t, (&key, &id))| {
+                let tag = entities.map_or(key, |map| map.get(&key).copied().unwrap_or(0));
+                u32::try_from(tag).map_err(|_| MeshError::Parse {
+                    file: file.to_string(),
+                    msg: format!("tet {t} (element id {id}): physical tag {tag} {NOT_A_REGION}"),
+                })
+            })
+            .collect::<Result<Vec<u32>, _>>()
+            .map(Some)
     }
 }
 
@@ -112,6 +149,18 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                 }
                 acc.have_nodes = true;
                 expect_end(&mut cur, b"$EndNodes")?;
+            }
+            b"Entities" if header.version == Version::V41 => {
+                let body = cur.rest();
+                if !cur.skip_past(b"$EndEntities") {
+                    return Err(cur.eof("section $Entities"));
+                }
+                let len = body.len() - cur.rest().len() - b"$EndEntities".len();
+                let mut entities = Cursor::new(body.get(..len).unwrap_or(&[]), file);
+                entities.section = "$Entities";
+                // Only the region ids need it: a section that does not parse gives none, and
+                // the mesh is read as before.
+                acc.volume_physical = entities_v41(&mut entities, &header).ok();
             }
             b"Elements" => {
                 if acc.have_elements {
@@ -145,6 +194,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         file: file.to_string(),
         msg: format!("$Nodes: node id {id} defined twice (vertices {a} and {b})"),
     })?;
+    let tet_regions = acc.tet_regions(header.version, file)?;
     Ok(RawMesh {
         positions: acc.positions,
         node_ids: Some(acc.node_ids),
@@ -152,6 +202,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         elem_ids: Some(acc.elem_ids),
         numbering,
         skipped: acc.skipped,
+        tet_regions,
     })
 }
 
@@ -295,6 +346,7 @@ fn elements_v2(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), Me
                 cur.err(format_args!("element {i} (id {id}): bad tag count {ntags}"))
             })?;
             let nodes = nums.get(3..).and_then(|r| r.get(tags..)).unwrap_or(&[]);
+            let physical = if tags > 0 { nums.get(3).copied() } else { None };
             if ty == TET4 || ty == TET10 {
                 let want = nodes_per_element(ty).unwrap_or(4);
                 if nodes.len() != want {
@@ -304,7 +356,7 @@ fn elements_v2(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), Me
                     )));
                 }
             }
-            acc.element(ty, id, nodes);
+            acc.element(ty, id, nodes, physical.unwrap_or(0));
         }
         return Ok(());
     }
@@ -327,14 +379,18 @@ fn elements_v2(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), Me
         for _ in 0..cnt {
             let what = format_args!("element {done}");
             let id = i64::from(cur.i32(h.big, &what)?);
-            for _ in 0..ntags {
-                cur.i32(h.big, &what)?;
+            let mut physical = 0;
+            for k in 0..ntags {
+                let tag = cur.i32(h.big, &what)?;
+                if k == 0 {
+                    physical = i64::from(tag);
+                }
             }
             nodes.clear();
             for _ in 0..nn {
                 nodes.push(i64::from(cur.i32(h.big, &what)?));
             }
-            acc.element(ty, id, &nodes);
+            acc.element(ty, id, &nodes, physical);
             done += 1;
         }
     }
@@ -445,7 +501,7 @@ fn elements_v41(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), M
     for b in 0..nblocks {
         let what = format_args!("element block {b}");
         int(cur, h, &what)?;
-        int(cur, h, &what)?;
+        let entity = int(cur, h, &what)?;
         let ty = int(cur, h, &what)?;
         let nb = size(cur, h, &what)?;
         let nb = to_usize(cur, nb, "element count")?;
@@ -465,7 +521,7 @@ fn elements_v41(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), M
                     let v = size(cur, h, &what)?;
                     nodes.push(i64::try_from(v).unwrap_or(i64::MAX));
                 }
-                acc.element(ty, i64::try_from(id).unwrap_or(i64::MAX), &nodes);
+                acc.element(ty, i64::try_from(id).unwrap_or(i64::MAX), &nodes, entity);
             } else {
                 let line = cur.nonempty_line().ok_or_else(|| cur.eof(what))?;
                 if cur.at_end() {
@@ -496,7 +552,7 @@ fn elements_v41(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), M
                     )));
                 }
                 let rest = rest.to_vec();
-                acc.element(ty, id, &rest);
+                acc.element(ty, id, &rest, entity);
             }
             done += 1;
         }
@@ -507,4 +563,60 @@ fn elements_v41(cur: &mut Cursor<'_>, h: &Header, acc: &mut Acc) -> Result<(), M
         )));
     }
     Ok(())
+}
+
+/// A 4.1 `double` (binary) or ASCII real.
+fn real(cur: &mut Cursor<'_>, h: &Header, what: &dyn core::fmt::Display) -> Result<f64, MeshError> {
+    if h.binary {
+        cur.f64(h.big, what)
+    } else {
+        cur.parse::<f64>(what)
+    }
+}
+
+/// The 4.1 `$Entities` section: every volume's tag → its first physical tag (0 without one).
+/// Points, curves and surfaces are read past. Every count is read from the input, and each
+/// entry consumes input, so a huge count ends at the end of the file.
+fn entities_v41(cur: &mut Cursor<'_>, h: &Header) -> Result<HashMap<i64, i64>, MeshError> {
+    if h.binary {
+        cur.skip_line();
+    }
+    let mut counts = [0u64; 4];
+    for (dim, n) in counts.iter_mut().enumerate() {
+        *n = size(
+            cur,
+            h,
+            &format_args!("number of entities of dimension {dim}"),
+        )?;
+    }
+    let mut volumes = HashMap::new();
+    for (dim, &n) in counts.iter().enumerate() {
+        for e in 0..n {
+            let what = format_args!("entity {e} of dimension {dim}");
+            let tag = int(cur, h, &what)?;
+            // A point has its coordinates, any other entity its bounding box.
+            let reals = if dim == 0 { 3 } else { 6 };
+            for _ in 0..reals {
+                real(cur, h, &what)?;
+            }
+            let physical_count = size(cur, h, &what)?;
+            let mut first = 0;
+            for k in 0..physical_count {
+                let physical = int(cur, h, &what)?;
+                if k == 0 {
+                    first = physical;
+                }
+            }
+            if dim > 0 {
+                let bounding = size(cur, h, &what)?;
+                for _ in 0..bounding {
+                    int(cur, h, &what)?;
+                }
+            }
+            if dim == 3 {
+                volumes.insert(tag, first);
+            }
+        }
+    }
+    Ok(volumes)
 }

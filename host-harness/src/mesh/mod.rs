@@ -52,6 +52,14 @@ pub struct MeshReport {
     pub unreferenced_vertices: Vec<u32>,
     /// Non-fatal findings, e.g. an open or non-manifold boundary surface.
     pub warnings: Vec<String>,
+    /// The region id of each tet (same order as [`TetMesh::tets`]), where the file has them:
+    /// MSH 2.2 the first tag of a tet element (its physical tag; 0 without tags), MSH 4.1 the
+    /// first physical tag of the tet's volume entity in `$Entities` (0 for an entity without
+    /// one; `None` without an `$Entities` section or with one that does not parse), VTK the integer `CELL_DATA` field named
+    /// `region` (a `SCALARS` or `FIELD` array; `None` without it), TetGen the first region
+    /// attribute of the `.ele` file (`None` without attributes). The scene's `[[region]]`
+    /// materials are looked up here (heterogeneous tissue).
+    pub tet_regions: Option<Vec<u32>>,
 }
 
 /// Input formats understood by [`read_mesh_bytes`]. TetGen needs two buffers: see [`read_tetgen`].
@@ -82,6 +90,7 @@ impl TetMesh {
             elem_ids: None,
             numbering: validate::Numbering::Base(0),
             skipped: 0,
+            tet_regions: None,
         };
         validate::validate(raw, source, source, source)
     }

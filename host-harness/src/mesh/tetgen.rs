@@ -1,6 +1,6 @@
 //! TetGen `.node` / `.ele` reader.
 
-use super::cursor::{cap, parse_tok, show};
+use super::cursor::{NOT_A_REGION, cap, parse_tok, region_id, show};
 use super::validate::{Numbering, RawMesh, validate};
 use super::{MeshError, MeshReport, TetMesh};
 
@@ -50,7 +50,9 @@ fn num<T: core::str::FromStr>(
 /// `source` names the mesh (e.g. the path without extension): messages about vertices name
 /// `{source}.node`, messages about tets `{source}.ele`. The numbering base (0 or 1) is the first
 /// index in the `.node` file; node indices must then be consecutive. `.ele` files with 10-node tets
-/// are read using their first 4 nodes (the corners). Attributes and boundary markers are ignored.
+/// are read using their first 4 nodes (the corners). The first `.ele` attribute of each tet is its
+/// region id ([`MeshReport::tet_regions`], an integer from 0 to `u32::MAX`); other attributes, the
+/// `.node` attributes and boundary markers are ignored.
 pub fn read_tetgen(
     node: &[u8],
     ele: &[u8],
@@ -134,7 +136,13 @@ pub fn read_tetgen(
             format_args!("{npt} nodes per tet, expected 4 or 10"),
         ));
     }
+    let nattr: usize = if h.len() > 2 {
+        num(&ef, hl, &h, 2, "attribute count")?
+    } else {
+        0
+    };
     let mut tets = Vec::with_capacity(cap(m, ele.len()));
+    let mut regions = Vec::with_capacity(if nattr > 0 { cap(m, ele.len()) } else { 0 });
     for i in 0..m {
         let (l, t) = it.next().ok_or_else(|| MeshError::Parse {
             file: ef.clone(),
@@ -155,6 +163,17 @@ pub fn read_tetgen(
             *v = num(&ef, l, &t, 1 + c, &format!("tet {i}: vertex index"))?;
         }
         tets.push(tet);
+        if nattr > 0 {
+            let attribute: f64 = num(&ef, l, &t, 1 + npt, &format!("tet {i}: region attribute"))?;
+            let region = region_id(attribute).ok_or_else(|| {
+                perr(
+                    &ef,
+                    l,
+                    format_args!("tet {i}: region attribute {attribute} {NOT_A_REGION}"),
+                )
+            })?;
+            regions.push(region);
+        }
     }
     let raw = RawMesh {
         positions,
@@ -163,6 +182,7 @@ pub fn read_tetgen(
         elem_ids: None,
         numbering: Numbering::Base(base),
         skipped: 0,
+        tet_regions: (nattr > 0).then_some(regions),
     };
     validate(raw, &nf, &ef, &nf)
 }

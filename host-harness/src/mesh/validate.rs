@@ -50,6 +50,9 @@ pub(crate) struct RawMesh {
     pub numbering: Numbering,
     /// Non-tet elements skipped.
     pub skipped: usize,
+    /// Region id per tet, in `tets` order, where the file has them
+    /// ([`MeshReport::tet_regions`]).
+    pub tet_regions: Option<Vec<u32>>,
 }
 
 /// `det[b-a, c-a, d-a] / 6`.
@@ -76,6 +79,7 @@ pub(crate) fn validate(
         elem_ids,
         numbering,
         skipped,
+        tet_regions,
     } = raw;
     let n = positions.len();
     if u32::try_from(n).is_err() {
@@ -238,6 +242,7 @@ pub(crate) fn validate(
         reoriented_tets: reoriented,
         unreferenced_vertices,
         warnings,
+        tet_regions,
     };
     Ok((mesh, report))
 }

@@ -1,8 +1,13 @@
 //! VTK legacy `UNSTRUCTURED_GRID` reader (ASCII and big-endian binary; classic `CELLS n size`
 //! layout and the 5.1 `OFFSETS`/`CONNECTIVITY` layout).
+//!
+//! Region ids ([`super::MeshReport::tet_regions`]): the `CELL_DATA` array named `region`, a
+//! `SCALARS` or a `FIELD` array of one component, each value an integer from 0 to `u32::MAX`
+//! (of any numeric type). The attribute arrays before it are read past (`SCALARS`, `FIELD`,
+//! `VECTORS`, `NORMALS`, `TENSORS`); the search ends at any other keyword, without regions.
 
 use super::MeshError;
-use super::cursor::{Cursor, cap, show};
+use super::cursor::{Cursor, NOT_A_REGION, cap, parse_tok, region_id, show};
 use super::validate::{Numbering, RawMesh};
 
 /// VTK cell type of the linear tet.
@@ -86,6 +91,8 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     let mut cells: Option<Vec<(usize, [i64; 4])>> = None;
     let mut types: Option<Vec<i64>> = None;
     let mut have_dataset = false;
+    // The attribute keyword that ended the geometry, if any.
+    let mut attributes: Option<&[u8]> = None;
     while let Some(tok) = r.cur.token() {
         match tok.to_ascii_uppercase().as_slice() {
             b"DATASET" => {
@@ -143,7 +150,10 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                 }
                 types = Some(ts);
             }
-            b"POINT_DATA" | b"CELL_DATA" => break,
+            b"POINT_DATA" | b"CELL_DATA" => {
+                attributes = Some(tok);
+                break;
+            }
             b"METADATA" | b"FIELD" => {
                 return Err(r.cur.err(format_args!(
                     "{} blocks are not supported before the cells",
@@ -174,7 +184,9 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
             types.len()
         )));
     }
+    let cell_regions = regions(&mut r, attributes, cells.len())?;
     let mut tets = Vec::new();
+    let mut tet_regions = Vec::new();
     let mut skipped = 0;
     for (i, (&(npts, ids), &ty)) in cells.iter().zip(&types).enumerate() {
         let want = match ty {
@@ -195,6 +207,9 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
             });
         }
         tets.push(ids);
+        if let Some(region) = cell_regions.as_ref().and_then(|all| all.get(i)) {
+            tet_regions.push(*region);
+        }
     }
     Ok(RawMesh {
         positions,
@@ -203,7 +218,227 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         elem_ids: None,
         numbering: Numbering::Base(0),
         skipped,
+        tet_regions: cell_regions.map(|_| tet_regions),
     })
+}
+
+/// A numeric type of an attribute array.
+#[derive(Clone, Copy)]
+enum DataType {
+    Float,
+    Double,
+    /// An integer of `bytes` bytes.
+    Int {
+        bytes: usize,
+        signed: bool,
+    },
+}
+
+impl DataType {
+    fn of(name: &[u8]) -> Option<DataType> {
+        let int = |bytes, signed| Some(DataType::Int { bytes, signed });
+        match name.to_ascii_lowercase().as_slice() {
+            b"float" => Some(DataType::Float),
+            b"double" => Some(DataType::Double),
+            b"char" => int(1, true),
+            b"unsigned_char" => int(1, false),
+            b"short" => int(2, true),
+            b"unsigned_short" => int(2, false),
+            b"int" | b"vtktypeint32" => int(4, true),
+            b"unsigned_int" | b"vtktypeuint32" => int(4, false),
+            b"long" | b"vtktypeint64" | b"vtkidtype" => int(8, true),
+            b"unsigned_long" | b"vtktypeuint64" => int(8, false),
+            _ => None,
+        }
+    }
+}
+
+impl Reader<'_> {
+    /// One attribute value of type `ty`, as a real (ASCII: any number).
+    fn value(&mut self, ty: DataType, what: &dyn core::fmt::Display) -> Result<f64, MeshError> {
+        match (self.binary, ty) {
+            (false, _) => self.cur.parse::<f64>(what),
+            (true, DataType::Float) => self.cur.f32(true, what),
+            (true, DataType::Double) => self.cur.f64(true, what),
+            (true, DataType::Int { bytes, signed }) => {
+                let raw = self.cur.bytes(bytes, what)?;
+                let unsigned = raw.iter().fold(0u64, |v, &b| (v << 8) | u64::from(b));
+                let bits = 8 * bytes as u32;
+                Ok(if signed && bits < 64 && unsigned >> (bits - 1) == 1 {
+                    (unsigned as i64 - (1i64 << bits)) as f64
+                } else if signed {
+                    unsigned as i64 as f64
+                } else {
+                    unsigned as f64
+                })
+            }
+        }
+    }
+
+    /// Reads past `n` values of type `ty`; `None` if they are not there.
+    fn skip_values(&mut self, ty: DataType, n: Option<usize>) -> Option<()> {
+        for _ in 0..n? {
+            self.value(ty, &"").ok()?;
+        }
+        Some(())
+    }
+}
+
+impl<'a> Reader<'a> {
+    /// The header line of an array: its whitespace-separated words.
+    fn words(&mut self) -> Vec<&'a [u8]> {
+        self.cur
+            .nonempty_line()
+            .map(|l| {
+                l.split(|c| c.is_ascii_whitespace())
+                    .filter(|w| !w.is_empty())
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+}
+
+/// One attribute array's header.
+struct Array {
+    /// The cells' array named `region`.
+    is_region: bool,
+    ty: DataType,
+    components: usize,
+    tuples: usize,
+}
+
+/// The region id of every cell: the `CELL_DATA` array named `region` among the attribute data
+/// that starts at `keyword` (`POINT_DATA` or `CELL_DATA`, already read), `None` without one.
+/// Errors only on the `region` array itself: not one value per cell, not one component, or a
+/// value that is not a region id.
+fn regions(
+    r: &mut Reader<'_>,
+    mut keyword: Option<&[u8]>,
+    cells: usize,
+) -> Result<Option<Vec<u32>>, MeshError> {
+    r.cur.section = "CELL_DATA";
+    let mut on_cells = false;
+    let mut count = 0usize;
+    let number = |w: Option<&&[u8]>| w.and_then(|w| parse_tok::<usize>(w));
+    let data_type = |w: Option<&&[u8]>| w.and_then(|w| DataType::of(w));
+    loop {
+        let Some(tok) = keyword.take().or_else(|| r.cur.token()) else {
+            return Ok(None);
+        };
+        let array = match tok.to_ascii_uppercase().as_slice() {
+            b"POINT_DATA" | b"CELL_DATA" => {
+                on_cells = tok.eq_ignore_ascii_case(b"CELL_DATA");
+                let Ok(n) = r.count("attribute count") else {
+                    return Ok(None);
+                };
+                count = n;
+                continue;
+            }
+            // SCALARS name type [components], then an optional LOOKUP_TABLE line.
+            b"SCALARS" => {
+                let words = r.words();
+                let components = if words.len() > 2 {
+                    number(words.get(2))
+                } else {
+                    Some(1)
+                };
+                if matches!(r.cur.peek_token(), Some(t) if t.eq_ignore_ascii_case(b"LOOKUP_TABLE"))
+                {
+                    r.cur.line();
+                }
+                let (Some(&name), Some(ty), Some(components)) =
+                    (words.first(), data_type(words.get(1)), components)
+                else {
+                    return Ok(None);
+                };
+                Array {
+                    is_region: on_cells && name == b"region",
+                    ty,
+                    components,
+                    tuples: count,
+                }
+            }
+            // FIELD name arrays, then per array: name components tuples type, values.
+            b"FIELD" => {
+                let Some(arrays) = number(r.words().get(1)) else {
+                    return Ok(None);
+                };
+                let mut region = None;
+                for _ in 0..arrays {
+                    let words = r.words();
+                    let (Some(&name), Some(components), Some(tuples), Some(ty)) = (
+                        words.first(),
+                        number(words.get(1)),
+                        number(words.get(2)),
+                        data_type(words.get(3)),
+                    ) else {
+                        return Ok(None);
+                    };
+                    let array = Array {
+                        is_region: on_cells && name == b"region",
+                        ty,
+                        components,
+                        tuples,
+                    };
+                    if array.is_region {
+                        region = Some(array);
+                        break;
+                    }
+                    if r.skip_values(ty, components.checked_mul(tuples)).is_none() {
+                        return Ok(None);
+                    }
+                }
+                let Some(region) = region else {
+                    continue;
+                };
+                region
+            }
+            b"VECTORS" | b"NORMALS" | b"TENSORS" => {
+                let per = if tok.eq_ignore_ascii_case(b"TENSORS") {
+                    9
+                } else {
+                    3
+                };
+                let Some(ty) = data_type(r.words().get(1)) else {
+                    return Ok(None);
+                };
+                if r.skip_values(ty, count.checked_mul(per)).is_none() {
+                    return Ok(None);
+                }
+                continue;
+            }
+            _ => return Ok(None),
+        };
+        if !array.is_region {
+            if r.skip_values(array.ty, array.components.checked_mul(array.tuples))
+                .is_none()
+            {
+                return Ok(None);
+            }
+            continue;
+        }
+        let Array {
+            ty,
+            components,
+            tuples,
+            ..
+        } = array;
+        if components != 1 || tuples != cells {
+            return Err(r.cur.err(format_args!(
+                "the region array has {tuples} values of {components} components for {cells} cells (expected one integer per cell)"
+            )));
+        }
+        let mut ids = Vec::with_capacity(cap(cells, r.cur.len()));
+        for i in 0..cells {
+            let v = r.value(ty, &format_args!("region of cell {i}"))?;
+            let id = region_id(v).ok_or_else(|| {
+                r.cur
+                    .err(format_args!("cell {i}: region {v} {NOT_A_REGION}"))
+            })?;
+            ids.push(id);
+        }
+        return Ok(Some(ids));
+    }
 }
 
 fn read_cells(

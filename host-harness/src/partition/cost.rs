@@ -32,7 +32,7 @@ use palpate_kernel::table::{PrecomputedTable, TensorMassTable};
 use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, TensorMassModel};
 
 use super::plan::{Partition, RegionModel};
-use crate::fem::material::Material;
+use crate::fem::material::{Material, TetMaterials};
 use crate::fix::FixPredicate;
 use crate::mesh::generate::box_mesh;
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
@@ -193,7 +193,7 @@ pub fn costs(
             } => {
                 let arrays = TensorMassArrays::new(
                     &sub,
-                    &options.material,
+                    &TetMaterials::uniform(options.material, sub.tets.len()),
                     options.density_kg_m3,
                     sub_fixed,
                 );

@@ -10,6 +10,7 @@
 
 pub mod generate;
 pub mod hybrid;
+pub mod materials;
 pub mod model;
 pub mod run;
 pub mod scene;
@@ -23,6 +24,7 @@ pub use generate::{
     CutLine, GenerateError, Generator, GraspPull, Keyframe, Pinch, Poke, Press, PressHold, Slide,
     Strike, sample_keyframes, sample_keyframes_with_tool_columns,
 };
+pub use materials::RegionSpec;
 pub use scene::{
     DynamicSpec, MAX_TOOL_POINTS, MaterialSpec, MeshSource, ModelSpec, Rates, Scene, SceneError,
     ToolSpec,

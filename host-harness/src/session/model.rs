@@ -100,8 +100,8 @@ impl SceneModel {
         })
     }
 
-    /// The f32 tables of the model (the scene's material, density and
-    /// supports), built in memory with the pipeline of `palpate tables
+    /// The f32 tables of the model (the scene's materials per tet, density
+    /// and supports), built in memory with the pipeline of `palpate tables
     /// build`.
     pub fn tables(
         self,
@@ -114,15 +114,21 @@ impl SceneModel {
             Ok(TableFile::from_bytes(&built.bytes))
         };
         Ok(match self {
-            Self::Precomputed => SceneTables::Precomputed(single(precomputed_options(scene)?)?),
-            Self::Dynamic(spec) => SceneTables::Dynamic(single(tensor_mass_options(scene)?)?, spec),
+            Self::Precomputed => {
+                SceneTables::Precomputed(single(precomputed_options(scene, mesh, report)?)?)
+            }
+            Self::Dynamic(spec) => {
+                SceneTables::Dynamic(single(tensor_mass_options(scene, mesh, report)?)?, spec)
+            }
             Self::Hybrid { spec, partition } => {
+                let materials = scene.tet_materials(mesh, report)?;
                 let options = HybridOptions::new(
-                    scene.elastic_material()?,
+                    materials.default_material(),
                     scene.material.density_kg_m3,
                     scene.fix.clone(),
                     Precision::F32,
-                );
+                )
+                .with_tet_materials(materials);
                 let tables = build_hybrid(mesh, report, &partition.dynamic, &options)
                     .with_context(|| scene.source.clone())?;
                 SceneTables::Hybrid(tables, spec)

@@ -61,42 +61,57 @@ use crate::table::file::Precision;
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::{OwnedState, OwnedSurface};
 
-/// The build options of `scene`'s table, by its model: its material and
+/// The build options of `scene`'s table on `mesh` (read with `report`), by
+/// its model: its materials per tet ([`Scene::tet_materials`]) and
 /// supports, f32 (the firmware precision), quiet; a pre-computed table
 /// solved by sparse Cholesky, a tensor-mass table of the scene's density.
-pub fn table_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
+pub fn table_options(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<BuildOptions> {
     match scene.model {
-        ModelSpec::Precomputed => precomputed_options(scene),
-        ModelSpec::Dynamic(_) => tensor_mass_options(scene),
+        ModelSpec::Precomputed => precomputed_options(scene, mesh, report),
+        ModelSpec::Dynamic(_) => tensor_mass_options(scene, mesh, report),
     }
 }
 
-/// The pre-computed table options of `scene` (see [`table_options`]).
-pub fn precomputed_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
-    let material = scene.elastic_material()?;
-    Ok(BuildOptions::precomputed(
-        material,
+/// The pre-computed table options of `scene` on `mesh` (see [`table_options`]).
+pub fn precomputed_options(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<BuildOptions> {
+    let materials = scene.tet_materials(mesh, report)?;
+    let options = BuildOptions::precomputed(
+        materials.default_material(),
         scene.fix.clone(),
         Solver::Cholesky,
         Precision::F32,
-    ))
+    );
+    Ok(options.with_tet_materials(materials))
 }
 
-/// The tensor-mass table options of `scene` (see [`table_options`]).
-pub fn tensor_mass_options(scene: &Scene) -> anyhow::Result<BuildOptions> {
-    let material = scene.elastic_material()?;
-    Ok(BuildOptions::tensor_mass(
-        material,
+/// The tensor-mass table options of `scene` on `mesh` (see [`table_options`]).
+pub fn tensor_mass_options(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<BuildOptions> {
+    let materials = scene.tet_materials(mesh, report)?;
+    let options = BuildOptions::tensor_mass(
+        materials.default_material(),
         scene.material.density_kg_m3,
         scene.fix.clone(),
         Precision::F32,
-    ))
+    );
+    Ok(options.with_tet_materials(materials))
 }
 
 /// The f32 table of `scene` (pre-computed or tensor-mass, by its model),
 /// built in memory with the same pipeline as `palpate tables build`.
 pub fn scene_table(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Vec<u8>> {
-    let options = table_options(scene)?;
+    let options = table_options(scene, mesh, report)?;
     Ok(build(mesh, report, &options)
         .with_context(|| scene.source.clone())?
         .bytes)
@@ -112,7 +127,7 @@ pub fn check_scene_table(
     mesh: &TetMesh,
     report: &MeshReport,
 ) -> anyhow::Result<TableEstimate> {
-    let options = table_options(scene)?;
+    let options = table_options(scene, mesh, report)?;
     let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
     let surface = boundary_surface(mesh);
     let estimate = TableEstimate::of_build(mesh, report, &options, &fixed, &surface);

@@ -58,6 +58,10 @@
 //! max_force_n = 4.0            # default 4
 //! max_slew_n_per_s = 2000.0    # default 2000
 //!
+//! [[region]]                   # optional, any number: per-region materials (super::materials)
+//! id = 2                       # the mesh's region id; tets of other regions take [material]
+//! young_pa = 30000.0
+//! poisson = 0.45
 //! # [[zone]] and [partition]: where the hybrid model must be dynamic (crate::session::zones)
 //! ```
 //!
@@ -78,6 +82,7 @@ use palpate_kernel::tensor_mass::Extrapolation;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
 
+use super::materials::{RegionSpec, check_regions};
 use super::zones::{PartitionFile, PartitionSpec, Zone, ZoneFile, zones_spec};
 use crate::fem::material::{Material, MaterialError};
 use crate::fix::FixPredicate;
@@ -335,8 +340,10 @@ pub struct Scene {
     pub mesh: MeshSource,
     /// Fixed-vertex predicates (mesh units); a vertex matching any is fixed.
     pub fix: Vec<FixPredicate>,
-    /// The material.
+    /// The material (of every tet without a `[[region]]`).
     pub material: MaterialSpec,
+    /// Per-region materials (`[[region]]`, heterogeneous tissue; [`Scene::tet_materials`]).
+    pub regions: Vec<RegionSpec>,
     /// The model.
     pub model: ModelSpec,
     /// The tool.
@@ -366,6 +373,8 @@ struct SceneFile {
     #[serde(default)]
     fix: Vec<String>,
     material: MaterialFile,
+    #[serde(default)]
+    region: Vec<RegionSpec>,
     #[serde(default)]
     model: ModelFile,
     #[serde(default)]
@@ -652,6 +661,7 @@ impl Scene {
                 poisson: 0.45,
                 density_kg_m3: DEFAULT_DENSITY_KG_M3,
             },
+            regions: Vec::new(),
             model: ModelSpec::Precomputed,
             tool: ToolSpec::probes(DEFAULT_TOOL_POINTS, DEFAULT_TOOL_RADIUS_M),
             cutting: CuttingSpec {
@@ -827,6 +837,7 @@ impl Scene {
                 poisson: raw.material.poisson,
                 density_kg_m3: raw.material.density_kg_m3,
             },
+            regions: raw.region,
             model,
             tool,
             cutting: CuttingSpec {
@@ -936,6 +947,7 @@ impl Scene {
             key,
             msg,
         };
+        check_regions(&self.regions, m.density_kg_m3).map_err(in_file)?;
         check_tool(&self.tool).map_err(in_file)?;
         check_removal(&self.cutting, self.tearing.as_ref(), &self.model).map_err(in_file)?;
         if !positive(self.rates.haptic_hz) {

@@ -52,15 +52,14 @@ pub fn check_stable_step(
     let ModelSpec::Dynamic(dynamic) = &scene.model else {
         return Ok(None);
     };
-    let material = scene
-        .elastic_material()
-        .with_context(|| scene.source.clone())?;
+    let materials = scene.tet_materials(mesh, report)?;
     let options = BuildOptions::tensor_mass(
-        material,
+        materials.default_material(),
         scene.material.density_kg_m3,
         scene.fix.clone(),
         Precision::F64,
-    );
+    )
+    .with_tet_materials(materials);
     let step = stable_step_limit(
         mesh,
         report,

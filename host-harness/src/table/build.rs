@@ -22,7 +22,7 @@ use super::file::{Precision, TableContents, write_table};
 use super::load::TableFile;
 use super::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 use crate::fem::assembly::FreeOrdering;
-use crate::fem::material::Material;
+use crate::fem::material::{Material, TetMaterials};
 use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, Surface, TetMesh, boundary_surface};
 
@@ -31,8 +31,12 @@ use crate::mesh::{MeshReport, Surface, TetMesh, boundary_surface};
 pub struct BuildOptions {
     /// Which table, with the options only that kind takes.
     pub kind: TableKindOptions,
-    /// Young's modulus and Poisson ratio.
+    /// Young's modulus and Poisson ratio of every tet, or the default of
+    /// [`Self::tet_materials`] (the table header's).
     pub material: Material,
+    /// Per-tet materials (heterogeneous tissue), `None` for every tet of
+    /// `material`; set with [`Self::with_tet_materials`].
+    pub tet_materials: Option<TetMaterials>,
     /// A vertex matching any predicate is fixed.
     pub fix: Vec<FixPredicate>,
     /// Stored float width.
@@ -73,6 +77,7 @@ impl BuildOptions {
         Self {
             kind: TableKindOptions::Precomputed { solver },
             material,
+            tet_materials: None,
             fix,
             precision,
             progress: false,
@@ -90,9 +95,36 @@ impl BuildOptions {
         Self {
             kind: TableKindOptions::TensorMass { density_kg_m3 },
             material,
+            tet_materials: None,
             fix,
             precision,
             progress: false,
+        }
+    }
+}
+
+impl BuildOptions {
+    /// The same options with each tet's own material (one per tet of the
+    /// mesh the table is built from); [`Self::material`] becomes their
+    /// default.
+    pub fn with_tet_materials(self, materials: TetMaterials) -> Self {
+        Self {
+            material: materials.default_material(),
+            tet_materials: Some(materials),
+            ..self
+        }
+    }
+
+    /// The material of each of `tet_count` tets: [`Self::tet_materials`], or
+    /// [`Self::material`] for every tet. Errors if the per-tet materials are
+    /// for another number of tets (another mesh).
+    pub fn materials_for(&self, tet_count: usize) -> anyhow::Result<TetMaterials> {
+        match &self.tet_materials {
+            Some(materials) => {
+                materials.check_tet_count(tet_count)?;
+                Ok(materials.clone())
+            }
+            None => Ok(TetMaterials::uniform(self.material, tet_count)),
         }
     }
 }
@@ -239,6 +271,9 @@ fn build_unchecked(
             );
         }
     }
+    let materials = options
+        .materials_for(mesh.tets.len())
+        .with_context(|| format!("{}: the materials", report.source))?;
     let surface = boundary_surface(mesh);
     let estimate = TableEstimate::of_build(mesh, report, options, &fixed, &surface);
     limits.check(&estimate, &report.source)?;
@@ -253,11 +288,16 @@ fn build_unchecked(
     };
     match options.kind {
         TableKindOptions::Precomputed { solver } => {
-            precomputed(mesh, report, options, solver, &fixed, &surface, summary)
+            let stages = Stages {
+                fixed: &fixed,
+                surface: &surface,
+                materials: &materials,
+            };
+            precomputed(mesh, report, options, solver, &stages, summary)
         }
         TableKindOptions::TensorMass { density_kg_m3 } => {
             let start = Instant::now();
-            let arrays = TensorMassArrays::new(mesh, &options.material, density_kg_m3, fixed);
+            let arrays = TensorMassArrays::new(mesh, &materials, density_kg_m3, fixed);
             let arrays_time = start.elapsed();
             if options.precision == Precision::F32 {
                 // All zero once stored: the loader accepts it, the model
@@ -293,23 +333,34 @@ fn build_unchecked(
     }
 }
 
+/// What the shared preparation gives the pre-computed stages.
+pub(crate) struct Stages<'a> {
+    pub(crate) fixed: &'a [bool],
+    pub(crate) surface: &'a Surface,
+    pub(crate) materials: &'a TetMaterials,
+}
+
 /// The pre-computed stages: the free/touchable ordering, the compliance,
-/// the collision index of `surface`, the writer.
+/// the collision index of the surface, the writer.
 pub(crate) fn precomputed(
     mesh: &TetMesh,
     report: &MeshReport,
     options: &BuildOptions,
     solver: Solver,
-    fixed: &[bool],
-    surface: &Surface,
+    stages: &Stages<'_>,
     summary: BuiltTable,
 ) -> anyhow::Result<BuiltTable> {
+    let Stages {
+        fixed,
+        surface,
+        materials,
+    } = *stages;
     let ordering = FreeOrdering::new(mesh.positions.len(), fixed, &surface.vertices);
     let start = Instant::now();
     let compliance = compute_compliance(
         &mesh.positions,
         &mesh.tets,
-        &options.material,
+        materials,
         &ordering,
         solver,
         options.progress,
@@ -319,7 +370,7 @@ pub(crate) fn precomputed(
     let collision = collision_index(&mesh.positions, &surface.triangles);
     let bytes = write_table(
         &TableContents {
-            tet_count: mesh.tets.len(),
+            tet_lame: &materials.lame(),
             young_pa: options.material.young_pa,
             poisson: options.material.poisson,
             mesh_hash: mesh.content_hash(),

@@ -9,7 +9,7 @@ use palpate_kernel::table::format::surface_block_index;
 use super::cg::JacobiCg;
 use crate::fem::assembly::{FreeOrdering, assemble_restricted};
 use crate::fem::llt::SparseLlt;
-use crate::fem::material::Material;
+use crate::fem::material::TetMaterials;
 
 /// How [`compute_compliance`] solves `A x = e`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,7 +53,8 @@ pub const BATCH_VERTICES: usize = 64;
 const CG_REL_TOL: f64 = 1e-10;
 
 /// Computes the compliance table ([`Compliance`]) of the mesh
-/// (`positions` in m, positively oriented `tets`) for material `m`, with the
+/// (`positions` in m, positively oriented `tets`) for the per-tet materials
+/// `m` (heterogeneous tissue; [`TetMaterials::uniform`] for one), with the
 /// fixed/touchable split of `ordering`.
 ///
 /// `A` (N/m) is [`assemble_restricted`] with `ordering.vertex_slot`; the
@@ -61,13 +62,13 @@ const CG_REL_TOL: f64 = 1e-10;
 /// (Cotin RR-3510 §4), computed with `solver`. `progress` shows a progress
 /// bar over the touchable vertices on stderr.
 ///
-/// Errors if the ordering does not match the mesh, a tet references a
-/// missing vertex, `A` is not positive definite (nothing fixed), or CG does
-/// not converge.
+/// Errors if the ordering or the materials do not match the mesh, a tet
+/// references a missing vertex, `A` is not positive definite (nothing
+/// fixed), or CG does not converge.
 pub fn compute_compliance(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
-    m: &Material,
+    m: &TetMaterials,
     ordering: &FreeOrdering,
     solver: Solver,
     progress: bool,
@@ -78,6 +79,7 @@ pub fn compute_compliance(
         "ordering is for {} vertices, mesh has {nv}",
         ordering.vertex_slot.len()
     );
+    m.check_tet_count(tets.len())?;
     let f = ordering.free_count();
     let s = ordering.touchable_count;
     ensure!(s <= f, "touchable_count {s} exceeds free count {f}");

@@ -20,11 +20,12 @@ pub enum Precision {
 
 /// Everything a pre-computed table holds, in `f64` before rounding.
 pub struct TableContents<'a> {
-    /// Tetrahedra of the source mesh (informative).
-    pub tet_count: usize,
-    /// Young's modulus, Pa.
+    /// Each tet's Lamé coefficients `[λ, μ]`, Pa, in the source mesh's tet
+    /// order (one per tet: their number is the header's tet count).
+    pub tet_lame: &'a [[f64; 2]],
+    /// Young's modulus of the default material, Pa.
     pub young_pa: f64,
-    /// Poisson ratio.
+    /// Poisson ratio of the default material.
     pub poisson: f64,
     /// CRC-64 of the source mesh (`TetMesh::content_hash`).
     pub mesh_hash: u64,
@@ -59,7 +60,7 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         grid_cell_count: (index.cell_start.len() - 1) as u32,
         surface_vertex_count: index.grid_vertex.len() as u32,
         vertex_count: c.vertex_slot.len() as u32,
-        tet_count: c.tet_count as u32,
+        tet_count: c.tet_lame.len() as u32,
         free_count: c.free_vertex.len() as u32,
         touchable_count: c.touchable_count as u32,
         triangle_count: c.triangles.len() as u32,
@@ -85,6 +86,7 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         ),
         Section::ints(SectionKind::VertexTriangle, &index.vertex_triangle),
         Section::floats(SectionKind::SurfacePlane, &index.planes, precision),
+        Section::floats(SectionKind::TetMaterial, c.tet_lame, precision),
     ];
     write_container(header, precision, &sections)
 }

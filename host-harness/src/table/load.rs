@@ -68,7 +68,7 @@ impl TableFile {
         let h: RawHeader = bytemuck::pod_read_unaligned(&head);
         h.check_identity().map_err(|e| match e {
             LoadError::UnsupportedVersion { .. } => {
-                anyhow::anyhow!("{name}: {e}: rebuild the table with tables build")
+                anyhow::anyhow!("{name}: {e}: rebuild the table with `palpate tables build`")
             }
             _ => anyhow::anyhow!("{name}: {e}"),
         })?;

@@ -21,15 +21,16 @@ use palpate_kernel::tensor_mass::stvk_terms::{TermArraysMut, TetPlace, tet_terms
 use super::file::{Precision, Section, write_container};
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::element::shape_gradients;
-use crate::fem::material::Material;
+use crate::fem::material::TetMaterials;
 use crate::mesh::TetMesh;
 
 /// The arrays of a tensor-mass table, in f64 before rounding.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TensorMassArrays {
-    /// Young's modulus and Poisson ratio the tensors and terms were
-    /// assembled with (the header's).
-    pub material: Material,
+    /// Each tet's material the tensors and terms were assembled with (its
+    /// Lamé coefficients are the `tet-material` section, its default the
+    /// header's `young_pa` and `poisson`).
+    pub materials: TetMaterials,
     /// Mass density the masses were lumped with, kg/m³ (the header's).
     pub density_kg_m3: f64,
     /// `true` for fixed vertices (N).
@@ -66,14 +67,23 @@ pub struct TensorMassArrays {
 }
 
 impl TensorMassArrays {
-    /// Assembles the arrays of `mesh` (positions in m) for `material`,
-    /// density `density_kg_m3` and the `fixed` flags (one per vertex). Every
-    /// block comes from the kernel's `stiffness_block`, and every
-    /// St Venant-Kirchhoff term from the kernel's `tet_terms`: the formulas
-    /// the kernel subtracts when it removes a tet.
-    pub fn new(mesh: &TetMesh, material: &Material, density_kg_m3: f64, fixed: Vec<bool>) -> Self {
+    /// Assembles the arrays of `mesh` (positions in m) for the per-tet
+    /// `materials`, density `density_kg_m3` and the `fixed` flags (one per
+    /// vertex). Every block comes from the kernel's `stiffness_block`, and
+    /// every St Venant-Kirchhoff term from the kernel's `tet_terms`, each with
+    /// its tet's Lamé coefficients: the formulas the kernel subtracts when it
+    /// removes a tet.
+    ///
+    /// # Panics
+    /// If `materials` is not for `mesh.tets.len()` tets.
+    pub fn new(
+        mesh: &TetMesh,
+        materials: &TetMaterials,
+        density_kg_m3: f64,
+        fixed: Vec<bool>,
+    ) -> Self {
+        assert_eq!(materials.len(), mesh.tets.len(), "one material per tet");
         let n = mesh.positions.len();
-        let (lambda, mu) = material.lame();
         let (row_start, column) = edge_csr(n, &mesh.tets);
         let edge_index = |a: u32, b: u32| -> u32 {
             let (lo, hi) = (a.min(b), a.max(b));
@@ -95,7 +105,7 @@ impl TensorMassArrays {
             })
             .collect();
         let mut arrays = Self {
-            material: *material,
+            materials: materials.clone(),
             density_kg_m3,
             fixed,
             masses_kg: vec![0.0; n],
@@ -113,7 +123,8 @@ impl TensorMassArrays {
             tet_triangles,
             column: column.clone(),
         };
-        for tet in &mesh.tets {
+        for (tet, material) in mesh.tets.iter().zip(materials.per_tet()) {
+            let (lambda, mu) = material.lame();
             let p = tet.map(|v| mesh.positions[v as usize]);
             let (a, volume) = shape_gradients(&p);
             let a = a.map(Vector3::from);
@@ -238,8 +249,8 @@ pub fn write_tensor_mass_table(
         free_count: ordering.free_count() as u32,
         triangle_count: triangles.len() as u32,
         edge_count: arrays.column.len() as u32,
-        young_pa: arrays.material.young_pa,
-        poisson: arrays.material.poisson,
+        young_pa: arrays.materials.default_material().young_pa,
+        poisson: arrays.materials.default_material().poisson,
         density_kg_m3: arrays.density_kg_m3,
         mesh_hash: mesh.content_hash(),
         mesh_triangle_count: arrays.mesh_triangles.len() as u64,
@@ -265,6 +276,7 @@ pub fn write_tensor_mass_table(
         Section::floats(SectionKind::TriangleTerms, &arrays.triangle_terms, p),
         Section::ints(SectionKind::TetTriangle, &arrays.tet_triangles),
         Section::floats(SectionKind::TetTerms, &arrays.tet_terms, p),
+        Section::floats(SectionKind::TetMaterial, &arrays.materials.lame(), p),
     ];
     write_container(header, p, &sections)
 }

@@ -65,6 +65,20 @@ pub(crate) fn check_finite<T: Real, const L: usize>(
     }
 }
 
+/// The [`SectionKind::TetMaterial`] check: every `(λ, μ)` finite, `μ > 0`
+/// and `λ + 2μ/3 > 0` (a positive shear and bulk modulus, MODELS.md §1).
+pub(crate) fn check_tet_materials<T: Real>(lame: &[[T; 2]]) -> Result<(), LoadError> {
+    check_finite(SectionKind::TetMaterial, lame)?;
+    let two_thirds = T::of_f64(2.0 / 3.0);
+    match lame
+        .iter()
+        .position(|&[lambda, mu]| !(mu > T::zero() && lambda + two_thirds * mu > T::zero()))
+    {
+        Some(tet) => Err(LoadError::BadTetMaterial { tet: tet as u32 }),
+        None => Ok(()),
+    }
+}
+
 fn read_header(bytes: &[u8]) -> Result<RawHeader, LoadError> {
     let too_short = LoadError::TooShort { len: bytes.len() };
     if bytes.len() < HEADER_LEN + CRC_LEN {

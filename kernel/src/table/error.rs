@@ -163,6 +163,12 @@ pub enum LoadError {
         /// Connection index `j`.
         connection: u32,
     },
+    /// A tet's Lamé coefficients ([`SectionKind::TetMaterial`]) are out of
+    /// range: `μ ≤ 0` or `λ ≤ −2μ/3` (a bulk modulus that is not positive).
+    BadTetMaterial {
+        /// Tet index.
+        tet: u32,
+    },
     /// A diagonal compliance block `C_kk` is not symmetric positive definite.
     NotPositiveDefinite {
         /// Touchable index `k` (free index; the vertex is `free-vertex[k]`).
@@ -175,9 +181,11 @@ impl fmt::Display for LoadError {
         match *self {
             LoadError::TooShort { len } => write!(f, "table too short ({len} bytes)"),
             LoadError::BadMagic => f.write_str("not a Palpate table (bad magic)"),
-            LoadError::UnsupportedVersion { found } => {
-                write!(f, "unsupported table format version {found}")
-            }
+            LoadError::UnsupportedVersion { found } => write!(
+                f,
+                "table format version {found} is not read by this kernel (version {})",
+                super::format::FORMAT_VERSION
+            ),
             LoadError::LengthMismatch { declared, actual } => write!(
                 f,
                 "table length {actual} bytes differs from the header's {declared} (truncated?)"
@@ -260,6 +268,10 @@ impl fmt::Display for LoadError {
             LoadError::BadVertexData { vertex } => write!(
                 f,
                 "vertex {vertex}: negative lumped mass or asymmetric vertex tensor"
+            ),
+            LoadError::BadTetMaterial { tet } => write!(
+                f,
+                "tet {tet}: Lame coefficients out of range (need mu > 0 and lambda > -2 mu / 3)"
             ),
             LoadError::NotPositiveDefinite { touchable } => write!(
                 f,

@@ -1,4 +1,4 @@
-//! The table file format, version 2: one definition shared by the host writer
+//! The table file format, version 3: one definition shared by the host writer
 //! and the kernel reader.
 //!
 //! ```text
@@ -33,14 +33,19 @@
 //! layouts are documented in the tensor-mass model's `stvk_terms` module),
 //! a 104-byte header at first, then [`RawHeader::grid_cell_count`] and
 //! [`RawHeader::surface_vertex_count`] with the collision-index sections of
-//! pre-computed tables: the 112-byte header of today ([`HEADER_LEN`]).
+//! pre-computed tables: the 112-byte header of today ([`HEADER_LEN`]). 3 adds
+//! [`SectionKind::TetMaterial`], each tet's own Lamé coefficients, required
+//! in both table kinds (heterogeneous tissue); the header's `young_pa` and
+//! `poisson` stay as the scene's default `[material]` (informative: every
+//! model reads the per-tet section). A version-2 table is refused
+//! ([`super::LoadError::UnsupportedVersion`]), never misread.
 
 use bytemuck::{Pod, Zeroable};
 
 /// First 8 bytes of every table.
 pub const MAGIC: [u8; 8] = *b"PALPTBL\0";
 /// The format version this kernel reads and the host writes.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 /// Every section starts at a multiple of this many bytes from the file start.
 pub const SECTION_ALIGN: usize = 16;
 /// Size of the CRC-32 trailer.
@@ -68,7 +73,8 @@ pub struct RawHeader {
     pub table_kind: u32,
     /// Vertices of the source mesh (`N`).
     pub vertex_count: u32,
-    /// Tetrahedra of the source mesh.
+    /// Tetrahedra of the source mesh (both kinds: the count of
+    /// [`SectionKind::TetMaterial`]).
     pub tet_count: u32,
     /// Free (not fixed) vertices (`F`).
     pub free_count: u32,
@@ -82,9 +88,11 @@ pub struct RawHeader {
     /// vertices shared by the pre-computed and the tensor-mass region. Zero
     /// in the other kinds (and it keeps the floats 8-byte aligned).
     pub connection_count: u32,
-    /// Young's modulus the table was built with, Pa.
+    /// Young's modulus of the default material (the scene's `[material]`),
+    /// Pa; each tet's own is in [`SectionKind::TetMaterial`].
     pub young_pa: f64,
-    /// Poisson ratio the table was built with, dimensionless.
+    /// Poisson ratio of the default material, dimensionless; each tet's own
+    /// is in [`SectionKind::TetMaterial`].
     pub poisson: f64,
     /// Mass density, kg/m³ (tensor-mass tables; zero otherwise).
     pub density_kg_m3: f64,
@@ -161,6 +169,7 @@ impl TableKind {
                 SectionKind::VertexTriangleStart,
                 SectionKind::VertexTriangle,
                 SectionKind::SurfacePlane,
+                SectionKind::TetMaterial,
             ],
             TableKind::TensorMass => &[
                 SectionKind::VertexSlot,
@@ -181,6 +190,7 @@ impl TableKind {
                 SectionKind::TriangleTerms,
                 SectionKind::TetTriangle,
                 SectionKind::TetTerms,
+                SectionKind::TetMaterial,
             ],
             TableKind::Interface => &[
                 SectionKind::ConnectionVertex,
@@ -294,6 +304,12 @@ pub enum SectionKind {
     /// `[scalar; 3]` × tet_count: the quartic terms owned by each tet (local
     /// positions in the tet's own vertex order), N/m³.
     TetTerms = 30,
+    // ---- Version 3: heterogeneous tissue (31..=39). ----
+    /// `[scalar; 2]` × tet_count: each tet's Lamé coefficients `(λ, μ)`, Pa
+    /// (MODELS.md §1), in the mesh's tet order; required in both kinds.
+    /// Checked at load: finite, `μ > 0` and `λ > −2μ/3` (a positive bulk
+    /// modulus, i.e. `−1 < ν < 0.5`).
+    TetMaterial = 31,
     /// `[u32; 2]` × c: each connection node `j` of an interface table, as
     /// `[mesh vertex, tensor-mass vertex]`; mesh vertices strictly
     /// ascending, and connection node `j` is tensor-mass vertex `j` (the
@@ -355,10 +371,12 @@ pub const EDGE_TERMS_LEN: usize = 16;
 pub const TRIANGLE_TERMS_LEN: usize = 15;
 /// Scalars per [`SectionKind::TetTerms`] element.
 pub const TET_TERMS_LEN: usize = 3;
+/// Scalars per [`SectionKind::TetMaterial`] element: `(λ, μ)`.
+pub const TET_MATERIAL_LEN: usize = 2;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 34] = [
+    pub const ALL: [SectionKind; 35] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -387,6 +405,7 @@ impl SectionKind {
         SectionKind::TriangleTerms,
         SectionKind::TetTriangle,
         SectionKind::TetTerms,
+        SectionKind::TetMaterial,
         SectionKind::ConnectionVertex,
         SectionKind::CondensedStiffness,
         SectionKind::ConnectionResponse,
@@ -428,6 +447,7 @@ impl SectionKind {
             SectionKind::EdgeTerms => EDGE_TERMS_LEN as u32 * scalar_bytes,
             SectionKind::TriangleTerms => TRIANGLE_TERMS_LEN as u32 * scalar_bytes,
             SectionKind::TetTerms => TET_TERMS_LEN as u32 * scalar_bytes,
+            SectionKind::TetMaterial => TET_MATERIAL_LEN as u32 * scalar_bytes,
         }
     }
 
@@ -459,7 +479,8 @@ impl SectionKind {
             | SectionKind::TetShape
             | SectionKind::TetNeighbour
             | SectionKind::TetTriangle
-            | SectionKind::TetTerms => Some(tets),
+            | SectionKind::TetTerms
+            | SectionKind::TetMaterial => Some(tets),
             SectionKind::MeshTriangle | SectionKind::TriangleTerms => Some(h.mesh_triangle_count),
             SectionKind::FreeVertex => Some(f),
             SectionKind::SurfaceGrid | SectionKind::GridDims => Some(1),
@@ -505,6 +526,7 @@ impl SectionKind {
             SectionKind::TriangleTerms => "triangle-terms",
             SectionKind::TetTriangle => "tet-triangle",
             SectionKind::TetTerms => "tet-terms",
+            SectionKind::TetMaterial => "tet-material",
             SectionKind::ConnectionVertex => "connection-vertex",
             SectionKind::CondensedStiffness => "condensed-stiffness",
             SectionKind::ConnectionResponse => "connection-response",

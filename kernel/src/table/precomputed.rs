@@ -4,8 +4,8 @@ use nalgebra::Matrix3;
 
 use super::LoadError;
 use super::collision::{SurfaceIndex, SurfaceSections};
-use super::container::{Container, check_finite};
-use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TableKind};
+use super::container::{Container, check_finite, check_tet_materials};
+use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TET_MATERIAL_LEN, TableKind};
 use super::index::{FreeIndex, VertexIndex, VertexSlot};
 use crate::Real;
 use crate::math::cholesky::cholesky3;
@@ -19,6 +19,7 @@ use crate::math::cholesky::cholesky3;
 /// - every surface triangle's vertices are `< N`;
 /// - every float is finite and every diagonal block `C_kk` is symmetric
 ///   positive definite;
+/// - every tet's Lamé coefficients have `μ > 0` and `λ > −2μ/3`;
 /// - section lengths match the header's counts exactly.
 #[derive(Clone, Copy, Debug)]
 pub struct PrecomputedTable<'a, T: Real> {
@@ -30,6 +31,7 @@ pub struct PrecomputedTable<'a, T: Real> {
     surface: &'a [[T; 9]],
     interior: &'a [[T; 9]],
     surface_index: SurfaceIndex<'a, T>,
+    tet_materials: &'a [[T; TET_MATERIAL_LEN]],
 }
 
 impl<'a, T: Real> PrecomputedTable<'a, T> {
@@ -65,11 +67,13 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             surface: c.section(SectionKind::ComplianceSurface)?,
             interior: c.section(SectionKind::ComplianceInterior)?,
             surface_index: SurfaceIndex::new(&sections, rest_positions, triangles)?,
+            tet_materials: c.section(SectionKind::TetMaterial)?,
         };
         table.check_vertex_maps()?;
         check_finite(SectionKind::ComplianceSurface, table.surface)?;
         check_finite(SectionKind::ComplianceInterior, table.interior)?;
         table.check_diagonal_blocks()?;
+        check_tet_materials(table.tet_materials)?;
         log::debug!(
             "table loaded: {} vertices, {} free, {} touchable, {}-byte floats",
             table.vertex_count(),
@@ -106,14 +110,22 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         self.header.touchable_count as usize
     }
 
-    /// Young's modulus the table was built with, Pa.
+    /// Young's modulus of the default material (the scene's `[material]`),
+    /// Pa; each tet's own is in [`Self::tet_materials`].
     pub fn young_pa(&self) -> f64 {
         self.header.young_pa
     }
 
-    /// Poisson ratio the table was built with.
+    /// Poisson ratio of the default material.
     pub fn poisson(&self) -> f64 {
         self.header.poisson
+    }
+
+    /// The Lamé coefficients `[λ, μ]` (Pa) each tet of the source mesh had
+    /// when the compliance was computed, in tet order (the model itself
+    /// reads only the compliance).
+    pub fn tet_materials(&self) -> &'a [[T; TET_MATERIAL_LEN]] {
+        self.tet_materials
     }
 
     /// `vertex` as a checked index of this table's vertices; `None` out of

@@ -3,10 +3,11 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::LoadError;
-use super::container::{Container, check_finite};
+use super::container::{Container, check_finite, check_tet_materials};
 use super::format::{
-    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_SHAPE_LEN, TET_TERMS_LEN,
-    TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN, tet_edge_vertices, tet_face_vertices,
+    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_MATERIAL_LEN,
+    TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN,
+    tet_edge_vertices, tet_face_vertices,
 };
 use super::index::{EdgeIndex, TetIndex, VertexIndex, csr_row, span};
 use crate::Real;
@@ -26,6 +27,7 @@ use crate::Real;
 ///   face opposite local vertex `j`, and every triangle is some tet's face
 ///   (their number equals the distinct faces counted with the neighbours);
 /// - masses are `≥ 0`, vertex tensors symmetric, every float finite;
+/// - every tet's Lamé coefficients have `μ > 0` and `λ > −2μ/3`;
 /// - fixed vertices are marked [`FIXED_SLOT`] in the vertex-slot section and
 ///   their number matches the header's free count.
 #[derive(Clone, Copy, Debug)]
@@ -49,6 +51,7 @@ pub struct TensorMassTable<'a, T: Real> {
     triangle_terms: &'a [[T; TRIANGLE_TERMS_LEN]],
     tet_triangles: &'a [[u32; 4]],
     tet_terms: &'a [[T; TET_TERMS_LEN]],
+    tet_materials: &'a [[T; TET_MATERIAL_LEN]],
 }
 
 impl<'a, T: Real> TensorMassTable<'a, T> {
@@ -77,6 +80,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
             triangle_terms: c.section(SectionKind::TriangleTerms)?,
             tet_triangles: c.section(SectionKind::TetTriangle)?,
             tet_terms: c.section(SectionKind::TetTerms)?,
+            tet_materials: c.section(SectionKind::TetMaterial)?,
         };
         if table.header.mesh_triangle_count > u64::from(u32::MAX) {
             return Err(LoadError::InconsistentHeader);
@@ -97,6 +101,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         check_finite(SectionKind::EdgeTerms, table.edge_terms)?;
         check_finite(SectionKind::TriangleTerms, table.triangle_terms)?;
         check_finite(SectionKind::TetTerms, table.tet_terms)?;
+        check_tet_materials(table.tet_materials)?;
         table.check_vertices()?;
         table.check_edges()?;
         table.check_tets()?;
@@ -138,10 +143,17 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         self.tets.len()
     }
 
-    /// Lamé coefficients `(λ, μ)` of the table's material, Pa.
-    pub fn lame(&self) -> (T, T) {
-        let (lambda, mu) = crate::math::element::lame(self.header.young_pa, self.header.poisson);
-        (T::of_f64(lambda), T::of_f64(mu))
+    /// Every tet's Lamé coefficients `[λ, μ]`, Pa, in tet order (checked at
+    /// load: `μ > 0`, `λ > −2μ/3`).
+    pub fn tet_materials(&self) -> &'a [[T; TET_MATERIAL_LEN]] {
+        self.tet_materials
+    }
+
+    /// The Lamé coefficients `(λ, μ)` of `tet`, Pa (MODELS.md §1); `None`
+    /// only for an index of a larger table.
+    pub fn tet_lame(&self, tet: TetIndex) -> Option<(T, T)> {
+        let &[lambda, mu] = self.tet_materials.get(tet.get())?;
+        Some((lambda, mu))
     }
 
     /// Mass density, kg/m³.

@@ -113,18 +113,19 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
         })
     }
 
-    /// Subtracts tet `t`'s blocks and mass shares and marks it removed. A
-    /// vertex left without live tets is detached: mass, vertex tensor and
-    /// velocity set to exactly zero (it keeps still).
+    /// Subtracts tet `t`'s blocks and St Venant-Kirchhoff terms (with its own
+    /// Lamé coefficients) and mass shares and marks it removed. A vertex left
+    /// without live tets is detached: mass, vertex tensor and velocity set to
+    /// exactly zero (it keeps still).
     fn subtract(&mut self, t: TetIndex) {
-        let (Some(tet), Some(edges), Some((a, volume))) = (
+        let (Some(tet), Some(edges), Some((a, volume)), Some((lambda, mu))) = (
             self.table.tet_vertices(t),
             self.table.tet_edge_indices(t),
             self.table.tet_shape(t.get()),
+            self.table.tet_lame(t),
         ) else {
             return;
         };
-        let (lambda, mu) = self.table.lame();
         let share = T::of_f64(self.table.density_kg_m3()) * volume / T::of_f64(4.0);
         let s = &mut self.state;
         for (&v, aj) in tet.iter().zip(&a) {

@@ -20,8 +20,6 @@ pub(crate) struct InternalForces<'b, 'a, T: Real> {
     /// refuses [`StvkForm::Tensors`] then).
     pub(crate) terms: NonLinearTerms<'b, T>,
     pub(crate) law: ElasticLaw,
-    /// Lamé coefficients `(λ, μ)`, Pa.
-    pub(crate) lame: (T, T),
     /// Penalty `γ` (N) of Picinbono 2001 §3.2, `None` when off.
     pub(crate) incompressibility_n: Option<T>,
     /// The pre-computed region of a hybrid model, `None` for a model alone.
@@ -33,12 +31,11 @@ impl<T: Real> InternalForces<'_, '_, T> {
     /// the elastic force of the law, plus the incompressibility penalty, plus
     /// the coupled pre-computed region's force on the connection nodes.
     pub(crate) fn forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
-        let (lambda, mu) = self.lame;
         match self.law {
             ElasticLaw::Linear => self.stiffness.elastic_forces(u, f),
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
                 f.fill([T::zero(); 3]);
-                self.tets.add_stvk_forces(lambda, mu, u, f);
+                self.tets.add_stvk_forces(u, f);
             }
             ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
                 self.stiffness.elastic_forces(u, f);
@@ -59,7 +56,6 @@ impl<T: Real> InternalForces<'_, '_, T> {
     /// and is not included. `scratch` (N entries) receives the linear
     /// forces where the law needs them.
     pub(crate) fn energy_j(&self, u: &[[T; 3]], scratch: &mut [[T; 3]]) -> T {
-        let (lambda, mu) = self.lame;
         // ½ uᵀ K u = −½ Σ u·f with f = −K u.
         let mut quadratic = || {
             self.stiffness.elastic_forces(u, scratch);
@@ -74,9 +70,7 @@ impl<T: Real> InternalForces<'_, '_, T> {
         coupled
             + match self.law {
                 ElasticLaw::Linear => quadratic(),
-                ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
-                    self.tets.stvk_energy_j(lambda, mu, u)
-                }
+                ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => self.tets.stvk_energy_j(u),
                 ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
                     quadratic() + self.terms.energy_j(u)
                 }

@@ -701,7 +701,6 @@ fn internal_forces<'b, 'a, T: Real>(
         tets: TetPass { table, tet_alive },
         terms,
         law: params.law,
-        lame: table.lame(),
         incompressibility_n: params.incompressibility_n,
         coupling: coupling.map(Coupling::forces),
     }

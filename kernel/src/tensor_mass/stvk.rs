@@ -8,11 +8,12 @@
 //! `∇U = Σ_j u_j a_jᵀ`, `F = I + ∇U`, Green strain `E = ½(FᵀF − I)`,
 //! second Piola-Kirchhoff stress `S = λ tr(E) I + 2μE`, energy
 //! `W = V (λ/2 (tr E)² + μ tr E²)` and force on corner `j`
-//! `f_j = −∂W/∂u_j = −V F S a_j`.
+//! `f_j = −∂W/∂u_j = −V F S a_j`, with each tet's own `(λ, μ)` (the table's
+//! `tet-material` section: heterogeneous tissue).
 
 use crate::Real;
 use crate::table::TensorMassTable;
-use crate::table::format::TET_SHAPE_LEN;
+use crate::table::format::{TET_MATERIAL_LEN, TET_SHAPE_LEN};
 
 /// What the per-tet passes read: the table (tets, rest shapes and
 /// positions) and which tets are alive.
@@ -43,14 +44,16 @@ fn lane<T: Real>(rows: &[Lanes<T>; 3], l: usize) -> [T; 3] {
 
 /// Up to [`LANES`] live tets gathered for the force pass: their corners,
 /// edge displacements `u_j − u_0` (m) and rest gradients `a_j` (1/m) for
-/// `j = 1..3` by component, and rest volumes (m³). An unused lane has zero
-/// volume and gradients, so it computes a zero force.
+/// `j = 1..3` by component, rest volumes (m³) and Lamé coefficients (Pa).
+/// An unused lane has zero volume and gradients, so it computes a zero force.
 struct Block<T> {
     corners: [[u32; 4]; LANES],
     used: usize,
     du: [[Lanes<T>; 3]; 3],
     a: [[Lanes<T>; 3]; 3],
     volume: Lanes<T>,
+    lambda: Lanes<T>,
+    mu: Lanes<T>,
 }
 
 // The lane loops index fixed-size arrays with literals < 3 and loop
@@ -69,12 +72,22 @@ impl<T: Real> Block<T> {
             du: [[z; 3]; 3],
             a: [[z; 3]; 3],
             volume: z,
+            lambda: z,
+            mu: z,
         }
     }
 
-    /// Adds a tet in the next lane (the caller checks `used < LANES`).
+    /// Adds a tet with its rest shape, Lamé coefficients `[λ, μ]` (Pa) and
+    /// corner displacements in the next lane (the caller checks
+    /// `used < LANES`).
     #[inline(always)]
-    fn push(&mut self, tet: [u32; 4], shape: &[T; TET_SHAPE_LEN], u: [&[T; 3]; 4]) {
+    fn push(
+        &mut self,
+        tet: [u32; 4],
+        shape: &[T; TET_SHAPE_LEN],
+        lame: &[T; TET_MATERIAL_LEN],
+        u: [&[T; 3]; 4],
+    ) {
         let l = self.used;
         let [u0, u1, u2, u3] = u;
         // Shape layout: a_0, a_1, a_2, a_3 (3 each), volume; a_0 is implied.
@@ -91,6 +104,9 @@ impl<T: Real> Block<T> {
         }
         if let (Some(v), Some(&volume)) = (self.volume.get_mut(l), shape.get(TET_SHAPE_LEN - 1)) {
             *v = volume;
+        }
+        if let (Some(lambda), Some(mu)) = (self.lambda.get_mut(l), self.mu.get_mut(l)) {
+            [*lambda, *mu] = *lame;
         }
         if let Some(c) = self.corners.get_mut(l) {
             *c = tet;
@@ -118,18 +134,20 @@ impl<T: Real> Block<T> {
     /// the St Venant-Kirchhoff energy, `P = F S`, whose negatives are the
     /// forces on corners 1–3 (corner 0 takes minus their sum, since
     /// `a_0 = −(a_1 + a_2 + a_3)`), and the energies
-    /// `V (λ/2 (tr E)² + μ tr E²)` (J).
+    /// `V (λ/2 (tr E)² + μ tr E²)` (J), each lane with its tet's `λ`, `μ`.
     ///
     /// One loop over the lanes with a branch-free body on
     /// structure-of-arrays data: the form the compiler vectorizes.
     #[inline(always)]
-    fn elastic(&self, lambda: T, mu: T) -> ([[Lanes<T>; 3]; 3], Lanes<T>) {
+    fn elastic(&self) -> ([[Lanes<T>; 3]; 3], Lanes<T>) {
         let z = [T::zero(); LANES];
         let mut gradients = [[z; 3]; 3];
         let mut energy = z;
         let a = &self.a;
-        let (one, half, two_mu) = (T::one(), T::of_f64(0.5), mu + mu);
+        let (one, half) = (T::one(), T::of_f64(0.5));
         for l in 0..LANES {
+            let (lambda, mu) = (self.lambda[l], self.mu[l]);
+            let two_mu = mu + mu;
             let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = self.deformation(l);
             // E = ½(FᵀF − I), symmetric.
             let e00 = (f00 * f00 + f10 * f10 + f20 * f20 - one) * half;
@@ -234,7 +252,8 @@ impl<T: Real> TetPass<'_, '_, T> {
     fn for_each_block(&self, u: &[[T; 3]], mut visit: impl FnMut(&Block<T>)) {
         let mut block = Block::empty();
         let tets = self.table.tets().iter().zip(self.table.tet_shapes());
-        for ((&tet, shape), &alive) in tets.zip(self.tet_alive) {
+        let tets = tets.zip(self.table.tet_materials());
+        for (((&tet, shape), lame), &alive) in tets.zip(self.tet_alive) {
             let (true, Some(u0), Some(u1), Some(u2), Some(u3)) = (
                 alive,
                 u.get(tet[0] as usize),
@@ -244,7 +263,7 @@ impl<T: Real> TetPass<'_, '_, T> {
             ) else {
                 continue;
             };
-            block.push(tet, shape, [u0, u1, u2, u3]);
+            block.push(tet, shape, lame, [u0, u1, u2, u3]);
             if block.used == LANES {
                 visit(&block);
                 block.used = 0;
@@ -262,11 +281,11 @@ impl<T: Real> TetPass<'_, '_, T> {
     }
 
     /// Adds to `f` (N) the St Venant-Kirchhoff forces `f_j = −V F S a_j`
-    /// of displacements `u` (m) with Lamé coefficients `lambda`, `mu` (Pa),
+    /// of displacements `u` (m) with each tet's Lamé coefficients (Pa),
     /// see [`Block::elastic`].
-    pub(crate) fn add_stvk_forces(&self, lambda: T, mu: T, u: &[[T; 3]], f: &mut [[T; 3]]) {
+    pub(crate) fn add_stvk_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
         self.for_each_block(u, |block| {
-            let ([r1, r2, r3], _) = block.elastic(lambda, mu);
+            let ([r1, r2, r3], _) = block.elastic();
             for (l, tet) in block.corners.iter().enumerate().take(block.used) {
                 let (g1, g2, g3) = (lane(&r1, l), lane(&r2, l), lane(&r3, l));
                 let g0 = [
@@ -300,11 +319,11 @@ impl<T: Real> TetPass<'_, '_, T> {
     }
 
     /// The St Venant-Kirchhoff energy `Σ V (λ/2 (tr E)² + μ tr E²)` (J) of
-    /// displacements `u` (m).
-    pub(crate) fn stvk_energy_j(&self, lambda: T, mu: T, u: &[[T; 3]]) -> T {
+    /// displacements `u` (m), each tet with its own `λ`, `μ`.
+    pub(crate) fn stvk_energy_j(&self, u: &[[T; 3]]) -> T {
         let mut energy = T::zero();
         self.for_each_block(u, |block| {
-            let (_, w) = block.elastic(lambda, mu);
+            let (_, w) = block.elastic();
             for x in w.iter().take(block.used) {
                 energy += *x;
             }

@@ -405,7 +405,7 @@ fn oversized_tables_are_refused_before_building() {
     assert!(elapsed < Duration::from_secs(1), "{elapsed:?}");
     assert!(!err.contains('\n'), "one line: {err}");
     for part in [
-        "box40: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.0 GB (",
+        "box40: the pre-computed table (501240880 compliance blocks: 67240 free x 7921 touchable vertices, f32) would be 18.1 GB (",
         "above the largest table file, 4.3 GB (4294967296 bytes) (MAX_TABLE_FILE_BYTES)",
         "refused before building",
         "tensor-mass",
@@ -433,7 +433,7 @@ fn oversized_tables_are_refused_before_building() {
         "{:#}",
         run_session(&scene, &poke, &mut Vec::new(), None).expect_err("refused")
     );
-    assert!(err.contains("would be 18.0 GB"), "{err}");
+    assert!(err.contains("would be 18.1 GB"), "{err}");
     assert!(started.elapsed() < Duration::from_secs(2));
     let (mesh40, report40) = scene.load_mesh().expect("generated");
     let err = check_scene_table(&scene, &mesh40, &report40)
