@@ -107,28 +107,34 @@ fn build_all(mesh: &TetMesh) -> Vec<Built> {
         .collect()
 }
 
-/// A touchable vertex of the top of each region: the highest vertex of the
-/// pre-computed table's touchable ones, and of the tensor-mass region's
-/// surface that is no connection node (mesh numbers).
-fn top_vertices(built: &HybridTables, mesh: &TetMesh) -> (u32, u32) {
+/// Two touchable vertices of the top of each region, at least 8 mm apart:
+/// the highest of the pre-computed table's touchable ones, and of the
+/// tensor-mass region's surface vertices that are no connection node
+/// (mesh numbers).
+fn top_vertices(built: &HybridTables, mesh: &TetMesh) -> ([u32; 2], [u32; 2]) {
     let table = PrecomputedTable::<f32>::load(built.precomputed.bytes()).expect("table");
     let z = |v: &u32| mesh.positions[*v as usize][2];
-    let touchable = &table.free_vertices()[..table.touchable_count()];
-    let p = *touchable
-        .iter()
-        .max_by(|a, b| z(a).total_cmp(&z(b)))
-        .expect("touchable");
+    let two = |mut candidates: Vec<u32>| -> [u32; 2] {
+        candidates.sort_by(|a, b| z(b).total_cmp(&z(a)));
+        let first = candidates[0];
+        let p = mesh.positions[first as usize];
+        let far = |v: &&u32| {
+            let q = mesh.positions[**v as usize];
+            (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>() > 0.008f64.powi(2)
+        };
+        [first, *candidates.iter().find(far).expect("a second vertex")]
+    };
+    let touchable = table.free_vertices()[..table.touchable_count()].to_vec();
     let surface = palpate::mesh::boundary_surface(mesh);
-    let d = *surface
+    let dynamic = surface
         .vertices
         .iter()
-        .filter(|&&v| {
-            built.split.dynamic_index[v as usize].is_some()
-                && !built.split.in_precomputed[v as usize]
+        .copied()
+        .filter(|&v| {
+            built.split.dynamic_index[v as usize].is_some() && !built.split.in_precomputed[v as usize]
         })
-        .max_by(|a, b| z(a).total_cmp(&z(b)))
-        .expect("dynamic surface vertex");
-    (p, d)
+        .collect();
+    (two(touchable), two(dynamic))
 }
 
 fn step(c: &mut Criterion) {
@@ -217,73 +223,64 @@ fn tick(c: &mut Criterion) {
     let mut group = c.benchmark_group("hybrid_tick");
     for b in &built {
         let label = format!("{:.0}%", b.fraction * 100.0);
-        let precomputed =
-            PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
-        let dynamic = TensorMassTable::<f32>::load(b.tables.dynamic.bytes()).expect("table");
-        let interface = InterfaceTable::<f32>::load(b.tables.interface.bytes()).expect("table");
         let (p, d) = top_vertices(&b.tables, &mesh);
-        let at = |v: u32, dx: f32| {
+        let at = |v: u32| {
             let x = mesh.positions[v as usize].map(|c| c as f32);
-            Vector3::new(
-                x[0] + dx,
-                x[1],
-                x[2] + palpate_benches::TOOL_RADIUS_M - 0.0005,
-            )
+            Vector3::new(x[0], x[1], x[2] + palpate_benches::TOOL_RADIUS_M - 0.0005)
         };
-        for (name, tools) in [
-            (
-                "precomputed_1",
-                [at(p, 0.0), at(p, 0.0), at(p, 0.0), at(p, 0.0)],
-            ),
-            (
-                "dynamic_1",
-                [at(d, 0.0), at(d, 0.0), at(d, 0.0), at(d, 0.0)],
-            ),
-            (
-                "both_4",
-                [at(p, 0.0), at(p, 0.004), at(d, 0.0), at(d, 0.004)],
-            ),
-        ] {
-            let mut state = OwnedState::for_table(&dynamic);
-            let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
-            let mut surface = OwnedSurface::for_model(&model);
-            let (surface_buffers, forces) = surface.buffers();
-            let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
-            let (coupling, hybrid_surface) = owned.buffers();
-            let tissue = HybridTissue::<f32, 4, 4>::new(
-                model,
-                surface_buffers,
-                forces,
-                PhysicsConfig::new(Integrator::SymplecticEuler, DT_S, 1),
-                precomputed,
-                interface,
-                coupling,
-                hybrid_surface,
-            )
-            .expect("tissue");
-            let mut haptic = HybridLoop::<f32, 4, 4>::new(tissue, haptic_config()).expect("loop");
-            let points = if name == "both_4" { 4 } else { 1 };
-            let lifted = tools.map(|t| t + Vector3::new(0.0, 0.0, 0.01));
-            let mut input = lifted;
-            input[..points].copy_from_slice(&tools[..points]);
-            // Descend from 1 cm above, then hold with a physics update.
-            for k in 0..=20 {
-                let s = k as f32 / 20.0;
-                let mut at_k = lifted;
-                for (t, (a, b)) in at_k.iter_mut().zip(lifted.iter().zip(&input)) {
-                    *t = a + (b - a) * s;
-                }
-                haptic.tick(&at_k);
-            }
-            haptic.physics_update().expect("update");
-            let contacts = haptic.tick(&input).contacts as usize;
-            assert_eq!(contacts, points, "{name} at {label}: contacts made");
-            group.bench_function(BenchmarkId::new(name, &label), |bench| {
-                bench.iter(|| haptic.tick(black_box(&input)))
-            });
-        }
+        tick_case::<1>(&mut group, "precomputed_1", &label, &b.tables, [at(p[0])]);
+        tick_case::<1>(&mut group, "dynamic_1", &label, &b.tables, [at(d[0])]);
+        tick_case::<4>(
+            &mut group,
+            "both_4",
+            &label,
+            &b.tables,
+            [at(p[0]), at(p[1]), at(d[0]), at(d[1])],
+        );
     }
     group.finish();
+}
+
+/// Benches one tick of the hybrid loop with `P` probes held 0.5 mm into
+/// the surface at `tools` (lowered from 1 cm above, one physics update).
+fn tick_case<const P: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    label: &str,
+    tables: &HybridTables,
+    tools: [Vector3<f32>; P],
+) {
+    let precomputed = PrecomputedTable::<f32>::load(tables.precomputed.bytes()).expect("table");
+    let dynamic = TensorMassTable::<f32>::load(tables.dynamic.bytes()).expect("table");
+    let interface = InterfaceTable::<f32>::load(tables.interface.bytes()).expect("table");
+    let mut state = OwnedState::for_table(&dynamic);
+    let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
+    let mut surface = OwnedSurface::for_model(&model);
+    let (surface_buffers, forces) = surface.buffers();
+    let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
+    let (coupling, hybrid_surface) = owned.buffers();
+    let tissue = HybridTissue::<f32, P, P>::new(
+        model,
+        surface_buffers,
+        forces,
+        PhysicsConfig::new(Integrator::SymplecticEuler, DT_S, 1),
+        precomputed,
+        interface,
+        coupling,
+        hybrid_surface,
+    )
+    .expect("tissue");
+    let mut haptic = HybridLoop::<f32, P, P>::new(tissue, haptic_config()).expect("loop");
+    for k in 0..=20 {
+        let lift = 0.01 * (1.0 - k as f32 / 20.0);
+        haptic.tick(&tools.map(|t| t + Vector3::new(0.0, 0.0, lift)));
+    }
+    haptic.physics_update().expect("update");
+    let contacts = haptic.tick(&tools).contacts as usize;
+    assert_eq!(contacts, P, "{name} at {label}: contacts made");
+    group.bench_function(BenchmarkId::new(name, label), |bench| {
+        bench.iter(|| haptic.tick(black_box(&tools)))
+    });
 }
 
 criterion_group!(benches, step, tick);
