@@ -4,10 +4,15 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::{Context, anyhow, bail};
 use clap::Subcommand;
+use palpate::hybrid::HybridOptions;
+use palpate::hybrid::stability::critical_dt_of_hybrid;
 use palpate::mesh::{MeshReport, TetMesh, read_mesh};
-use palpate::table::build::BuildOptions;
+use palpate::partition::Partition;
+use palpate::session::Scene;
+use palpate::session::run::tensor_mass_options;
+use palpate::table::build::{BuildOptions, TableKindOptions};
 use palpate::table::file::Precision;
 use palpate::tensor_mass::run::RunOptions;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
@@ -55,18 +60,29 @@ pub enum DynamicCommand {
     },
 }
 
-/// What both `dynamic` commands take: the mesh, its material and supports,
-/// the damping and the integrator.
+/// What both `dynamic` commands take: the mesh, its material and supports
+/// (or a scene in their place), the damping and the integrator.
 #[derive(clap::Args)]
 #[command(mut_arg("fix", optional_fix))]
 pub struct DynamicModelArgs {
     /// Input mesh (.msh, .node/.ele, .vtk), metres.
-    mesh: PathBuf,
-    #[command(flatten)]
-    material: MaterialArgs,
+    #[arg(required_unless_present = "scene")]
+    mesh: Option<PathBuf>,
+    /// A scene (file, or a built-in name) in place of the mesh, --young,
+    /// --poisson, --density and --fix: its mesh, per-region materials and
+    /// supports; its [[zone]]s, when they make part of the mesh dynamic,
+    /// run the hybrid model (displacements of every mesh vertex).
+    #[arg(long, conflicts_with_all = ["mesh", "young", "poisson", "density", "fix"])]
+    scene: Option<String>,
+    /// Young's modulus, Pa.
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
+    young: Option<f64>,
+    /// Poisson ratio, in [0, 0.5).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
+    poisson: Option<f64>,
     /// Mass density, kg/m3.
-    #[arg(long)]
-    density: f64,
+    #[arg(long, required_unless_present = "scene")]
+    density: Option<f64>,
     /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
     #[arg(long)]
     damping: f64,
@@ -79,18 +95,61 @@ pub struct DynamicModelArgs {
     json: JsonArgs,
 }
 
+/// What a `dynamic` command runs on.
+struct Setup {
+    mesh: TetMesh,
+    report: MeshReport,
+    /// The (f64) tensor-mass table options: materials, density, supports.
+    table: BuildOptions,
+    /// The tets a scene's zones make dynamic, when they make some but not
+    /// all: the hybrid model.
+    hybrid: Option<Vec<bool>>,
+    /// The mesh file or the scene, for messages.
+    name: String,
+}
+
 impl DynamicModelArgs {
-    /// Checks `--json`, reads the mesh and gathers the (f64) table options.
-    fn read(&self, command: &str) -> anyhow::Result<(TetMesh, MeshReport, BuildOptions)> {
+    /// Checks `--json`, reads the mesh (or the scene and its mesh) and
+    /// gathers the (f64) table options.
+    fn read(&self, command: &str) -> anyhow::Result<Setup> {
         self.json.require(&format!("dynamic {command}"))?;
-        let (mesh, report) = read_mesh(&self.mesh)?;
-        let options = BuildOptions::tensor_mass(
-            self.material.material()?,
-            self.density,
-            self.fix.fix.clone(),
-            Precision::F64,
-        );
-        Ok((mesh, report, options))
+        if let Some(name) = &self.scene {
+            let scene = Scene::named(name)?;
+            let (mesh, report) = scene.load_mesh()?;
+            let mut table = tensor_mass_options(&scene, &mesh, &report)?;
+            table.precision = Precision::F64;
+            let hybrid = if scene.zones.is_empty() {
+                None
+            } else {
+                let partition =
+                    Partition::of_scene(&scene, &mesh, &report).map_err(|e| anyhow!("{e}"))?;
+                let dynamic = partition.dynamic.iter().filter(|&&d| d).count();
+                (dynamic > 0 && dynamic < mesh.tets.len()).then_some(partition.dynamic)
+            };
+            return Ok(Setup {
+                mesh,
+                report,
+                table,
+                hybrid,
+                name: scene.source,
+            });
+        }
+        let (Some(path), Some(young), Some(poisson), Some(density)) =
+            (&self.mesh, self.young, self.poisson, self.density)
+        else {
+            bail!("give a mesh with --young, --poisson and --density, or --scene");
+        };
+        let (mesh, report) = read_mesh(path)?;
+        let material = MaterialArgs { young, poisson }.material()?;
+        let table =
+            BuildOptions::tensor_mass(material, density, self.fix.fix.clone(), Precision::F64);
+        Ok(Setup {
+            mesh,
+            report,
+            table,
+            hybrid: None,
+            name: path.display().to_string(),
+        })
     }
 }
 
@@ -171,10 +230,10 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             form,
             incompressibility,
         } => {
-            let (mesh, report, table) = model.read("run")?;
+            let setup = model.read("run")?;
             let (law, incompressibility_n) = law.law(form, incompressibility)?;
             let options = RunOptions {
-                table,
+                table: setup.table,
                 damping_per_s: model.damping,
                 law,
                 incompressibility_n,
@@ -185,22 +244,58 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
                 steps,
                 cut_tets,
             };
-            let output = palpate::tensor_mass::run::run(&mesh, &report, &options)
-                .with_context(|| model.mesh.display().to_string())?;
+            let (mesh, report) = (&setup.mesh, &setup.report);
+            let output = match &setup.hybrid {
+                Some(dynamic) => palpate::hybrid::run::run(mesh, report, dynamic, &options),
+                None => palpate::tensor_mass::run::run(mesh, report, &options),
+            }
+            .with_context(|| setup.name.clone())?;
             stdout::println(&serde_json::to_string(&output)?)?;
             Ok(())
         }
         DynamicCommand::CriticalDt { model } => {
-            let (mesh, report, table) = model.read("critical-dt")?;
-            let result = palpate::tensor_mass::stability::critical_dt_of_mesh(
-                &mesh,
-                &report,
-                &table,
-                model.damping,
-                model.integrator.into(),
-            )
-            .with_context(|| model.mesh.display().to_string())?;
-            stdout::println(&serde_json::to_string(&result)?)?;
+            let setup = model.read("critical-dt")?;
+            let (mesh, report, table) = (&setup.mesh, &setup.report, &setup.table);
+            let integrator = model.integrator.into();
+            let json = match &setup.hybrid {
+                Some(dynamic) => {
+                    let density = match table.kind {
+                        TableKindOptions::TensorMass { density_kg_m3 } => density_kg_m3,
+                        TableKindOptions::Precomputed { .. } => 0.0,
+                    };
+                    let options = HybridOptions {
+                        build: table.clone(),
+                        ..HybridOptions::new(
+                            table.material,
+                            density,
+                            table.fix.clone(),
+                            Precision::F64,
+                        )
+                    };
+                    let result = critical_dt_of_hybrid(
+                        mesh,
+                        report,
+                        dynamic,
+                        &options,
+                        model.damping,
+                        integrator,
+                    )
+                    .with_context(|| setup.name.clone())?;
+                    serde_json::to_string(&result)?
+                }
+                None => {
+                    let result = palpate::tensor_mass::stability::critical_dt_of_mesh(
+                        mesh,
+                        report,
+                        table,
+                        model.damping,
+                        integrator,
+                    )
+                    .with_context(|| setup.name.clone())?;
+                    serde_json::to_string(&result)?
+                }
+            };
+            stdout::println(&json)?;
             Ok(())
         }
     }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
 use palpate::output::atomic::{self, AtomicFile};
-use palpate::session::generate::surgery;
+use palpate::session::generate::{hepatectomy, surgery};
 use palpate::session::run::{removed_path, removes_tets, run_session_to_files};
 use palpate::session::{
     CutLine, Generator, GraspPull, MeshSource, Pinch, Poke, PressHold, Scene, Slide, Strike,
@@ -19,8 +19,10 @@ pub enum SessionCommand {
     /// Drive the haptic loop tick by tick; write `t,fx,fy,fz,contacts,status` per tick.
     Run {
         /// Scene file (TOML), `built-in` (the demo block, pre-computed model),
-        /// `built-in-dynamic` (the same block on the dynamic model) or
-        /// `built-in-tools` (the dynamic block with a grasper and a cutter).
+        /// `built-in-dynamic` (the same block on the dynamic model),
+        /// `built-in-tools` (the dynamic block with a grasper and a cutter) or
+        /// `built-in-hybrid` (the organ on the hybrid model: a grasper on its
+        /// pre-computed region, a cutter in its tensor-mass region).
         scene: String,
         /// Trajectory file: CSV `t,tool,x,y,z` (s, tool point, m) with a header,
         /// optionally with the tool columns `jaw_m,cut` (header
@@ -68,6 +70,9 @@ pub enum TrajectoryKind {
     CutLine,
     // The `built-in-tools` scene's grasper (tool 0) and cutter (tool 1) at work together.
     Surgery,
+    // The `built-in-hybrid` scene's grasper (tool 0) holding the organ's right lobe while its
+    // cutter (tool 1) cuts a segment off.
+    Hepatectomy,
 }
 
 /// Runs a `session` command.
@@ -150,6 +155,7 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                 TrajectoryKind::GraspPull => GraspPull::default().trajectory(),
                 TrajectoryKind::CutLine => CutLine::default().trajectory(),
                 TrajectoryKind::Surgery => surgery(&Scene::built_in_tools().tool),
+                TrajectoryKind::Hepatectomy => hepatectomy(&Scene::built_in_hybrid().tool),
             }
             .map_err(|e| anyhow::anyhow!("{e}"))?;
             let mut file = AtomicFile::create(&output)?;

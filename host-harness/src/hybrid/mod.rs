@@ -10,6 +10,7 @@
 pub mod build;
 pub mod condense;
 pub mod owned;
+pub mod run;
 pub mod split;
 pub mod stability;
 

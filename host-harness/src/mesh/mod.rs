@@ -20,7 +20,7 @@ mod validate;
 mod vtk;
 
 pub use error::MeshError;
-pub use surface::{Surface, boundary_surface};
+pub use surface::{Surface, boundary_surface, top_height};
 pub use tetgen::read_tetgen;
 
 /// A validated tetrahedral mesh (linear 4-node tets).

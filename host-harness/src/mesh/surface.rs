@@ -116,3 +116,25 @@ pub(crate) fn check(mesh: &TetMesh) -> Vec<String> {
     }
     warnings
 }
+
+/// Height (z, m) of the highest of `triangles` (over `positions`) whose
+/// projection on the xy plane holds `(x, y)`, `None` if none does: where a
+/// tool coming straight down meets the rest surface.
+pub fn top_height(positions: &[[f64; 3]], triangles: &[[u32; 3]], x: f64, y: f64) -> Option<f64> {
+    let mut top: Option<f64> = None;
+    for tri in triangles {
+        let [a, b, c] = tri.map(|v| positions[v as usize]);
+        let det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+        if det.abs() < 1e-18 {
+            continue;
+        }
+        let wb = ((x - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (y - a[1])) / det;
+        let wc = ((b[0] - a[0]) * (y - a[1]) - (x - a[0]) * (b[1] - a[1])) / det;
+        let wa = 1.0 - wb - wc;
+        if [wa, wb, wc].iter().all(|&w| w >= -1e-9) {
+            let z = wa * a[2] + wb * b[2] + wc * c[2];
+            top = Some(top.map_or(z, |t| t.max(z)));
+        }
+    }
+    top
+}

@@ -1016,3 +1016,27 @@ pub fn surgery(tool: &super::scene::ToolSpec) -> Result<Trajectory, GenerateErro
     }
     sample_keyframes_with_tool_columns(&keyframes, 1000.0, true)
 }
+
+/// The built-in hybrid scene's tools at work on the organ
+/// ([`super::scene::Scene::built_in_hybrid`], sites [`super::scene::HepatectomySites`]): the
+/// grasper (tool 0) grasps the right lobe's terrace and pulls it up, the cutter (tool 1, the
+/// scene's blade) cuts along the cut line at the same time; 1 kHz with the tool columns
+/// (`session generate hepatectomy`).
+pub fn hepatectomy(tool: &super::scene::ToolSpec) -> Result<Trajectory, GenerateError> {
+    let sites = super::scene::HepatectomySites::on_the_organ();
+    let mut keyframes = GraspPull {
+        tool: 0,
+        surface_m: sites.grasp_m,
+        ..GraspPull::default()
+    }
+    .keyframes()?;
+    let mut cut = CutLine {
+        tool: 1,
+        blade_m: tool.blade_m,
+        distance_m: sites.cut_to_m[0] - sites.cut_from_m[0],
+        ..CutLine::default()
+    };
+    cut.press.surface_m = sites.cut_from_m;
+    keyframes.extend(cut.keyframes()?);
+    sample_keyframes_with_tool_columns(&keyframes, 1000.0, true)
+}

@@ -83,12 +83,14 @@ use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
 
 use super::materials::{RegionSpec, check_regions};
-use super::zones::{PartitionFile, PartitionSpec, Zone, ZoneFile, zones_spec};
+use super::zones::{
+    PartitionFile, PartitionSpec, Zone, ZoneFile, ZoneKind, ZoneShape, zones_spec,
+};
 use crate::fem::material::{Material, MaterialError};
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_HAPTIC_HZ, MAX_SCENE_FILE_BYTES, read_bounded};
-use crate::mesh::generate::box_mesh;
-use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh};
+use crate::mesh::generate::{ORGAN_CUBE_M, box_mesh, organ_mesh};
+use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh, top_height};
 
 /// Largest number of tool points of a scene, both the trajectory's tool points (`[tool] points`)
 /// and the kernel tool points their kinds need ([`ToolSpec::kernel_points`]: a grasper's two jaws
@@ -160,6 +162,9 @@ pub enum MeshSource {
         /// Cells per axis, each ≥ 1 (6 tets per cell).
         cells: [usize; 3],
     },
+    /// The generated liver-like organ ([`organ_mesh`] at [`ORGAN_CUBE_M`]: 1386 vertices,
+    /// 5868 tets, its flat underside the lowest vertices); the built-in hybrid scene's.
+    GeneratedOrgan,
 }
 
 /// The tissue material.
@@ -546,6 +551,46 @@ struct SafetyFile {
     max_slew_n_per_s: f64,
 }
 
+/// Radius of the built-in hybrid scene's cut zone around its cut line, m: the blade's 1 cm
+/// and the sphere below it, and a few millimetres.
+pub const HEPATECTOMY_CUT_RADIUS_M: f64 = 0.012;
+
+/// Where the built-in hybrid scene's tools work on the organ's rest surface (m): the right
+/// lobe's upper terrace, flat in the voxel surface (the benches' sites).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HepatectomySites {
+    /// The surface point between the grasper's jaws.
+    pub grasp_m: [f64; 3],
+    /// The cut line on the surface, from and to (along +x).
+    pub cut_from_m: [f64; 3],
+    /// See `cut_from_m`.
+    pub cut_to_m: [f64; 3],
+    /// Height of the organ's flat underside (its lowest vertices).
+    pub floor_m: f64,
+}
+
+impl HepatectomySites {
+    /// The sites on [`organ_mesh`] at [`ORGAN_CUBE_M`]: the grasp at `(0.030, −0.028)`, the
+    /// cut along `y = 2c + 1 mm` (1 mm off a row of vertices) from `x = 0.006` to `0.053`,
+    /// each at the height of the rest surface there.
+    pub fn on_the_organ() -> Self {
+        let mesh = organ_mesh(ORGAN_CUBE_M);
+        let surface = crate::mesh::boundary_surface(&mesh);
+        let on_top = |x: f64, y: f64| {
+            // The sites are on the organ (a fixed, generated mesh).
+            let z = top_height(&mesh.positions, &surface.triangles, x, y).unwrap_or(0.0);
+            [x, y, z]
+        };
+        let y = 2.0 * ORGAN_CUBE_M + 0.001;
+        Self {
+            grasp_m: on_top(0.030, -0.028),
+            cut_from_m: on_top(0.006, y),
+            cut_to_m: on_top(0.053, y),
+            floor_m: mesh.positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min),
+        }
+    }
+}
+
 /// Default density, kg/m³ (water; soft tissue is 1000–1100).
 pub const DEFAULT_DENSITY_KG_M3: f64 = 1000.0;
 /// Default tool point count.
@@ -724,17 +769,61 @@ impl Scene {
         }
     }
 
+    /// The built-in hepatectomy-style scene on the hybrid model (RR-3510 §6.2): the organ
+    /// ([`MeshSource::GeneratedOrgan`], E = 5 kPa, ν = 0.4, 1000 kg/m³, its flat underside
+    /// fixed), a grasper (trajectory tool 0) holding the right lobe on its upper terrace and a
+    /// cutter (tool 1) cutting a segment off along a 4.7 cm line of the same terrace
+    /// ([`HepatectomySites`]); the one `[[zone]]`, a cut capsule of radius
+    /// [`HEPATECTOMY_CUT_RADIUS_M`] around the cut line, with the default margin, makes the
+    /// tensor-mass region (linear: no large-deformation zone), the rest of the organ is
+    /// pre-computed, so the grasper holds pre-computed tissue and the blade cuts tensor-mass
+    /// tissue. Symplectic Euler in 0.5 ms steps, damping 30/s, physics every 10 ticks, tearing
+    /// past 100 % edge elongation. `session generate hepatectomy` writes its trajectory.
+    pub fn built_in_hybrid() -> Scene {
+        let sites = HepatectomySites::on_the_organ();
+        let (a, b) = (sites.cut_from_m, sites.cut_to_m);
+        Scene {
+            source: "built-in hybrid scene".into(),
+            mesh: MeshSource::GeneratedOrgan,
+            // Parses (a number formatted by Rust).
+            fix: format!("z<{}", sites.floor_m + 1e-6)
+                .parse::<FixPredicate>()
+                .into_iter()
+                .collect(),
+            material: MaterialSpec {
+                young_pa: 5000.0,
+                poisson: 0.4,
+                density_kg_m3: DEFAULT_DENSITY_KG_M3,
+            },
+            zones: vec![Zone {
+                kind: ZoneKind::Cut,
+                shape: ZoneShape::Capsule {
+                    a_m: a,
+                    b_m: b,
+                    radius_m: HEPATECTOMY_CUT_RADIUS_M,
+                },
+            }],
+            ..Self::built_in_tools()
+        }
+    }
+
     /// The built-in scene names [`Self::named`] knows.
-    pub const BUILT_IN: [&'static str; 3] = ["built-in", "built-in-dynamic", "built-in-tools"];
+    pub const BUILT_IN: [&'static str; 4] = [
+        "built-in",
+        "built-in-dynamic",
+        "built-in-tools",
+        "built-in-hybrid",
+    ];
 
     /// The scene a command line names: `built-in` ([`Self::built_in`]), `built-in-dynamic`
-    /// ([`Self::built_in_dynamic`]), `built-in-tools` ([`Self::built_in_tools`]), or a scene
-    /// file ([`Self::read`]).
+    /// ([`Self::built_in_dynamic`]), `built-in-tools` ([`Self::built_in_tools`]),
+    /// `built-in-hybrid` ([`Self::built_in_hybrid`]), or a scene file ([`Self::read`]).
     pub fn named(name: &str) -> Result<Scene, SceneError> {
         match name {
             "built-in" => Ok(Self::built_in()),
             "built-in-dynamic" => Ok(Self::built_in_dynamic()),
             "built-in-tools" => Ok(Self::built_in_tools()),
+            "built-in-hybrid" => Ok(Self::built_in_hybrid()),
             path => Self::read(Path::new(path)),
         }
     }
@@ -1074,6 +1163,13 @@ impl Scene {
                 };
                 Ok((mesh, report))
             }
+            MeshSource::GeneratedOrgan => Ok((
+                organ_mesh(ORGAN_CUBE_M),
+                MeshReport {
+                    source: format!("generated organ, {ORGAN_CUBE_M} m cubes"),
+                    ..MeshReport::default()
+                },
+            )),
         }
     }
 }
