@@ -15,6 +15,7 @@ mod host {
     mod robustness;
     mod session;
     mod session_generate_tools;
+    mod session_hybrid;
     mod session_run;
     mod session_scene_tools;
     mod session_stability;

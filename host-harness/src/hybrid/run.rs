@@ -62,7 +62,9 @@ pub fn run(
     with_hybrid(&tables, params, |hybrid| -> anyhow::Result<RunOutput> {
         for &tet in &options.cut_tets {
             let Some(local) = mesh_tet.iter().position(|&t| t == tet) else {
-                bail!("--cut-tets {tet}: not a tet of the tensor-mass region (the pre-computed region cannot be cut)");
+                bail!(
+                    "--cut-tets {tet}: not a tet of the tensor-mass region (the pre-computed region cannot be cut)"
+                );
             };
             hybrid
                 .dynamic_mut()

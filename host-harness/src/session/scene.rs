@@ -83,9 +83,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, StvkForm};
 use serde::Deserialize;
 
 use super::materials::{RegionSpec, check_regions};
-use super::zones::{
-    PartitionFile, PartitionSpec, Zone, ZoneFile, ZoneKind, ZoneShape, zones_spec,
-};
+use super::zones::{PartitionFile, PartitionSpec, Zone, ZoneFile, ZoneKind, ZoneShape, zones_spec};
 use crate::fem::material::{Material, MaterialError};
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_HAPTIC_HZ, MAX_SCENE_FILE_BYTES, read_bounded};
@@ -586,7 +584,11 @@ impl HepatectomySites {
             grasp_m: on_top(0.030, -0.028),
             cut_from_m: on_top(0.006, y),
             cut_to_m: on_top(0.053, y),
-            floor_m: mesh.positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min),
+            floor_m: mesh
+                .positions
+                .iter()
+                .map(|p| p[2])
+                .fold(f64::INFINITY, f64::min),
         }
     }
 }
