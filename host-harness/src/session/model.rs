@@ -131,7 +131,7 @@ impl SceneModel {
                 .with_tet_materials(materials);
                 let tables = build_hybrid(mesh, report, &partition.dynamic, &options)
                     .with_context(|| scene.source.clone())?;
-                SceneTables::Hybrid(tables, spec)
+                SceneTables::Hybrid(Box::new(tables), spec)
             }
         })
     }
@@ -144,5 +144,5 @@ pub enum SceneTables {
     /// The tensor-mass table and the model's settings.
     Dynamic(TableFile, DynamicSpec),
     /// The hybrid's three tables and its tensor-mass region's settings.
-    Hybrid(HybridTables, DynamicSpec),
+    Hybrid(Box<HybridTables>, DynamicSpec),
 }

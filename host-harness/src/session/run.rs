@@ -407,7 +407,7 @@ pub fn run_session_into(
             SessionTissue::Dynamic(DynamicSetup::of(scene, spec, table)?)
         }
         SceneTables::Hybrid(tables, spec) => {
-            SessionTissue::Hybrid(HybridSetup::of(scene, spec, tables)?)
+            SessionTissue::Hybrid(Box::new(HybridSetup::of(scene, spec, tables)?))
         }
     };
     with_tool_points(
@@ -426,7 +426,7 @@ pub fn run_session_into(
 enum SessionTissue<'t> {
     Precomputed(PrecomputedTable<'t, f32>, LoopConfig<f32>),
     Dynamic(DynamicSetup<'t>),
-    Hybrid(HybridSetup<'t>),
+    Hybrid(Box<HybridSetup<'t>>),
 }
 
 /// A session's ticks on its tissue, run with the scene's tool points.
