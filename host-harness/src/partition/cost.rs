@@ -6,19 +6,21 @@
 //!   imposes their displacement). The interface table follows [`interface_table_bytes`].
 //! - A tensor-mass region's step: its sub-mesh's f32 table built in memory, stepped alone under
 //!   gravity ([`TIMED_STEPS`] steps after [`WARMUP_STEPS`], the median of the single steps),
-//!   plus the interface update: the `9c²` multiply-adds of the condensed stiffness `C_cc⁻¹`
-//!   applied to the connection displacements (MODELS.md §5), timed as a dense `3c × 3c` f32
-//!   matrix-vector product (median of [`TIMED_PRODUCTS`]; above [`MAX_TIMED_CONNECTIONS`]
-//!   connection nodes, timed at that size and scaled by `c²`).
+//!   plus the interface update: the `9c²` multiply-adds of the condensed stiffness `S`
+//!   applied to the connection displacements (MODELS.md §5), timed as the kernel's `3c` row
+//!   products of a dense `3c × 3c` f32 matrix (median of [`TIMED_PRODUCTS`]; above
+//!   [`MAX_TIMED_CONNECTIONS`] connection nodes, timed at that size and scaled by `c²`).
 //! - The pre-computed region's tick: the kernel's contact solve for [`MAX_CONTACTS`] vertex
 //!   contacts (median of [`TIMED_SOLVES`]), whose work is `O(m³)` and independent of the mesh
-//!   (README "The model"), timed on a 4 × 4 × 4-cell box of the scene's material; plus the
-//!   interface's two triangular solves with `C_cc`'s factor (`c²` 3×3 blocks, timed as above)
-//!   when there are connection nodes.
+//!   (README "The model"), timed on a 4 × 4 × 4-cell box of the scene's material; plus, when
+//!   there are connection nodes, the interface update (the pre-computed region's response to
+//!   the connection nodes is read per contact from the background the physics update
+//!   computes, so a tick adds nothing per connection node; the update is listed once more as
+//!   the region's share of each physics step).
 //! - A tensor-mass region's stable step: `ω_max` of its f64 linear model at rest (Lanczos,
-//!   [`lanczos_omega_max`]) and the integrator's condition ([`integrator_limit`]). With the
-//!   connection nodes fixed this is the region's own limit; the coupled limit also sees the
-//!   interface stiffness `C_cc⁻¹` (MODELS.md §5), which the hybrid build checks.
+//!   [`lanczos_omega_max`]) and the integrator's condition ([`integrator_limit`]), the
+//!   connection nodes fixed. The coupled limit (`dynamic critical-dt --scene`) is measured at
+//!   or above the all-tensor-mass model's (README "The hybrid model").
 
 use std::time::Instant;
 
@@ -26,6 +28,7 @@ use anyhow::Context;
 use core::hint::black_box;
 use nalgebra::Vector3;
 use palpate_kernel::MAX_CONTACTS;
+use palpate_kernel::math::dense::dot;
 use palpate_kernel::precomputed::{Constraint, PrecomputedModel};
 use palpate_kernel::table::format::TableKind;
 use palpate_kernel::table::{PrecomputedTable, TensorMassTable};
@@ -39,7 +42,7 @@ use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, build};
 use crate::table::compliance::Solver;
 use crate::table::estimate::{TableCounts, TableEstimate};
-use crate::table::file::{Precision, layout};
+use crate::table::file::Precision;
 use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 use crate::tensor_mass::OwnedState;
 use crate::tensor_mass::run::diagonal;
@@ -102,34 +105,23 @@ pub struct InterfaceCost {
     pub update_s: f64,
 }
 
-/// The size of the interface table, bytes: the container (header, directory, sections aligned
-/// to 16 bytes, CRC) of the sections: the connection vertices (`12c`), the condensed stiffness
-/// (`c(c+1)/2` 3×3 blocks), the response of the pre-computed region's free vertices to the
-/// connection displacements (`F_P·c` blocks), the pre-computed free displacements (`3F_P`) and
-/// the connection forces (`3c`) in scalars of `scalar_bytes`, and one 8-byte slot per mesh
-/// vertex (`8N`). `u64::MAX` when a length overflows.
+/// The size of the interface table, bytes: its layout from the counts (`table/estimate.rs`,
+/// the format's sections: `c` connection vertices, the `3c × 3c` condensed stiffness, the
+/// `3F_P × 3c` response of the pre-computed region's free vertices, their load displacements,
+/// the connection forces, one entry per mesh vertex), in scalars of `precision`.
 pub fn interface_table_bytes(
     c: u64,
     free_precomputed: u64,
     vertices: u64,
-    scalar_bytes: u64,
+    precision: Precision,
 ) -> u64 {
-    let sections = (|| {
-        let block = 9 * scalar_bytes;
-        Some([
-            c.checked_mul(12)?,
-            c.checked_mul(c.checked_add(1)?)?
-                .checked_div(2)?
-                .checked_mul(block)?,
-            free_precomputed.checked_mul(c)?.checked_mul(block)?,
-            free_precomputed.checked_mul(3 * scalar_bytes)?,
-            c.checked_mul(3 * scalar_bytes)?,
-            vertices.checked_mul(8)?,
-        ])
-    })();
-    sections
-        .and_then(|s| layout(&s))
-        .map_or(u64::MAX, |(_, len)| len)
+    let counts = TableCounts {
+        vertices,
+        free: free_precomputed,
+        connections: c,
+        ..TableCounts::default()
+    };
+    TableEstimate::new(TableKind::Interface, precision, counts).table_bytes
 }
 
 /// A region's tets as a mesh of their own (vertices renumbered in ascending order of the
@@ -221,7 +213,7 @@ pub fn costs(
             c as u64,
             precomputed_free,
             mesh.positions.len() as u64,
-            u64::from(PRECISION.scalar_bytes()),
+            PRECISION,
         ),
         update_s,
     };
@@ -296,7 +288,9 @@ fn stable_step_s(
         .then(|| integrator_limit(options.integrator, omega, options.damping_per_s).0))
 }
 
-/// One interface update (`9c²` multiply-adds, a dense `3c × 3c` f32 product), s.
+/// One interface update (`9c²` multiply-adds: the `3c` row products of the condensed
+/// stiffness with the connection displacements, f32, with the kernel's own row product,
+/// [`palpate_kernel::math::dense::dot`]), s.
 pub fn interface_update_s(c: usize) -> f64 {
     let timed = c.min(MAX_TIMED_CONNECTIONS);
     let n = 3 * timed;
@@ -305,7 +299,7 @@ pub fn interface_update_s(c: usize) -> f64 {
     let mut y = vec![0.0f32; n];
     let t = median_s(TIMED_PRODUCTS, || {
         for (row, out) in matrix.chunks_exact(n).zip(y.iter_mut()) {
-            *out = row.iter().zip(&x).map(|(a, b)| a * b).sum();
+            *out = dot(row, black_box(&x));
         }
         black_box(&mut y);
     });

@@ -10,7 +10,7 @@ const LANES: usize = 8;
 
 /// `Σ_i a_i b_i` over the common prefix of `a` and `b`.
 #[inline]
-pub(crate) fn dot<T: Real>(a: &[T], b: &[T]) -> T {
+pub fn dot<T: Real>(a: &[T], b: &[T]) -> T {
     let mut acc = [T::zero(); LANES];
     let (a_chunks, a_rest) = a.as_chunks::<LANES>();
     let (b_chunks, b_rest) = b.as_chunks::<LANES>();
@@ -28,7 +28,7 @@ pub(crate) fn dot<T: Real>(a: &[T], b: &[T]) -> T {
 
 /// `y_i += a x_i` over the common prefix of `x` and `y`.
 #[inline]
-pub(crate) fn axpy<T: Real>(a: T, x: &[T], y: &mut [T]) {
+pub fn axpy<T: Real>(a: T, x: &[T], y: &mut [T]) {
     for (y, &x) in y.iter_mut().zip(x) {
         *y += a * x;
     }
