@@ -39,17 +39,20 @@ use std::process::Command;
 use anyhow::{Context, bail};
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::contact::{MAX_WALK_STEPS, Tissue};
-use palpate_kernel::haptic::{ForceOutput, HapticLoop, PrecomputedLoop, TickCounters, ToolInput};
+use palpate_kernel::haptic::{
+    ForceOutput, HapticLoop, PhysicsTissue, PrecomputedLoop, TickCounters, ToolInput,
+};
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 
 use crate::mesh::{MeshReport, TetMesh};
-use crate::session::generate::surgery;
-use crate::session::run::{DynamicSetup, loop_config, scene_table, ticks};
-use crate::session::scene::{ToolKind, ToolSpec};
+use crate::session::generate::{hepatectomy, surgery};
+use crate::session::hybrid::HybridSetup;
+use crate::session::model::{SceneModel, SceneTables};
+use crate::session::run::{DynamicSetup, loop_config, ticks};
+use crate::session::scene::{MeshSource, ToolKind};
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
-use crate::session::{ModelSpec, Scene, Trajectory};
-use crate::table::load::TableFile;
+use crate::session::{Scene, Trajectory};
 
 /// Instructions of a tick outside detection, tracking and solves.
 pub const BASE_IR: u64 = 600;
@@ -94,28 +97,57 @@ pub fn dynamic_tick_bound(table: &TensorMassTable<'_, f32>, points: u64, capacit
         + (points + 1) * DYNAMIC_SOLVE_IR * capacity
 }
 
-/// The f32 table of `scene` on `mesh` (pre-computed or tensor-mass, by its
-/// model) and the static bound of its tick.
+/// The static per-tick bound (instructions) of the hybrid model's tick
+/// (RR-3510 §6.2), between physics updates, for `points` tool points and
+/// capacity `capacity`: a detection tests at most every triangle reference
+/// of the whole surface twice (`2 × 3 (B + F)`, the pre-computed region's
+/// `B` boundary triangles and the tensor-mass region's `F` faces), and each
+/// solve is the pre-computed one (`O(M³)`) and the tensor-mass one
+/// (linear) together.
+pub fn hybrid_tick_bound(
+    precomputed: &PrecomputedTable<'_, f32>,
+    dynamic: &TensorMassTable<'_, f32>,
+    points: u64,
+    capacity: u64,
+) -> u64 {
+    let slots = precomputed.surface_triangles().len() + dynamic.mesh_triangles().len();
+    let detection = 2 * 3 * slots as u64;
+    BASE_IR
+        + points
+            * (TRIANGLE_IR * detection
+                + WALK_IR * u64::from(MAX_WALK_STEPS)
+                + TRACK_IR.max(DYNAMIC_TRACK_IR))
+        + (points + 1)
+            * (SOLVE_IR_PER_M3 * capacity * capacity * capacity + DYNAMIC_SOLVE_IR * capacity)
+}
+
+/// The f32 tables of `scene` on `mesh` (pre-computed, tensor-mass or
+/// hybrid, by its model: [`SceneModel`]) and the static bound of its tick.
 pub fn budget_table(
     scene: &Scene,
     mesh: &TetMesh,
     report: &MeshReport,
-) -> anyhow::Result<(Vec<u8>, u64)> {
+) -> anyhow::Result<(SceneTables, u64)> {
     let points = scene.tool.kernel_points() as u64;
-    let bytes = scene_table(scene, mesh, report)?;
-    let file = TableFile::from_bytes(&bytes);
+    let tables = SceneModel::of(scene, mesh, report)?.tables(scene, mesh, report)?;
     let load = |e| anyhow::anyhow!("table: {e}");
-    let bound = match scene.model {
-        ModelSpec::Precomputed => {
+    let bound = match &tables {
+        SceneTables::Precomputed(file) => {
             let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
             tick_bound(&table, points, points)
         }
-        ModelSpec::Dynamic(_) => {
+        SceneTables::Dynamic(file, _) => {
             let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
             dynamic_tick_bound(&table, points, points)
         }
+        SceneTables::Hybrid(files, _) => {
+            let precomputed =
+                PrecomputedTable::<f32>::load(files.precomputed.bytes()).map_err(load)?;
+            let dynamic = TensorMassTable::<f32>::load(files.dynamic.bytes()).map_err(load)?;
+            hybrid_tick_bound(&precomputed, &dynamic, points, points)
+        }
     };
-    Ok((bytes, bound))
+    Ok((tables, bound))
 }
 
 /// One tick, kept out of line so callgrind can collect exactly its cost
@@ -129,15 +161,19 @@ pub fn budget_tick<B: Tissue<f32, P>, const P: usize>(
 }
 
 /// Runs every tick of `trajectory` through [`budget_tick`] on the loop of
-/// `scene` over `table` (a table's bytes, aligned: `TableFile::bytes`) and
+/// `scene` over its `tables` and
 /// returns each tick's work counters (the child side of [`measure`]) and
 /// the wall time spent in the ticks. A dynamic scene's physics updates run
 /// every `physics_every` ticks, after the tick and outside [`budget_tick`].
-pub fn probe(table: &[u8], scene: &Scene, trajectory: &Trajectory) -> anyhow::Result<Probe> {
+pub fn probe(
+    tables: &SceneTables,
+    scene: &Scene,
+    trajectory: &Trajectory,
+) -> anyhow::Result<Probe> {
     with_tool_points(
         scene.tool.kernel_points(),
         ProbeRun {
-            bytes: table,
+            tables,
             scene,
             trajectory,
         },
@@ -154,7 +190,7 @@ pub struct Probe {
 
 /// [`probe`]'s arguments, run with the scene's tool points.
 struct ProbeRun<'a> {
-    bytes: &'a [u8],
+    tables: &'a SceneTables,
     scene: &'a Scene,
     trajectory: &'a Trajectory,
 }
@@ -163,19 +199,19 @@ impl ForToolPoints for ProbeRun<'_> {
     type Output = anyhow::Result<Probe>;
 
     fn call<const P: usize>(self) -> anyhow::Result<Probe> {
-        probe_with::<P>(self.bytes, self.scene, self.trajectory)
+        probe_with::<P>(self.tables, self.scene, self.trajectory)
     }
 }
 
 fn probe_with<const P: usize>(
-    bytes: &[u8],
+    tables: &SceneTables,
     scene: &Scene,
     trajectory: &Trajectory,
 ) -> anyhow::Result<Probe> {
     let load = |e| anyhow::anyhow!("table: {e}");
-    match scene.model {
-        ModelSpec::Precomputed => {
-            let table = PrecomputedTable::<f32>::load(bytes).map_err(load)?;
+    match tables {
+        SceneTables::Precomputed(file) => {
+            let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
             let mut haptic = PrecomputedLoop::<f32, P, P>::new(
                 PrecomputedTissue::new(&table),
                 loop_config(scene),
@@ -183,16 +219,20 @@ fn probe_with<const P: usize>(
             .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
             probe_ticks(&mut haptic, scene, trajectory, |_| {})
         }
-        ModelSpec::Dynamic(spec) => {
-            let table = TensorMassTable::<f32>::load(bytes).map_err(load)?;
-            DynamicSetup::of(scene, &spec, table)?.with_loop::<P, _>(|haptic| {
-                // A failed update faults the following ticks: measured too.
-                probe_ticks(haptic, scene, trajectory, |h| {
-                    let _ = h.physics_update();
-                })
-            })
+        SceneTables::Dynamic(file, spec) => {
+            let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
+            DynamicSetup::of(scene, spec, table)?
+                .with_loop::<P, _>(|haptic| probe_ticks(haptic, scene, trajectory, physics_update))
         }
+        SceneTables::Hybrid(files, spec) => HybridSetup::of(scene, spec, files)?
+            .with_loop::<P, _>(|haptic| probe_ticks(haptic, scene, trajectory, physics_update)),
     }
+}
+
+/// One physics update; a failed one faults the following ticks, which are
+/// measured too.
+fn physics_update<B: PhysicsTissue<f32, P>, const P: usize>(haptic: &mut HapticLoop<f32, B, P, P>) {
+    let _ = haptic.physics_update();
 }
 
 fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
@@ -305,14 +345,21 @@ pub struct BudgetRow {
 /// Cortex-M4F-class controller at 168 MHz, one instruction per cycle.
 pub const M4F_IPS: f64 = 168e6;
 
-/// The generated trajectories a budget runs for `tool`: for probes the
-/// poke, press-hold, slide and strike (and the pinch with two points); for a
-/// scene with a grasper or a cutter, [`surgery`].
-pub fn trajectories(tool: &ToolSpec) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
+/// The generated trajectories a budget runs for `scene`'s tool: for probes
+/// the poke, press-hold, slide and strike (and the pinch with two points);
+/// for a scene with a grasper or a cutter, [`surgery`] (on the built-in
+/// block's top), or [`hepatectomy`] on the generated organ.
+pub fn trajectories(scene: &Scene) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
     use crate::session::{Generator, Pinch, Poke, PressHold, Slide, Strike};
     let err = |e: crate::session::GenerateError| anyhow::anyhow!("{e}");
+    let tool = &scene.tool;
     if tool.kinds.iter().any(|k| *k != ToolKind::Probe) {
-        return Ok(vec![("surgery", surgery(tool).map_err(err)?)]);
+        return Ok(match scene.mesh {
+            MeshSource::GeneratedOrgan => {
+                vec![("hepatectomy", hepatectomy(tool).map_err(err)?)]
+            }
+            _ => vec![("surgery", surgery(tool).map_err(err)?)],
+        });
     }
     let mut out = vec![
         ("poke", Poke::default().trajectory().map_err(err)?),

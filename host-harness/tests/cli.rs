@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assert_one_line_error, build_cube_table, palpate, reference, temp};
+use common::{assert_one_line_error, build_cube_table, fresh_dir, palpate, reference, temp};
 use std::process::Output;
 
 #[test]
@@ -445,6 +445,53 @@ fn budget_ticks_stay_within_the_static_bound() {
             assert!(row["ticks"].as_u64().unwrap() > 900);
             assert!(max > 0 && max <= bound, "{row}");
         }
+    }
+}
+
+/// `palpate budget` on a hybrid scene (a 6 × 6 × 3-cell block whose
+/// `[[zone]]` makes its top corner tensor-mass, the rest pre-computed):
+/// every tick of the `poke` at or below the hybrid's static bound (the
+/// whole surface's triangles, both solves), on both mesh sizes.
+#[test]
+fn budget_of_a_hybrid_scene_stays_within_the_static_bound() {
+    let dir = fresh_dir("budget-hybrid");
+    let scene = dir.join("hybrid.toml");
+    std::fs::write(
+        &scene,
+        "fix = [\"z<0.0001\"]\n[generated]\nbox_m = [0.12, 0.12, 0.06]\ncells = [6, 6, 3]\n\
+         [material]\nyoung_pa = 3000.0\npoisson = 0.45\n[model]\nkind = \"dynamic\"\n\
+         dt_s = 0.0005\ndamping_per_s = 30.0\n[rates]\nphysics_every = 10\n[[zone]]\n\
+         kind = \"cut\"\nshape = \"box\"\nmin_m = [0.08, 0.08, 0.04]\nmax_m = [0.12, 0.12, 0.06]\n\
+         [partition]\nmargin_rings = 1\n",
+    )
+    .unwrap();
+    let out = palpate(&[
+        "budget",
+        scene.to_str().unwrap(),
+        "--json",
+        "--trajectory",
+        "poke",
+        "--work-dir",
+        dir.join("work").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 2, "1 trajectory x 2 meshes");
+    for row in rows {
+        let (max, bound) = (
+            row["max_ir"].as_u64().unwrap(),
+            row["bound_ir"].as_u64().unwrap(),
+        );
+        println!(
+            "hybrid: {} on {}: {max} <= {bound}",
+            row["trajectory"], row["mesh"]
+        );
+        assert!(max > 0 && max <= bound, "{row}");
     }
 }
 

@@ -7,17 +7,18 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use palpate::budget::{BudgetRow, M4F_IPS, budget_table, measure, probe, trajectories};
+use palpate::session::model::{SceneModel, SceneTables};
 use palpate::session::run::check_scene_table;
 use palpate::session::stability::check_stable_step;
 use palpate::session::{MeshSource, Scene, Trajectory};
-use palpate::table::load::TableFile;
 
 use super::stdout;
 
 /// `palpate budget`'s arguments.
 #[derive(clap::Args)]
 pub struct BudgetArgs {
-    /// Scene file (TOML), `built-in`, `built-in-dynamic` or `built-in-tools`.
+    /// Scene file (TOML), `built-in`, `built-in-dynamic`, `built-in-tools` or
+    /// `built-in-hybrid`.
     scene: String,
     /// Working folder for tables, trajectories and callgrind dumps.
     #[arg(long, default_value = "budget-out")]
@@ -47,9 +48,11 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     } = args;
     let mut scene = Scene::named(scene_arg)?;
     if let Some([table_path, trajectory_path]) = probe_paths.as_deref() {
-        let bytes = TableFile::read(table_path)?;
+        let (mesh, report) = scene.load_mesh()?;
+        let model = SceneModel::of(&scene, &mesh, &report)?;
+        let tables = SceneTables::read(model, table_path)?;
         let trajectory = Trajectory::read(trajectory_path, scene.tool.points)?;
-        let counters = probe(bytes.bytes(), &scene, &trajectory)
+        let counters = probe(&tables, &scene, &trajectory)
             .with_context(|| table_path.display().to_string())?
             .counters;
         let lines: Vec<String> = counters
@@ -77,7 +80,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             },
         );
     }
-    let mut chosen = trajectories(&scene.tool)?;
+    let mut chosen = trajectories(&scene)?;
     if let Some(unknown) = only
         .iter()
         .find(|name| !chosen.iter().any(|(known, _)| known == name))
@@ -104,10 +107,9 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
         let (mesh, report) = scene.load_mesh()?;
-        let (bytes, bound) = budget_table(&scene, &mesh, &report)?;
+        let (tables, bound) = budget_table(&scene, &mesh, &report)?;
         let table_path = work_dir.join(format!("table-{s}.bin"));
-        std::fs::write(&table_path, &bytes)?;
-        let file = TableFile::from_bytes(&bytes);
+        tables.write(&table_path)?;
         for (name, trajectory) in &chosen {
             let csv = work_dir.join(format!("{name}-{s}.csv"));
             trajectory.write_csv_file(&csv)?;
@@ -130,7 +132,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             let total_ir = irs.iter().sum::<u64>();
             let mean_ir = total_ir as f64 / irs.len().max(1) as f64;
             // The host's time per instruction in the ticks, run natively.
-            let native = probe(file.bytes(), &scene, trajectory)?;
+            let native = probe(&tables, &scene, trajectory)?;
             let host_ns_per_ir = native.ticks_s * 1e9 / total_ir.max(1) as f64;
             rows.push(BudgetRow {
                 mesh: format!(

@@ -8,10 +8,10 @@ use palpate_kernel::haptic::HybridLoop;
 use palpate_kernel::hybrid::HybridTissue;
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 
+use super::model::HybridFiles;
 use super::run::{DynamicSetup, PhysicsView};
 use super::{DynamicSpec, Scene};
 use crate::hybrid::owned::OwnedHybridBuffers;
-use crate::hybrid::{HybridTables, RegionSplit};
 
 /// A hybrid scene's tables and settings: everything to build its loop.
 pub struct HybridSetup<'t> {
@@ -27,7 +27,7 @@ pub struct HybridSetup<'t> {
 impl<'t> HybridSetup<'t> {
     /// The settings of `scene` (its tensor-mass region's `spec`) over the f32
     /// `tables`.
-    pub fn of(scene: &Scene, spec: &DynamicSpec, tables: &'t HybridTables) -> anyhow::Result<Self> {
+    pub fn of(scene: &Scene, spec: &DynamicSpec, tables: &'t HybridFiles) -> anyhow::Result<Self> {
         let dynamic = TensorMassTable::<f32>::load(tables.dynamic.bytes())
             .context("tensor-mass region table")?;
         Ok(Self {
@@ -36,8 +36,8 @@ impl<'t> HybridSetup<'t> {
                 .context("pre-computed region table")?,
             interface: InterfaceTable::<f32>::load(tables.interface.bytes())
                 .context("interface table")?,
-            mesh_tet: mesh_tets(&tables.split),
-            tet_count: tables.split.dynamic_tet.len(),
+            mesh_tet: mesh_tets(&tables.dynamic_tet),
+            tet_count: tables.dynamic_tet.len(),
         })
     }
 
@@ -78,10 +78,10 @@ impl<'t> HybridSetup<'t> {
 }
 
 /// The mesh tet of each tet of the tensor-mass region (its tets are the
-/// mesh's dynamic ones in mesh order).
-fn mesh_tets(split: &RegionSplit) -> Vec<u32> {
-    (0..split.dynamic_tet.len() as u32)
-        .filter(|&t| split.dynamic_tet[t as usize])
+/// mesh's dynamic ones, `dynamic_tet`, in mesh order).
+fn mesh_tets(dynamic_tet: &[bool]) -> Vec<u32> {
+    (0..dynamic_tet.len() as u32)
+        .filter(|&t| dynamic_tet[t as usize])
         .collect()
 }
 

@@ -12,12 +12,15 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use super::run::{precomputed_options, tensor_mass_options};
 use super::{DynamicSpec, ModelSpec, Scene};
 use crate::experiment::scenes::penalty_n;
-use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
+use crate::hybrid::{HybridOptions, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
 use crate::table::build::build;
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 
 /// A scene's model, resolved.
 pub enum SceneModel {
@@ -131,7 +134,15 @@ impl SceneModel {
                 .with_tet_materials(materials);
                 let tables = build_hybrid(mesh, report, &partition.dynamic, &options)
                     .with_context(|| scene.source.clone())?;
-                SceneTables::Hybrid(Box::new(tables), spec)
+                SceneTables::Hybrid(
+                    Box::new(HybridFiles {
+                        precomputed: tables.precomputed,
+                        dynamic: tables.dynamic,
+                        interface: tables.interface,
+                        dynamic_tet: partition.dynamic,
+                    }),
+                    spec,
+                )
             }
         })
     }
@@ -144,5 +155,71 @@ pub enum SceneTables {
     /// The tensor-mass table and the model's settings.
     Dynamic(TableFile, DynamicSpec),
     /// The hybrid's three tables and its tensor-mass region's settings.
-    Hybrid(Box<HybridTables>, DynamicSpec),
+    Hybrid(Box<HybridFiles>, DynamicSpec),
 }
+
+/// The three tables of a hybrid and its partition.
+pub struct HybridFiles {
+    /// The pre-computed region's table.
+    pub precomputed: TableFile,
+    /// The tensor-mass region's table.
+    pub dynamic: TableFile,
+    /// The interface table.
+    pub interface: TableFile,
+    /// Per mesh tet: in the tensor-mass region.
+    pub dynamic_tet: Vec<bool>,
+}
+
+impl SceneTables {
+    /// The files of the tables with base path `base`: the table itself, or
+    /// for a hybrid `BASE.precomputed`, `BASE.dynamic`, `BASE.interface`.
+    pub fn paths(&self, base: &Path) -> Vec<PathBuf> {
+        match self {
+            Self::Hybrid(..) => HYBRID_PARTS
+                .iter()
+                .map(|part| base.with_extension(part))
+                .collect(),
+            _ => vec![base.to_path_buf()],
+        }
+    }
+
+    /// Writes the tables to [`Self::paths`]`(base)` (the budget's work
+    /// files; each written whole, [`AtomicFile`]).
+    pub fn write(&self, base: &Path) -> anyhow::Result<()> {
+        let files: Vec<&TableFile> = match self {
+            Self::Precomputed(file) | Self::Dynamic(file, _) => vec![file],
+            Self::Hybrid(h, _) => vec![&h.precomputed, &h.dynamic, &h.interface],
+        };
+        for (path, file) in self.paths(base).iter().zip(files) {
+            let mut out = AtomicFile::create(path)?;
+            out.write_all(file.bytes())?;
+            out.commit()?;
+        }
+        Ok(())
+    }
+
+    /// Reads the tables of `model` (resolved on the scene's mesh, whose
+    /// tets `mesh_tets` counts) back from [`Self::paths`]`(base)`.
+    pub fn read(model: SceneModel, base: &Path) -> anyhow::Result<Self> {
+        let read = |path: PathBuf| TableFile::read(&path);
+        Ok(match model {
+            SceneModel::Precomputed => Self::Precomputed(read(base.to_path_buf())?),
+            SceneModel::Dynamic(spec) => Self::Dynamic(read(base.to_path_buf())?, spec),
+            SceneModel::Hybrid { spec, partition } => {
+                let [p, d, i] = HYBRID_PARTS.map(|part| base.with_extension(part));
+                Self::Hybrid(
+                    Box::new(HybridFiles {
+                        precomputed: read(p)?,
+                        dynamic: read(d)?,
+                        interface: read(i)?,
+                        dynamic_tet: partition.dynamic,
+                    }),
+                    spec,
+                )
+            }
+        })
+    }
+}
+
+/// The extensions of a hybrid's three table files ([`SceneTables::paths`]).
+const HYBRID_PARTS: [&str; 3] = ["precomputed", "dynamic", "interface"];

@@ -108,15 +108,6 @@ pub fn tensor_mass_options(
     Ok(options.with_tet_materials(materials))
 }
 
-/// The f32 table of `scene` (pre-computed or tensor-mass, by its model),
-/// built in memory with the same pipeline as `palpate tables build`.
-pub fn scene_table(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Vec<u8>> {
-    let options = table_options(scene, mesh, report)?;
-    Ok(build(mesh, report, &options)
-        .with_context(|| scene.source.clone())?
-        .bytes)
-}
-
 /// Checks that `scene`'s table on `mesh` fits the limits every build
 /// applies ([`SizeLimits::system`]: the largest table file, the memory
 /// available), from the estimate of its size, without building it (linear

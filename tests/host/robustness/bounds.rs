@@ -415,7 +415,7 @@ fn oversized_tables_are_refused_before_building() {
     }
 
     // The same box as a generated scene: refused by `session run` (and
-    // `budget`, which builds through the same `scene_table`).
+    // `budget`, which builds through the same `SceneModel::tables`).
     let mut scene = Scene::built_in();
     scene.mesh = MeshSource::GeneratedBox {
         size_m: [0.4, 0.4, 0.4],
