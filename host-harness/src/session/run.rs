@@ -54,7 +54,7 @@ use crate::limits::{
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::output::atomic::{self, AtomicFile, SeriesDir};
 use crate::output::vtk;
-use crate::table::build::{BuildOptions, build};
+use crate::table::build::BuildOptions;
 use crate::table::compliance::Solver;
 use crate::table::estimate::{SizeLimits, TableEstimate};
 use crate::table::file::Precision;
