@@ -581,3 +581,38 @@ fn haptic_loop_press_on_either_region_settles_to_the_global_equilibrium() {
         assert!(error <= 1e-6, "{region}: relative force error {error:e}");
     }
 }
+
+/// The three tables of a hybrid are one build: an interface with the
+/// region tables of another material or another partition of the same
+/// mesh is refused where they meet (`HybridError::Mismatch`, naming the
+/// checksums), never coupled.
+#[test]
+fn region_tables_of_another_build_are_refused() {
+    use palpate::hybrid::owned::with_hybrid_files;
+
+    let (mesh, report) = block();
+    let base = options([0.0; 3], Vec::new());
+    let ours = tables(&mesh, &report, &base);
+    let stiffer = HybridOptions {
+        build: palpate::table::build::BuildOptions {
+            material: Material::new(6000.0, 0.3).expect("material"),
+            ..base.build.clone()
+        },
+        ..base.clone()
+    };
+    let other_material = tables(&mesh, &report, &stiffer);
+    let mut other_zone = corner(&mesh);
+    let first_dynamic = other_zone.iter().position(|&d| d).expect("dynamic tet");
+    other_zone[first_dynamic] = false;
+    let other_partition = build_hybrid(&mesh, &report, &other_zone, &base).expect("tables");
+    for (what, other) in [("material", &other_material), ("partition", &other_partition)] {
+        let result = with_hybrid_files::<f64, ()>(
+            [&other.precomputed, &ours.dynamic, &ours.interface],
+            params(),
+            |_| (),
+        );
+        let message = format!("{:#}", result.expect_err(what));
+        println!("another {what}: {message}");
+        assert!(message.contains("checksums differ"), "{what}: {message}");
+    }
+}

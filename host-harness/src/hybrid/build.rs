@@ -217,7 +217,16 @@ pub fn build_hybrid(
     }
     let dsurface = boundary_surface(&dmesh);
     let dynamic = write_tensor_mass_table(&dmesh, &dsurface.triangles, &arrays, build.precision);
-    let interface = write_interface_table(mesh, &split, &ordering, &condensed, &materials, options);
+    let checksums = [&precomputed_summary.bytes, &dynamic].map(|bytes| trailer(bytes));
+    let interface = write_interface_table(
+        mesh,
+        &split,
+        &ordering,
+        &condensed,
+        &materials,
+        checksums,
+        options,
+    );
     let tables = HybridTables {
         precomputed: TableFile::from_bytes(&precomputed_summary.bytes),
         dynamic: TableFile::from_bytes(&dynamic),
@@ -255,6 +264,7 @@ fn write_interface_table(
     ordering: &FreeOrdering,
     condensed: &Condensed,
     materials: &TetMaterials,
+    region_checksums: [u32; 2],
     options: &HybridOptions,
 ) -> Vec<u8> {
     let material = materials.default_material();
@@ -293,6 +303,16 @@ fn write_interface_table(
         ),
         Section::floats(SectionKind::LoadForce, &condensed.load_force, p),
         Section::ints(SectionKind::DynamicVertex, &dynamic_vertex),
+        Section::ints(SectionKind::RegionChecksums, &[region_checksums]),
     ];
     write_container(header, p, &sections)
+}
+
+/// A table file's CRC-32 trailer (its last 4 bytes, little-endian).
+fn trailer(bytes: &[u8]) -> u32 {
+    let mut crc = [0u8; 4];
+    if let Some(tail) = bytes.len().checked_sub(4).and_then(|at| bytes.get(at..)) {
+        crc.copy_from_slice(tail);
+    }
+    u32::from_le_bytes(crc)
 }

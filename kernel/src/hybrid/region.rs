@@ -107,8 +107,10 @@ pub struct CondensedRegion<'a, 's, T: Real> {
 
 impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     /// Couples `dynamic` to the pre-computed region of `precomputed` through
-    /// `interface`, after checking that the three belong together: one
-    /// vertex numbering (the interface's and the pre-computed table's vertex
+    /// `interface`, after checking that the three belong together: the
+    /// region tables are the ones the interface was built with (their
+    /// CRC-32 trailers, recorded in it: same mesh, partition and
+    /// materials), one vertex numbering (the interface's and the pre-computed table's vertex
     /// counts, free counts and touchable counts agree), every vertex of the
     /// tensor-mass table mapped from exactly one mesh vertex at the same
     /// rest position and fixed in the pre-computed table, every connection
@@ -124,6 +126,12 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
         buffers: HybridBuffers<'s, T>,
     ) -> Result<Self, HybridError> {
         let mismatch = |what, vertex| HybridError::Mismatch { what, vertex };
+        if interface.region_checksums() != [precomputed.checksum(), dynamic.table().checksum()] {
+            return Err(mismatch(
+                "the region tables are not the ones it was built with (checksums differ)",
+                0,
+            ));
+        }
         let n = precomputed.vertex_count();
         if interface.vertex_count() != n {
             return Err(mismatch("vertex count", 0));

@@ -13,6 +13,8 @@ use crate::Real;
 /// located (bounds and alignment checked) but not yet viewed.
 pub(crate) struct Container<'a> {
     pub(crate) header: RawHeader,
+    /// The CRC-32 trailer (checked): what identifies the table's contents.
+    pub(crate) checksum: u32,
     sections: [Option<&'a [u8]>; SectionKind::ALL.len()],
 }
 
@@ -23,8 +25,9 @@ impl<'a> Container<'a> {
     /// bounds, alignment), and that every section `kind` requires is present.
     pub(crate) fn parse<T: Real>(bytes: &'a [u8], kind: TableKind) -> Result<Self, LoadError> {
         let header = read_header(bytes)?;
-        check_header::<T>(&header, bytes, kind)?;
-        let container = locate_sections::<T>(header, bytes)?;
+        let checksum = check_header::<T>(&header, bytes, kind)?;
+        let mut container = locate_sections::<T>(header, bytes)?;
+        container.checksum = checksum;
         for &required in kind.sections() {
             if container.raw(required).is_none() {
                 return Err(LoadError::MissingSection { kind: required });
@@ -88,7 +91,8 @@ fn read_header(bytes: &[u8]) -> Result<RawHeader, LoadError> {
     Ok(bytemuck::pod_read_unaligned(raw))
 }
 
-fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result<(), LoadError> {
+/// The header checks of [`Container::parse`]; returns the (checked) CRC-32.
+fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result<u32, LoadError> {
     h.check_identity()?;
     if h.file_len != bytes.len() as u64 {
         return Err(LoadError::LengthMismatch {
@@ -137,7 +141,7 @@ fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result
     if !material_ok {
         return Err(LoadError::BadMaterial);
     }
-    Ok(())
+    Ok(stored)
 }
 
 fn locate_sections<T: Real>(h: RawHeader, bytes: &[u8]) -> Result<Container<'_>, LoadError> {
@@ -147,6 +151,7 @@ fn locate_sections<T: Real>(h: RawHeader, bytes: &[u8]) -> Result<Container<'_>,
         .ok_or(LoadError::InconsistentHeader)?;
     let mut located = Container {
         header: h,
+        checksum: 0,
         sections: [None; SectionKind::ALL.len()],
     };
     for raw in directory.chunks_exact(SECTION_ENTRY_LEN) {

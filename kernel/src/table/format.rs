@@ -199,6 +199,7 @@ impl TableKind {
                 SectionKind::LoadDisplacement,
                 SectionKind::LoadForce,
                 SectionKind::DynamicVertex,
+                SectionKind::RegionChecksums,
             ],
         }
     }
@@ -340,6 +341,11 @@ pub enum SectionKind {
     /// `u32` × N: the tensor-mass vertex of each mesh vertex, or
     /// [`FIXED_SLOT`] for a vertex of the pre-computed region only.
     DynamicVertex = 45,
+    /// `[u32; 2]` × 1: the CRC-32 trailers of the pre-computed region's and
+    /// the tensor-mass region's tables this interface was built with: the
+    /// three tables of a hybrid are one build (same mesh, partition and
+    /// materials), checked where they meet.
+    RegionChecksums = 46,
 }
 
 /// The vertex pairs of a tet's six edges, in [`SectionKind::TetEdge`] order:
@@ -376,7 +382,7 @@ pub const TET_MATERIAL_LEN: usize = 2;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 35] = [
+    pub const ALL: [SectionKind; 36] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -412,6 +418,7 @@ impl SectionKind {
         SectionKind::LoadDisplacement,
         SectionKind::LoadForce,
         SectionKind::DynamicVertex,
+        SectionKind::RegionChecksums,
     ];
 
     /// Bytes per element for a table whose floats have `scalar_bytes` bytes.
@@ -422,7 +429,7 @@ impl SectionKind {
             | SectionKind::EdgeRowStart
             | SectionKind::EdgeColumn
             | SectionKind::DynamicVertex => 4,
-            SectionKind::ConnectionVertex => 8,
+            SectionKind::ConnectionVertex | SectionKind::RegionChecksums => 8,
             SectionKind::CondensedStiffness
             | SectionKind::ConnectionResponse
             | SectionKind::LoadDisplacement
@@ -465,6 +472,7 @@ impl SectionKind {
             SectionKind::ConnectionResponse => f.checked_mul(c)?.checked_mul(3),
             SectionKind::LoadDisplacement => Some(f),
             SectionKind::DynamicVertex => Some(n),
+            SectionKind::RegionChecksums => Some(1),
             SectionKind::VertexSlot
             | SectionKind::RestPositions
             | SectionKind::LumpedMass
@@ -533,6 +541,7 @@ impl SectionKind {
             SectionKind::LoadDisplacement => "load-displacement",
             SectionKind::LoadForce => "load-force",
             SectionKind::DynamicVertex => "dynamic-vertex",
+            SectionKind::RegionChecksums => "region-checksums",
         }
     }
 }

@@ -25,12 +25,14 @@ use crate::Real;
 #[derive(Clone, Copy, Debug)]
 pub struct InterfaceTable<'a, T: Real> {
     header: RawHeader,
+    checksum: u32,
     connections: &'a [[u32; 2]],
     condensed: &'a [[T; 3]],
     response: &'a [[T; 3]],
     load_displacement: &'a [[T; 3]],
     load_force: &'a [[T; 3]],
     dynamic_vertex: &'a [u32],
+    region_checksums: [u32; 2],
 }
 
 impl<'a, T: Real> InterfaceTable<'a, T> {
@@ -41,12 +43,20 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         let c = Container::parse::<T>(bytes, TableKind::Interface)?;
         let table = Self {
             header: c.header,
+            checksum: c.checksum,
             connections: c.section(SectionKind::ConnectionVertex)?,
             condensed: c.section(SectionKind::CondensedStiffness)?,
             response: c.section(SectionKind::ConnectionResponse)?,
             load_displacement: c.section(SectionKind::LoadDisplacement)?,
             load_force: c.section(SectionKind::LoadForce)?,
             dynamic_vertex: c.section(SectionKind::DynamicVertex)?,
+            region_checksums: c
+                .section::<[u32; 2]>(SectionKind::RegionChecksums)?
+                .first()
+                .copied()
+                .ok_or(LoadError::SectionSize {
+                    kind: SectionKind::RegionChecksums,
+                })?,
         };
         check_finite(SectionKind::CondensedStiffness, table.condensed)?;
         check_finite(SectionKind::ConnectionResponse, table.response)?;
@@ -76,6 +86,13 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
     /// The header as stored.
     pub fn header(&self) -> &RawHeader {
         &self.header
+    }
+
+    /// The table's CRC-32 trailer (checked at load): what identifies its
+    /// contents, so a hybrid's interface can name the region tables it was
+    /// built with.
+    pub fn checksum(&self) -> u32 {
+        self.checksum
     }
 
     /// Vertices of the whole mesh (`N`).
@@ -132,6 +149,12 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
             .get(vertex as usize)
             .copied()
             .filter(|&d| d != FIXED_SLOT)
+    }
+
+    /// The CRC-32 trailers of the pre-computed and the tensor-mass region
+    /// tables this interface was built with.
+    pub fn region_checksums(&self) -> [u32; 2] {
+        self.region_checksums
     }
 
     /// The `dynamic-vertex` section as stored ([`FIXED_SLOT`] for a vertex

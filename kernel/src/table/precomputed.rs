@@ -24,6 +24,7 @@ use crate::math::cholesky::cholesky3;
 #[derive(Clone, Copy, Debug)]
 pub struct PrecomputedTable<'a, T: Real> {
     header: RawHeader,
+    checksum: u32,
     vertex_slot: &'a [u32],
     free_vertex: &'a [u32],
     rest_positions: &'a [[T; 3]],
@@ -60,6 +61,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         };
         let table = Self {
             header: c.header,
+            checksum: c.checksum,
             vertex_slot,
             free_vertex: c.section(SectionKind::FreeVertex)?,
             rest_positions,
@@ -93,6 +95,13 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// The header as stored.
     pub fn header(&self) -> &RawHeader {
         &self.header
+    }
+
+    /// The table's CRC-32 trailer (checked at load): what identifies its
+    /// contents, so a hybrid's interface can name the region tables it was
+    /// built with.
+    pub fn checksum(&self) -> u32 {
+        self.checksum
     }
 
     /// Vertices of the source mesh (`N`).

@@ -33,6 +33,7 @@ use crate::Real;
 #[derive(Clone, Copy, Debug)]
 pub struct TensorMassTable<'a, T: Real> {
     header: RawHeader,
+    checksum: u32,
     vertex_slot: &'a [u32],
     rest_positions: &'a [[T; 3]],
     triangles: &'a [[u32; 3]],
@@ -62,6 +63,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         let masses: &[T] = c.section(SectionKind::LumpedMass)?;
         let table = Self {
             header: c.header,
+            checksum: c.checksum,
             vertex_slot: c.section(SectionKind::VertexSlot)?,
             rest_positions: c.section(SectionKind::RestPositions)?,
             triangles: c.section(SectionKind::SurfaceTriangles)?,
@@ -126,6 +128,13 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
     /// The header as stored.
     pub fn header(&self) -> &RawHeader {
         &self.header
+    }
+
+    /// The table's CRC-32 trailer (checked at load): what identifies its
+    /// contents, so a hybrid's interface can name the region tables it was
+    /// built with.
+    pub fn checksum(&self) -> u32 {
+        self.checksum
     }
 
     /// Vertices (`N`).
