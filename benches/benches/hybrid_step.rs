@@ -122,7 +122,10 @@ fn top_vertices(built: &HybridTables, mesh: &TetMesh) -> ([u32; 2], [u32; 2]) {
             let q = mesh.positions[**v as usize];
             (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>() > 0.008f64.powi(2)
         };
-        [first, *candidates.iter().find(far).expect("a second vertex")]
+        [
+            first,
+            *candidates.iter().find(far).expect("a second vertex"),
+        ]
     };
     let touchable = table.free_vertices()[..table.touchable_count()].to_vec();
     let surface = palpate::mesh::boundary_surface(mesh);
@@ -131,7 +134,8 @@ fn top_vertices(built: &HybridTables, mesh: &TetMesh) -> ([u32; 2], [u32; 2]) {
         .iter()
         .copied()
         .filter(|&v| {
-            built.split.dynamic_index[v as usize].is_some() && !built.split.in_precomputed[v as usize]
+            built.split.dynamic_index[v as usize].is_some()
+                && !built.split.in_precomputed[v as usize]
         })
         .collect();
     (two(touchable), two(dynamic))

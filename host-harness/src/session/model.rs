@@ -120,21 +120,33 @@ impl SceneModel {
             Self::Dynamic(spec) => {
                 SceneTables::Dynamic(single(tensor_mass_options(scene, mesh, report)?)?, spec)
             }
-            Self::Hybrid { spec, partition } => {
-                let materials = scene.tet_materials(mesh, report)?;
-                let options = HybridOptions::new(
-                    materials.default_material(),
-                    scene.material.density_kg_m3,
-                    scene.fix.clone(),
-                    Precision::F32,
-                )
-                .with_tet_materials(materials);
-                let tables = build_hybrid(mesh, report, &partition.dynamic, &options)
-                    .with_context(|| scene.source.clone())?;
-                SceneTables::Hybrid(tables, spec)
-            }
+            Self::Hybrid { spec, partition } => SceneTables::Hybrid(
+                hybrid_tables(scene, mesh, report, &partition, Precision::F32)?,
+                spec,
+            ),
         })
     }
+}
+
+/// The hybrid's three tables for `partition` of `scene` (its materials per
+/// tet, density and supports) in `precision`, built in memory
+/// ([`build_hybrid`]).
+pub fn hybrid_tables(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+    partition: &Partition,
+    precision: Precision,
+) -> anyhow::Result<HybridTables> {
+    let materials = scene.tet_materials(mesh, report)?;
+    let options = HybridOptions::new(
+        materials.default_material(),
+        scene.material.density_kg_m3,
+        scene.fix.clone(),
+        precision,
+    )
+    .with_tet_materials(materials);
+    build_hybrid(mesh, report, &partition.dynamic, &options).with_context(|| scene.source.clone())
 }
 
 /// A scene's tables, by its model.
