@@ -138,7 +138,6 @@ pub(super) struct HybridState {
     cell_start: [u32; CELLS + 1],
     grid_vertex: [u32; VERTICES],
     mesh_vertex: [u32; VERTICES],
-    displacements_m: [[f32; 3]; VERTICES],
 }
 
 impl HybridState {
@@ -154,7 +153,6 @@ impl HybridState {
             cell_start: [0; CELLS + 1],
             grid_vertex: [0; VERTICES],
             mesh_vertex: [0; VERTICES],
-            displacements_m: [[0.0; 3]; VERTICES],
         }
     }
 
