@@ -58,7 +58,8 @@ pub enum SceneCommand {
     },
 }
 
-/// The files `scene tables` writes in its `--out-dir`, in [`TableSet`] order.
+/// The files `scene tables` writes in its `--out-dir`: the pre-computed region's table, the
+/// tensor-mass region's, the interface (RR-3510 §6.2).
 const TABLE_FILES: [&str; 3] = ["precomputed.bin", "dynamic.bin", "interface.bin"];
 
 /// Runs a `scene` command.
