@@ -1,28 +1,48 @@
 #!/usr/bin/env bash
-# Builds the Cortex-M4F example with the firmware table, runs it under QEMU
-# (mps2-an386), replays the same sequence on the host with the same table and
-# requires byte-identical output (every f32 as its bit pattern); then reports
-# flash and RAM figures. Run from any directory.
+# Builds the Cortex-M4F example with its tables, runs it under QEMU
+# (mps2-an386), replays the same sequence on the host with the same tables
+# and requires byte-identical output (every f32 as its bit pattern); then
+# reports flash and RAM figures. Run from any directory.
+#
+#   tools/firmware-check.sh            the pre-computed model: box-table.sh's table,
+#                                      sequence.txt, vs `palpate precomputed replay`
+#   tools/firmware-check.sh --hybrid   the hybrid (RR-3510 §6.2): hybrid-tables.sh's three
+#                                      tables, hybrid-sequence.txt, firmware built with
+#                                      `--features hybrid`, vs `palpate scene replay-hybrid`
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$PWD"
-table="$(tools/box-table.sh)" # host CLI, dev profile; prints the table path
-sequence="$root/tools/firmware-m4f/sequence.txt"
 out="$root/target/firmware"
 mkdir -p "$out"
 
-cargo run -q -p palpate -- precomputed replay "$table" "$sequence" >"$out/host.txt"
+if [[ "${1:-}" == --hybrid ]]; then
+    mode=hybrid
+    tables="$(tools/hybrid-tables.sh)" # host CLI, dev profile; prints the tables' folder
+    sequence="$root/tools/firmware-m4f/hybrid-sequence.txt"
+    host=(scene replay-hybrid "$tables" "$sequence")
+    build=(env PALPATE_HYBRID_TABLES="$tables" cargo build -q --release --features hybrid)
+else
+    mode=precomputed
+    table="$(tools/box-table.sh)" # host CLI, dev profile; prints the table path
+    sequence="$root/tools/firmware-m4f/sequence.txt"
+    host=(precomputed replay "$table" "$sequence")
+    build=(env PALPATE_TABLE="$table" cargo build -q --release)
+fi
+host_txt="$out/$mode-host.txt"
+firmware_txt="$out/$mode-firmware.txt"
+
+cargo run -q -p palpate -- "${host[@]}" >"$host_txt"
 
 cd tools/firmware-m4f
-PALPATE_TABLE="$table" cargo build -q --release
+"${build[@]}"
 elf="$PWD/target/thumbv7em-none-eabihf/release/palpate-firmware-m4f"
 # The firmware ends QEMU through semihosting (exit status 0 on success); the
 # timeout only catches a hang (the whole replay takes well under a second).
 status=0
 timeout 120 qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic \
-    -semihosting-config enable=on,target=native -kernel "$elf" >"$out/firmware.txt" || status=$?
+    -semihosting-config enable=on,target=native -kernel "$elf" >"$firmware_txt" || status=$?
 if [ "$status" != 0 ]; then
-    cat "$out/firmware.txt" >&2
+    cat "$firmware_txt" >&2
     if [ "$status" = 124 ]; then
         echo "FAIL: the firmware did not exit within 120 s under QEMU" >&2
     else
@@ -32,14 +52,14 @@ if [ "$status" != 0 ]; then
 fi
 
 # `#` lines are the firmware's own report (table size, contact-state size).
-grep '^#' "$out/firmware.txt" || true
-if ! grep -v '^#' "$out/firmware.txt" | diff -u "$out/host.txt" -; then
-    echo "FAIL: firmware (QEMU, Cortex-M4F) and host (palpate precomputed replay) outputs differ" >&2
+grep '^#' "$firmware_txt" || true
+if ! grep -v '^#' "$firmware_txt" | diff -u "$host_txt" -; then
+    echo "FAIL: firmware (QEMU, Cortex-M4F) and host (palpate ${host[*]:0:2}) outputs differ ($mode)" >&2
     exit 1
 fi
-steps="$(wc -l <"$out/host.txt")"
-refused="$(grep -c ' error ' "$out/host.txt" || true)"
-echo "firmware vs host: $steps steps ($refused refused), bit-identical f32 device and contact forces and largest displacement"
+steps="$(wc -l <"$host_txt")"
+refused="$(grep -c ' error ' "$host_txt" || true)"
+echo "firmware vs host ($mode): $steps steps ($refused refused), bit-identical f32 device and contact forces, largest displacement$([[ $mode == hybrid ]] && echo ', kinetic energy')"
 
 llvm_bin="$(echo "$(rustc --print sysroot)"/lib/rustlib/*/bin)"
 "$llvm_bin/llvm-size" -A "$elf" | awk '

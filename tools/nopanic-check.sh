@@ -11,8 +11,13 @@
 #   outputs, round after round on one model;
 # - the haptic loop over each model: construction, tick_tools (probe, grip
 #   and blade actions), reset, and for the dynamic model the physics update
-#   with its blades, tearing, exposed faces and deforming surface.
-# Both tables are built from the firmware example's box by tools/box-table.sh.
+#   with its blades, tearing, exposed faces and deforming surface;
+# - the hybrid (RR-3510 §6.2): the interface table's load, HybridModel::new,
+#   reset, impose, update_background, contact_forces, pass_contact_forces,
+#   step with each integrator, displacements; the haptic loop over
+#   HybridTissue (new, tick_tools, physics_update, reset).
+# The tables are built from the firmware example's box by tools/box-table.sh
+# and (the hybrid's three) tools/hybrid-tables.sh.
 #
 # On failure it rebuilds with `--features locate` (a panic handler that links)
 # and lists every call into a panic function with its source line, from the
@@ -22,7 +27,9 @@ cd "$(dirname "$0")/.."
 root="$PWD"
 table="$(tools/box-table.sh)"
 tensor_table="$(tools/box-table.sh --tensor-mass)"
-export PALPATE_TABLE="$table" PALPATE_TENSOR_TABLE="$tensor_table"
+hybrid_tables="$(tools/hybrid-tables.sh)"
+export PALPATE_TABLE="$table" PALPATE_TENSOR_TABLE="$tensor_table" \
+    PALPATE_HYBRID_TABLES="$hybrid_tables"
 cd tools/nopanic-check
 mkdir -p target
 log="$PWD/target/build.log"
@@ -38,7 +45,10 @@ if cargo build --release 2>"$log"; then
         "tear, surface_triangles, displacements_m, velocities_m_s, elastic_forces_n, fault;" \
         "HapticLoop::new, tick_tools, reset (pre-computed); DynamicTissue::new, HapticLoop::new," \
         "tick_tools (touch, grip, cut), physics_update (blades, tearing, exposed faces), removed," \
-        "reset (tensor-mass, deforming surface)"
+        "reset (tensor-mass, deforming surface); InterfaceTable::load, HybridModel::new, reset," \
+        "impose, update_background, contact_forces::<MAX_CONTACTS>, pass_contact_forces, step" \
+        "(each integrator), displacements; HybridTissue::new, HapticLoop::new, tick_tools" \
+        "(touch, grip, cut), physics_update, removed, reset (hybrid)"
     exit 0
 fi
 

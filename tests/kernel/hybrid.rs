@@ -605,7 +605,10 @@ fn region_tables_of_another_build_are_refused() {
     let first_dynamic = other_zone.iter().position(|&d| d).expect("dynamic tet");
     other_zone[first_dynamic] = false;
     let other_partition = build_hybrid(&mesh, &report, &other_zone, &base).expect("tables");
-    for (what, other) in [("material", &other_material), ("partition", &other_partition)] {
+    for (what, other) in [
+        ("material", &other_material),
+        ("partition", &other_partition),
+    ] {
         let result = with_hybrid_files::<f64, ()>(
             [&other.precomputed, &ours.dynamic, &ours.interface],
             params(),

@@ -1,7 +1,9 @@
-//! Puts `memory.x` on the linker path and copies the table named by the
-//! `PALPATE_TABLE` environment variable to `$OUT_DIR/table.bin`, where
-//! `include_table!` links it into flash. `tools/firmware-check.sh` builds the
-//! table with `palpate tables build` and sets the variable.
+//! Puts `memory.x` on the linker path and copies the tables where
+//! `include_table!` links them into flash: by default the pre-computed table
+//! named by `PALPATE_TABLE` to `$OUT_DIR/table.bin`; with the `hybrid`
+//! feature the three tables in the folder named by `PALPATE_HYBRID_TABLES`
+//! (`precomputed.bin`, `dynamic.bin`, `interface.bin`). `tools/firmware-check.sh`
+//! builds them with the host CLI and sets the variable.
 
 use std::path::PathBuf;
 
@@ -11,13 +13,38 @@ fn main() {
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=sequence.txt");
-    println!("cargo:rerun-if-env-changed=PALPATE_TABLE");
-    let Some(table) = std::env::var_os("PALPATE_TABLE") else {
-        panic!(
-            "set PALPATE_TABLE to a table built by `palpate tables build` (see tools/firmware-check.sh)"
-        );
+    println!("cargo:rerun-if-changed=hybrid-sequence.txt");
+    let (var, command, files): (_, _, &[(&str, &str)]) =
+        if std::env::var_os("CARGO_FEATURE_HYBRID").is_some() {
+            (
+                "PALPATE_HYBRID_TABLES",
+                "a folder written by `palpate scene tables`",
+                &[
+                    ("precomputed.bin", "precomputed.bin"),
+                    ("dynamic.bin", "dynamic.bin"),
+                    ("interface.bin", "interface.bin"),
+                ],
+            )
+        } else {
+            (
+                "PALPATE_TABLE",
+                "a table built by `palpate tables build`",
+                &[("", "table.bin")],
+            )
+        };
+    println!("cargo:rerun-if-env-changed={var}");
+    let Some(path) = std::env::var_os(var).map(PathBuf::from) else {
+        panic!("set {var} to {command} (see tools/firmware-check.sh)");
     };
-    println!("cargo:rerun-if-changed={}", table.to_string_lossy());
-    std::fs::copy(&table, out.join("table.bin"))
-        .unwrap_or_else(|e| panic!("PALPATE_TABLE={}: {e}", table.to_string_lossy()));
+    for (from, to) in files {
+        // "": the variable names the file itself.
+        let from = if from.is_empty() {
+            path.clone()
+        } else {
+            path.join(from)
+        };
+        println!("cargo:rerun-if-changed={}", from.display());
+        std::fs::copy(&from, out.join(to))
+            .unwrap_or_else(|e| panic!("{var}: {}: {e}", from.display()));
+    }
 }

@@ -1,8 +1,9 @@
 //! Puts the firmware example's `memory.x` (QEMU mps2-an386) on the linker
 //! path, and copies the pre-computed table named by `PALPATE_TABLE` to
 //! `$OUT_DIR/table.bin` and the tensor-mass table named by
-//! `PALPATE_TENSOR_TABLE` to `$OUT_DIR/tensor_table.bin`
-//! (`tools/nopanic-check.sh` builds both).
+//! `PALPATE_TENSOR_TABLE` to `$OUT_DIR/tensor_table.bin`, and the hybrid's
+//! three tables in the folder `PALPATE_HYBRID_TABLES` to `$OUT_DIR/hybrid/`
+//! (`tools/nopanic-check.sh` builds them all).
 
 use std::path::PathBuf;
 
@@ -26,5 +27,20 @@ fn main() {
         println!("cargo:rerun-if-changed={}", table.to_string_lossy());
         std::fs::copy(&table, out.join(file))
             .unwrap_or_else(|e| panic!("{var}={}: {e}", table.to_string_lossy()));
+    }
+    // The hybrid's three tables, from the folder `palpate scene tables` wrote.
+    let var = "PALPATE_HYBRID_TABLES";
+    println!("cargo:rerun-if-env-changed={var}");
+    let Some(dir) = std::env::var_os(var).map(PathBuf::from) else {
+        panic!(
+            "set {var} to a folder written by `palpate scene tables` (see tools/nopanic-check.sh)"
+        );
+    };
+    std::fs::create_dir_all(out.join("hybrid")).expect("create $OUT_DIR/hybrid");
+    for file in ["precomputed.bin", "dynamic.bin", "interface.bin"] {
+        let table = dir.join(file);
+        println!("cargo:rerun-if-changed={}", table.display());
+        std::fs::copy(&table, out.join("hybrid").join(file))
+            .unwrap_or_else(|e| panic!("{var}: {}: {e}", table.display()));
     }
 }

@@ -1,15 +1,23 @@
 //! `palpate scene`: what a scene asks of the models. `plan` prints the hybrid partition the
 //! harness chooses from the scene's zones (MODELS.md §5): per region its model and law, tets,
 //! vertices and connection nodes, table size, predicted step cost, stable step and why.
+//! `tables` writes a hybrid scene's three tables (RR-3510 §6.2) for firmware; `replay-hybrid`
+//! runs the firmware's scripted hybrid sequence on them through the same code
+//! ([`palpate_script::hybrid`]), for `tools/firmware-check.sh --hybrid` to compare byte for byte.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use clap::Subcommand;
+use palpate::hybrid::owned::with_hybrid_files;
+use palpate::limits::{MAX_SEQUENCE_FILE_BYTES, read_bounded};
 use palpate::output::atomic;
 use palpate::output::vtk::write_regions;
 use palpate::partition::{Partition, PlanReport};
+use palpate::session::model::{SceneModel, hybrid_tables};
 use palpate::session::{MeshSource, Scene, ZoneShape};
+use palpate::table::file::Precision;
+use palpate::table::load::TableFile;
 
 use super::mesh_files;
 use super::stdout;
@@ -28,17 +36,48 @@ pub enum SceneCommand {
         #[arg(long)]
         vtk: Option<PathBuf>,
     },
+    /// Write a hybrid scene's three tables: DIR/precomputed.bin, DIR/dynamic.bin,
+    /// DIR/interface.bin (the scene's zones must make some, not all, tets dynamic).
+    Tables {
+        /// Scene file (TOML), or a built-in scene name as `session run` takes.
+        scene: String,
+        /// Output folder (created if missing); each table is written atomically.
+        #[arg(long)]
+        out_dir: PathBuf,
+        /// Stored float width: f32 (firmware) or f64 (verification).
+        #[arg(long, value_enum, default_value = "f32")]
+        precision: Precision,
+    },
+    /// Replay the firmware's hybrid sequence on f32 tables written by `scene tables` and print
+    /// one line per step (format: the palpate-script crate's `hybrid` module).
+    ReplayHybrid {
+        /// Folder holding precomputed.bin, dynamic.bin and interface.bin.
+        tables: PathBuf,
+        /// Sequence file (palpate-script contact syntax, one line per step).
+        sequence: PathBuf,
+    },
 }
+
+/// The files `scene tables` writes in its `--out-dir`: the pre-computed region's table, the
+/// tensor-mass region's, the interface (RR-3510 §6.2).
+const TABLE_FILES: [&str; 3] = ["precomputed.bin", "dynamic.bin", "interface.bin"];
 
 /// Runs a `scene` command.
 pub fn run(command: SceneCommand) -> anyhow::Result<()> {
     match command {
         SceneCommand::Plan { scene, json, vtk } => plan(&scene, json, vtk.as_deref()),
+        SceneCommand::Tables {
+            scene,
+            out_dir,
+            precision,
+        } => tables(&scene, &out_dir, precision),
+        SceneCommand::ReplayHybrid { tables, sequence } => replay_hybrid(&tables, &sequence),
     }
 }
 
-/// `scene plan`.
-fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
+/// The scene named `name` and the files it reads (the scene file, its mesh, its zones'
+/// trajectories), labelled for [`atomic::refuse_input`].
+fn scene_and_inputs(name: &str) -> anyhow::Result<(Scene, Vec<(&'static str, PathBuf)>)> {
     let mut inputs: Vec<(&str, PathBuf)> = Vec::new();
     if !Scene::BUILT_IN.contains(&name) {
         inputs.push(("the scene", PathBuf::from(name)));
@@ -56,9 +95,20 @@ fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
             inputs.push(("a [[zone]] trajectory", trajectory.clone()));
         }
     }
+    Ok((scene, inputs))
+}
+
+/// Refuses `output` (labelled `label`) if it is one of `inputs`.
+fn refuse_input(label: &str, output: &Path, inputs: &[(&str, PathBuf)]) -> anyhow::Result<()> {
+    let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(l, p)| (*l, p.as_path())).collect();
+    Ok(atomic::refuse_input((label, output), &inputs)?)
+}
+
+/// `scene plan`.
+fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
+    let (scene, inputs) = scene_and_inputs(name)?;
     if let Some(out) = vtk {
-        let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(l, p)| (*l, p.as_path())).collect();
-        atomic::refuse_input(("--vtk", out), &inputs)?;
+        refuse_input("--vtk", out, &inputs)?;
     }
     let (mesh, report) = scene.load_mesh()?;
     let partition = Partition::of_scene(&scene, &mesh, &report)?;
@@ -77,5 +127,60 @@ fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
     } else {
         stdout::print(&plan.text())?;
     }
+    Ok(())
+}
+
+/// `scene tables`: the three tables of a hybrid scene, built in memory, then each written
+/// atomically into `out_dir` (none is written if the build fails).
+fn tables(name: &str, out_dir: &Path, precision: Precision) -> anyhow::Result<()> {
+    let (scene, inputs) = scene_and_inputs(name)?;
+    let outputs = TABLE_FILES.map(|f| out_dir.join(f));
+    for out in &outputs {
+        refuse_input("--out-dir", out, &inputs)?;
+    }
+    let (mesh, report) = scene.load_mesh()?;
+    let SceneModel::Hybrid { partition, .. } = SceneModel::of(&scene, &mesh, &report)? else {
+        bail!(
+            "scene {name}: not a hybrid: its [[zone]]s must make some tets dynamic, not none or all (see `palpate scene plan`)"
+        );
+    };
+    let built = hybrid_tables(&scene, &mesh, &report, &partition, precision)?;
+    std::fs::create_dir_all(out_dir)
+        .with_context(|| format!("{}: cannot create the folder", out_dir.display()))?;
+    for (out, table) in outputs
+        .iter()
+        .zip([&built.precomputed, &built.dynamic, &built.interface])
+    {
+        atomic::write_file(out, table.bytes())?;
+    }
+    Ok(())
+}
+
+/// `scene replay-hybrid`: the three f32 tables of `dir` and the sequence, through
+/// [`palpate_script::hybrid::replay`] on heap buffers (the firmware's are static arrays).
+fn replay_hybrid(dir: &Path, sequence: &Path) -> anyhow::Result<()> {
+    let [precomputed, dynamic, interface] = TABLE_FILES.map(|f| TableFile::read(&dir.join(f)));
+    let text = read_bounded(
+        sequence,
+        MAX_SEQUENCE_FILE_BYTES,
+        "a sequence file (MAX_SEQUENCE_FILE_BYTES)",
+    )
+    .and_then(|bytes| {
+        String::from_utf8(bytes)
+            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+    })
+    .with_context(|| format!("{}: cannot read", sequence.display()))?;
+    let mut out = String::new();
+    with_hybrid_files(
+        [&precomputed?, &dynamic?, &interface?],
+        palpate_script::hybrid::params(),
+        |model| {
+            let mut displacements = vec![[0.0f32; 3]; model.interface().vertex_count()];
+            palpate_script::hybrid::replay(model, &text, &mut displacements, &mut out)
+        },
+    )
+    .with_context(|| format!("{}: the hybrid tables", dir.display()))?
+    .with_context(|| sequence.display().to_string())?;
+    stdout::print(&out)?;
     Ok(())
 }

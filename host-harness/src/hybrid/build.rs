@@ -219,13 +219,7 @@ pub fn build_hybrid(
     let dynamic = write_tensor_mass_table(&dmesh, &dsurface.triangles, &arrays, build.precision);
     let checksums = [&precomputed_summary.bytes, &dynamic].map(|bytes| trailer(bytes));
     let interface = write_interface_table(
-        mesh,
-        &split,
-        &ordering,
-        &condensed,
-        &materials,
-        checksums,
-        options,
+        mesh, &split, &ordering, &condensed, &materials, checksums, options,
     );
     let tables = HybridTables {
         precomputed: TableFile::from_bytes(&precomputed_summary.bytes),

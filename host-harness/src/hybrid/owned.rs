@@ -8,6 +8,7 @@ use palpate_kernel::tensor_mass::{DynamicParams, TensorMassModel};
 use palpate_kernel::{PrecomputedTable, Real};
 
 use super::build::HybridTables;
+use crate::table::load::TableFile;
 use crate::tensor_mass::OwnedState;
 
 /// Loads `tables` in precision `T`, builds the hybrid model with `params`
@@ -17,11 +18,24 @@ pub fn with_hybrid<T: Real, R>(
     params: DynamicParams<T>,
     run: impl FnOnce(&mut HybridModel<'_, '_, T>) -> R,
 ) -> anyhow::Result<R> {
+    with_hybrid_files(
+        [&tables.precomputed, &tables.dynamic, &tables.interface],
+        params,
+        run,
+    )
+}
+
+/// [`with_hybrid`] on the three tables given as files: pre-computed region,
+/// tensor-mass region, interface (`palpate scene tables` writes them).
+pub fn with_hybrid_files<T: Real, R>(
+    [precomputed, dynamic, interface]: [&TableFile; 3],
+    params: DynamicParams<T>,
+    run: impl FnOnce(&mut HybridModel<'_, '_, T>) -> R,
+) -> anyhow::Result<R> {
     let precomputed =
-        PrecomputedTable::<T>::load(tables.precomputed.bytes()).context("pre-computed region")?;
-    let dynamic =
-        TensorMassTable::<T>::load(tables.dynamic.bytes()).context("tensor-mass region")?;
-    let interface = InterfaceTable::<T>::load(tables.interface.bytes()).context("interface")?;
+        PrecomputedTable::<T>::load(precomputed.bytes()).context("pre-computed region")?;
+    let dynamic = TensorMassTable::<T>::load(dynamic.bytes()).context("tensor-mass region")?;
+    let interface = InterfaceTable::<T>::load(interface.bytes()).context("interface")?;
     let mut state = OwnedState::for_table(&dynamic);
     let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
     let model = TensorMassModel::new(dynamic, state.buffers(), params)

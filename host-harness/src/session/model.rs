@@ -12,7 +12,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use super::run::{precomputed_options, tensor_mass_options};
 use super::{DynamicSpec, ModelSpec, Scene};
 use crate::experiment::scenes::penalty_n;
-use crate::hybrid::{HybridOptions, build_hybrid};
+use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
@@ -124,16 +124,7 @@ impl SceneModel {
                 SceneTables::Dynamic(single(tensor_mass_options(scene, mesh, report)?)?, spec)
             }
             Self::Hybrid { spec, partition } => {
-                let materials = scene.tet_materials(mesh, report)?;
-                let options = HybridOptions::new(
-                    materials.default_material(),
-                    scene.material.density_kg_m3,
-                    scene.fix.clone(),
-                    Precision::F32,
-                )
-                .with_tet_materials(materials);
-                let tables = build_hybrid(mesh, report, &partition.dynamic, &options)
-                    .with_context(|| scene.source.clone())?;
+                let tables = hybrid_tables(scene, mesh, report, &partition, Precision::F32)?;
                 SceneTables::Hybrid(
                     Box::new(HybridFiles {
                         precomputed: tables.precomputed,
@@ -146,6 +137,27 @@ impl SceneModel {
             }
         })
     }
+}
+
+/// The hybrid's three tables for `partition` of `scene` (its materials per
+/// tet, density and supports) in `precision`, built in memory
+/// ([`build_hybrid`]).
+pub fn hybrid_tables(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+    partition: &Partition,
+    precision: Precision,
+) -> anyhow::Result<HybridTables> {
+    let materials = scene.tet_materials(mesh, report)?;
+    let options = HybridOptions::new(
+        materials.default_material(),
+        scene.material.density_kg_m3,
+        scene.fix.clone(),
+        precision,
+    )
+    .with_tet_materials(materials);
+    build_hybrid(mesh, report, &partition.dynamic, &options).with_context(|| scene.source.clone())
 }
 
 /// A scene's tables, by its model.

@@ -52,7 +52,31 @@
 //!   held grips impose their full displacement, the step, tearing, the
 //!   exposed-face update of the surface, held forces, re-binning) and
 //!   `reset`; the tets each update removed (`DynamicTissue::removed`) are
-//!   published.
+//!   published;
+//!
+//! and the hybrid model (RR-3510 §6.2, module `hybrid`), on the three f32
+//! tables of the firmware's hybrid box (`$OUT_DIR/hybrid/`, from
+//! `PALPATE_HYBRID_TABLES`: the top corner cell a tensor-mass region, the
+//! rest pre-computed, 7 connection nodes):
+//! - `InterfaceTable::load` (and the two region tables' loads), each on a
+//!   volatile length of its bytes;
+//! - `HybridModel::new` on a `TensorMassModel` of the region (state buffers
+//!   and coupling buffers `passed_force_n`, `background_m` sliced to
+//!   volatile lengths, so the length and table-mismatch refusals are
+//!   reachable), then rounds on one model of `reset`, `impose` on the
+//!   tensor-mass region, `update_background` with a volatile row count,
+//!   `contact_forces::<MAX_CONTACTS>` with a volatile contact set,
+//!   `pass_contact_forces` with the solution or none, `step` with each
+//!   integrator, `displacements` into a volatile length;
+//! - the haptic loop over the hybrid: `HybridTissue::new` (every buffer
+//!   length volatile: the region's state and surface buffers, the coupling,
+//!   the hybrid surface's eight buffers), `HybridLoop::new`, `tick_tools`
+//!   with volatile positions, actions and blades, `physics_update` on a
+//!   volatile flag, `reset`, and the tets each update removed.
+//!
+//! The hybrid proof is not vacuous either: `.unwrap()` on
+//! `update_background` in the model round, or on `HybridLoop::new`, makes
+//! the link fail and the script name the call (`core::result::unwrap_failed`).
 //!
 //! Why the proof holds for every input, not just one: every input (the table
 //! lengths, the contact count, each contact's kind, vertices, barycentric
@@ -75,7 +99,7 @@
 //! `core::hint::black_box` is not used: its documentation says it must not be
 //! relied on for correctness, and a too-weak barrier would make this check pass
 //! vacuously. The table bytes themselves are link-time constants (only the
-//! length passed to `load` is opaque), so strictly the proof is for these two
+//! length passed to `load` is opaque), so strictly the proof is for these five
 //! tables; the kernel does not rely on their values, as it reads every index
 //! taken from a table through `get`.
 //!
@@ -86,13 +110,15 @@
 // call to the undefined symbol. The kernel itself stays `forbid(unsafe_code)`.
 #![allow(unsafe_code)]
 
+mod hybrid;
+
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use cortex_m_rt::entry;
 use nalgebra::Vector3;
 use palpate_kernel::haptic::{
-    DynamicLoop, ForceOutput, LoopConfig, OutputStatus, PrecomputedLoop, SafetyLimits, ToolAction,
-    ToolInput,
+    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop,
+    SafetyLimits, ToolAction, ToolInput,
 };
 use palpate_kernel::precomputed::{Constraint, PrecomputedTissue};
 use palpate_kernel::table::TensorMassTable;
@@ -105,7 +131,7 @@ use palpate_kernel::tensor_mass::{
     MAX_REMOVED_PER_UPDATE, PhysicsConfig, StateBuffers, StvkForm, SurfaceBuffers, TearThresholds,
     Tearing, TensorMassModel, VertexMode,
 };
-use palpate_kernel::{MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
+use palpate_kernel::{ContactSolution, MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
 /// The f32 table of the firmware example's box (64 vertices), 16-byte aligned
 /// as `load` requires.
@@ -125,8 +151,19 @@ const SLOTS: usize = MAX_CONTACTS + 1;
 struct Inputs {
     /// Bytes of `TABLE` passed to `load` (clamped to the table length).
     table_len: usize,
+    /// The contact set.
+    contacts: ContactInputs,
+    /// Entries passed to `displacements` (clamped to `VERTICES`).
+    vertex_len: usize,
+    /// Entries passed to `free_displacements` (clamped to `VERTICES`).
+    free_len: usize,
+}
+
+/// A contact set, opaque to the optimiser.
+#[derive(Clone, Copy)]
+struct ContactInputs {
     /// Contacts in the set (clamped to `SLOTS`).
-    contact_count: usize,
+    count: usize,
     /// Non-zero: contact `p` is a triangle contact; zero: a vertex contact.
     on_triangle: [u8; SLOTS],
     /// Mesh vertex indices (a vertex contact uses the first).
@@ -135,20 +172,48 @@ struct Inputs {
     weights: [[f32; 3]; SLOTS],
     /// Imposed displacement of each contact point, m.
     displacement_m: [[f32; 3]; SLOTS],
-    /// Entries passed to `displacements` (clamped to `VERTICES`).
-    vertex_len: usize,
-    /// Entries passed to `free_displacements` (clamped to `VERTICES`).
-    free_len: usize,
+}
+
+/// No contact.
+const NO_CONTACTS: ContactInputs = ContactInputs {
+    count: 0,
+    on_triangle: [0; SLOTS],
+    vertices: [[0; 3]; SLOTS],
+    weights: [[0.0; 3]; SLOTS],
+    displacement_m: [[0.0; 3]; SLOTS],
+};
+
+impl ContactInputs {
+    /// Every slot's constraint; the set is the first `count` of them
+    /// ([`contact_set`]).
+    fn constraints(&self) -> [Constraint<f32>; SLOTS] {
+        core::array::from_fn(|p| {
+            let (Some(&kind), Some(&vertices), Some(&weights), Some(&d)) = (
+                self.on_triangle.get(p),
+                self.vertices.get(p),
+                self.weights.get(p),
+                self.displacement_m.get(p),
+            ) else {
+                return Constraint::at_vertex(0, [0.0f32; 3].into());
+            };
+            if kind != 0 {
+                Constraint::on_triangle(vertices, weights, d.into())
+            } else {
+                Constraint::at_vertex(vertices[0], d.into())
+            }
+        })
+    }
+}
+
+/// The first `count` of `contacts` (all of them if `count` is larger).
+fn contact_set(contacts: &[Constraint<f32>; SLOTS], count: usize) -> &[Constraint<f32>] {
+    contacts.get(..count).unwrap_or(&contacts[..])
 }
 
 /// The inputs, read with `read_volatile` only.
 static mut INPUTS: Inputs = Inputs {
     table_len: usize::MAX,
-    contact_count: 0,
-    on_triangle: [0; SLOTS],
-    vertices: [[0; 3]; SLOTS],
-    weights: [[0.0; 3]; SLOTS],
-    displacement_m: [[0.0; 3]; SLOTS],
+    contacts: NO_CONTACTS,
     vertex_len: VERTICES,
     free_len: VERTICES,
 };
@@ -179,6 +244,7 @@ fn main() -> ! {
     let mut displacements = [[0.0f32; 3]; VERTICES];
     let mut state = TensorState::new();
     let mut surface = SurfaceState::new();
+    let mut hybrid = hybrid::HybridState::new();
     loop {
         // SAFETY: single-threaded, no interrupt touches INPUTS or
         // TENSOR_INPUTS; a volatile read of a plain-old-data static is always
@@ -199,6 +265,8 @@ fn main() -> ! {
             )
         };
         dynamic_haptic_step(&tensor, &dynamic, &mut state, &mut surface);
+        hybrid::model_step(&tensor, &mut state, &mut hybrid);
+        hybrid::haptic_step(&tensor, &dynamic, &mut state, &mut surface, &mut hybrid);
     }
 }
 
@@ -458,6 +526,26 @@ impl SurfaceState {
             forces_n: [[0.0; 3]; VERTICES],
         }
     }
+
+    /// The surface buffers and the force scratch, each the first
+    /// `lengths` entries of its array (`DynamicInputs::surface_lengths`).
+    fn buffers(
+        &mut self,
+        [p, tr, fs, st, pl, vs, vt, c, g, f]: [usize; 10],
+    ) -> (SurfaceBuffers<'_, f32>, &mut [[f32; 3]]) {
+        let buffers = SurfaceBuffers {
+            positions_m: prefix(&mut self.positions_m, p),
+            triangles: prefix(&mut self.triangles, tr),
+            face_slot: prefix(&mut self.face_slot, fs),
+            slot_tet: prefix(&mut self.slot_tet, st),
+            planes: prefix(&mut self.planes, pl),
+            vertex_triangle_start: prefix(&mut self.vertex_triangle_start, vs),
+            vertex_triangle: prefix(&mut self.vertex_triangle, vt),
+            cell_start: prefix(&mut self.cell_start, c),
+            grid_vertex: prefix(&mut self.grid_vertex, g),
+        };
+        (buffers, prefix(&mut self.forces_n, f))
+    }
 }
 
 /// Load, model, dynamic tissue and loop on volatile inputs (surface buffer
@@ -481,19 +569,26 @@ fn dynamic_haptic_step(
         refused();
         return;
     };
-    let [p, tr, fs, st, pl, vs, vt, c, g, f] = inputs.surface_lengths;
-    let buffers = SurfaceBuffers {
-        positions_m: prefix(&mut surface.positions_m, p),
-        triangles: prefix(&mut surface.triangles, tr),
-        face_slot: prefix(&mut surface.face_slot, fs),
-        slot_tet: prefix(&mut surface.slot_tet, st),
-        planes: prefix(&mut surface.planes, pl),
-        vertex_triangle_start: prefix(&mut surface.vertex_triangle_start, vs),
-        vertex_triangle: prefix(&mut surface.vertex_triangle, vt),
-        cell_start: prefix(&mut surface.cell_start, c),
-        grid_vertex: prefix(&mut surface.grid_vertex, g),
+    let (buffers, forces) = surface.buffers(inputs.surface_lengths);
+    let Ok(tissue) =
+        DynamicTissue::<f32, TOOL_POINTS>::new(model, buffers, forces, physics_config(inputs))
+    else {
+        refused();
+        return;
     };
-    let physics = PhysicsConfig {
+    let Ok(haptic) =
+        DynamicLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(tissue, loop_config(inputs.config))
+    else {
+        refused();
+        return;
+    };
+    tick_with_physics(haptic, |tissue| tissue.removed());
+}
+
+/// The physics configuration of `inputs`: integrator, extrapolation, step,
+/// sub-steps, cut capacity and force, tearing.
+fn physics_config(inputs: &DynamicInputs) -> PhysicsConfig<f32> {
+    PhysicsConfig {
         extrapolation: if inputs.extrapolation == 0 {
             Extrapolation::Secant
         } else {
@@ -508,20 +603,20 @@ fn dynamic_haptic_step(
             thresholds: tear_thresholds(inputs.tear_on, inputs.tear_thresholds),
             capacity_tets: inputs.tear_capacity_tets,
         }),
-    };
-    let forces = prefix(&mut surface.forces_n, f);
-    let Ok(tissue) = DynamicTissue::<f32, TOOL_POINTS>::new(model, buffers, forces, physics) else {
-        refused();
-        return;
-    };
-    let Ok(mut haptic) =
-        DynamicLoop::<f32, TOOL_POINTS, TOOL_POINTS>::new(tissue, loop_config(inputs.config))
-    else {
-        refused();
-        return;
-    };
-    for _ in 0..inputs.ticks {
-        // SAFETY: single-threaded; plain-old-data static.
+    }
+}
+
+/// Ticks `haptic` `DYNAMIC_INPUTS.ticks` times on freshly read tool points,
+/// with `reset` and `physics_update` on volatile flags, publishing every
+/// output and the tets each update removed (`removed` of the tissue).
+fn tick_with_physics<B: PhysicsTissue<f32, TOOL_POINTS>>(
+    mut haptic: HapticLoop<f32, B, TOOL_POINTS, TOOL_POINTS>,
+    removed: impl Fn(&B) -> &[u32],
+) {
+    // SAFETY: single-threaded; plain-old-data static.
+    let ticks = unsafe { read_volatile(addr_of!(DYNAMIC_INPUTS)) }.ticks;
+    for _ in 0..ticks {
+        // SAFETY: as above.
         let tick = unsafe { read_volatile(addr_of!(DYNAMIC_INPUTS)) };
         if tick.reset != 0 {
             haptic.reset();
@@ -531,7 +626,7 @@ fn dynamic_haptic_step(
         if tick.update != 0 && haptic.physics_update().is_err() {
             refused();
         }
-        publish_removed(haptic.tissue().removed());
+        publish_removed(removed(haptic.tissue()));
     }
 }
 
@@ -559,46 +654,13 @@ fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
     };
     let model = PrecomputedModel::new(table);
 
-    let mut contacts = [Constraint::at_vertex(0, [0.0f32; 3].into()); SLOTS];
-    for (p, contact) in contacts.iter_mut().enumerate() {
-        let (Some(&kind), Some(&vertices), Some(&weights), Some(&d)) = (
-            inputs.on_triangle.get(p),
-            inputs.vertices.get(p),
-            inputs.weights.get(p),
-            inputs.displacement_m.get(p),
-        ) else {
-            continue;
-        };
-        *contact = if kind != 0 {
-            Constraint::on_triangle(vertices, weights, d.into())
-        } else {
-            Constraint::at_vertex(vertices[0], d.into())
-        };
-    }
-    let set = contacts
-        .get(..inputs.contact_count)
-        .unwrap_or(&contacts[..]);
-
+    let contacts = inputs.contacts.constraints();
+    let set = contact_set(&contacts, inputs.contacts.count);
     let Ok(solution) = model.contact_forces::<MAX_CONTACTS>(set) else {
         refused();
         return;
     };
-    let out = addr_of_mut!(OUTPUTS);
-    // SAFETY (all volatile writes below): single-threaded, `out` points to a
-    // live static, every field is plain old data.
-    unsafe {
-        write_volatile(
-            addr_of_mut!((*out).device_force_n),
-            solution.device_force_n().into(),
-        );
-        for (g, o) in solution
-            .contact_forces_n()
-            .iter()
-            .zip((*out).contact_forces_n.iter_mut())
-        {
-            write_volatile(o, (*g).into());
-        }
-    }
+    publish_solution(&solution);
 
     let vertex_len = inputs.vertex_len.min(VERTICES);
     if model
@@ -616,6 +678,27 @@ fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
         refused();
     }
     publish(displacements);
+}
+
+/// Writes the device force and each contact force of `solution` to
+/// `OUTPUTS` (volatile).
+fn publish_solution(solution: &ContactSolution<f32, MAX_CONTACTS>) {
+    let out = addr_of_mut!(OUTPUTS);
+    // SAFETY: single-threaded, `out` points to a live static, every field is
+    // plain old data.
+    unsafe {
+        write_volatile(
+            addr_of_mut!((*out).device_force_n),
+            solution.device_force_n().into(),
+        );
+        for (g, o) in solution
+            .contact_forces_n()
+            .iter()
+            .zip((*out).contact_forces_n.iter_mut())
+        {
+            write_volatile(o, (*g).into());
+        }
+    }
 }
 
 /// Counts a refusal (volatile, so the error arms are not dead code).

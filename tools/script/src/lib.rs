@@ -1,5 +1,6 @@
 //! Contact-script syntax and the scripted replay runner, shared by the host
-//! CLI (`palpate precomputed solve`/`replay`) and the Cortex-M4F firmware, so
+//! CLI (`palpate precomputed solve`/`replay`, `palpate scene replay-hybrid`: the
+//! [`hybrid`] module) and the Cortex-M4F firmware, so
 //! that both parse the same text and print the same bytes.
 //!
 //! `no_std`, no `alloc`: the firmware parses its sequence from flash.
@@ -29,6 +30,7 @@
     clippy::indexing_slicing
 )]
 
+pub mod hybrid;
 mod parse;
 mod replay;
 

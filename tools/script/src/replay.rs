@@ -3,7 +3,7 @@
 
 use core::fmt::{self, Write};
 
-use palpate_kernel::{MAX_CONTACTS, PrecomputedModel};
+use palpate_kernel::{ContactSolution, MAX_CONTACTS, PrecomputedModel};
 
 use crate::parse::{ParseError, steps};
 
@@ -77,23 +77,10 @@ pub fn replay<W: Write>(
         match model.contact_forces::<MAX_CONTACTS>(&contacts) {
             Err(error) => writeln!(out, " error {error}")?,
             Ok(solution) => {
-                let f = solution.device_force_n();
-                write!(
-                    out,
-                    " device {} {} {} contacts",
-                    hex(f.x),
-                    hex(f.y),
-                    hex(f.z)
-                )?;
-                for g in solution.contact_forces_n() {
-                    write!(out, " {} {} {}", hex(g.x), hex(g.y), hex(g.z))?;
-                }
+                write_forces(out, &solution)?;
                 // The buffer length was checked above; this cannot fail.
                 let umax = match model.displacements(&solution, displacements) {
-                    Ok(()) => displacements
-                        .iter()
-                        .flatten()
-                        .fold(0.0f32, |m, u| m.max(u.abs())),
+                    Ok(()) => largest(displacements),
                     Err(_) => f32::NAN,
                 };
                 writeln!(out, " umax {}", hex(umax))?;
@@ -103,8 +90,36 @@ pub fn replay<W: Write>(
     Ok(())
 }
 
+/// Writes ` device <fx> <fy> <fz> contacts <g0x> <g0y> <g0z> ...` (N, f32 bit
+/// patterns) for `solution`.
+pub(crate) fn write_forces<W: Write>(
+    out: &mut W,
+    solution: &ContactSolution<f32, MAX_CONTACTS>,
+) -> fmt::Result {
+    let f = solution.device_force_n();
+    write!(
+        out,
+        " device {} {} {} contacts",
+        hex(f.x),
+        hex(f.y),
+        hex(f.z)
+    )?;
+    for g in solution.contact_forces_n() {
+        write!(out, " {} {} {}", hex(g.x), hex(g.y), hex(g.z))?;
+    }
+    Ok(())
+}
+
+/// The largest absolute displacement component of any vertex, m.
+pub(crate) fn largest(displacements: &[[f32; 3]]) -> f32 {
+    displacements
+        .iter()
+        .flatten()
+        .fold(0.0f32, |m, u| m.max(u.abs()))
+}
+
 /// An f32 as its IEEE-754 bit pattern, `0x` and eight hex digits.
-fn hex(x: f32) -> impl fmt::Display {
+pub(crate) fn hex(x: f32) -> impl fmt::Display {
     struct Bits(u32);
     impl fmt::Display for Bits {
         fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
