@@ -38,12 +38,12 @@ pub enum HybridError {
         /// Entries given.
         found: usize,
     },
-    /// The tables disagree: what, at which mesh vertex.
+    /// The tables disagree: what, and at which mesh vertex if at one.
     Mismatch {
         /// What disagrees.
         what: &'static str,
-        /// Mesh vertex (0 for a count).
-        vertex: u32,
+        /// The mesh vertex, `None` for a count or the whole table.
+        vertex: Option<u32>,
     },
 }
 
@@ -58,10 +58,16 @@ impl fmt::Display for HybridError {
                 f,
                 "buffer {name} holds {found} entries, the tables need {expected}"
             ),
-            HybridError::Mismatch { what, vertex } => write!(
-                f,
-                "the interface table does not belong with the region tables: {what} (vertex {vertex})"
-            ),
+            HybridError::Mismatch { what, vertex } => {
+                write!(
+                    f,
+                    "the interface table does not belong with the region tables: {what}"
+                )?;
+                match vertex {
+                    Some(v) => write!(f, " (vertex {v})"),
+                    None => Ok(()),
+                }
+            }
         }
     }
 }
@@ -129,19 +135,19 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
         if interface.region_checksums() != [precomputed.checksum(), dynamic.table().checksum()] {
             return Err(mismatch(
                 "the region tables are not the ones it was built with (checksums differ)",
-                0,
+                None,
             ));
         }
         let n = precomputed.vertex_count();
         if interface.vertex_count() != n {
-            return Err(mismatch("vertex count", 0));
+            return Err(mismatch("vertex count", None));
         }
         if interface.free_count() != precomputed.free_count()
             || interface.header().touchable_count as usize != precomputed.touchable_count()
         {
             return Err(mismatch(
                 "free or touchable count of the pre-computed region",
-                0,
+                None,
             ));
         }
         let dynamic_table = *dynamic.table();
@@ -154,23 +160,23 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
             mapped += 1;
             let same_place = dynamic_table.rest_positions().get(d as usize) == Some(p);
             if !same_place {
-                return Err(mismatch("rest position of a dynamic vertex", vertex));
+                return Err(mismatch("rest position of a dynamic vertex", Some(vertex)));
             }
             if !matches!(precomputed.slot(vertex), Some(VertexSlot::Fixed)) {
                 return Err(mismatch(
                     "dynamic vertex free in the pre-computed region",
-                    vertex,
+                    Some(vertex),
                 ));
             }
         }
         if mapped != dynamic_table.vertex_count() {
-            return Err(mismatch("dynamic vertex count", 0));
+            return Err(mismatch("dynamic vertex count", None));
         }
         for &[vertex, d] in interface.connections() {
             if dynamic.modes().get(d as usize) != Some(&VertexMode::Free) {
                 return Err(mismatch(
                     "connection node not free in the dynamic region",
-                    vertex,
+                    Some(vertex),
                 ));
             }
         }
