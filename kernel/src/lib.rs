@@ -4,12 +4,14 @@
 //! Layers, each depending only on those above it in this list:
 //! - [`math`]: the scalar, the P1 element, the small dense Cholesky;
 //! - [`table`]: the byte format and the validated views (pre-computed,
-//!   tensor-mass, collision index), checked once at load;
+//!   tensor-mass, interface, collision index), checked once at load;
 //! - [`contact`]: the collision grid builder, detection and tracking, the one
 //!   [`contact::Contact`] type and its bounded set, the [`contact::Tissue`]
 //!   trait;
 //! - [`precomputed`] and [`tensor_mass`]: the two models, each with its
 //!   tissue adapter for the haptic loop;
+//! - [`hybrid`]: the two joined at connection nodes (RR-3510 §6.2), the
+//!   pre-computed region condensed onto them, and its tissue adapter;
 //! - [`haptic`]: the fixed-timestep loop and the safety supervisor.
 //!
 //! Data flow: table bytes (built offline by the host harness, linked into

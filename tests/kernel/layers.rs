@@ -1,6 +1,6 @@
 //! The kernel's folders form layers with no import cycle (`kernel/src/lib.rs`
 //! lists them): `math` < `table` < `contact` < {`precomputed`,
-//! `tensor_mass`} < `haptic`. Code in a folder may name items of its own
+//! `tensor_mass`} < `hybrid` < `haptic`. Code in a folder may name items of its own
 //! folder or of a lower layer only; `precomputed` and `tensor_mass` are
 //! peers and name neither each other. The root's own constants (`pub const`
 //! in `lib.rs`) are allowed everywhere; a root re-export (`crate::Real`)
@@ -15,13 +15,14 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The folders, lowest first, with their rank; equal ranks are peers.
-const LAYERS: [(&str, u32); 6] = [
+const LAYERS: [(&str, u32); 7] = [
     ("math", 0),
     ("table", 1),
     ("contact", 2),
     ("precomputed", 3),
     ("tensor_mass", 3),
-    ("haptic", 4),
+    ("hybrid", 4),
+    ("haptic", 5),
 ];
 
 /// What a `crate::` path's first segment names.
