@@ -25,18 +25,18 @@ use std::time::Instant;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use palpate::fem::material::Material;
-use palpate::hybrid::owned::OwnedHybridBuffers;
+use palpate::hybrid::owned::{OwnedHybridBuffers, with_hybrid_tissue};
 use palpate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use palpate::mesh::generate::{ORGAN_CUBE_M, organ_mesh};
 use palpate::mesh::{MeshReport, TetMesh};
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::compliance::Solver;
 use palpate::table::file::Precision;
-use palpate::tensor_mass::{OwnedState, OwnedSurface};
+use palpate::tensor_mass::OwnedState;
 use palpate_benches::haptic_config;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::HybridLoop;
-use palpate_kernel::hybrid::{HybridModel, HybridTissue};
+use palpate_kernel::hybrid::HybridModel;
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator, PhysicsConfig, TensorMassModel};
 
@@ -254,37 +254,22 @@ fn tick_case<const P: usize>(
     tables: &HybridTables,
     tools: [Vector3<f32>; P],
 ) {
-    let precomputed = PrecomputedTable::<f32>::load(tables.precomputed.bytes()).expect("table");
-    let dynamic = TensorMassTable::<f32>::load(tables.dynamic.bytes()).expect("table");
-    let interface = InterfaceTable::<f32>::load(tables.interface.bytes()).expect("table");
-    let mut state = OwnedState::for_table(&dynamic);
-    let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
-    let mut surface = OwnedSurface::for_model(&model);
-    let (surface_buffers, forces) = surface.buffers();
-    let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
-    let (coupling, hybrid_surface) = owned.buffers();
-    let tissue = HybridTissue::<f32, P, P>::new(
-        model,
-        surface_buffers,
-        forces,
-        PhysicsConfig::new(Integrator::SymplecticEuler, DT_S, 1),
-        precomputed,
-        interface,
-        coupling,
-        hybrid_surface,
-    )
-    .expect("tissue");
-    let mut haptic = HybridLoop::<f32, P, P>::new(tissue, haptic_config()).expect("loop");
-    for k in 0..=20 {
-        let lift = 0.01 * (1.0 - k as f32 / 20.0);
-        haptic.tick(&tools.map(|t| t + Vector3::new(0.0, 0.0, lift)));
-    }
-    haptic.physics_update().expect("update");
-    let contacts = haptic.tick(&tools).contacts as usize;
-    assert_eq!(contacts, P, "{name} at {label}: contacts made");
-    group.bench_function(BenchmarkId::new(name, label), |bench| {
-        bench.iter(|| haptic.tick(black_box(&tools)))
-    });
+    let files = [&tables.precomputed, &tables.dynamic, &tables.interface];
+    let physics = PhysicsConfig::new(Integrator::SymplecticEuler, DT_S, 1);
+    with_hybrid_tissue::<f32, P, P, _>(files, params(), physics, |tissue| {
+        let mut haptic = HybridLoop::<f32, P, P>::new(tissue, haptic_config()).expect("loop");
+        for k in 0..=20 {
+            let lift = 0.01 * (1.0 - k as f32 / 20.0);
+            haptic.tick(&tools.map(|t| t + Vector3::new(0.0, 0.0, lift)));
+        }
+        haptic.physics_update().expect("update");
+        let contacts = haptic.tick(&tools).contacts as usize;
+        assert_eq!(contacts, P, "{name} at {label}: contacts made");
+        group.bench_function(BenchmarkId::new(name, label), |bench| {
+            bench.iter(|| haptic.tick(black_box(&tools)))
+        });
+    })
+    .expect("hybrid tissue");
 }
 
 criterion_group!(benches, step, tick);

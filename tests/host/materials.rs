@@ -342,32 +342,7 @@ fn removing_a_nodule_tet_leaves_the_stiffness_of_the_mesh_without_it() {
         1000.0,
         vec![false; mesh.positions.len()],
     );
-    let scale = rebuilt
-        .vertex_tensors
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    let mut worst = 0.0f64;
-    for (ours, theirs) in model.vertex_tensors().iter().zip(&rebuilt.vertex_tensors) {
-        for (a, b) in ours.iter().zip(theirs) {
-            worst = worst.max((a - b).abs());
-        }
-    }
-    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
-    let rows = table.edge_row_starts();
-    for i in 0..table.vertex_count() {
-        for e in rows[i] as usize..rows[i + 1] as usize {
-            let j = table.edge_columns()[e];
-            let start = rebuilt.row_start[i] as usize;
-            let row = &rebuilt.column[start..rebuilt.row_start[i + 1] as usize];
-            let want = row
-                .binary_search(&j)
-                .map_or([0.0; 9], |k| rebuilt.edge_tensors[start + k]);
-            for (a, b) in model.edge_tensors()[e].iter().zip(&want) {
-                worst = worst.max((a - b).abs());
-            }
-        }
-    }
+    let (worst, scale) = palpate_tests::tensor_difference(&model, &file, &rebuilt);
     println!(
         "removal vs rebuild: {:.1e} of the largest tensor",
         worst / scale

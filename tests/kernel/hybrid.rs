@@ -440,23 +440,18 @@ fn stvk_in_the_dynamic_region_against_all_stvk_under_a_large_rotation() {
 /// also checked to reach the probe's depth (within 1e-3).
 #[test]
 fn haptic_loop_press_on_either_region_settles_to_the_global_equilibrium() {
-    use palpate::hybrid::owned::OwnedHybridBuffers;
+    use palpate::hybrid::owned::with_hybrid_tissue;
     use palpate::table::build::{BuildOptions, build};
     use palpate::table::compliance::Solver;
     use palpate::table::load::TableFile;
-    use palpate::tensor_mass::{OwnedState, OwnedSurface};
     use palpate_kernel::haptic::HybridLoop;
-    use palpate_kernel::hybrid::HybridTissue;
-    use palpate_kernel::table::{InterfaceTable, TensorMassTable};
-    use palpate_kernel::tensor_mass::{PhysicsConfig, TensorMassModel};
+    use palpate_kernel::tensor_mass::PhysicsConfig;
     use palpate_kernel::{PrecomputedModel, PrecomputedTable};
     use palpate_tests::unclamped_loop_config;
 
     let (mesh, report) = block();
     let built = tables(&mesh, &report, &options([0.0; 3], Vec::new()));
-    let precomputed = PrecomputedTable::<f64>::load(built.precomputed.bytes()).expect("table");
-    let dynamic = TensorMassTable::<f64>::load(built.dynamic.bytes()).expect("table");
-    let interface = InterfaceTable::<f64>::load(built.interface.bytes()).expect("table");
+    let files = [&built.precomputed, &built.dynamic, &built.interface];
     let global_file = TableFile::from_bytes(
         &build(
             &mesh,
@@ -479,23 +474,8 @@ fn haptic_loop_press_on_either_region_settles_to_the_global_equilibrium() {
         (4 * 25 + 2 * 5 + 1, "pre-computed"),
         (4 * 25 + 2 * 5 + 3, "dynamic"),
     ] {
-        let mut state = OwnedState::for_table(&dynamic);
-        let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
-        let mut surface = OwnedSurface::for_model(&model);
-        let (surface_buffers, forces) = surface.buffers();
-        let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
-        let (coupling, hybrid_surface) = owned.buffers();
-        let tissue = HybridTissue::<f64, 1, 1>::new(
-            model,
-            surface_buffers,
-            forces,
-            PhysicsConfig::new(Integrator::SymplecticEuler, 2e-4, 5),
-            precomputed,
-            interface,
-            coupling,
-            hybrid_surface,
-        )
-        .expect("hybrid tissue");
+        let physics = PhysicsConfig::new(Integrator::SymplecticEuler, 2e-4, 5);
+        with_hybrid_tissue::<f64, 1, 1, _>(files, params(), physics, |tissue| {
         let mut haptic = HybridLoop::<f64, 1, 1>::new(tissue, unclamped_loop_config(radius, 1e-3))
             .expect("loop");
         let top = Vector3::from(mesh.positions[vertex as usize]);
@@ -579,6 +559,8 @@ fn haptic_loop_press_on_either_region_settles_to_the_global_equilibrium() {
             reference.norm()
         );
         assert!(error <= 1e-6, "{region}: relative force error {error:e}");
+        })
+        .expect("hybrid tissue");
     }
 }
 

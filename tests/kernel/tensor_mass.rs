@@ -461,33 +461,7 @@ fn removal_equals_rebuild_and_keeps_the_mesh_conformal() {
         DENSITY,
         fixed,
     );
-    let scale = rebuilt
-        .vertex_tensors
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    let mut worst = 0.0f64;
-    for (ours, theirs) in model.vertex_tensors().iter().zip(&rebuilt.vertex_tensors) {
-        for (a, b) in ours.iter().zip(theirs) {
-            worst = worst.max((a - b).abs());
-        }
-    }
-    // Edges: look each original edge up in the rebuilt CSR (absent = zero).
-    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
-    let rows = table.edge_row_starts();
-    for i in 0..table.vertex_count() {
-        for e in rows[i] as usize..rows[i + 1] as usize {
-            let j = table.edge_columns()[e];
-            let start = rebuilt.row_start[i] as usize;
-            let row = &rebuilt.column[start..rebuilt.row_start[i + 1] as usize];
-            let want = row
-                .binary_search(&j)
-                .map_or([0.0; 9], |k| rebuilt.edge_tensors[start + k]);
-            for (a, b) in model.edge_tensors()[e].iter().zip(&want) {
-                worst = worst.max((a - b).abs());
-            }
-        }
-    }
+    let (worst, scale) = palpate_tests::tensor_difference(&model, &file, &rebuilt);
     println!(
         "tensors after {removed} removals vs rebuild: {:e}",
         worst / scale

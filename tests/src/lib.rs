@@ -383,3 +383,44 @@ pub fn unclamped_loop_config(
         },
     }
 }
+
+/// The largest difference between `model`'s current vertex and edge tensors
+/// (its table in `file`, edges in that table's CSR order) and the tensors of
+/// `rebuilt` (a mesh's arrays assembled afresh; an edge it lacks counts as
+/// zero), and the largest entry of `rebuilt`'s vertex tensors, N/m: a local
+/// removal checked against a rebuild without the removed tets.
+pub fn tensor_difference(
+    model: &palpate_kernel::tensor_mass::TensorMassModel<'_, '_, f64>,
+    file: &palpate::table::load::TableFile,
+    rebuilt: &palpate::table::tensor_mass::TensorMassArrays,
+) -> (f64, f64) {
+    let scale = rebuilt
+        .vertex_tensors
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut worst = 0.0f64;
+    for (ours, theirs) in model.vertex_tensors().iter().zip(&rebuilt.vertex_tensors) {
+        for (a, b) in ours.iter().zip(theirs) {
+            worst = worst.max((a - b).abs());
+        }
+    }
+    // Edges: look each original edge up in the rebuilt CSR (absent = zero).
+    let table =
+        palpate_kernel::table::TensorMassTable::<f64>::load(file.bytes()).expect("valid table");
+    let rows = table.edge_row_starts();
+    for i in 0..table.vertex_count() {
+        for e in rows[i] as usize..rows[i + 1] as usize {
+            let j = table.edge_columns()[e];
+            let start = rebuilt.row_start[i] as usize;
+            let row = &rebuilt.column[start..rebuilt.row_start[i + 1] as usize];
+            let want = row
+                .binary_search(&j)
+                .map_or([0.0; 9], |k| rebuilt.edge_tensors[start + k]);
+            for (a, b) in model.edge_tensors()[e].iter().zip(&want) {
+                worst = worst.max((a - b).abs());
+            }
+        }
+    }
+    (worst, scale)
+}

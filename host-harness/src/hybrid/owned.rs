@@ -2,14 +2,14 @@
 //! tests (firmware keeps the same buffers in static arrays).
 
 use anyhow::{Context, anyhow};
-use palpate_kernel::hybrid::{HybridBuffers, HybridModel, HybridSurfaceBuffers};
+use palpate_kernel::hybrid::{HybridBuffers, HybridModel, HybridSurfaceBuffers, HybridTissue};
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
-use palpate_kernel::tensor_mass::{DynamicParams, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, PhysicsConfig, TensorMassModel};
 use palpate_kernel::{PrecomputedTable, Real};
 
 use super::build::HybridTables;
 use crate::table::load::TableFile;
-use crate::tensor_mass::OwnedState;
+use crate::tensor_mass::{OwnedState, OwnedSurface};
 
 /// Loads `tables` in precision `T`, builds the hybrid model with `params`
 /// for its tensor-mass region over heap buffers, and runs `run` on it.
@@ -43,6 +43,40 @@ pub fn with_hybrid_files<T: Real, R>(
     let (buffers, _) = owned.buffers();
     let mut hybrid = HybridModel::new(model, precomputed, interface, buffers)?;
     Ok(run(&mut hybrid))
+}
+
+/// Builds the hybrid tissue (`P` tool points, `M` contacts) of the three
+/// tables given as files, its tensor-mass region with `params` and
+/// `physics`, over heap buffers, and runs `run` on it (tests and benches:
+/// wrap it in a `HybridLoop`).
+pub fn with_hybrid_tissue<T: Real, const P: usize, const M: usize, R>(
+    [precomputed, dynamic, interface]: [&TableFile; 3],
+    params: DynamicParams<T>,
+    physics: PhysicsConfig<T>,
+    run: impl FnOnce(HybridTissue<'_, '_, T, P, M>) -> R,
+) -> anyhow::Result<R> {
+    let precomputed =
+        PrecomputedTable::<T>::load(precomputed.bytes()).context("pre-computed region")?;
+    let dynamic = TensorMassTable::<T>::load(dynamic.bytes()).context("tensor-mass region")?;
+    let interface = InterfaceTable::<T>::load(interface.bytes()).context("interface")?;
+    let mut state = OwnedState::for_table(&dynamic);
+    let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
+    let model = TensorMassModel::new(dynamic, state.buffers(), params)
+        .map_err(|e| anyhow!("tensor-mass region: {e}"))?;
+    let mut surface = OwnedSurface::for_model(&model);
+    let (surface_buffers, forces) = surface.buffers();
+    let (coupling, hybrid_surface) = owned.buffers();
+    let tissue = HybridTissue::new(
+        model,
+        surface_buffers,
+        forces,
+        physics,
+        precomputed,
+        interface,
+        coupling,
+        hybrid_surface,
+    )?;
+    Ok(run(tissue))
 }
 
 /// Heap storage for a hybrid tissue's own buffers: the coupling's

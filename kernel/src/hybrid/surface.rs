@@ -22,7 +22,7 @@ use crate::contact::{Supports, SurfaceGeometry};
 use crate::table::{
     BuiltLists, DEAD_TRIANGLE, Grid, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex,
 };
-use crate::tensor_mass::{NonFinitePosition, SurfaceBufferError, TensorMassModel};
+use crate::tensor_mass::{NonFinitePosition, SurfaceBufferError, TensorMassModel, check_lengths};
 
 /// The caller's buffers of a hybrid surface (static arrays on firmware);
 /// lengths from [`HybridSurfaceBuffers::lengths`].
@@ -134,20 +134,7 @@ impl<'s, T: Real> HybridSurface<'s, T> {
                 buffers.mesh_vertex.len(),
             ),
         ];
-        if let Some(&(buffer, expected, found)) = checks.iter().find(|(_, e, f)| e != f) {
-            return Err(SurfaceBufferError {
-                buffer,
-                expected,
-                found,
-            });
-        }
-        if buffers.cell_start.len() < need.cell_start {
-            return Err(SurfaceBufferError {
-                buffer: "cell_start",
-                expected: need.cell_start,
-                found: buffers.cell_start.len(),
-            });
-        }
+        check_lengths(&checks, need.cell_start, buffers.cell_start.len())?;
         let interface = region.interface();
         for (v, &d) in interface.dynamic_vertices().iter().enumerate() {
             if let Some(m) = buffers.mesh_vertex.get_mut(d as usize) {

@@ -36,6 +36,7 @@ pub use law::{ElasticLaw, StvkForm};
 pub use limits::Limits;
 pub use model::{DynamicParams, InputError, StepError, StepReport, TensorMassModel};
 pub use state::{Fault, StateBuffers, StateError, VertexMode};
+pub(crate) use surface::check_lengths;
 pub use surface::{
     DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers, SurfaceLengths,
 };

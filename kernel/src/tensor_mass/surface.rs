@@ -135,6 +135,31 @@ impl fmt::Display for NonFinitePosition {
 
 impl core::error::Error for NonFinitePosition {}
 
+/// `Err` naming the first of `checks` (`(buffer, expected, found)`) whose
+/// lengths differ, or `cell_start` if it holds fewer than `cells_needed`
+/// entries (`cells_found`): the buffer checks of a surface's constructor.
+pub(crate) fn check_lengths(
+    checks: &[(&'static str, usize, usize)],
+    cells_needed: usize,
+    cells_found: usize,
+) -> Result<(), SurfaceBufferError> {
+    if let Some(&(buffer, expected, found)) = checks.iter().find(|(_, e, f)| e != f) {
+        return Err(SurfaceBufferError {
+            buffer,
+            expected,
+            found,
+        });
+    }
+    if cells_found < cells_needed {
+        return Err(SurfaceBufferError {
+            buffer: "cell_start",
+            expected: cells_needed,
+            found: cells_found,
+        });
+    }
+    Ok(())
+}
+
 /// The deforming surface: the boundary of the live tets at the positions
 /// of the last [`Self::rebin`].
 pub struct DeformingSurface<'a, 's, T: Real> {
@@ -180,20 +205,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             ),
             ("grid_vertex", need.vertices, buffers.grid_vertex.len()),
         ];
-        if let Some(&(buffer, expected, found)) = checks.iter().find(|(_, e, f)| e != f) {
-            return Err(SurfaceBufferError {
-                buffer,
-                expected,
-                found,
-            });
-        }
-        if buffers.cell_start.len() < need.cell_start {
-            return Err(SurfaceBufferError {
-                buffer: "cell_start",
-                expected: need.cell_start,
-                found: buffers.cell_start.len(),
-            });
-        }
+        check_lengths(&checks, need.cell_start, buffers.cell_start.len())?;
         let mut surface = Self {
             table: *model.table(),
             buffers,
