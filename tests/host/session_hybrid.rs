@@ -59,6 +59,29 @@ fn built_in_hybrid_cuts_its_tensor_mass_region_and_grasps_its_precomputed_one() 
         summary.max_force_n
     );
     assert!(removed.len() >= 10, "{} removed", removed.len());
+    // No pre-computed boundary triangle of the organ's surface has only
+    // connection nodes (a contact there would be refused: its vertices are
+    // all held in the pre-computed table): the partition leaves none.
+    let surface = palpate::mesh::boundary_surface(&mesh);
+    let mut owner = std::collections::HashMap::new();
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        for face in palpate_kernel::table::format::tet_face_vertices(*tet) {
+            let mut key = face;
+            key.sort_unstable();
+            owner.insert(key, t);
+        }
+    }
+    let connects = |v: u32| partition.connection_nodes.binary_search(&v).is_ok();
+    let held_only = surface
+        .triangles
+        .iter()
+        .filter(|tri| {
+            let mut key = **tri;
+            key.sort_unstable();
+            !partition.dynamic[owner[&key]] && tri.iter().all(|&v| connects(v))
+        })
+        .count();
+    assert_eq!(held_only, 0);
     assert!(removed.iter().all(|&t| partition.dynamic[t as usize]));
     assert!(summary.max_force_n > 0.5);
 }

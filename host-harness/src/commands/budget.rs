@@ -30,9 +30,10 @@ pub struct BudgetArgs {
     /// one the scene's tool can run).
     #[arg(long = "trajectory", value_name = "NAME")]
     only: Vec<String>,
-    /// Internal: run the ticks of this trajectory on this table (the
-    /// process callgrind measures).
-    #[arg(long, hide = true, num_args = 2, value_names = ["TABLE", "TRAJECTORY"])]
+    /// Internal: run the ticks of this trajectory on this table, built for
+    /// the scene's mesh size SIZE (0 the coarse box, or the scene's own)
+    /// (the process callgrind measures).
+    #[arg(long, hide = true, num_args = 3, value_names = ["TABLE", "TRAJECTORY", "SIZE"])]
     probe: Option<Vec<PathBuf>>,
 }
 
@@ -47,7 +48,14 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         probe: probe_paths,
     } = args;
     let mut scene = Scene::named(scene_arg)?;
-    if let Some([table_path, trajectory_path]) = probe_paths.as_deref() {
+    let sizes = mesh_sizes(&scene);
+    if let Some([table_path, trajectory_path, size]) = probe_paths.as_deref() {
+        // The model of the mesh the parent built these tables for.
+        let size: usize = size.to_string_lossy().parse().context("--probe SIZE")?;
+        scene.mesh = sizes
+            .get(size)
+            .context("--probe SIZE out of range")?
+            .clone();
         let (mesh, report) = scene.load_mesh()?;
         let model = SceneModel::of(&scene, &mesh, &report)?;
         let tables = SceneTables::read(model, table_path)?;
@@ -69,17 +77,6 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
     let exe = std::env::current_exe()?;
-    let mut sizes = vec![scene.mesh.clone()];
-    if let MeshSource::GeneratedBox { size_m, cells } = &scene.mesh {
-        let coarse = cells.map(|c| (c / 2).max(1));
-        sizes.insert(
-            0,
-            MeshSource::GeneratedBox {
-                size_m: *size_m,
-                cells: coarse,
-            },
-        );
-    }
     let mut chosen = trajectories(&scene)?;
     if let Some(unknown) = only
         .iter()
@@ -119,6 +116,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
                 "--probe".into(),
                 table_path.display().to_string(),
                 csv.display().to_string(),
+                s.to_string(),
             ];
             let irs = measure(&exe, &probe_args, &work_dir.join(format!("cg-{name}-{s}")))?;
             let work = std::fs::read_to_string(csv.with_extension("work"))?;
@@ -197,4 +195,21 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The meshes a budget measures: a generated box at half its resolution
+/// first, then the scene's own mesh.
+fn mesh_sizes(scene: &Scene) -> Vec<MeshSource> {
+    let mut sizes = vec![scene.mesh.clone()];
+    if let MeshSource::GeneratedBox { size_m, cells } = &scene.mesh {
+        let coarse = cells.map(|c| (c / 2).max(1));
+        sizes.insert(
+            0,
+            MeshSource::GeneratedBox {
+                size_m: *size_m,
+                cells: coarse,
+            },
+        );
+    }
+    sizes
 }

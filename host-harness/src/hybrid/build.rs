@@ -189,7 +189,7 @@ pub fn build_hybrid(
             *l += f;
         }
     }
-    let condensed = condense(
+    let mut condensed = condense(
         &mesh.positions,
         &pmesh.tets,
         &pmaterials,
@@ -198,6 +198,15 @@ pub fn build_hybrid(
         &load_n,
     )
     .with_context(|| format!("{source}: condensing the pre-computed region"))?;
+    if options.connection_mass == ConnectionMass::DynamicTetsOnly {
+        // The connection nodes' share of the pre-computed tets' gravity,
+        // which their tensor-mass masses do not carry in this mode.
+        for (force, &v) in condensed.load_force.iter_mut().zip(&split.connection) {
+            for (f, g) in force.iter_mut().zip(options.gravity_m_s2) {
+                *f += precomputed_mass[v as usize] * g;
+            }
+        }
+    }
 
     // The tensor-mass region, the connection nodes carrying both regions' mass.
     let dmesh = split.dynamic_mesh(mesh);

@@ -28,21 +28,15 @@ pub fn with_hybrid<T: Real, R>(
 /// [`with_hybrid`] on the three tables given as files: pre-computed region,
 /// tensor-mass region, interface (`palpate scene tables` writes them).
 pub fn with_hybrid_files<T: Real, R>(
-    [precomputed, dynamic, interface]: [&TableFile; 3],
+    files: [&TableFile; 3],
     params: DynamicParams<T>,
     run: impl FnOnce(&mut HybridModel<'_, '_, T>) -> R,
 ) -> anyhow::Result<R> {
-    let precomputed =
-        PrecomputedTable::<T>::load(precomputed.bytes()).context("pre-computed region")?;
-    let dynamic = TensorMassTable::<T>::load(dynamic.bytes()).context("tensor-mass region")?;
-    let interface = InterfaceTable::<T>::load(interface.bytes()).context("interface")?;
-    let mut state = OwnedState::for_table(&dynamic);
-    let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
-    let model = TensorMassModel::new(dynamic, state.buffers(), params)
-        .map_err(|e| anyhow!("tensor-mass region: {e}"))?;
-    let (buffers, _) = owned.buffers();
-    let mut hybrid = HybridModel::new(model, precomputed, interface, buffers)?;
-    Ok(run(&mut hybrid))
+    with_parts(files, params, |model, precomputed, interface, owned| {
+        let (buffers, _) = owned.buffers();
+        let mut hybrid = HybridModel::new(model, precomputed, interface, buffers)?;
+        Ok(run(&mut hybrid))
+    })
 }
 
 /// Builds the hybrid tissue (`P` tool points, `M` contacts) of the three
@@ -50,10 +44,41 @@ pub fn with_hybrid_files<T: Real, R>(
 /// `physics`, over heap buffers, and runs `run` on it (tests and benches:
 /// wrap it in a `HybridLoop`).
 pub fn with_hybrid_tissue<T: Real, const P: usize, const M: usize, R>(
-    [precomputed, dynamic, interface]: [&TableFile; 3],
+    files: [&TableFile; 3],
     params: DynamicParams<T>,
     physics: PhysicsConfig<T>,
     run: impl FnOnce(HybridTissue<'_, '_, T, P, M>) -> R,
+) -> anyhow::Result<R> {
+    with_parts(files, params, |model, precomputed, interface, owned| {
+        let mut surface = OwnedSurface::for_model(&model);
+        let (surface_buffers, forces) = surface.buffers();
+        let (coupling, hybrid_surface) = owned.buffers();
+        let tissue = HybridTissue::new(
+            model,
+            surface_buffers,
+            forces,
+            physics,
+            precomputed,
+            interface,
+            coupling,
+            hybrid_surface,
+        )?;
+        Ok(run(tissue))
+    })
+}
+
+/// Loads the three tables in precision `T` and builds the tensor-mass
+/// region's model with `params` over heap buffers; runs `body` on the
+/// model, the two other tables and the hybrid's own buffers.
+fn with_parts<T: Real, R>(
+    [precomputed, dynamic, interface]: [&TableFile; 3],
+    params: DynamicParams<T>,
+    body: impl FnOnce(
+        TensorMassModel<'_, '_, T>,
+        PrecomputedTable<'_, T>,
+        InterfaceTable<'_, T>,
+        &mut OwnedHybridBuffers<T>,
+    ) -> anyhow::Result<R>,
 ) -> anyhow::Result<R> {
     let precomputed =
         PrecomputedTable::<T>::load(precomputed.bytes()).context("pre-computed region")?;
@@ -63,20 +88,7 @@ pub fn with_hybrid_tissue<T: Real, const P: usize, const M: usize, R>(
     let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
     let model = TensorMassModel::new(dynamic, state.buffers(), params)
         .map_err(|e| anyhow!("tensor-mass region: {e}"))?;
-    let mut surface = OwnedSurface::for_model(&model);
-    let (surface_buffers, forces) = surface.buffers();
-    let (coupling, hybrid_surface) = owned.buffers();
-    let tissue = HybridTissue::new(
-        model,
-        surface_buffers,
-        forces,
-        physics,
-        precomputed,
-        interface,
-        coupling,
-        hybrid_surface,
-    )?;
-    Ok(run(tissue))
+    body(model, precomputed, interface, &mut owned)
 }
 
 /// Heap storage for a hybrid tissue's own buffers: the coupling's

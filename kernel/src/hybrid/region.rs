@@ -22,7 +22,7 @@ pub struct HybridBuffers<'s, T> {
     pub passed_force_n: &'s mut [[T; 3]],
     /// One per free vertex of the pre-computed table (`F`, its free index
     /// order): the displacement the connection nodes and the load give it,
-    /// m ([`HybridModel::update_background`]).
+    /// m ([`CondensedRegion::update_background`]).
     pub background_m: &'s mut [[T; 3]],
 }
 
@@ -74,7 +74,7 @@ impl fmt::Display for HybridError {
 
 impl core::error::Error for HybridError {}
 
-/// Why [`HybridModel::displacements`] wrote nothing.
+/// Why [`CondensedRegion::displacements`] wrote nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FieldError {
     /// The output buffer does not hold one entry per mesh vertex.
@@ -363,9 +363,11 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     }
 
     /// The displacement of mesh vertex `v` as the surface sees it (m): a
-    /// tensor-mass vertex's from `u` (the model's displacements), a
-    /// touchable vertex's background, zero otherwise (fixed, or an
-    /// interior vertex of this region, which no contact touches).
+    /// tensor-mass vertex's from `u` (the model's displacements), a free
+    /// vertex's background as last refreshed (the touchable rows, which
+    /// the surface's triangles use, at every physics update; an interior
+    /// row since its last full refresh, which no triangle uses), `None`
+    /// (zero) for a fixed vertex.
     pub fn surface_displacement<'u>(&'u self, u: &'u [[T; 3]], v: u32) -> Option<&'u [T; 3]> {
         match (
             self.interface.dynamic_vertex(v),
@@ -378,8 +380,9 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     }
 
     /// The background at a contact point: `Σ_a β_a b(v_a)` over
-    /// [`Self::surface_displacement`] (zero for a faulted region, `u`
-    /// empty, whose contacts the caller drops).
+    /// [`Self::surface_displacement`] (with `u` empty, a faulted model's,
+    /// the tensor-mass vertices count zero; the caller's solve refuses a
+    /// faulted tissue's contacts).
     fn background_at(&self, u: &[[T; 3]], point: ContactPoint<T>) -> Vector3<T> {
         let (vertices, weights) = match point {
             ContactPoint::Vertex(v) => ([v, v, v], [T::one(), T::zero(), T::zero()]),

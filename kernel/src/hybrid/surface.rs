@@ -8,7 +8,13 @@
 //! ([`DEAD_TRIANGLE`]: they are inside the organ); `B..B + F` the
 //! tensor-mass region's surface slots (its
 //! [`crate::tensor_mass::DeformingSurface::triangles`], faces a cut exposes
-//! included) in mesh vertex numbers. Positions: a tensor-mass vertex at its
+//! included) in mesh vertex numbers, its copies of the shared faces empty
+//! too. A cut that removes a tensor-mass tet on a shared face leaves that
+//! face out of the surface (the pre-computed side cannot answer a contact
+//! there: its vertices are all connection nodes, held in its table), so
+//! cuts belong inside the tensor-mass region, which the zones' margin
+//! keeps away from the interface (README "Scenes that model no more than
+//! they need"). Positions: a tensor-mass vertex at its
 //! displacement, a touchable pre-computed vertex at its background (the
 //! displacement the connection nodes and the load give it; a contact's own
 //! dimple is the contact's), every other vertex at rest.
@@ -195,12 +201,27 @@ impl<'s, T: Real> HybridSurface<'s, T> {
     ) -> Result<(), NonFinitePosition> {
         let b = &mut self.buffers;
         let mesh_vertex = &*b.mesh_vertex;
+        let table = region.precomputed().table();
+        let connections = region.interface().connection_count();
+        // A face the tensor-mass region shares with the pre-computed one is
+        // inside the organ: its vertices are connection nodes (numbered
+        // first) and it is a boundary triangle of the pre-computed table.
+        let inside = |tri: &[u32; 3], mapped: [u32; 3]| {
+            tri.iter().all(|&d| (d as usize) < connections)
+                && match mapped.map(|v| table.vertex(v)) {
+                    [Some(a), Some(b), Some(c)] => {
+                        table.surface_index().find_triangle([a, b, c]).is_some()
+                    }
+                    _ => false,
+                }
+        };
         let slots = b.triangles.get_mut(self.dynamic_first..).unwrap_or(&mut []);
         for (slot, tri) in slots.iter_mut().zip(dynamic_triangles) {
-            *slot = if *tri == DEAD_TRIANGLE {
+            let mapped = tri.map(|d| mesh_vertex.get(d as usize).copied().unwrap_or(u32::MAX));
+            *slot = if *tri == DEAD_TRIANGLE || inside(tri, mapped) {
                 DEAD_TRIANGLE
             } else {
-                tri.map(|d| mesh_vertex.get(d as usize).copied().unwrap_or(u32::MAX))
+                mapped
             };
         }
         let u = dynamic.displacements_m().unwrap_or(&[]);
@@ -245,14 +266,6 @@ impl<'s, T: Real> HybridSurface<'s, T> {
             }
             _ => None,
         }
-    }
-
-    /// The slot of the tensor-mass region's surface slot `d`.
-    pub fn slot_of_dynamic(&self, d: TriangleIndex) -> Option<TriangleIndex> {
-        TriangleIndex::new(
-            (self.dynamic_first + d.get()) as u32,
-            self.buffers.triangles.len(),
-        )
     }
 
     /// The mesh vertex of each tensor-mass vertex.
