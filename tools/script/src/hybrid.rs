@@ -35,7 +35,7 @@ use palpate_kernel::precomputed::{Constraint, ContactPoint};
 use palpate_kernel::tensor_mass::{DynamicParams, InputError, Integrator};
 
 use crate::parse::{StepContacts, steps};
-use crate::replay::{ReplayError, hex, largest, write_forces};
+use crate::replay::{ReplayError, check_inputs, hex, largest, write_forces};
 
 /// The tensor-mass region's integrator (the scene's `[model] integrator`).
 pub const INTEGRATOR: Integrator = Integrator::SymplecticEuler;
@@ -63,16 +63,7 @@ pub fn replay<W: Write>(
     displacements: &mut [[f32; 3]],
     out: &mut W,
 ) -> Result<(), ReplayError> {
-    let expected = model.interface().vertex_count();
-    if displacements.len() != expected {
-        return Err(ReplayError::DisplacementBuffer {
-            expected,
-            found: displacements.len(),
-        });
-    }
-    if let Some((line, Err(error))) = steps::<f32>(sequence).find(|(_, s)| s.is_err()) {
-        return Err(ReplayError::Parse { line, error });
-    }
+    check_inputs(model.interface().vertex_count(), sequence, displacements)?;
     let touchable = model.region().precomputed().table().touchable_count();
     for (index, (_, step)) in steps::<f32>(sequence).enumerate() {
         let Ok(contacts) = step else { continue };

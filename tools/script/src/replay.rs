@@ -61,16 +61,7 @@ pub fn replay<W: Write>(
     displacements: &mut [[f32; 3]],
     out: &mut W,
 ) -> Result<(), ReplayError> {
-    let expected = model.table().vertex_count();
-    if displacements.len() != expected {
-        return Err(ReplayError::DisplacementBuffer {
-            expected,
-            found: displacements.len(),
-        });
-    }
-    if let Some((line, Err(error))) = steps::<f32>(sequence).find(|(_, s)| s.is_err()) {
-        return Err(ReplayError::Parse { line, error });
-    }
+    check_inputs(model.table().vertex_count(), sequence, displacements)?;
     for (index, (_, step)) in steps::<f32>(sequence).enumerate() {
         let Ok(contacts) = step else { continue };
         write!(out, "step {index}")?;
@@ -127,4 +118,24 @@ pub(crate) fn hex(x: f32) -> impl fmt::Display {
         }
     }
     Bits(x.to_bits())
+}
+
+/// The checks before a replay writes anything: `displacements` holds
+/// `expected` entries (one per mesh vertex) and every line of `sequence`
+/// parses.
+pub(crate) fn check_inputs(
+    expected: usize,
+    sequence: &str,
+    displacements: &[[f32; 3]],
+) -> Result<(), ReplayError> {
+    if displacements.len() != expected {
+        return Err(ReplayError::DisplacementBuffer {
+            expected,
+            found: displacements.len(),
+        });
+    }
+    if let Some((line, Err(error))) = steps::<f32>(sequence).find(|(_, s)| s.is_err()) {
+        return Err(ReplayError::Parse { line, error });
+    }
+    Ok(())
 }
