@@ -62,13 +62,9 @@ fn params() -> DynamicParams<f32> {
 
 /// The `fraction` of the tets with the lowest centroid x.
 fn dynamic_tets(mesh: &TetMesh, fraction: f64) -> Vec<bool> {
-    let x = |t: &[u32; 4]| {
-        t.iter()
-            .map(|&v| mesh.positions[v as usize][0])
-            .sum::<f64>()
-    };
+    let x = |t: usize| mesh.tet_centroid(t)[0];
     let mut order: Vec<usize> = (0..mesh.tets.len()).collect();
-    order.sort_by(|&a, &b| x(&mesh.tets[a]).total_cmp(&x(&mesh.tets[b])));
+    order.sort_by(|&a, &b| x(a).total_cmp(&x(b)));
     let mut dynamic = vec![false; mesh.tets.len()];
     for &t in order
         .iter()

@@ -46,13 +46,9 @@ fn block() -> TetMesh {
 
 /// Region 2 for the tets whose centroid lies in the nodule's box, 1 elsewhere.
 fn regions(mesh: &TetMesh) -> Vec<u32> {
-    mesh.tets
-        .iter()
+    (0..mesh.tets.len())
         .map(|t| {
-            let c = t.iter().fold([0.0; 3], |c, &v| {
-                let p = mesh.positions[v as usize];
-                [c[0] + p[0] / 4.0, c[1] + p[1] / 4.0, c[2] + p[2] / 4.0]
-            });
+            let c = mesh.tet_centroid(t);
             let inside = (0.02..0.04).contains(&c[0])
                 && (0.02..0.04).contains(&c[1])
                 && (0.01..0.03).contains(&c[2]);

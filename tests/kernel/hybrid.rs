@@ -44,13 +44,9 @@ fn block() -> (TetMesh, MeshReport) {
 /// The tets of the upper corner `x > 2 cm, z > 2 cm` are dynamic (96 of
 /// 384; 15 connection nodes).
 fn corner(mesh: &TetMesh) -> Vec<bool> {
-    mesh.tets
-        .iter()
+    (0..mesh.tets.len())
         .map(|t| {
-            let c = t.iter().fold([0.0; 3], |c, &v| {
-                let p = mesh.positions[v as usize];
-                [c[0] + p[0] / 4.0, c[1] + p[1] / 4.0, c[2] + p[2] / 4.0]
-            });
+            let c = mesh.tet_centroid(t);
             c[0] > SIZE_M / 2.0 && c[2] > SIZE_M / 2.0
         })
         .collect()

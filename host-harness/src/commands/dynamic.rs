@@ -12,7 +12,7 @@ use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::partition::Partition;
 use palpate::session::Scene;
 use palpate::session::run::tensor_mass_options;
-use palpate::table::build::{BuildOptions, TableKindOptions};
+use palpate::table::build::BuildOptions;
 use palpate::table::file::Precision;
 use palpate::tensor_mass::run::RunOptions;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
@@ -259,19 +259,7 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             let integrator = model.integrator.into();
             let json = match &setup.hybrid {
                 Some(dynamic) => {
-                    let density = match table.kind {
-                        TableKindOptions::TensorMass { density_kg_m3 } => density_kg_m3,
-                        TableKindOptions::Precomputed { .. } => 0.0,
-                    };
-                    let options = HybridOptions {
-                        build: table.clone(),
-                        ..HybridOptions::new(
-                            table.material,
-                            density,
-                            table.fix.clone(),
-                            Precision::F64,
-                        )
-                    };
+                    let options = HybridOptions::of_tensor_mass(table)?;
                     let result = critical_dt_of_hybrid(
                         mesh,
                         report,

@@ -16,7 +16,7 @@ use crate::fem::element::shape_gradients;
 use crate::fem::material::{Material, TetMaterials};
 use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
-use crate::table::build::{BuildOptions, BuiltTable, Stages, precomputed};
+use crate::table::build::{BuildOptions, BuiltTable, Stages, TableKindOptions, precomputed};
 use crate::table::compliance::Solver;
 use crate::table::file::{Precision, Section, write_container};
 use crate::table::load::TableFile;
@@ -72,6 +72,23 @@ impl HybridOptions {
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
         }
+    }
+
+    /// The options of a tensor-mass table's `build` (its materials, one or
+    /// per tet, density, supports and precision), with no load and the
+    /// default connection mass; an error for pre-computed options (no
+    /// density).
+    pub fn of_tensor_mass(build: &BuildOptions) -> anyhow::Result<Self> {
+        let TableKindOptions::TensorMass { density_kg_m3 } = build.kind else {
+            bail!("a hybrid needs the options of a tensor-mass table (its density)");
+        };
+        Ok(Self {
+            build: build.clone(),
+            density_kg_m3,
+            gravity_m_s2: [0.0; 3],
+            point_loads: Vec::new(),
+            connection_mass: ConnectionMass::AllTets,
+        })
     }
 
     /// The same with one material per tet of the whole mesh.

@@ -40,15 +40,9 @@ pub fn run(
     let mut build = options.table.clone();
     build.precision = Precision::F64;
     let hybrid = HybridOptions {
-        build,
         gravity_m_s2: options.gravity_m_s2,
         point_loads: precomputed_loads,
-        ..HybridOptions::new(
-            options.table.material,
-            options.density_kg_m3()?,
-            options.table.fix.clone(),
-            Precision::F64,
-        )
+        ..HybridOptions::of_tensor_mass(&build)?
     };
     let tables = build_hybrid(mesh, report, dynamic_tet, &hybrid)?;
     let split = &tables.split;

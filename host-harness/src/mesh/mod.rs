@@ -103,6 +103,18 @@ impl TetMesh {
         validate::signed_volume(p(a), p(b), p(c), p(d))
     }
 
+    /// Centroid of tet `t`, mesh units (m): the mean of its 4 vertices.
+    /// Panics if `t >= self.tets.len()`.
+    pub fn tet_centroid(&self, t: usize) -> [f64; 3] {
+        let tet = self.tets[t];
+        core::array::from_fn(|i| {
+            tet.iter()
+                .map(|&v| self.positions[v as usize][i])
+                .sum::<f64>()
+                / 4.0
+        })
+    }
+
     /// Per vertex: whether some tet uses it. Length `positions.len()`.
     pub fn referenced(&self) -> Vec<bool> {
         let mut used = vec![false; self.positions.len()];

@@ -278,7 +278,7 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
         scene: input.scene.to_owned(),
         region,
         tets: tets.len(),
-        at_m: centroid(mesh, tets[0]),
+        at_m: mesh.tet_centroid(tets[0] as usize),
     };
     let vertex_count = |tets: &[u32]| distinct_vertices(mesh, tets).len();
     let connection_count = |tets: &[u32]| {
@@ -421,17 +421,6 @@ pub fn distinct_vertices(mesh: &TetMesh, tets: &[u32]) -> Vec<u32> {
     v.sort_unstable();
     v.dedup();
     v
-}
-
-/// The centroid of tet `t`, m.
-fn centroid(mesh: &TetMesh, t: u32) -> [f64; 3] {
-    let tet = mesh.tets[t as usize];
-    core::array::from_fn(|i| {
-        tet.iter()
-            .map(|&v| mesh.positions[v as usize][i])
-            .sum::<f64>()
-            / 4.0
-    })
 }
 
 /// Why the pre-computed region is pre-computed.

@@ -13,7 +13,7 @@ use serde::Serialize;
 use super::OwnedState;
 use crate::fem::element::shape_gradients;
 use crate::mesh::{MeshReport, TetMesh};
-use crate::table::build::{BuildOptions, TableKindOptions, build};
+use crate::table::build::{BuildOptions, build};
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
 
@@ -41,18 +41,6 @@ pub struct RunOptions {
     pub steps: usize,
     /// Tets removed before the first step.
     pub cut_tets: Vec<u32>,
-}
-
-impl RunOptions {
-    /// The density of the table options, kg/m³.
-    pub fn density_kg_m3(&self) -> anyhow::Result<f64> {
-        match self.table.kind {
-            TableKindOptions::TensorMass { density_kg_m3 } => Ok(density_kg_m3),
-            TableKindOptions::Precomputed { .. } => {
-                bail!("a dynamic run needs the options of a tensor-mass table")
-            }
-        }
-    }
 }
 
 /// The JSON object `dynamic run --json` prints (a CLI contract).

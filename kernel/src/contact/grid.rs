@@ -25,7 +25,7 @@
 use nalgebra::Vector3;
 
 use crate::Real;
-use crate::table::{DEAD_TRIANGLE, Grid, max_row};
+use crate::table::{BuiltLists, DEAD_TRIANGLE, Grid, SurfaceIndex, max_row};
 
 /// Factor by which the cell edge grows until the grid fits its capacity.
 pub const CELL_GROWTH: f64 = 1.25;
@@ -60,6 +60,107 @@ pub struct Binned<T> {
     pub filed: usize,
     /// Most vertices in one cell.
     pub max_bucket: u32,
+}
+
+/// A moving surface's grid: what [`vertex_triangles`] and [`bin`] last left
+/// in its owner's buffers, re-binned at each physics update, and the index
+/// over those buffers. The tensor-mass model's deforming surface and the
+/// hybrid's whole surface both keep one.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rebinned<T> {
+    grid: Grid<T>,
+    /// Cells of the current grid.
+    cells: usize,
+    /// Surface vertices filed (the used prefix of `grid_vertex`).
+    filed: usize,
+    /// Most vertices in one cell of the current grid; most triangles
+    /// around one vertex.
+    max_bucket: u32,
+    max_valence: u32,
+}
+
+/// A moving surface's buffers, as [`Rebinned::rebin`] reads and writes them
+/// (lengths as [`vertex_triangles`] and [`bin`] take them).
+pub(crate) struct SurfaceLists<'b, T> {
+    pub(crate) positions_m: &'b [[T; 3]],
+    pub(crate) triangles: &'b [[u32; 3]],
+    pub(crate) vertex_triangle_start: &'b mut [u32],
+    pub(crate) vertex_triangle: &'b mut [u32],
+    pub(crate) planes: &'b mut [[T; 4]],
+    pub(crate) cell_start: &'b mut [u32],
+    pub(crate) grid_vertex: &'b mut [u32],
+}
+
+impl<T: Real> Rebinned<T> {
+    /// Before the first [`Self::rebin`]: one empty cell.
+    pub(crate) fn empty() -> Self {
+        Self {
+            grid: Grid {
+                origin_m: Vector3::zeros(),
+                cell_m: T::one(),
+                dims: [1; 3],
+            },
+            cells: 1,
+            filed: 0,
+            max_bucket: 0,
+            max_valence: 0,
+        }
+    }
+
+    /// Rebuilds each vertex's triangle list when `lists_changed` (the
+    /// triangles changed since the last call), then the planes and a new
+    /// grid at `lists.positions_m`. Bounded (module docs).
+    pub(crate) fn rebin(&mut self, lists: SurfaceLists<'_, T>, lists_changed: bool) {
+        if lists_changed {
+            self.max_valence = vertex_triangles(
+                lists.triangles,
+                lists.vertex_triangle_start,
+                lists.vertex_triangle,
+            );
+        }
+        let Binned {
+            grid,
+            cells,
+            filed,
+            max_bucket,
+        } = bin(
+            lists.positions_m,
+            lists.triangles,
+            lists.vertex_triangle_start,
+            BinBuffers {
+                planes: lists.planes,
+                cell_start: lists.cell_start,
+                grid_vertex: lists.grid_vertex,
+            },
+        );
+        (self.grid, self.cells, self.filed, self.max_bucket) = (grid, cells, filed, max_bucket);
+    }
+
+    /// The index over the buffers the last [`Self::rebin`] filled (the
+    /// same slices, read back; constant time).
+    pub(crate) fn index<'b>(
+        &self,
+        triangles: &'b [[u32; 3]],
+        vertex_triangle_start: &'b [u32],
+        vertex_triangle: &'b [u32],
+        planes: &'b [[T; 4]],
+        cell_start: &'b [u32],
+        grid_vertex: &'b [u32],
+    ) -> SurfaceIndex<'b, T> {
+        SurfaceIndex::assembled(
+            self.grid,
+            BuiltLists {
+                triangles,
+                cell_start: cell_start.get(..=self.cells).unwrap_or(&[]),
+                grid_vertex: grid_vertex.get(..self.filed).unwrap_or(&[]),
+                vertex_triangle_start,
+                vertex_triangle,
+                planes,
+                max_bucket: self.max_bucket,
+                max_valence: self.max_valence,
+            },
+        )
+    }
 }
 
 /// Each vertex's surface triangles, ascending, as a CSR list: `start` has

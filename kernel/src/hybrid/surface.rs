@@ -19,15 +19,11 @@
 //! displacement the connection nodes and the load give it; a contact's own
 //! dimple is the contact's), every other vertex at rest.
 
-use nalgebra::Vector3;
-
 use super::region::CondensedRegion;
 use crate::Real;
-use crate::contact::grid::{self, BinBuffers, Binned};
+use crate::contact::grid::{Rebinned, SurfaceLists};
 use crate::contact::{Supports, SurfaceGeometry};
-use crate::table::{
-    BuiltLists, DEAD_TRIANGLE, Grid, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex,
-};
+use crate::table::{DEAD_TRIANGLE, PrecomputedTable, TensorMassTable, TriangleIndex};
 use crate::tensor_mass::{NonFinitePosition, SurfaceBufferError, TensorMassModel, check_lengths};
 
 /// The caller's buffers of a hybrid surface (static arrays on firmware);
@@ -96,11 +92,7 @@ pub struct HybridSurface<'s, T: Real> {
     buffers: HybridSurfaceBuffers<'s, T>,
     /// First slot of the tensor-mass region (`B`).
     dynamic_first: usize,
-    grid: Grid<T>,
-    cells: usize,
-    filed: usize,
-    max_bucket: u32,
-    max_valence: u32,
+    bins: Rebinned<T>,
 }
 
 impl<'s, T: Real> HybridSurface<'s, T> {
@@ -166,15 +158,7 @@ impl<'s, T: Real> HybridSurface<'s, T> {
         let mut surface = Self {
             buffers,
             dynamic_first: precomputed.surface_triangles().len(),
-            grid: Grid {
-                origin_m: Vector3::zeros(),
-                cell_m: T::one(),
-                dims: [1; 3],
-            },
-            cells: 1,
-            filed: 0,
-            max_bucket: 0,
-            max_valence: 0,
+            bins: Rebinned::empty(),
         };
         // The rest state is finite (validated tables), so this bins.
         surface
@@ -234,24 +218,20 @@ impl<'s, T: Real> HybridSurface<'s, T> {
                 return Err(NonFinitePosition { vertex: v as u32 });
             }
         }
-        self.max_valence =
-            grid::vertex_triangles(b.triangles, b.vertex_triangle_start, b.vertex_triangle);
-        let Binned {
-            grid,
-            cells,
-            filed,
-            max_bucket,
-        } = grid::bin(
-            b.positions_m,
-            b.triangles,
-            b.vertex_triangle_start,
-            BinBuffers {
+        // The tensor-mass slots are copied at every update (a cut changes
+        // them), so the lists are always rebuilt.
+        self.bins.rebin(
+            SurfaceLists {
+                positions_m: b.positions_m,
+                triangles: b.triangles,
+                vertex_triangle_start: b.vertex_triangle_start,
+                vertex_triangle: b.vertex_triangle,
                 planes: b.planes,
                 cell_start: b.cell_start,
                 grid_vertex: b.grid_vertex,
             },
+            true,
         );
-        (self.grid, self.cells, self.filed, self.max_bucket) = (grid, cells, filed, max_bucket);
         Ok(())
     }
 
@@ -280,20 +260,16 @@ impl<'s, T: Real> HybridSurface<'s, T> {
 
     /// The surface at the last rebuild, for detection and tracking.
     pub fn geometry<'g>(&'g self, supports: Supports<'g, T>) -> SurfaceGeometry<'g, T> {
+        let b = &self.buffers;
         SurfaceGeometry::of_parts(
-            self.buffers.positions_m,
-            SurfaceIndex::assembled(
-                self.grid,
-                BuiltLists {
-                    triangles: self.buffers.triangles,
-                    cell_start: self.buffers.cell_start.get(..=self.cells).unwrap_or(&[]),
-                    grid_vertex: self.buffers.grid_vertex.get(..self.filed).unwrap_or(&[]),
-                    vertex_triangle_start: self.buffers.vertex_triangle_start,
-                    vertex_triangle: self.buffers.vertex_triangle,
-                    planes: self.buffers.planes,
-                    max_bucket: self.max_bucket,
-                    max_valence: self.max_valence,
-                },
+            b.positions_m,
+            self.bins.index(
+                b.triangles,
+                b.vertex_triangle_start,
+                b.vertex_triangle,
+                b.planes,
+                b.cell_start,
+                b.grid_vertex,
             ),
             supports,
         )

@@ -190,7 +190,8 @@ impl<'a, 's, T: Real, const P: usize, const M: usize> HybridTissue<'a, 's, T, P,
             // As many as `blades` holds.
             let _ = local_blades.push(Blade { pressing, ..*blade });
         }
-        let report = self.dynamic.update(&local, &local_blades)?;
+        // The whole surface is binned below: the region's own is not.
+        let report = self.dynamic.update_unbinned(&local, &local_blades)?;
         let touchable = self.region.precomputed().table().touchable_count();
         self.region
             .update_background(self.dynamic.model(), touchable)

@@ -27,16 +27,12 @@
 
 use core::fmt;
 
-use nalgebra::Vector3;
-
 use super::TensorMassModel;
 use crate::Real;
-use crate::contact::grid::{self, BinBuffers, Binned};
+use crate::contact::grid::{Rebinned, SurfaceLists};
 use crate::contact::{Supports, SurfaceGeometry};
 use crate::table::format::{NO_NEIGHBOUR, tet_face_vertices};
-use crate::table::{
-    BuiltLists, DEAD_TRIANGLE, Grid, SurfaceIndex, TensorMassTable, TetIndex, TriangleIndex,
-};
+use crate::table::{DEAD_TRIANGLE, SurfaceIndex, TensorMassTable, TetIndex, TriangleIndex};
 
 /// The caller's buffers of a deforming surface (static arrays on
 /// firmware). Lengths for a table of `N` vertices and `F` mesh triangles
@@ -167,15 +163,7 @@ pub struct DeformingSurface<'a, 's, T: Real> {
     buffers: SurfaceBuffers<'s, T>,
     /// Faces changed since the vertex-to-triangle lists were built.
     dirty: bool,
-    grid: Grid<T>,
-    /// Cells of the current grid.
-    cells: usize,
-    /// Surface vertices filed (the used prefix of `grid_vertex`).
-    filed: usize,
-    /// Most vertices in one cell of the current grid; most triangles
-    /// around one vertex.
-    max_bucket: u32,
-    max_valence: u32,
+    bins: Rebinned<T>,
 }
 
 impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
@@ -210,15 +198,7 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
             table: *model.table(),
             buffers,
             dirty: true,
-            grid: Grid {
-                origin_m: Vector3::zeros(),
-                cell_m: T::one(),
-                dims: [1; 3],
-            },
-            cells: 1,
-            filed: 0,
-            max_bucket: 0,
-            max_valence: 0,
+            bins: Rebinned::empty(),
         };
         surface.reset_faces();
         surface.remove_tets(model.tet_alive(), model.table().tet_indices());
@@ -253,47 +233,33 @@ impl<'a, 's, T: Real> DeformingSurface<'a, 's, T> {
                 return Err(NonFinitePosition { vertex: v as u32 });
             }
         }
-        if self.dirty {
-            self.max_valence = grid::vertex_triangles(
-                self.buffers.triangles,
-                self.buffers.vertex_triangle_start,
-                self.buffers.vertex_triangle,
-            );
-            self.dirty = false;
-        }
-        let Binned {
-            grid,
-            cells,
-            filed,
-            max_bucket,
-        } = grid::bin(
-            self.buffers.positions_m,
-            self.buffers.triangles,
-            self.buffers.vertex_triangle_start,
-            BinBuffers {
-                planes: self.buffers.planes,
-                cell_start: self.buffers.cell_start,
-                grid_vertex: self.buffers.grid_vertex,
+        let b = &mut self.buffers;
+        self.bins.rebin(
+            SurfaceLists {
+                positions_m: b.positions_m,
+                triangles: b.triangles,
+                vertex_triangle_start: b.vertex_triangle_start,
+                vertex_triangle: b.vertex_triangle,
+                planes: b.planes,
+                cell_start: b.cell_start,
+                grid_vertex: b.grid_vertex,
             },
+            self.dirty,
         );
-        (self.grid, self.cells, self.filed, self.max_bucket) = (grid, cells, filed, max_bucket);
+        self.dirty = false;
         Ok(())
     }
 
     /// The index over the current lists (constant time).
     fn index(&self) -> SurfaceIndex<'_, T> {
-        SurfaceIndex::assembled(
-            self.grid,
-            BuiltLists {
-                triangles: self.buffers.triangles,
-                cell_start: self.buffers.cell_start.get(..=self.cells).unwrap_or(&[]),
-                grid_vertex: self.buffers.grid_vertex.get(..self.filed).unwrap_or(&[]),
-                vertex_triangle_start: self.buffers.vertex_triangle_start,
-                vertex_triangle: self.buffers.vertex_triangle,
-                planes: self.buffers.planes,
-                max_bucket: self.max_bucket,
-                max_valence: self.max_valence,
-            },
+        let b = &self.buffers;
+        self.bins.index(
+            b.triangles,
+            b.vertex_triangle_start,
+            b.vertex_triangle,
+            b.planes,
+            b.cell_start,
+            b.grid_vertex,
         )
     }
 

@@ -520,7 +520,29 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         set: &ContactSet<T, M>,
         blades: &Blades<T>,
     ) -> Result<StepReport<T>, PhysicsError> {
-        let result = self.try_update(set, blades);
+        self.update_binning(set, blades, true)
+    }
+
+    /// [`Self::update`] without the re-bin of this tissue's surface: for a
+    /// wrapper that bins a surface of its own over these triangles (the
+    /// hybrid's whole surface, which checks the positions too). The faces a
+    /// cut exposes are brought up to date all the same; the grid, planes and
+    /// positions of this surface stay as they were.
+    pub(crate) fn update_unbinned<const M: usize>(
+        &mut self,
+        set: &ContactSet<T, M>,
+        blades: &Blades<T>,
+    ) -> Result<StepReport<T>, PhysicsError> {
+        self.update_binning(set, blades, false)
+    }
+
+    fn update_binning<const M: usize>(
+        &mut self,
+        set: &ContactSet<T, M>,
+        blades: &Blades<T>,
+        rebin: bool,
+    ) -> Result<StepReport<T>, PhysicsError> {
+        let result = self.try_update(set, blades, rebin);
         if let Err(e) = result {
             self.fault = Some(e);
             self.held = [None; P];
@@ -593,6 +615,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         &mut self,
         set: &ContactSet<T, M>,
         blades: &Blades<T>,
+        rebin: bool,
     ) -> Result<StepReport<T>, PhysicsError> {
         // A faulted update removes nothing (the log is this update's).
         self.removed.clear();
@@ -755,11 +778,13 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
                 });
             }
         }
-        let u = self
-            .model
-            .displacements_m()
-            .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
-        self.surface.rebin(u).map_err(PhysicsError::Surface)?;
+        if rebin {
+            let u = self
+                .model
+                .displacements_m()
+                .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
+            self.surface.rebin(u).map_err(PhysicsError::Surface)?;
+        }
         self.period_ticks = self.ticks_since_update.max(1);
         self.ticks_since_update = 0;
         report.ok_or(PhysicsError::Step(StepError::BadTimeStep))
