@@ -111,9 +111,9 @@ pub struct Equilibrium {
 /// One stage: the force and the three equilibria.
 #[derive(Clone, Debug, Serialize)]
 pub struct Stage {
-    /// [`Protocol::Tilt`]: target of the measure on the St Venant-Kirchhoff
-    /// + incompressibility model; [`Protocol::PaperLoads`]: the force in
-    /// units of `F`.
+    /// [`Protocol::Tilt`]: target of the measure on the penalized St
+    /// Venant-Kirchhoff model; [`Protocol::PaperLoads`]: the force in units
+    /// of `F`.
     pub target: f64,
     /// Total applied force, N.
     pub force_n: f64,
