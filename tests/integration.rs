@@ -31,6 +31,7 @@ mod kernel {
     mod hybrid;
     mod layers;
     mod precomputed;
+    mod remap;
     mod stvk;
     mod stvk_terms;
     mod table;

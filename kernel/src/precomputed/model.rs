@@ -5,6 +5,7 @@ use core::fmt;
 use nalgebra::{Matrix3, Vector3};
 
 use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
+use super::remap::QuasiNonLinear;
 use crate::math::cholesky::solve_blocks;
 use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
@@ -13,9 +14,11 @@ use crate::{MAX_CONTACT_CAPACITY, Real};
 /// The pre-computed model over a validated table (RR-3510 §4, MODELS.md §2).
 /// Holds no mutable state: every query is a pure function of the table and
 /// the contact set, so it is trivially deterministic and re-entrant.
+/// Optionally quasi-non-linear ([`Self::with_remap`], Cotin 1999 TVCG §3).
 #[derive(Clone, Copy, Debug)]
 pub struct PrecomputedModel<'a, T: Real> {
     table: PrecomputedTable<'a, T>,
+    remap: Option<QuasiNonLinear<T>>,
 }
 
 /// Contact forces for one contact set: the output of the haptic path, and the
@@ -25,7 +28,13 @@ pub struct PrecomputedModel<'a, T: Real> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactSolution<T: Real, const M: usize> {
     points: [ResolvedPoint<T>; M],
+    /// The forces on the tool's side: the linear `g`, remapped when the
+    /// model is quasi-non-linear.
     forces_n: [Vector3<T>; M],
+    /// The linear `g`, which the displacement update superposes.
+    linear_forces_n: [Vector3<T>; M],
+    /// `d̂` of a quasi-non-linear model's contact set (`None`: linear).
+    direction: Option<Vector3<T>>,
     len: usize,
 }
 
@@ -41,7 +50,8 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
     }
 
     /// `g_p`: the force the tool applies to the tissue at each contact, N, in
-    /// the order the contacts were given.
+    /// the order the contacts were given (with its colinear amplitude
+    /// remapped by `ψ` when the model is quasi-non-linear).
     pub fn contact_forces_n(&self) -> &[Vector3<T>] {
         self.forces_n.get(..self.len).unwrap_or(&[])
     }
@@ -55,8 +65,12 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
             .fold(Vector3::zeros(), |acc, g| acc - g)
     }
 
+    /// The contact points with their linear forces.
     pub(crate) fn resolved(&self) -> impl Iterator<Item = (&ResolvedPoint<T>, &Vector3<T>)> {
-        self.points.iter().zip(self.forces_n.iter()).take(self.len)
+        self.points
+            .iter()
+            .zip(self.linear_forces_n.iter())
+            .take(self.len)
     }
 }
 
@@ -84,7 +98,22 @@ impl core::error::Error for DisplacementError {}
 impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// A model over a table validated by [`PrecomputedTable::load`].
     pub fn new(table: PrecomputedTable<'a, T>) -> Self {
-        Self { table }
+        Self { table, remap: None }
+    }
+
+    /// The quasi-non-linear model (Cotin 1999 TVCG §3, [`QuasiNonLinear`]):
+    /// contact forces and displacements are the linear ones with their
+    /// amplitudes remapped.
+    pub fn with_remap(self, remap: QuasiNonLinear<T>) -> Self {
+        Self {
+            remap: Some(remap),
+            ..self
+        }
+    }
+
+    /// The remap, `None` for the linear model.
+    pub fn remap(&self) -> Option<&QuasiNonLinear<T>> {
+        self.remap.as_ref()
     }
 
     /// The table this model reads.
@@ -119,12 +148,14 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         let mut solution = ContactSolution {
             points: [ResolvedPoint::empty(); M],
             forces_n: [Vector3::zeros(); M],
+            linear_forces_n: [Vector3::zeros(); M],
+            direction: None,
             len: m,
         };
         for (p, ((contact, point), d)) in contacts
             .iter()
             .zip(solution.points.iter_mut())
-            .zip(solution.forces_n.iter_mut())
+            .zip(solution.linear_forces_n.iter_mut())
             .enumerate()
         {
             *point = resolve(&self.table, p, contact)?;
@@ -155,8 +186,18 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
         }
-        solve_blocks(&mut blocks, &mut solution.forces_n, m, min_pivot)
+        solve_blocks(&mut blocks, &mut solution.linear_forces_n, m, min_pivot)
             .map_err(|contact| ContactError::IllConditioned { contact })?;
+        solution.forces_n = solution.linear_forces_n;
+        if let Some(remap) = &self.remap {
+            solution.direction =
+                QuasiNonLinear::direction(contacts.iter().map(|c| c.displacement_m()));
+            if let Some(direction) = &solution.direction {
+                for g in solution.forces_n.iter_mut().take(m) {
+                    *g = remap.force(direction, *g);
+                }
+            }
+        }
         if !solution
             .contact_forces_n()
             .iter()
@@ -198,6 +239,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         check_length(self.table.free_count(), out)?;
         out.fill([T::zero(); 3]);
         self.add_rows(solution, 0, out);
+        self.remap_rows(solution, out);
         Ok(())
     }
 
@@ -220,6 +262,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             let mut buffer = [[T::zero(); 3]; CHUNK];
             let rows = buffer.get_mut(..vertices.len()).unwrap_or(&mut []);
             self.add_rows(solution, chunk * CHUNK, rows);
+            self.remap_rows(solution, rows);
             for (u, &v) in rows.iter().zip(vertices) {
                 if let Some(o) = out.get_mut(v as usize) {
                     *o = *u;
@@ -227,6 +270,16 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             }
         }
         Ok(())
+    }
+
+    /// The quasi-non-linear model's displacement remap of `rows` (m), in
+    /// place; nothing for the linear model or a set without direction.
+    fn remap_rows<const M: usize>(&self, solution: &ContactSolution<T, M>, rows: &mut [[T; 3]]) {
+        if let (Some(remap), Some(direction)) = (&self.remap, &solution.direction) {
+            for u in rows {
+                *u = remap.displacement(direction, Vector3::from(*u)).into();
+            }
+        }
     }
 
     /// `out[i] += Σ_terms C_{first+i, k} w` over the contact terms: free rows
