@@ -12,6 +12,7 @@ mod host {
     mod mesh;
     mod mesh_regions;
     mod partition;
+    mod remap;
     mod robustness;
     mod session;
     mod session_generate_tools;

@@ -18,6 +18,7 @@ pub mod mesh;
 pub mod output;
 pub mod partition;
 pub mod precomputed;
+pub mod remap;
 pub mod replay;
 pub mod session;
 pub mod table;

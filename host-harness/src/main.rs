@@ -11,7 +11,9 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod commands;
 
-use commands::{budget, demo, dynamic, experiment, precomputed, scene, session, stvk, tables};
+use commands::{
+    budget, demo, dynamic, experiment, precomputed, remap, scene, session, stvk, tables,
+};
 
 #[derive(Parser)]
 #[command(
@@ -41,6 +43,9 @@ enum Command {
     /// Experiments that reproduce the papers' figures.
     #[command(subcommand)]
     Experiment(experiment::ExperimentCommand),
+    /// The quasi-non-linear pre-computed model's remaps (Cotin 1999 TVCG §3).
+    #[command(subcommand)]
+    Remap(remap::RemapCommand),
     /// Haptic sessions: the kernel's fixed-timestep loop driven by a trajectory.
     #[command(subcommand)]
     Session(session::SessionCommand),
@@ -83,6 +88,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
         Command::Dynamic(command) => dynamic::run(command),
         Command::Stvk(command) => stvk::run(command),
         Command::Experiment(command) => experiment::run(command),
+        Command::Remap(command) => remap::run(command),
         Command::Session(command) => session::run(command),
         Command::Scene(command) => scene::run(command),
         Command::Budget(args) => budget::run(&args),

@@ -29,7 +29,10 @@ fn remap_matches_hand_computed_values() {
         (0.0, 0.0),
     ] {
         let got = phi.apply(x);
-        assert!((got - expected).abs() <= 1e-15, "φ({x}) = {got}, expected {expected}");
+        assert!(
+            (got - expected).abs() <= 1e-15,
+            "φ({x}) = {got}, expected {expected}"
+        );
     }
     assert_eq!(Remap::<f64>::identity().apply(0.37), 0.37);
 }
@@ -65,7 +68,9 @@ fn quasi_non_linear_splits_and_remaps_one_vertex() {
 fn bad_remaps_are_refused() {
     assert_eq!(
         Remap::new([1.0, -100.0, 0.0, 0.0, 0.0], 0.01),
-        Err(RemapError::Decreasing { at: 0.01 * 33.0 / 64.0 })
+        Err(RemapError::Decreasing {
+            at: 0.01 * 33.0 / 64.0
+        })
     );
     assert_eq!(
         Remap::new([f64::NAN, 0.0, 0.0, 0.0, 0.0], 0.01),

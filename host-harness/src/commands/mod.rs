@@ -9,6 +9,7 @@ pub mod demo;
 pub mod dynamic;
 pub mod experiment;
 pub mod precomputed;
+pub mod remap;
 pub mod scene;
 pub mod session;
 pub mod stdout;

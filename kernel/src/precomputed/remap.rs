@@ -51,7 +51,10 @@ impl fmt::Display for RemapError {
             Self::NonFinite => write!(f, "remap coefficient or range is not finite"),
             Self::EmptyRange => write!(f, "remap range end is not positive"),
             Self::Decreasing { at } => {
-                write!(f, "remap polynomial decreases at input {at:e} inside its range")
+                write!(
+                    f,
+                    "remap polynomial decreases at input {at:e} inside its range"
+                )
             }
         }
     }
