@@ -11,6 +11,7 @@ mod host {
     mod materials;
     mod mesh;
     mod mesh_regions;
+    mod newton;
     mod partition;
     mod remap;
     mod robustness;

@@ -30,10 +30,8 @@ use serde::Serialize;
 
 use super::relax::{Relaxation, relax};
 use crate::fem::material::{Material, TetMaterials};
-use crate::mesh::{TetMesh, boundary_surface};
-use crate::table::file::Precision;
-use crate::table::load::TableFile;
-use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+use crate::mesh::TetMesh;
+use crate::table::tensor_mass::static_study_table;
 use crate::tensor_mass::OwnedState;
 use crate::tensor_mass::run::{diagonal, volume_change};
 use crate::tensor_mass::stability::omega_max;
@@ -254,13 +252,7 @@ pub fn run_scene(
     // The fixed flags are the scene's own (no predicates): the arrays and
     // the writer of the table build, without its predicate stage.
     let materials = TetMaterials::uniform(scene.material, scene.mesh.tets.len());
-    let arrays = TensorMassArrays::new(&scene.mesh, &materials, 1000.0, scene.fixed.clone());
-    let file = TableFile::from_bytes(&write_tensor_mass_table(
-        &scene.mesh,
-        &boundary_surface(&scene.mesh).triangles,
-        &arrays,
-        Precision::F64,
-    ));
+    let file = static_study_table(&scene.mesh, &materials, scene.fixed.clone());
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let n = scene.mesh.positions.len();
 

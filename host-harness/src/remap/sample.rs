@@ -20,11 +20,9 @@ use crate::fem::assembly::assemble_restricted;
 use crate::fem::llt::SparseLlt;
 use crate::fem::material::{Material, TetMaterials};
 use crate::fem::static_solve::solve_prescribed;
+use crate::mesh::TetMesh;
 use crate::mesh::generate::cylinder_mesh;
-use crate::mesh::{TetMesh, boundary_surface};
-use crate::table::file::Precision;
-use crate::table::load::TableFile;
-use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+use crate::table::tensor_mass::static_study_table;
 use crate::tensor_mass::OwnedState;
 
 /// Radial cells of the sample's mesh ([`cylinder_mesh`]).
@@ -174,13 +172,7 @@ pub fn stvk_curves(
     let mesh = &sample.mesh;
     let n = mesh.positions.len();
     let materials = TetMaterials::uniform(sample.material, mesh.tets.len());
-    let arrays = TensorMassArrays::new(mesh, &materials, 1000.0, sample.base_flags());
-    let file = TableFile::from_bytes(&write_tensor_mass_table(
-        mesh,
-        &boundary_surface(mesh).triangles,
-        &arrays,
-        Precision::F64,
-    ));
+    let file = static_study_table(mesh, &materials, sample.base_flags());
     let table = TensorMassTable::<f64>::load(file.bytes()).context("sample table")?;
     let mut state = OwnedState::for_table(&table);
     let params = DynamicParams::linear(0.0, sample.height_m)
