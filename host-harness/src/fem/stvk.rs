@@ -84,10 +84,10 @@ impl StvkTet {
                 let ftdf = f.transpose() * df;
                 let de = (ftdf + ftdf.transpose()) * 0.5;
                 let dp = df * s + f * self.pk2(&de);
-                for (j, aj) in self.gradients.iter().enumerate() {
+                for (row, aj) in k.iter_mut().zip(&self.gradients) {
                     let column = dp * aj * self.volume_m3;
-                    for a in 0..3 {
-                        k[j][kk][a][c] = column[a];
+                    for (entry, value) in row[kk].iter_mut().zip(column.iter()) {
+                        entry[c] = *value;
                     }
                 }
             }
