@@ -39,4 +39,5 @@ mod kernel {
 
 mod tools {
     mod script;
+    mod script_ticks;
 }

@@ -100,18 +100,24 @@ pub const HOST_IR: UnitCosts = UnitCosts {
 };
 
 /// The Cortex-M4F's unit costs, cycles at zero wait states: the largest
-/// per-unit costs `tools/cycles-check.sh` counted on the release build of
-/// `tools/cycles-m4f` (the kernel as firmware links it) over every
-/// trajectory of the three scenes it records, rounded up (see
-/// `tools/README.md`, "Cycles on the Cortex-M4F").
+/// per-unit costs `palpate-cycles --unit-costs` (`tools/cycles`) derived
+/// from every tick of `tools/cycles-check.sh --all` (the release build of
+/// `tools/cycles-m4f`: the kernel as firmware links it, every generated
+/// trajectory with 1 to 4 probes on the three scenes it records), the
+/// largest over the three models, rounded up: an idle tick 4682 (the
+/// hybrid's; 2336 pre-computed), a triangle tested 582, an edge crossed
+/// 3922 (the dynamic model's, its base not separable: every idle tick there
+/// tests triangles), a tracked contact with its solve 1971 (pre-computed)
+/// and 3381 (dynamic), a solve 819 per `M³` (hybrid; 520 pre-computed) and
+/// 821 per `M` (dynamic).
 pub const M4F_CYCLES: UnitCosts = UnitCosts {
-    base: 600,
-    triangle: 125,
-    walk: 700,
-    track: 1000,
-    solve_per_m3: 2500,
-    dynamic_track: 1000,
-    dynamic_solve: 1500,
+    base: 5000,
+    triangle: 600,
+    walk: 4000,
+    track: 2000,
+    solve_per_m3: 850,
+    dynamic_track: 3500,
+    dynamic_solve: 900,
 };
 
 /// The static per-tick bound (in the unit of `costs`) for `points` tool
@@ -340,8 +346,10 @@ pub const RECORD_RUNS: &str = "runs.txt";
 /// [`palpate_script::ticks::write_tick`]), which the target must print
 /// byte for byte; and [`RECORD_RUNS`], one line per trajectory,
 /// `<trajectory> <ticks> <bound>`, with the tick's static bound in
-/// Cortex-M4F cycles ([`M4F_CYCLES`]). Returns the runs' lines.
-pub fn record(scene: &Scene, dir: &Path) -> anyhow::Result<Vec<String>> {
+/// Cortex-M4F cycles ([`M4F_CYCLES`]). Only the trajectories named in
+/// `only`, if any (each must be one of the scene's). Returns the runs' lines.
+pub fn record(scene: &Scene, dir: &Path, only: &[String]) -> anyhow::Result<Vec<String>> {
+    let chosen = chosen_trajectories(scene, only)?;
     let (mesh, report) = scene.load_mesh()?;
     check_scene_table(scene, &mesh, &report)?;
     check_stable_step(scene, &mesh, &report)?;
@@ -371,7 +379,7 @@ pub fn record(scene: &Scene, dir: &Path) -> anyhow::Result<Vec<String>> {
         dynamic,
     };
     let mut runs = Vec::new();
-    for (name, trajectory) in trajectories(scene)? {
+    for (name, trajectory) in chosen {
         let probe = probe(&tables, scene, &trajectory)?;
         let header = Header {
             points: scene.tool.kernel_points(),
@@ -495,6 +503,29 @@ pub struct BudgetRow {
 /// Instructions per second assumed for the equivalent times: a
 /// Cortex-M4F-class controller at 168 MHz, one instruction per cycle.
 pub const M4F_IPS: f64 = 168e6;
+
+/// The generated trajectories of `scene` ([`trajectories`]) named in
+/// `only`, or all of them; an error names an unknown one and the known.
+pub fn chosen_trajectories(
+    scene: &Scene,
+    only: &[String],
+) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
+    let mut chosen = trajectories(scene)?;
+    if let Some(unknown) = only
+        .iter()
+        .find(|name| !chosen.iter().any(|(known, _)| known == name))
+    {
+        let known: Vec<&str> = chosen.iter().map(|(name, _)| *name).collect();
+        bail!(
+            "--trajectory {unknown}: not a generated trajectory of this scene (one of: {})",
+            known.join(", ")
+        );
+    }
+    if !only.is_empty() {
+        chosen.retain(|(name, _)| only.iter().any(|o| o == name));
+    }
+    Ok(chosen)
+}
 
 /// Spacing of the probe sites of a scene with several probes, m: tool
 /// point `k` presses at the default press's point (the built-in block's

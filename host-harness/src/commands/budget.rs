@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use palpate::budget::{
-    BudgetRow, HOST_IR, M4F_IPS, budget_table, measure, probe, record, trajectories,
+    BudgetRow, HOST_IR, M4F_IPS, budget_table, chosen_trajectories, measure, probe, record,
 };
 use palpate::session::model::{SceneModel, SceneTables};
 use palpate::session::run::check_scene_table;
@@ -38,11 +38,11 @@ pub struct BudgetArgs {
     /// only).
     #[arg(long, value_name = "N")]
     points: Option<usize>,
-    /// Measure nothing: write the scene's tables, every generated
-    /// trajectory's ticks and the host's output of each tick into the
-    /// folder DIR, for the Cortex-M4F cycle count (`tools/cycles-check.sh`;
-    /// the scene's own mesh only).
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["json", "only", "probe"])]
+    /// Measure nothing: write the scene's tables, each generated
+    /// trajectory's ticks (`--trajectory`: those only) and the host's output
+    /// of each tick into the folder DIR, for the Cortex-M4F cycle count
+    /// (`tools/cycles-check.sh`; the scene's own mesh only).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["json", "probe"])]
     record: Option<PathBuf>,
     /// Internal: run the ticks of this trajectory on this table, built for
     /// the scene's mesh size SIZE (0 the coarse box, or the scene's own)
@@ -68,7 +68,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         with_probes(&mut scene, points)?;
     }
     if let Some(dir) = record_dir {
-        let runs = record(&scene, dir)?;
+        let runs = record(&scene, dir, only)?;
         let mut text = format!("recorded in {}:\n", dir.display());
         for run in runs {
             let _ = writeln!(text, "  {run}");
@@ -105,20 +105,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
     let exe = std::env::current_exe()?;
-    let mut chosen = trajectories(&scene)?;
-    if let Some(unknown) = only
-        .iter()
-        .find(|name| !chosen.iter().any(|(known, _)| known == name))
-    {
-        let known: Vec<&str> = chosen.iter().map(|(name, _)| *name).collect();
-        bail!(
-            "--trajectory {unknown}: not a generated trajectory of this scene (one of: {})",
-            known.join(", ")
-        );
-    }
-    if !only.is_empty() {
-        chosen.retain(|(name, _)| only.iter().any(|o| o == name));
-    }
+    let chosen = chosen_trajectories(&scene, only)?;
     // Every size's table is checked against the build limits before the
     // first is built (the coarse one can take a while).
     for source in &sizes {

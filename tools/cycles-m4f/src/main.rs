@@ -19,6 +19,8 @@
 #![no_std]
 #![no_main]
 
+// The pre-computed tissue takes no buffer from the arena.
+#[cfg_attr(not(any(feature = "dynamic", feature = "hybrid")), allow(dead_code))]
 mod arena;
 #[cfg(any(feature = "dynamic", feature = "hybrid"))]
 mod buffers;

@@ -11,7 +11,7 @@ use palpate_kernel::{PrecomputedTable, include_table};
 use palpate_script::ticks::Recording;
 
 use crate::arena::Arena;
-use crate::{Failed, Measured, Ticking, measured_tick};
+use crate::{Failed, Measured, Ticking, measured_tick, refuse};
 
 /// The f32 table of the recorded scene, 16-byte aligned in flash.
 static TABLE: &[u8] = include_table!(concat!(env!("OUT_DIR"), "/table.bin"));
@@ -24,9 +24,8 @@ pub struct Model {
 impl Model {
     /// Loads the table and reports it on a `#` line.
     pub fn load(out: &mut HostStream) -> Result<Self, Failed> {
-        let table = PrecomputedTable::<f32>::load(TABLE).map_err(|e| {
-            let _ = writeln!(out, "# table refused: {e}");
-        })?;
+        let table = PrecomputedTable::<f32>::load(TABLE)
+            .map_err(|e| refuse(out, format_args!("table refused: {e}")))?;
         let _ = writeln!(
             out,
             "# pre-computed table: {} bytes in flash, {} vertices, {} touchable",
@@ -48,9 +47,7 @@ impl Measured for Model {
     ) -> Result<(), Failed> {
         let config = recording.header().settings.loop_config;
         let haptic = PrecomputedLoop::<f32, P, P>::new(PrecomputedTissue::new(&self.table), config)
-            .map_err(|e| {
-                let _ = writeln!(out, "# haptic loop: {e}");
-            })?;
+            .map_err(|e| refuse(out, format_args!("haptic loop: {e}")))?;
         body(&mut Quasistatic(haptic), out)
     }
 }

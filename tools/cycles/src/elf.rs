@@ -127,3 +127,18 @@ impl Program {
         self.functions.get(index).map_or("?", |(_, n)| n)
     }
 }
+
+#[cfg(test)]
+impl Program {
+    /// A program of one image at address 0, RAM up to `ram_end` and the
+    /// functions `(start, name)`, sorted.
+    pub fn from_image(image: Vec<u8>, ram_end: u64, functions: Vec<(u64, String)>) -> Self {
+        let starts = functions.iter().map(|(a, _)| *a).collect();
+        Self {
+            loads: vec![(0, image)],
+            ram_end,
+            functions,
+            starts,
+        }
+    }
+}

@@ -460,3 +460,98 @@ fn emit(state: &mut State, bytes: &[u8]) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::elf::Program;
+
+    /// A program counted by hand, from `arm-none-eabi-as` (cortex-m4,
+    /// fpv4-sp-d16): the reset handler calls `measured` twice, then exits
+    /// through semihosting:
+    ///
+    /// ```text
+    /// 40: f000 f81e  bl measured            68: (after the calls)
+    /// 44: f000 f81c  bl measured
+    /// 48: 2018       movs r0, #0x18          SYS_EXIT
+    /// 4a: 4901       ldr r1, [pc, #4]        0x20026, application exit
+    /// 4c: beab       bkpt 0xab
+    /// 80: b510       push {r4, lr}           1 + 2               3
+    /// 82: 2403       movs r4, #3                                 1
+    /// 84: 3c01       subs r4, #1             × 3                 3
+    /// 86: ee30 0a20  vadd.f32 s0, s0, s1     × 3                 3
+    /// 8a: d1fb       bne 84                  × 3, taken twice    3 + 2P
+    /// 8c: 4802       ldr r0, [pc, #8]        a literal in flash  2
+    /// 8e: fbb0 f0f0  udiv r0, r0, r0                             12
+    /// 92: ee80 1a20  vdiv.f32 s2, s0, s1                         14
+    /// 96: bd10       pop {r4, pc}            1 + 2, taken        3 + P
+    /// ```
+    ///
+    /// 15 instructions and 44 + 3P = 53 cycles per call at P = 3; its
+    /// blocks fetch the words of 0x80-0x8b (3), 0x84-0x8b twice (2 each),
+    /// then 0x8c-0x97 (3): 10 words, and load one word (the literal) from
+    /// flash, so at `W` wait states 53 + 11 W.
+    #[test]
+    fn a_hand_counted_program_counts_exactly() {
+        let code: &[(u64, &[u16])] = &[
+            (
+                0x40,
+                &[0xf000, 0xf81e, 0xf000, 0xf81c, 0x2018, 0x4901, 0xbeab],
+            ),
+            (0x50, &[0x0026, 0x0002]),
+            (
+                0x80,
+                &[
+                    0xb510, 0x2403, 0x3c01, 0xee30, 0x0a20, 0xd1fb, 0x4802, 0xfbb0, 0xf0f0, 0xee80,
+                    0x1a20, 0xbd10,
+                ],
+            ),
+            (0x98, &[0x0007, 0x0000]),
+        ];
+        let mut image = vec![0u8; 0x9c];
+        image[..8].copy_from_slice(&[0x00, 0x10, 0x00, 0x20, 0x41, 0, 0, 0]);
+        for (at, halfwords) in code {
+            for (i, h) in halfwords.iter().enumerate() {
+                let a = *at as usize + 2 * i;
+                image[a..a + 2].copy_from_slice(&h.to_le_bytes());
+            }
+        }
+        let program = Program::from_image(
+            image,
+            0x2000_1000,
+            vec![(0x40, "reset".into()), (0x80, "measured".into())],
+        );
+        let costs = Costs {
+            refill: 3,
+            divide: 12,
+            wait_states: 5,
+        };
+        let run = run(&program, &program.entries("measured"), costs).unwrap();
+        assert!(run.success);
+        assert_eq!(run.calls.len(), 2);
+        for call in &run.calls {
+            assert_eq!(call.instructions, 15);
+            assert_eq!(call.cycles, 53);
+            assert_eq!(call.taken, 3);
+            assert_eq!(call.fetch_words, 10);
+            assert_eq!(call.flash_words, 1);
+            assert_eq!(call.cycles_at(5), 53 + 5 * 11);
+            let by_class = |c: Class| {
+                (
+                    call.class_instructions[c.index()],
+                    call.class_cycles[c.index()],
+                )
+            };
+            assert_eq!(by_class(Class::Multiple), (2, 6));
+            assert_eq!(by_class(Class::Alu), (4, 4));
+            assert_eq!(by_class(Class::FpAlu), (3, 3));
+            // The refills of the two taken `bne` and of the `pop` into PC.
+            assert_eq!(by_class(Class::Branch), (3, 3 + 3 * 3));
+            assert_eq!(by_class(Class::Load), (1, 2));
+            assert_eq!(by_class(Class::Divide), (1, 12));
+            assert_eq!(by_class(Class::FpDivide), (1, 14));
+        }
+        // Every cycle is the measured function's.
+        assert_eq!(run.call_functions[0], vec![(1, 53)]);
+    }
+}

@@ -7,11 +7,13 @@
 //!
 //! ```text
 //! palpate-cycles ELF [--model NAME] [--output FILE] [--csv FILE] [--profile N]
-//!                    [--wait-states W] [--refill P] [--divide D]
-//!                    [--limit PREFIX=CYCLES]...
+//!                    [--unit-costs] [--wait-states W] [--refill P] [--divide D]
+//!                    [--limit PREFIX=CYCLES]... [--warn-limit PREFIX=CYCLES]...
 //! ```
 //!
-//! Exit status: 0; 1 when a tick exceeds its run's bound or a `--limit`
+//! `--limit` (and `--warn-limit`, which only reports) applies to the runs
+//! whose label starts with `PREFIX`. Exit status: 0; 1 when a tick exceeds
+//! its run's bound or a `--limit`
 //! (zero wait states), a run has fewer ticks than it declares, or the
 //! program exits with failure; 2 on a usage or emulation error.
 //!
@@ -37,12 +39,14 @@ struct Args {
     output: Option<String>,
     csv: Option<String>,
     profile: usize,
+    unit_costs: bool,
     costs: Costs,
     limits: Vec<(String, u64)>,
+    warn_limits: Vec<(String, u64)>,
 }
 
 const USAGE: &str = "usage: palpate-cycles ELF [--model NAME] [--output FILE] [--csv FILE] \
-[--profile N] [--wait-states W] [--refill P] [--divide D] [--limit PREFIX=CYCLES]...";
+[--profile N] [--unit-costs] [--wait-states W] [--refill P] [--divide D] [--limit PREFIX=CYCLES]... [--warn-limit PREFIX=CYCLES]...";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = std::env::args().skip(1);
@@ -52,8 +56,10 @@ fn parse_args() -> Result<Args, String> {
         output: None,
         csv: None,
         profile: 0,
+        unit_costs: false,
         costs: Costs::default(),
         limits: Vec::new(),
+        warn_limits: Vec::new(),
     };
     let number = |flag: &str, v: Option<String>| -> Result<u64, String> {
         v.as_deref()
@@ -66,6 +72,7 @@ fn parse_args() -> Result<Args, String> {
             "--output" => parsed.output = Some(args.next().ok_or("--output: expected a file")?),
             "--csv" => parsed.csv = Some(args.next().ok_or("--csv: expected a file")?),
             "--profile" => parsed.profile = number(&arg, args.next())? as usize,
+            "--unit-costs" => parsed.unit_costs = true,
             "--wait-states" => parsed.costs.wait_states = number(&arg, args.next())? as u32,
             "--refill" => {
                 let p = number(&arg, args.next())? as u32;
@@ -208,8 +215,12 @@ fn run() -> Result<bool, String> {
     if args.profile > 0 {
         print!("{}", profile(&program, &runs, args.profile, w));
     }
+    let work = tick_work(&emulation.output);
+    if args.unit_costs {
+        print!("{}", unit_costs(&runs, &work));
+    }
     if let Some(path) = &args.csv {
-        std::fs::write(path, csv(&args.model, &runs, &emulation.output, w))
+        std::fs::write(path, csv(&args.model, &runs, &work, w))
             .map_err(|e| format!("{path}: {e}"))?;
     }
     Ok(ok)
@@ -283,28 +294,56 @@ fn profile(program: &elf::Program, runs: &[Run<'_>], top: usize, w: u32) -> Stri
     text
 }
 
-/// One CSV line per tick: the counts, and the work counters of the tick's
-/// output line (`work <tests> <walk> <solves>`).
-fn csv(model: &str, runs: &[Run<'_>], output: &[u8], w: u32) -> String {
+/// What a tick's output line says it did: contacts after it, triangles
+/// tested, edges crossed, solves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Work {
+    contacts: u64,
+    tests: u64,
+    walk: u64,
+    solves: u64,
+}
+
+/// The work of every tick line (`tick <k> ... contacts <c> ... work <tests>
+/// <walk> <solves>`) of `output`, in order.
+fn tick_work(output: &[u8]) -> Vec<Work> {
     let text = String::from_utf8_lossy(output);
-    let mut work = text.lines().filter(|l| l.starts_with("tick ")).map(|l| {
-        let fields: Vec<&str> = l.split(' ').collect();
-        fields
-            .iter()
-            .position(|f| *f == "work")
-            .and_then(|i| fields.get(i + 1..i + 4))
-            .map(|w| w.join(","))
-            .unwrap_or_default()
-    });
+    text.lines()
+        .filter(|l| l.starts_with("tick "))
+        .map(|l| {
+            let fields: Vec<&str> = l.split(' ').collect();
+            let after = |key: &str, n: usize| {
+                fields
+                    .iter()
+                    .position(|f| *f == key)
+                    .and_then(|i| fields.get(i + 1 + n))
+                    .and_then(|v| v.parse().ok())
+                    .unwrap_or(0)
+            };
+            Work {
+                contacts: after("contacts", 0),
+                tests: after("work", 0),
+                walk: after("work", 1),
+                solves: after("work", 2),
+            }
+        })
+        .collect()
+}
+
+/// One CSV line per tick: the counts, and the work of the tick's output
+/// line.
+fn csv(model: &str, runs: &[Run<'_>], work: &[Work], w: u32) -> String {
+    let mut work = work.iter();
     let mut out = format!(
         "model,run,m,tick,instructions,cycles,cycles_at_{w}ws,fetch_words,flash_words,taken,\
-         triangles_tested,walk_steps,solves\n"
+         contacts,triangles_tested,walk_steps,solves\n"
     );
     for run in runs {
         for (k, c) in run.ticks.iter().enumerate() {
+            let t = work.next().copied().unwrap_or_default();
             let _ = writeln!(
                 out,
-                "{model},{},{},{k},{},{},{},{},{},{},{}",
+                "{model},{},{},{k},{},{},{},{},{},{},{},{},{},{}",
                 run.label,
                 run.points,
                 c.instructions,
@@ -313,9 +352,58 @@ fn csv(model: &str, runs: &[Run<'_>], output: &[u8], w: u32) -> String {
                 c.fetch_words,
                 c.flash_words,
                 c.taken,
-                work.next().unwrap_or_default()
+                t.contacts,
+                t.tests,
+                t.walk,
+                t.solves
             );
         }
     }
     out
+}
+
+/// The largest per-unit costs (cycles at zero wait states) of the static
+/// bound's terms (`palpate::budget::UnitCosts`), as the host's were derived
+/// (one probe first, then the solve over the larger loops), each the
+/// largest residual after the terms before it: `base` the largest tick
+/// without contact, test or walk of a one-point loop; `track` (a tracked
+/// contact with its solve) the largest `cycles − base` of one-point ticks
+/// with a contact but no test or walk; `triangle` the largest `(cycles −
+/// base − contacts·track) / tests` of one-point ticks with tests; `walk`
+/// the same per edge crossed of one-point ticks with walks and no test;
+/// then the solve per solve per cubed capacity `M³` (the block Cholesky),
+/// the largest `(cycles − base − M·track) / (solves·M³)` of ticks of loops
+/// of `M ≥ 2` points without test or walk, and the same per `M` (the
+/// dynamic model's solve, linear in the capacity).
+fn unit_costs(runs: &[Run<'_>], work: &[Work]) -> String {
+    let ticks: Vec<(u64, u64, Work)> = runs
+        .iter()
+        .flat_map(|r| r.ticks.iter().map(|c| (u64::from(r.points), c.cycles)))
+        .zip(work.iter().copied())
+        .map(|((m, cycles), w)| (m, cycles, w))
+        .collect();
+    let max = |f: &dyn Fn(u64, f64, &Work) -> Option<f64>| {
+        ticks
+            .iter()
+            .filter_map(|(m, c, w)| f(*m, *c as f64, w))
+            .fold(0.0f64, f64::max)
+            .ceil()
+    };
+    let quiet = |w: &Work| w.tests == 0 && w.walk == 0;
+    let base = max(&|m, c, w| (m == 1 && w.contacts == 0 && quiet(w)).then_some(c));
+    let track = max(&|m, c, w| (m == 1 && w.contacts > 0 && quiet(w)).then_some(c - base));
+    let one = |c: f64, w: &Work| c - base - w.contacts as f64 * track;
+    let triangle = max(&|m, c, w| (m == 1 && w.tests > 0).then(|| one(c, w) / w.tests as f64));
+    let walk =
+        max(&|m, c, w| (m == 1 && w.walk > 0 && w.tests == 0).then(|| one(c, w) / w.walk as f64));
+    let solved = |m: u64, c: f64, w: &Work, per: u64| {
+        (m >= 2 && quiet(w) && w.solves > 0)
+            .then(|| (c - base - (m as f64) * track) / (w.solves * per) as f64)
+    };
+    let cubic = max(&|m, c, w| solved(m, c, w, m * m * m));
+    let linear = max(&|m, c, w| solved(m, c, w, m));
+    format!(
+        "unit costs (cycles, zero wait states, largest measured): base {base}, track {track}, \
+         triangle {triangle}, walk {walk}, solve per M^3 {cubic} (or per M {linear})\n"
+    )
 }

@@ -356,3 +356,175 @@ fn registers(cs: &Capstone, insn: &Insn<'_>) -> Vec<String> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use capstone::arch::arm::{ArchExtraMode, ArchMode};
+    use capstone::arch::{BuildsCapstone, BuildsCapstoneExtraMode};
+
+    use super::*;
+
+    /// Each instruction's class, cycles and PC write against the table (the
+    /// module docs), on encodings from `arm-none-eabi-as -mcpu=cortex-m4
+    /// -mfpu=fpv4-sp-d16` (halfwords as `objdump -d` prints them).
+    #[test]
+    fn the_table_times_each_class() {
+        use Class::*;
+        let cases: &[(&[u16], &str, Option<Class>, u32, bool)] = &[
+            (
+                &[0xed2d, 0x8b10],
+                "vpush {d8-d15}",
+                Some(FpMultiple),
+                17,
+                false,
+            ),
+            (
+                &[0xecbd, 0x8a04],
+                "vpop {s16-s19}",
+                Some(FpMultiple),
+                5,
+                false,
+            ),
+            (&[0xee10, 0x0a10], "vmov r0, s0", Some(FpMove), 2, false),
+            (&[0xee00, 0x1a90], "vmov s1, r1", Some(FpMove), 2, false),
+            (&[0xeeb0, 0x1a61], "vmov.f32 s2, s3", Some(FpAlu), 1, false),
+            (&[0xec53, 0x2b14], "vmov r2, r3, d4", Some(FpMove), 2, false),
+            (
+                &[0xe9d2, 0x0102],
+                "ldrd r0, r1, [r2, #8]",
+                Some(Pair),
+                3,
+                false,
+            ),
+            (
+                &[0xe9c2, 0x0102],
+                "strd r0, r1, [r2, #8]",
+                Some(Pair),
+                3,
+                false,
+            ),
+            (
+                &[0xed90, 0x0a01],
+                "vldr s0, [r0, #4]",
+                Some(FpLoadStore),
+                2,
+                false,
+            ),
+            (
+                &[0xed90, 0x0b02],
+                "vldr d0, [r0, #8]",
+                Some(FpLoadStore),
+                3,
+                false,
+            ),
+            (
+                &[0xeca0, 0x0a04],
+                "vstmia r0!, {s0-s3}",
+                Some(FpMultiple),
+                5,
+                false,
+            ),
+            (
+                &[0xee00, 0x0a81],
+                "vmla.f32 s0, s1, s2",
+                Some(FpMac),
+                3,
+                false,
+            ),
+            (
+                &[0xeea0, 0x0a81],
+                "vfma.f32 s0, s1, s2",
+                Some(FpMac),
+                3,
+                false,
+            ),
+            (
+                &[0xeeb1, 0x0ae0],
+                "vsqrt.f32 s0, s1",
+                Some(FpDivide),
+                14,
+                false,
+            ),
+            (&[0xc81e], "ldmia r0!, {r1-r4}", Some(Multiple), 5, false),
+            (
+                &[0xe92d, 0x00f0],
+                "stmdb sp!, {r4-r7}",
+                Some(Multiple),
+                5,
+                false,
+            ),
+            (&[0xbdf0], "pop {r4-r7, pc}", Some(Multiple), 6, true),
+            // A load into PC (Capstone may call it `pop {pc}`): 2 + P.
+            (&[0xf85d, 0xfb04], "ldr.w pc, [sp], #4", None, 2, true),
+            (&[0x46f7], "mov pc, lr", Some(Alu), 1, true),
+            (
+                &[0xe8df, 0xf000],
+                "tbb [pc, r0]",
+                Some(TableBranch),
+                2,
+                true,
+            ),
+            (
+                &[0xfb01, 0xf002],
+                "mul.w r0, r1, r2",
+                Some(Multiply),
+                1,
+                false,
+            ),
+            (
+                &[0xfbc2, 0x0103],
+                "smlal r0, r1, r2, r3",
+                Some(Multiply),
+                1,
+                false,
+            ),
+            (
+                &[0xfb91, 0xf0f2],
+                "sdiv r0, r1, r2",
+                Some(Divide),
+                12,
+                false,
+            ),
+            (&[0xb100], "cbz r0, +4", Some(Branch), 1, true),
+            (&[0xbf08], "it eq", Some(Alu), 1, false),
+            (&[0x2001], "moveq r0, #1", Some(Alu), 1, false),
+            (&[0x5c88], "ldrb r0, [r1, r2]", Some(Load), 2, false),
+            (&[0x8048], "strh r0, [r1, #2]", Some(Store), 2, false),
+            (
+                &[0xeebd, 0x0ac0],
+                "vcvt.s32.f32 s0, s0",
+                Some(FpAlu),
+                1,
+                false,
+            ),
+            (
+                &[0xeef1, 0xfa10],
+                "vmrs APSR_nzcv, fpscr",
+                Some(FpAlu),
+                1,
+                false,
+            ),
+        ];
+        let cs = Capstone::new()
+            .arm()
+            .mode(ArchMode::Thumb)
+            .extra_mode([ArchExtraMode::MClass].into_iter())
+            .detail(true)
+            .build()
+            .unwrap();
+        let code: Vec<u8> = cases
+            .iter()
+            .flat_map(|(h, ..)| h.iter().flat_map(|h| h.to_le_bytes()))
+            .collect();
+        let insns = cs.disasm_all(&code, 0).unwrap();
+        assert_eq!(insns.len(), cases.len());
+        for (insn, (_, asm, class, cycles, writes_pc)) in insns.iter().zip(cases) {
+            let t = time(&cs, insn, &Costs::default());
+            assert_eq!(t.cycles, *cycles, "{asm} ({insn})");
+            assert_eq!(t.writes_pc, *writes_pc, "{asm} ({insn})");
+            if let Some(class) = class {
+                assert_eq!(t.class, *class, "{asm} ({insn})");
+            }
+        }
+    }
+}
