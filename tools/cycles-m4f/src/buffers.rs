@@ -15,20 +15,20 @@ use palpate_kernel::tensor_mass::{
 
 use crate::arena::Arena;
 
+/// A tensor-mass model, its surface buffers and its force scratch.
+pub type ModelParts<'a> = (
+    TensorMassModel<'a, 'a, f32>,
+    SurfaceBuffers<'a, f32>,
+    &'a mut [[f32; 3]],
+);
+
 /// The tensor-mass model of `table` with `params` at rest, its surface
 /// buffers and force scratch; `Err` names what failed.
 pub fn model_parts<'a>(
     arena: &'a Arena,
     table: TensorMassTable<'a, f32>,
     params: DynamicParams<f32>,
-) -> Result<
-    (
-        TensorMassModel<'a, 'a, f32>,
-        SurfaceBuffers<'a, f32>,
-        &'a mut [[f32; 3]],
-    ),
-    &'static str,
-> {
+) -> Result<ModelParts<'a>, &'static str> {
     let full = "arena full";
     let n = table.vertex_count();
     let e = table.edge_count();

@@ -51,7 +51,8 @@ impl Measured for Model {
     ) -> Result<(), Failed> {
         let settings = recording.header().settings;
         let Some((params, physics)) = settings.dynamic else {
-            return Err(refuse(out, "the recording has no dynamic settings"));
+            refuse(out, "the recording has no dynamic settings");
+            return Err(());
         };
         let (model, surface, forces) =
             model_parts(arena, self.table, params).map_err(|e| refuse(out, e))?;

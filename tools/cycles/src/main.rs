@@ -210,6 +210,15 @@ fn run() -> Result<bool, String> {
                 ok = false;
             }
         }
+        for (prefix, limit) in &args.warn_limits {
+            if run.label.starts_with(prefix.as_str()) && worst > *limit {
+                eprintln!(
+                    "warning: {}: a tick of {worst} cycles exceeds the target {limit} \
+                     (reported, not enforced)",
+                    run.label
+                );
+            }
+        }
     }
     print!("{text}");
     if args.profile > 0 {

@@ -367,10 +367,14 @@ mod tests {
     /// Each instruction's class, cycles and PC write against the table (the
     /// module docs), on encodings from `arm-none-eabi-as -mcpu=cortex-m4
     /// -mfpu=fpv4-sp-d16` (halfwords as `objdump -d` prints them).
+    /// Halfwords, assembly, class (`None`: either of two Capstone names),
+    /// cycles, writes PC.
+    type Case = (&'static [u16], &'static str, Option<Class>, u32, bool);
+
     #[test]
     fn the_table_times_each_class() {
         use Class::*;
-        let cases: &[(&[u16], &str, Option<Class>, u32, bool)] = &[
+        let cases: &[Case] = &[
             (
                 &[0xed2d, 0x8b10],
                 "vpush {d8-d15}",
