@@ -88,12 +88,17 @@ fn parse_args() -> Result<Args, String> {
                 }
                 parsed.costs.divide = d;
             }
-            "--limit" => {
+            "--limit" | "--warn-limit" => {
                 let v = args.next().ok_or("--limit: expected PREFIX=CYCLES")?;
                 let (prefix, cycles) =
                     v.split_once('=').ok_or("--limit: expected PREFIX=CYCLES")?;
                 let cycles = cycles.parse().map_err(|_| "--limit: CYCLES is a number")?;
-                parsed.limits.push((prefix.to_string(), cycles));
+                let limits = if arg == "--limit" {
+                    &mut parsed.limits
+                } else {
+                    &mut parsed.warn_limits
+                };
+                limits.push((prefix.to_string(), cycles));
             }
             "-h" | "--help" => return Err(USAGE.into()),
             a if a.starts_with('-') => return Err(format!("{a}: unknown option\n{USAGE}")),
