@@ -42,4 +42,5 @@ mod kernel {
 
 mod tools {
     mod script;
+    mod script_ticks;
 }

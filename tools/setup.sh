@@ -9,6 +9,8 @@
 # - qemu-system-arm (runs the firmware) and valgrind (callgrind instruction
 #   counts of `palpate budget` and its test), from apt-get, with sudo when
 #   not root;
+# - cmake and libclang-dev (apt-get): tools/cycles builds the Unicorn
+#   emulator's C with cmake and its Rust bindings with bindgen (libclang);
 # - cargo-deny (licenses, bans, sources, advisories; `deny.toml`), built from
 #   crates.io with `cargo install --locked` (about 3-5 min the first time).
 # Idempotent; a fast no-op when all is present.
@@ -21,6 +23,8 @@ command -v cargo-deny >/dev/null || cargo install cargo-deny --locked --version 
 missing=()
 command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
 command -v valgrind >/dev/null || missing+=(valgrind)
+command -v cmake >/dev/null || missing+=(cmake)
+ldconfig -p 2>/dev/null | grep -q 'libclang[-0-9.]*\.so\b' || missing+=(libclang-dev)
 if [ ${#missing[@]} -gt 0 ]; then
     sudo=""
     if [ "$(id -u)" != 0 ]; then
@@ -36,4 +40,5 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 qemu-system-arm --version | head -1
 valgrind --version
+cmake --version | head -1
 cargo deny --version
