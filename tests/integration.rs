@@ -38,5 +38,6 @@ mod kernel {
 }
 
 mod tools {
+    mod firmware_c;
     mod script;
 }
