@@ -24,10 +24,10 @@
 //! ([`status::Status::NotInitialized`]).
 //!
 //! Nothing panics across the boundary: the entry points use no indexing,
-//! `unwrap` or `panic!` (denied by this crate's lints), the kernel's step
-//! path has no panic (`tools/nopanic-check`), and `tools/ffi-check.sh`
-//! links every entry point for the Cortex-M4F against a panic handler that
-//! does not exist (the link fails if a panic is reachable). On the host
+//! `unwrap` or `panic!` (denied by this crate's lints), and
+//! `tools/firmware-check.sh --c` links every entry point for the Cortex-M4F
+//! against a panic handler that calls a function defined nowhere (feature
+//! `prove-no-panic`): the link fails if any panic is reachable. On the host
 //! the crate links `std`, and a panic (none is reachable) would abort, never
 //! unwind into C.
 //!
@@ -102,10 +102,30 @@ pub extern "C" fn palpate_abi_version() -> u32 {
     PALPATE_ABI_VERSION
 }
 
-/// Firmware builds: a panic handler that calls a function defined nowhere,
-/// so a program that could reach a panic in this library does not link
-/// (no panic is reachable: `tools/ffi-check.sh` links every entry point).
-#[cfg(target_os = "none")]
+/// Firmware builds: no panic is reachable (the entry points' proof:
+/// `prove-no-panic` below); were one reached, the core would take a
+/// HardFault at once (`udf`), which firmware handles as a fault (the safe
+/// state), rather than run on.
+#[cfg(all(target_os = "none", not(feature = "prove-no-panic")))]
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
+    loop {
+        #[cfg(target_arch = "arm")]
+        // SAFETY: `udf` raises the undefined-instruction fault; it reads and
+        // writes no memory.
+        unsafe {
+            core::arch::asm!("udf #0", options(nomem, nostack));
+        }
+    }
+}
+
+/// The link-time proof's build (`--features prove-no-panic`,
+/// `tools/firmware-check.sh --c`): the panic handler calls a function
+/// defined nowhere, so a program that links every entry point
+/// (`tools/firmware-c/entry_points.c`) links only if no panic is reachable
+/// from any of them, on any input (a C caller's arguments are opaque to the
+/// optimiser).
+#[cfg(all(target_os = "none", feature = "prove-no-panic"))]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
     unsafe extern "C" {

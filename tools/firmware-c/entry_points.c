@@ -1,15 +1,18 @@
 /*
- * Link roots for two checks of libpalpate_ffi.a on the Cortex-M4F
+ * Link roots for the checks of libpalpate_ffi.a on the Cortex-M4F
  * (tools/firmware-check.sh --c), each linked alone with --gc-sections and
  * its table as the entry symbol, so the image holds exactly what the listed
- * functions reach:
- * - palpate_every_entry_point: every function of palpate.h. The library's
- *   panic handler calls a symbol defined nowhere, so this links only if no
- *   panic is reachable from any entry point on any input (a C caller's
- *   arguments are opaque to the compiler).
- * - palpate_haptic_path: what a pre-computed haptic loop calls (load the
- *   table, create the loop, tick, reset, the displacement field): the
- *   library's flash cost for that path.
+ * functions reach (its .text: their flash cost, the library's own memcpy
+ * and the like included):
+ * - palpate_haptic_path: what a pre-computed haptic loop runs at the haptic
+ *   rate (create it, tick, reset after a fault);
+ * - palpate_haptic_path_with_load: the same plus loading and validating
+ *   the table (once, at start-up) and its counts;
+ * - palpate_every_entry_point: every function of palpate.h. Linked against
+ *   the library built with `--features prove-no-panic`, whose panic handler
+ *   calls a symbol defined nowhere: it links only if no panic is reachable
+ *   from any entry point on any input (a C caller's arguments are opaque to
+ *   the compiler).
  */
 #include "palpate.h"
 
@@ -47,11 +50,15 @@ const entry palpate_every_entry_point[] = {
 };
 
 const entry palpate_haptic_path[] = {
-    (entry)palpate_precomputed_table_load,
-    (entry)palpate_table_get_info,
-    (entry)palpate_loop_config_default,
     (entry)palpate_precomputed_loop_create,
     (entry)palpate_precomputed_loop_tick,
     (entry)palpate_precomputed_loop_reset,
-    (entry)palpate_precomputed_loop_displacements,
+};
+
+const entry palpate_haptic_path_with_load[] = {
+    (entry)palpate_precomputed_table_load,
+    (entry)palpate_table_get_info,
+    (entry)palpate_precomputed_loop_create,
+    (entry)palpate_precomputed_loop_tick,
+    (entry)palpate_precomputed_loop_reset,
 };

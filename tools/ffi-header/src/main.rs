@@ -63,7 +63,7 @@ fn main() -> ExitCode {
         .position(|(a, b)| a != b)
         .unwrap_or_else(|| committed.lines().count().min(generated.lines().count()));
     eprintln!(
-        "FAIL: ffi/include/palpate.h differs from what ffi/src generates (first at line {}):\n  committed: {}\n  generated: {}\nregenerate it: PALPATE_BLESS=1 cargo run --manifest-path tools/ffi-header/Cargo.toml",
+        "FAIL: ffi/include/palpate.h differs from what ffi/src generates (first at line {}):\n  committed: {}\n  generated: {}\nregenerate it: PALPATE_BLESS=1 tools/ffi-check.sh",
         line + 1,
         committed.lines().nth(line).unwrap_or("(end of file)"),
         generated.lines().nth(line).unwrap_or("(end of file)"),
