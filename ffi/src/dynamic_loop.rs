@@ -43,6 +43,15 @@ pub struct DynamicLoop {
     opaque: [u64; PALPATE_DYNAMIC_LOOP_WORDS],
 }
 
+/// Zeroed, as C's static storage: not initialized until created.
+impl Default for DynamicLoop {
+    fn default() -> Self {
+        Self {
+            opaque: [0; PALPATE_DYNAMIC_LOOP_WORDS],
+        }
+    }
+}
+
 // SAFETY: `DynamicLoop` is a `#[repr(C)]` struct of `u64` words.
 unsafe impl Handle for DynamicLoop {
     type Value = Live<DynamicTissue<'static, 'static, f32, P>>;

@@ -29,6 +29,15 @@ pub struct Error {
     opaque: [u64; PALPATE_ERROR_WORDS],
 }
 
+/// Zeroed, as C's static storage: not initialized until created.
+impl Default for Error {
+    fn default() -> Self {
+        Self {
+            opaque: [0; PALPATE_ERROR_WORDS],
+        }
+    }
+}
+
 /// A failure: the boundary's own status, or a kernel error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Detail {
@@ -188,10 +197,9 @@ pub unsafe extern "C" fn palpate_error_message(
     buffer: *mut c_char,
     capacity: usize,
 ) -> usize {
-    // SAFETY: the contract; a null, misaligned or dead handle is refused.
-    let Ok(detail) = (unsafe { handle::get(error) }) else {
-        return 0;
-    };
+    // SAFETY: the contract; a null, misaligned or dead handle is refused
+    // (the empty message).
+    let detail = unsafe { handle::get(error) }.ok();
     let buffer: &mut [u8] = if capacity == 0 {
         &mut []
     } else {
@@ -209,7 +217,9 @@ pub unsafe extern "C" fn palpate_error_message(
         written: 0,
         total: 0,
     };
-    let _ = write!(out, "{detail}");
+    if let Some(detail) = detail {
+        let _ = write!(out, "{detail}");
+    }
     let (written, total) = (out.written, out.total);
     if let Some(nul) = buffer.get_mut(written) {
         *nul = 0;

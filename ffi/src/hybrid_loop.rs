@@ -37,6 +37,15 @@ pub struct HybridLoop {
     opaque: [u64; PALPATE_HYBRID_LOOP_WORDS],
 }
 
+/// Zeroed, as C's static storage: not initialized until created.
+impl Default for HybridLoop {
+    fn default() -> Self {
+        Self {
+            opaque: [0; PALPATE_HYBRID_LOOP_WORDS],
+        }
+    }
+}
+
 // SAFETY: `HybridLoop` is a `#[repr(C)]` struct of `u64` words.
 unsafe impl Handle for HybridLoop {
     type Value = Live<HybridTissue<'static, 'static, f32, P, M>>;

@@ -29,6 +29,15 @@ pub struct PrecomputedLoop {
     opaque: [u64; PALPATE_PRECOMPUTED_LOOP_WORDS],
 }
 
+/// Zeroed, as C's static storage: not initialized until created.
+impl Default for PrecomputedLoop {
+    fn default() -> Self {
+        Self {
+            opaque: [0; PALPATE_PRECOMPUTED_LOOP_WORDS],
+        }
+    }
+}
+
 // SAFETY: `PrecomputedLoop` is a `#[repr(C)]` struct of `u64` words.
 unsafe impl Handle for PrecomputedLoop {
     type Value = Live<PrecomputedTissue<'static, f32, M>>;

@@ -82,6 +82,15 @@ pub struct SolutionState {
     opaque: [u64; PALPATE_SOLUTION_WORDS],
 }
 
+/// Zeroed, as C's static storage: not initialized until created.
+impl Default for SolutionState {
+    fn default() -> Self {
+        Self {
+            opaque: [0; PALPATE_SOLUTION_WORDS],
+        }
+    }
+}
+
 // SAFETY: `SolutionState` is a `#[repr(C)]` struct of `u64` words.
 unsafe impl Handle for SolutionState {
     type Value = ContactSolution<f32, M>;
@@ -101,6 +110,18 @@ pub struct Solution {
     pub contact_forces_n: [[f32; 3]; PALPATE_MAX_CONTACTS as usize],
     /// The kernel's solution, for `palpate_precomputed_displacements`.
     pub state: SolutionState,
+}
+
+/// No contact solved yet.
+impl Default for Solution {
+    fn default() -> Self {
+        Self {
+            count: 0,
+            device_force_n: [0.0; 3],
+            contact_forces_n: [[0.0; 3]; PALPATE_MAX_CONTACTS as usize],
+            state: SolutionState::default(),
+        }
+    }
 }
 
 /// Solves `count` contacts at `contacts` on pre-computed table `table`

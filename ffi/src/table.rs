@@ -33,6 +33,15 @@ pub struct Table {
     opaque: [u64; PALPATE_TABLE_WORDS],
 }
 
+/// Zeroed, as C's static storage: not initialized until created.
+impl Default for Table {
+    fn default() -> Self {
+        Self {
+            opaque: [0; PALPATE_TABLE_WORDS],
+        }
+    }
+}
+
 /// What a table is for (the kind in its header).
 #[repr(u32)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -9,7 +9,7 @@
 //! the formatter is checked against the bit patterns by decoding its output
 //! independently.
 
-use std::fmt::Write;
+use core::fmt::Write;
 use std::path::PathBuf;
 
 use palpate_kernel::precomputed::{AsConstraint, ContactPoint};
