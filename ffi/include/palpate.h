@@ -115,14 +115,14 @@
 /*
  Words of a `palpate_table` on 64-bit targets (the host).
  */
-#define PALPATE_TABLE_WORDS 64
+#define PALPATE_TABLE_WORDS 72
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_table` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_TABLE_WORDS 40
+#define PALPATE_TABLE_WORDS 48
 #endif
 
 /*
@@ -134,14 +134,14 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 152
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 168
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 132
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 144
 #endif
 
 #if defined(PALPATE_POINTER_64)
@@ -162,14 +162,14 @@
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 580
+#define PALPATE_HYBRID_LOOP_WORDS 592
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 460
+#define PALPATE_HYBRID_LOOP_WORDS 472
 #endif
 
 /*
@@ -1193,8 +1193,11 @@ palpate_status palpate_precomputed_loop_displacements(const struct palpate_preco
 /*
  Writes to `bytes` the size of the memory block a dynamic loop over
  tensor-mass table `table` with `physics` needs (aligned to
- `PALPATE_MEMORY_ALIGN`). About `200 N + 100 F` bytes for `N` vertices
- and `F` mesh triangles (linear law, no RK4).
+ `PALPATE_MEMORY_ALIGN`): `141 N + 36 E + 48 F + T` bytes and a few of
+ alignment for `N` vertices, `E` edges, `F` mesh triangles (every tet
+ face once) and `T` tets; RK4 adds `48 N`, the split St Venant-Kirchhoff
+ form `16 N + 64 E + 60 F + 12 T`. The firmware box (64 vertices, 279
+ edges, 378 faces, 162 tets): 37 384 bytes.
 
  # Safety
 

@@ -15,7 +15,10 @@ use core::ptr::{addr_of, addr_of_mut};
 
 use crate::status::Status;
 
-/// A handle type: the C struct and what it holds.
+/// A handle type: the C struct and what it holds. A value that outgrows its
+/// struct fails the build ([`init`]'s compile-time assertion): raise the
+/// handle's `PALPATE_*_WORDS` (the header's sizes) and
+/// `PALPATE_ABI_VERSION`.
 ///
 /// # Safety
 ///

@@ -46,7 +46,7 @@ fn main() -> ExitCode {
             eprintln!("{}: {e}", header.display());
             return ExitCode::FAILURE;
         }
-        println!("wrote {}", header.display());
+        println!("wrote ffi/include/palpate.h");
         return ExitCode::SUCCESS;
     }
     let committed = std::fs::read_to_string(&header).unwrap_or_default();
