@@ -1,8 +1,23 @@
 //! Every workspace integration test, in one binary whose modules mirror the
 //! source tree: `kernel::…` (the `no_std` kernel), `host::…` (the harness),
-//! `tools::…` (the shared script crate). Each module states the independent
+//! `ffi::…` (the C ABI), `tools::…` (the shared script crate, the C
+//! example's sequence). Each module states the independent
 //! truth it checks against; the shared readers of the reference data are in
 //! `src/lib.rs`.
+
+// The C ABI (`ffi/`, crate `palpate-ffi`), called as C calls it: raw
+// pointers to handles and buffers, hence `unsafe` (each call says why it is
+// sound).
+#[allow(unsafe_code)]
+mod ffi {
+    mod dynamic_loop;
+    mod error;
+    mod hybrid_loop;
+    mod precomputed_loop;
+    mod solve;
+    mod status;
+    mod table;
+}
 
 mod host {
     mod compliance;
@@ -41,6 +56,7 @@ mod kernel {
 }
 
 mod tools {
+    mod firmware_c;
     mod script;
     mod script_ticks;
 }

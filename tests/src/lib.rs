@@ -424,3 +424,68 @@ pub fn tensor_difference(
     }
     (worst, scale)
 }
+
+/// The f32 tables of the firmware example's box (`tools/firmware-m4f/mesh/box.*`: 3 × 3 × 3
+/// cells of 1 cm, 64 vertices, 162 tets, base fixed, E = 3 kPa, ν = 0.45), built in memory
+/// exactly as `tools/box-table.sh` (pre-computed; tensor-mass with ρ = 1000 kg/m³) and
+/// `tools/hybrid-tables.sh` (the hybrid of `hybrid-scene.toml`: the top corner cell
+/// tensor-mass) build them: what the C ABI's tests load.
+pub struct FirmwareBoxTables {
+    /// The pre-computed table.
+    pub precomputed: palpate::table::load::TableFile,
+    /// The tensor-mass table.
+    pub tensor_mass: palpate::table::load::TableFile,
+    /// The hybrid's three tables.
+    pub hybrid: palpate::hybrid::HybridTables,
+}
+
+/// [`FirmwareBoxTables`], built once per test binary.
+pub fn firmware_box_tables() -> &'static FirmwareBoxTables {
+    use palpate::fem::material::Material;
+    use palpate::session::model::{SceneModel, hybrid_tables};
+    use palpate::table::build::{BuildOptions, build};
+    use palpate::table::compliance::Solver;
+    use palpate::table::file::Precision;
+    use palpate::table::load::TableFile;
+
+    static TABLES: std::sync::OnceLock<FirmwareBoxTables> = std::sync::OnceLock::new();
+    TABLES.get_or_init(|| {
+        let firmware = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tools/firmware-m4f");
+        let (mesh, report) =
+            palpate::mesh::read_mesh(&firmware.join("mesh/box.node")).expect("box mesh");
+        let material = Material::new(3000.0, 0.45).expect("material");
+        let fix = vec!["z<0.001".parse().expect("predicate")];
+        let table = |options: BuildOptions| {
+            TableFile::from_bytes(&build(&mesh, &report, &options).expect("table").bytes)
+        };
+        let scene = Scene::read(&firmware.join("hybrid-scene.toml")).expect("hybrid scene");
+        let (scene_mesh, scene_report) = scene.load_mesh().expect("scene mesh");
+        let SceneModel::Hybrid { partition, .. } =
+            SceneModel::of(&scene, &scene_mesh, &scene_report).expect("scene model")
+        else {
+            panic!("hybrid-scene.toml is not a hybrid");
+        };
+        FirmwareBoxTables {
+            precomputed: table(BuildOptions::precomputed(
+                material,
+                fix.clone(),
+                Solver::Cholesky,
+                Precision::F32,
+            )),
+            tensor_mass: table(BuildOptions::tensor_mass(
+                material,
+                1000.0,
+                fix,
+                Precision::F32,
+            )),
+            hybrid: hybrid_tables(
+                &scene,
+                &scene_mesh,
+                &scene_report,
+                &partition,
+                Precision::F32,
+            )
+            .expect("hybrid tables"),
+        }
+    })
+}

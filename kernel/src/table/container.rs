@@ -100,13 +100,14 @@ fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result
             actual: bytes.len(),
         });
     }
-    let body_len = bytes.len() - CRC_LEN;
-    let (body, trailer) = bytes.split_at(body_len);
-    let stored = u32::from_le_bytes(
-        trailer
-            .try_into()
-            .map_err(|_| LoadError::TooShort { len: bytes.len() })?,
-    );
+    // Checked, not `split_at`: the length check is in `read_header`, which
+    // the optimiser may not see, and a C caller's bytes are opaque (the C
+    // ABI's link-time no-panic proof, `tools/ffi-check.sh`).
+    let (body, trailer) = bytes
+        .split_last_chunk::<CRC_LEN>()
+        .ok_or(LoadError::TooShort { len: bytes.len() })?;
+    let body_len = body.len();
+    let stored = u32::from_le_bytes(*trailer);
     let computed = crc::Crc::<u32>::new(&format::CRC32).checksum(body);
     if stored != computed {
         return Err(LoadError::ChecksumMismatch { stored, computed });
