@@ -128,20 +128,20 @@
 /*
  Words of a `palpate_solution_state`.
  */
-#define PALPATE_SOLUTION_WORDS 24
+#define PALPATE_SOLUTION_WORDS 32
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 168
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 192
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 144
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 168
 #endif
 
 #if defined(PALPATE_POINTER_64)
@@ -162,14 +162,14 @@
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 592
+#define PALPATE_HYBRID_LOOP_WORDS 624
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 472
+#define PALPATE_HYBRID_LOOP_WORDS 504
 #endif
 
 /*

@@ -74,7 +74,7 @@ fn check_kinds(contacts: &[Contact]) -> Result<(), Status> {
 }
 
 /// Words of a `palpate_solution_state`.
-pub const PALPATE_SOLUTION_WORDS: usize = 24;
+pub const PALPATE_SOLUTION_WORDS: usize = 32;
 
 /// The kernel's contact solution inside a `palpate_solution` (opaque).
 #[repr(C)]

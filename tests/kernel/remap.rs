@@ -49,8 +49,7 @@ fn quasi_non_linear_splits_and_remaps_one_vertex() {
         radial: cubic(),
         force: Remap::new([2.0, 0.0, 0.0, 0.0, 0.0], 1.0).expect("linear"),
     };
-    let direction =
-        QuasiNonLinear::direction([Vector3::new(0.0, 0.0, -0.002)].into_iter()).expect("d̂");
+    let direction = QuasiNonLinear::direction(&Vector3::new(0.0, 0.0, -0.002)).expect("d̂");
     assert_eq!(direction, Vector3::new(0.0, 0.0, -1.0));
     let u = remap.displacement(&direction, Vector3::new(0.003, 0.004, -0.001));
     let expected = Vector3::new(0.00300015, 0.0040002, -0.001);
@@ -58,7 +57,7 @@ fn quasi_non_linear_splits_and_remaps_one_vertex() {
     let g = remap.force(&direction, Vector3::new(0.1, 0.0, 0.5));
     assert!((g - Vector3::new(0.1, 0.0, 1.0)).amax() <= 1e-15, "{g}");
     // No direction without an imposed displacement: no remap.
-    assert!(QuasiNonLinear::<f64>::direction([Vector3::zeros()].into_iter()).is_none());
+    assert!(QuasiNonLinear::<f64>::direction(&Vector3::zeros()).is_none());
 }
 
 /// Refusals: a polynomial whose slope `1 − 200x` turns negative past
@@ -130,4 +129,52 @@ fn remapped_model_is_the_linear_model_remapped() {
     }
     // The remap does change the force: ψ(x) = x + 40x² on the colinear part.
     assert!((remapped_force - force).norm() > 1e-3 * force.norm());
+}
+
+/// A pinch: two contacts with opposed imposed displacements (a grasper's
+/// jaws). Each contact force is remapped along its own contact's direction
+/// (the remap stays on although the displacements sum to zero), and the
+/// field is remapped along the larger jaw's direction: the same field as
+/// along the other jaw's, since the split does not depend on the sign.
+#[test]
+fn a_pinch_remaps_each_jaw_along_its_own_direction() {
+    let file = reference_cube_table(Precision::F64);
+    let AnyModel::F64(linear) = file.model().expect("valid table") else {
+        panic!("f64 table expected");
+    };
+    let remap = QuasiNonLinear {
+        radial: cubic(),
+        force: Remap::new([1.0, 40.0, 0.0, 0.0, 0.0], 1.0).expect("monotone"),
+    };
+    let d = Vector3::new(0.0, 0.003, 0.0);
+    let contacts = [
+        Constraint::at_vertex(194, d),
+        Constraint::at_vertex(200, -d * 0.999),
+    ];
+    let lin = linear
+        .contact_forces::<MAX_CONTACTS>(&contacts)
+        .expect("linear");
+    let nl = linear
+        .with_remap(remap)
+        .contact_forces::<MAX_CONTACTS>(&contacts)
+        .expect("remapped");
+    let direction = Vector3::new(0.0, 1.0, 0.0);
+    for (g_lin, g_nl) in lin.contact_forces_n().iter().zip(nl.contact_forces_n()) {
+        let expected = remap.force(&direction, *g_lin);
+        assert!((expected - g_nl).amax() <= 1e-15, "{g_nl} vs {expected}");
+        assert!((g_nl - g_lin).norm() > 1e-3 * g_lin.norm(), "remap is on");
+    }
+    let n = linear.table().vertex_count();
+    let (mut u_lin, mut u_nl) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    linear.displacements(&lin, &mut u_lin).expect("field");
+    linear
+        .with_remap(remap)
+        .displacements(&nl, &mut u_nl)
+        .expect("field");
+    for (a, b) in u_lin.iter().zip(&u_nl) {
+        let along_larger = remap.displacement(&direction, Vector3::from(*a));
+        let along_other = remap.displacement(&-direction, Vector3::from(*a));
+        assert!((along_larger - Vector3::from(*b)).amax() <= 1e-18);
+        assert!((along_other - along_larger).amax() <= 1e-18);
+    }
 }

@@ -71,6 +71,10 @@ pub struct Equilibrium {
     pub iterations: usize,
     /// Largest residual force on an unknown DOF at the end, N.
     pub residual_n: f64,
+    /// `false` when an increment ended at rounding level above the
+    /// requested tolerance (below 1e-6 of the load scale, where no step
+    /// decreased the residual): `residual_n` says how close it got.
+    pub tolerance_met: bool,
     /// For each prescribed vertex, in order, the force the constraint
     /// applies to the body, `−f_int − f_ext`, N.
     pub reactions_n: Vec<[f64; 3]>,
@@ -143,6 +147,7 @@ pub fn solve_stvk(
     let mut u = vec![[0.0; 3]; n];
     let mut iterations = 0;
     let mut residual_n = 0.0;
+    let mut tolerance_met = true;
     for step in 1..=options.load_steps {
         let s = step as f64 / options.load_steps as f64;
         for &(v, d) in problem.prescribed {
@@ -214,6 +219,7 @@ pub fn solve_stvk(
             }
             if !accepted && largest(&r) <= STAGNATION * scale {
                 // At rounding level: no step can decrease the residual.
+                tolerance_met = false;
                 break;
             }
             if !accepted {
@@ -238,6 +244,7 @@ pub fn solve_stvk(
         u,
         iterations,
         residual_n,
+        tolerance_met,
         reactions_n,
     })
 }

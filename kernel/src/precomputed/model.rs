@@ -33,7 +33,8 @@ pub struct ContactSolution<T: Real, const M: usize> {
     forces_n: [Vector3<T>; M],
     /// The linear `g`, which the displacement update superposes.
     linear_forces_n: [Vector3<T>; M],
-    /// `d̂` of a quasi-non-linear model's contact set (`None`: linear).
+    /// `d̂` of a quasi-non-linear model's field: the direction of the
+    /// contact with the largest imposed displacement (`None`: linear).
     direction: Option<Vector3<T>>,
     len: usize,
 }
@@ -190,11 +191,15 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             .map_err(|contact| ContactError::IllConditioned { contact })?;
         solution.forces_n = solution.linear_forces_n;
         if let Some(remap) = &self.remap {
-            solution.direction =
-                QuasiNonLinear::direction(contacts.iter().map(|c| c.displacement_m()));
-            if let Some(direction) = &solution.direction {
-                for g in solution.forces_n.iter_mut().take(m) {
-                    *g = remap.force(direction, *g);
+            let mut largest = T::zero();
+            for (g, contact) in solution.forces_n.iter_mut().zip(contacts).take(m) {
+                let d = contact.displacement_m();
+                if let Some(direction) = QuasiNonLinear::direction(&d) {
+                    *g = remap.force(&direction, *g);
+                    if d.norm() > largest {
+                        largest = d.norm();
+                        solution.direction = Some(direction);
+                    }
                 }
             }
         }

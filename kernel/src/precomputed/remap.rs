@@ -2,18 +2,25 @@
 //! §3; MODELS.md §7).
 //!
 //! The linear pre-computed solution keeps its deformation law; only
-//! amplitudes change. With `d̂` the direction of the imposed constraint
-//! (the contacts' summed imposed displacement, normalized: Cotin's single
-//! tool point has one; several contacts share the sum's direction):
+//! amplitudes change, along the direction `d̂` of an imposed constraint
+//! (a contact's imposed displacement, normalized):
+//! - each contact force's colinear amplitude `g_p·d̂_p` becomes
+//!   `ψ(g_p·d̂_p)` (sign kept) along its own contact's direction; its
+//!   orthogonal part keeps its linear value;
 //! - each vertex's linear displacement `u` is split into its colinear part
-//!   `(u·d̂) d̂` and its orthogonal part `u⊥`; the colinear amplitude keeps
-//!   its linear value (the compression test imposes it: the axial
+//!   `(u·d̂) d̂` and its orthogonal part `u⊥`, `d̂` the direction of the
+//!   contact with the largest imposed displacement (Cotin's single tool
+//!   point has one; a pinch's two opposed jaws give the same field, since
+//!   the split does not depend on the sign of `d̂`); the colinear amplitude
+//!   keeps its linear value (the compression test imposes it: the axial
 //!   displacement is the test's independent variable) and the orthogonal
-//!   amplitude `|u⊥|` becomes `φ(|u⊥|)`, the measured radial displacement
-//!   as a function of the linear one;
-//! - each contact force's colinear amplitude `g·d̂` becomes `ψ(g·d̂)` (sign
-//!   kept), the measured force as a function of the linear one; its
-//!   orthogonal part keeps its linear value.
+//!   amplitude `|u⊥|` becomes `φ(|u⊥|)`, the measured radial displacement as
+//!   a function of the linear one.
+//!
+//! Both maps are odd, so a direction's sign never matters. A contact on a
+//! triangle has its three vertices remapped, so the remapped surface no
+//! longer passes exactly through the tool point (a rendering effect; the
+//! force is the remapped contact force).
 //!
 //! `φ` and `ψ` are [`Remap`]s, polynomials fitted on the host to a
 //! compression test's force/axial/radial curves. Cost: one polynomial per
@@ -158,13 +165,12 @@ pub struct QuasiNonLinear<T: Real> {
 }
 
 impl<T: Real> QuasiNonLinear<T> {
-    /// The constraint direction `d̂` of a contact set: its summed imposed
-    /// displacement, normalized; `None` (no remap) when the sum is below
-    /// `1e-12` m, where no direction is defined.
-    pub fn direction(displacements_m: impl Iterator<Item = Vector3<T>>) -> Option<Vector3<T>> {
-        let sum = displacements_m.fold(Vector3::zeros(), |acc, d| acc + d);
-        let norm = sum.norm();
-        (norm > T::of_f64(1e-12) && norm.finite()).then(|| sum / norm)
+    /// The direction `d̂` of an imposed displacement `displacement_m`:
+    /// normalized; `None` (no remap) below `1e-12` m, where no direction is
+    /// defined.
+    pub fn direction(displacement_m: &Vector3<T>) -> Option<Vector3<T>> {
+        let norm = displacement_m.norm();
+        (norm > T::of_f64(1e-12) && norm.finite()).then(|| displacement_m / norm)
     }
 
     /// `u` with its orthogonal amplitude remapped by `φ`, m.
