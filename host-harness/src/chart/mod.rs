@@ -75,11 +75,13 @@ pub const QUICK_MESHES: [(usize, usize); 2] = [(1, 5), (2, 10)];
 pub const LEVELS: [f64; 3] = [0.01, 0.05, 0.20];
 /// Levels of `--quick`.
 pub const QUICK_LEVELS: [f64; 2] = [0.01, 0.05];
-/// Steps of one relaxation at most.
+/// Steps of one relaxation at most (full run).
 pub const MAX_RELAX_STEPS: usize = 200_000;
-/// Relaxation tolerance: largest residual force over the load per loaded
-/// vertex.
-pub const RELAX_TOLERANCE: f64 = 1e-4;
+/// Steps of one relaxation at most in `--quick`.
+pub const QUICK_RELAX_STEPS: usize = 20_000;
+/// Relaxation tolerance: largest residual force over the largest load on
+/// a vertex (the volume experiment's).
+pub const RELAX_TOLERANCE: f64 = 1e-3;
 /// Newton load increments of the reference per 1 % of tip displacement
 /// (at least one).
 const NEWTON_STEPS_PER_PERCENT: f64 = 0.5;
@@ -161,6 +163,8 @@ pub struct Matrix {
     pub levels: Vec<f64>,
     /// The stability map's extent.
     pub stability: stability::MapExtent,
+    /// Steps of one relaxation at most.
+    pub max_relax_steps: usize,
 }
 
 impl Matrix {
@@ -171,6 +175,7 @@ impl Matrix {
             loads: Load::ALL.to_vec(),
             levels: LEVELS.to_vec(),
             stability: stability::MapExtent::full(),
+            max_relax_steps: MAX_RELAX_STEPS,
         }
     }
 
@@ -181,6 +186,7 @@ impl Matrix {
             loads: vec![Load::Press, Load::Bend],
             levels: QUICK_LEVELS.to_vec(),
             stability: stability::MapExtent::quick(),
+            max_relax_steps: QUICK_RELAX_STEPS,
         }
     }
 
@@ -399,10 +405,17 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
             for body in &bodies {
                 let same_mesh = core::ptr::eq(body, finest);
                 for model in Model::ALL {
-                    let (mut run, u) = run_model(body, model, load, level, magnitude, &quasi)
-                        .with_context(|| {
-                            format!("{} on {} {}", model.name(), body.label, load.name())
-                        })?;
+                    let (mut run, u) = run_model(
+                        body,
+                        model,
+                        load,
+                        (level, magnitude),
+                        &quasi,
+                        matrix.max_relax_steps,
+                    )
+                    .with_context(|| {
+                        format!("{} on {} {}", model.name(), body.label, load.name())
+                    })?;
                     score(&mut run, &u, &reference, same_mesh);
                     progress.tick(&format!(
                         "{} {} {:.0} % {}",
@@ -513,22 +526,23 @@ fn run_model(
     body: &Body,
     model: Model,
     load: Load,
-    level: f64,
-    magnitude: f64,
+    (level, magnitude): (f64, f64),
     quasi: &(QuasiNonLinear<f64>, QuasiNonLinear<f32>),
+    max_steps: usize,
 ) -> anyhow::Result<(Run, Vec<[f64; 3]>)> {
     let loads = body.loads(load, magnitude);
     let stvk = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
     let outcome = match model {
         Model::PrecomputedLinear => precomputed(body, &loads, None)?,
         Model::PrecomputedQuasi => precomputed(body, &loads, Some(quasi))?,
-        Model::TensorMassLinear => dynamic(body, &loads, ElasticLaw::Linear, None)?,
-        Model::Stvk => dynamic(body, &loads, stvk, None)?,
+        Model::TensorMassLinear => dynamic(body, &loads, ElasticLaw::Linear, None, max_steps)?,
+        Model::Stvk => dynamic(body, &loads, stvk, None, max_steps)?,
         Model::StvkPenalty => dynamic(
             body,
             &loads,
             stvk,
             Some(penalty_n(&body.mesh, &body.material)),
+            max_steps,
         )?,
     };
     let alive = vec![true; body.mesh.tets.len()];
@@ -713,6 +727,7 @@ fn dynamic(
     loads: &[[f64; 3]],
     law: ElasticLaw,
     incompressibility_n: Option<f64>,
+    max_steps: usize,
 ) -> anyhow::Result<Outcome> {
     let n = body.mesh.positions.len();
     let file = static_study_table(&body.mesh, &body.materials(), body.fixed.clone());
@@ -741,7 +756,7 @@ fn dynamic(
         loads,
         dt_s,
         RELAX_TOLERANCE * largest,
-        MAX_RELAX_STEPS,
+        max_steps,
         &mut u,
     ) {
         Ok(r) if r.converged => (None, r.steps),

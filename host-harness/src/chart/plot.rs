@@ -85,7 +85,9 @@ pub fn model_colour(model: Model) -> RGBColor {
 fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
     if lo.is_finite() {
         (lo / 2.0, hi * 2.0)
     } else {
@@ -290,7 +292,11 @@ fn cost_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, study: &Study) -
             .label(format!("{} (slope {slope:.2})", model.name()))
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
         chart
-            .draw_series(points.into_iter().map(|p| Circle::new(p, 4, colour.filled())))
+            .draw_series(
+                points
+                    .into_iter()
+                    .map(|p| Circle::new(p, 4, colour.filled())),
+            )
             .map_err(err)?;
     }
     chart
@@ -404,7 +410,10 @@ fn square((x, y): (f64, f64)) -> [(f64, f64); 2] {
 
 /// Volume change against load, per model and protocol (Picinbono 2001
 /// table 2).
-fn volume_chart<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, results: &[SceneResult]) -> Drawn {
+fn volume_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    results: &[SceneResult],
+) -> Drawn {
     root.fill(&WHITE).map_err(err)?;
     let force = results
         .iter()
@@ -483,7 +492,11 @@ fn volume_chart<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, results: &[Sc
                     });
             }
             chart
-                .draw_series(points.into_iter().map(|p| Circle::new(p, 4, colour.filled())))
+                .draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 4, colour.filled())),
+                )
                 .map_err(err)?;
         }
     }

@@ -92,7 +92,10 @@ pub fn markdown(
         out,
         "| load | level | mesh | model | tip error | force error | L2 error | max error mm | ΔV/V₀ % | inverted | step µs f64 | step µs f32 | steps to settle | settle ms | fault |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        out,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     let opt = |x: Option<f64>, scale: f64| x.map_or("-".into(), |x| format!("{:.3}", scale * x));
     for r in &study.runs {
         let _ = writeln!(
@@ -161,7 +164,9 @@ pub fn failures(study: &Study) -> Vec<String> {
                 r.mesh,
                 r.load.name(),
                 100.0 * r.level,
-                r.fault.as_deref().map_or(String::new(), |f| format!("{f}; ")),
+                r.fault
+                    .as_deref()
+                    .map_or(String::new(), |f| format!("{f}; ")),
                 r.inverted_tets
             ));
         }
@@ -193,7 +198,12 @@ pub fn failures(study: &Study) -> Vec<String> {
             .cells
             .iter()
             .filter(|c| c.outcome != Outcome::Stable)
-            .map(|c| format!("{:?} at E = {} Pa, Δt = {:.2e} s", c.outcome, c.young_pa, c.dt_s))
+            .map(|c| {
+                format!(
+                    "{:?} at E = {} Pa, Δt = {:.2e} s",
+                    c.outcome, c.young_pa, c.dt_s
+                )
+            })
             .collect();
         lines.push(format!(
             "{}: measured critical step {:.3e} s, 2/ω_max {:.3e} s at E = {} Pa; {} of {} trials fail{}",

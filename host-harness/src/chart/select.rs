@@ -11,9 +11,9 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
         .iter()
         .map(|p| {
             finite(p)
-                && !points.iter().any(|q| {
-                    finite(q) && q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1)
-                })
+                && !points
+                    .iter()
+                    .any(|q| finite(q) && q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1))
         })
         .collect()
 }
@@ -27,4 +27,45 @@ pub fn cheapest_within(points: &[(f64, f64)], bound: f64) -> Option<usize> {
         .filter(|(_, p)| p.0.is_finite() && p.1.is_finite() && p.1 <= bound)
         .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
         .map(|(i, _)| i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Hand-made points: (1, 0.5) and (2, 0.1) and (4, 0.01) are each
+    /// best at their cost; (3, 0.2) is dominated by (2, 0.1); (5, 0.01)
+    /// by (4, 0.01) (costlier, no better); (0.5, NaN) has no error and is
+    /// off the front without dominating anything; the duplicate of (2, 0.1)
+    /// stays on it.
+    #[test]
+    fn pareto_front_of_hand_made_points() {
+        let points = [
+            (1.0, 0.5),
+            (3.0, 0.2),
+            (2.0, 0.1),
+            (4.0, 0.01),
+            (5.0, 0.01),
+            (0.5, f64::NAN),
+            (2.0, 0.1),
+        ];
+        assert_eq!(
+            pareto_front(&points),
+            [true, false, true, true, false, false, true]
+        );
+    }
+
+    /// Within 20 %: (1, 0.15) is cheapest; within 5 %: (2, 0.04) beats the
+    /// costlier (4, 0.001); within 0.05 %: none; the bound is inclusive;
+    /// equal costs give the first.
+    #[test]
+    fn cheapest_within_bounds() {
+        let points = [(4.0, 0.001), (1.0, 0.15), (2.0, 0.04), (2.0, 0.03)];
+        assert_eq!(cheapest_within(&points, 0.20), Some(1));
+        assert_eq!(cheapest_within(&points, 0.05), Some(2));
+        assert_eq!(cheapest_within(&points, 0.15), Some(1));
+        assert_eq!(cheapest_within(&points, 0.002), Some(0));
+        assert_eq!(cheapest_within(&points, 0.0005), None);
+        assert_eq!(cheapest_within(&[(1.0, f64::NAN)], 1.0), None);
+    }
 }

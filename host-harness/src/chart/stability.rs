@@ -174,8 +174,8 @@ fn with_model<R>(
     let file = static_study_table(&body.mesh, &materials, body.fixed.clone());
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
-    let params = DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions))
-        .with_law(law);
+    let params =
+        DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions)).with_law(law);
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     f(&mut model)
 }

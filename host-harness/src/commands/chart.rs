@@ -8,8 +8,8 @@ use std::path::PathBuf;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use palpate::chart::{self, Matrix, plot, report};
-use palpate::experiment::volume_bend::{self, Protocol};
 use palpate::experiment::scenes;
+use palpate::experiment::volume_bend::{self, Protocol};
 use palpate::output::atomic::write_file;
 
 use super::stdout;
@@ -85,7 +85,13 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         .map(|r| volume_bend::table(std::slice::from_ref(r)))
         .collect::<Vec<_>>()
         .join("\n");
-    let markdown = report::markdown(&study, &matrix.loads, &matrix.levels, &charts, &volume_table);
+    let markdown = report::markdown(
+        &study,
+        &matrix.loads,
+        &matrix.levels,
+        &charts,
+        &volume_table,
+    );
     write_file(&args.out.join("report.md"), markdown.as_bytes())?;
     write_file(
         &args.out.join("index.html"),
