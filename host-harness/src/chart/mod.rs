@@ -591,9 +591,9 @@ fn precomputed(
     let n = body.mesh.positions.len();
     let mut slot = vec![None; n];
     let mut free = Vec::new();
-    for v in 0..n {
+    for (v, s) in slot.iter_mut().enumerate() {
         if !body.fixed[v] {
-            slot[v] = Some(free.len() as u32);
+            *s = Some(free.len() as u32);
             free.push(v);
         }
     }
@@ -639,14 +639,14 @@ fn precomputed(
         if let (Some((q, _)), Some(d)) = (quasi, &direction) {
             remap_rows(q, d, 1.0, &mut out64);
         }
-        std::hint::black_box(&out64);
+        core::hint::black_box(&out64);
     });
     let step_f32_s = timing::median_time_s(|| {
         compliance_product(&c32, &w32, &mut out32);
         if let (Some((_, q)), Some(d)) = (quasi, &direction32) {
             remap_rows(q, d, 1.0, &mut out32);
         }
-        std::hint::black_box(&out32);
+        core::hint::black_box(&out32);
     });
     compliance_product(&c64, &weights, &mut out64);
     if let (Some((q, _)), Some(d)) = (quasi, &direction) {
@@ -670,7 +670,7 @@ fn compliance_product<T: palpate_kernel::Real>(c: &[T], w: &[T], out: &mut [T]) 
     out.fill(T::zero());
     for (column, &wj) in c.chunks_exact(out.len()).zip(w) {
         for (o, &cij) in out.iter_mut().zip(column) {
-            *o = *o + cij * wj;
+            *o += cij * wj;
         }
     }
 }
@@ -775,7 +775,7 @@ fn dynamic(
         model.reset();
     }
     let step_s = timing::median_time_s(|| {
-        let _ = std::hint::black_box(model.step(Integrator::SymplecticEuler, dt_s));
+        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt_s));
     });
     let step_f32_s = dynamic_f32_step(body, loads, law, incompressibility_n, dt_s)?;
     Ok(Outcome {
@@ -825,6 +825,6 @@ fn dynamic_f32_step(
         if model.fault().is_some() {
             model.reset();
         }
-        let _ = std::hint::black_box(model.step(Integrator::SymplecticEuler, dt));
+        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt));
     }))
 }

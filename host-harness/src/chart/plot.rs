@@ -66,7 +66,7 @@ fn encode_png(rgb: &[u8]) -> anyhow::Result<Vec<u8>> {
     Ok(out)
 }
 
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
+fn err(e: impl core::fmt::Display) -> anyhow::Error {
     anyhow::anyhow!("drawing: {e}")
 }
 

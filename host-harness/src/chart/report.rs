@@ -12,7 +12,7 @@ pub const BOUNDS: [f64; 3] = [0.01, 0.05, 0.20];
 
 /// The runs of one load and level with an error, as (cost, error) points:
 /// time per step (s) and tip error.
-pub fn points<'a>(study: &'a Study, load: Load, level: f64) -> (Vec<&'a Run>, Vec<(f64, f64)>) {
+pub fn points(study: &Study, load: Load, level: f64) -> (Vec<&Run>, Vec<(f64, f64)>) {
     let runs: Vec<&Run> = study
         .runs
         .iter()

@@ -233,7 +233,7 @@ fn trial(
                     .map(|(f, u)| Vector3::from(*f).dot(&Vector3::from(*u)))
                     .sum();
                 let energy = kinetic + model.elastic_energy_of(u, &mut scratch) - external;
-                grew = !(energy <= ENERGY_GROWTH * work);
+                grew = energy.is_nan() || energy > ENERGY_GROWTH * work;
             }
         }
         let Ok(u) = model.displacements_m() else {

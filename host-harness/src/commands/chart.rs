@@ -82,7 +82,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     let charts = plot::draw_all(&study, &volume, &args.out, &matrix.loads, &matrix.levels)?;
     let volume_table: String = volume
         .iter()
-        .map(|r| volume_bend::table(std::slice::from_ref(r)))
+        .map(|r| volume_bend::table(core::slice::from_ref(r)))
         .collect::<Vec<_>>()
         .join("\n");
     let markdown = report::markdown(
