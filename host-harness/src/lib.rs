@@ -8,6 +8,7 @@
 //! the kernel's (`palpate_kernel::table`, `palpate_kernel::tensor_mass`).
 
 pub mod budget;
+pub mod chart;
 pub mod demo;
 pub mod experiment;
 pub mod fem;

@@ -12,7 +12,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 mod commands;
 
 use commands::{
-    budget, demo, dynamic, experiment, precomputed, remap, scene, session, stvk, tables,
+    budget, chart, demo, dynamic, experiment, precomputed, remap, scene, session, stvk, tables,
 };
 
 #[derive(Parser)]
@@ -55,6 +55,9 @@ enum Command {
     /// Per-tick instruction counts (callgrind) of every generated trajectory
     /// against the static bound from the table sizes and capacities.
     Budget(budget::BudgetArgs),
+    /// The speed/accuracy study: every model against the Newton St
+    /// Venant-Kirchhoff reference, timed; charts and a report.
+    Chart(chart::ChartArgs),
     /// Built-in scene: two-probe press and release, forces, timings, VTK series.
     Demo(demo::DemoArgs),
 }
@@ -92,6 +95,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
         Command::Session(command) => session::run(command),
         Command::Scene(command) => scene::run(command),
         Command::Budget(args) => budget::run(&args),
+        Command::Chart(args) => chart::run(&args),
         Command::Demo(args) => demo::run(&args),
     }
 }

@@ -5,6 +5,7 @@
 
 pub mod args;
 pub mod budget;
+pub mod chart;
 pub mod demo;
 pub mod dynamic;
 pub mod experiment;
