@@ -134,6 +134,7 @@ impl Tiny {
                 triangles: &self.triangles,
                 surface: &self.surface,
                 interior: &self.interior,
+                compressed: None,
                 collision: &collision_index(&self.positions, &self.triangles),
             },
             Precision::F32,

@@ -125,12 +125,23 @@ impl TableEstimate {
         fixed: &[bool],
         surface: &Surface,
     ) -> Self {
-        let kind = match options.kind {
-            TableKindOptions::Precomputed { .. } => TableKind::Precomputed,
-            TableKindOptions::TensorMass { .. } => TableKind::TensorMass,
+        let (kind, compressed) = match options.kind {
+            TableKindOptions::Precomputed { compression, .. } => {
+                (TableKind::Precomputed, compression.is_some())
+            }
+            TableKindOptions::TensorMass { .. } => (TableKind::TensorMass, false),
         };
         let counts = TableCounts::of(mesh, report, fixed, surface);
-        Self::new(kind, options.precision, counts)
+        let mut estimate = Self::new(kind, options.precision, counts);
+        if compressed {
+            // The f32 table's size bounds the compressed one's; its build
+            // also holds the draft, the final table and the two aligned
+            // copies its errors are measured on.
+            estimate.peak_bytes = estimate
+                .peak_bytes
+                .saturating_add(estimate.table_bytes.saturating_mul(4));
+        }
+        estimate
     }
 
     /// The estimate of a table of `kind` stored in `precision` for `counts`.

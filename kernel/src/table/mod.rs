@@ -11,6 +11,7 @@
 //! raw `u32`s: the format's sentinels stay inside this module.
 
 mod collision;
+mod compressed;
 mod container;
 mod error;
 pub mod format;
@@ -21,6 +22,7 @@ mod tensor_mass;
 
 pub(crate) use collision::BuiltLists;
 pub use collision::{DEAD_TRIANGLE, Grid, SurfaceIndex, max_row, within};
+pub use compressed::{CodedBlocks, ComplianceBlocks};
 pub use error::LoadError;
 pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};
