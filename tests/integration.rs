@@ -22,6 +22,7 @@ mod host {
     mod session_tools;
     mod session_trajectory_tools;
     mod stability;
+    mod table_compress;
 }
 
 mod kernel {
@@ -34,6 +35,7 @@ mod kernel {
     mod stvk;
     mod stvk_terms;
     mod table;
+    mod table_compressed;
     mod tensor_mass;
 }
 

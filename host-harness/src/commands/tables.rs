@@ -45,12 +45,12 @@ pub enum TablesCommand {
         /// With --compress: leave out each interior compliance block whose
         /// largest entry is below REL times the largest of its column
         /// (far-field blocks; they count as zero), REL in [0, 1).
-        #[arg(long, value_name = "REL", requires = "compress")]
+        #[arg(long, value_name = "REL")]
         drop_below: Option<f64>,
         /// With --compress: how the touchable-touchable blocks (the contact
         /// solve's) are stored: coded (default), f32, or coded with
         /// --drop-below applied to them too (costs contact force accuracy).
-        #[arg(long, value_enum, requires = "compress")]
+        #[arg(long, value_enum)]
         contact_blocks: Option<ContactBlocks>,
         /// No progress bar.
         #[arg(long)]
@@ -137,6 +137,14 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 .subcommand_matches("build")
                 .and_then(|m| m.value_source("solver"))
                 == Some(ValueSource::CommandLine);
+            if compress.is_none() {
+                if drop_below.is_some() {
+                    bail!("--drop-below applies to a compressed table: add --compress f16|q16");
+                }
+                if contact_blocks.is_some() {
+                    bail!("--contact-blocks applies to a compressed table: add --compress f16|q16");
+                }
+            }
             let kind = match (kind, density) {
                 (TableKindArg::TensorMass, None) => {
                     bail!("--kind tensor-mass needs --density <kg/m3>")

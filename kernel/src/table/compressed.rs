@@ -136,10 +136,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
                     add_products(blocks, w, out);
                 }
             }
-            ComplianceBlocks::Coded(coded) => match coded.code {
-                Code::F16 => coded.add_products(format::f16_to_f32, first, column, w, out),
-                Code::Q16 => coded.add_products(q16_value, first, column, w, out),
-            },
+            ComplianceBlocks::Coded(coded) => coded.add_products(first, column, w, out),
         }
     }
 
@@ -178,7 +175,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
 
 impl<T: Real> CodedBlocks<'_, T> {
     /// The decoded values of one stored block, before its column's scale.
-    #[inline(always)]
+    #[inline(never)]
     fn values(&self, codes: &[u16; 9]) -> [T; 9] {
         match self.code {
             Code::F16 => codes.map(|c| T::of_f32(format::f16_to_f32(c))),
@@ -203,23 +200,14 @@ impl<T: Real> CodedBlocks<'_, T> {
         })
     }
 
-    /// See [`ComplianceBlocks::add_products`]; `value` decodes one code.
-    /// `out[i] += scale · (Q_i w)`: the codes times `w`, then the column's
-    /// scale once per row.
-    #[inline(always)]
-    fn add_products(
-        &self,
-        value: impl Fn(u16) -> f32,
-        first: usize,
-        column: usize,
-        w: &Vector3<T>,
-        out: &mut [[T; 3]],
-    ) {
+    /// See [`ComplianceBlocks::add_products`]: `out[i] += scale · (Q_i w)`,
+    /// the decoded codes times `w`, then the column's scale once per row.
+    fn add_products(&self, first: usize, column: usize, w: &Vector3<T>, out: &mut [[T; 3]]) {
         let Some(&scale) = self.scales.get(column) else {
             return;
         };
         let add = |codes: &[u16; 9], u: &mut [T; 3]| {
-            let q = codes.map(|c| T::of_f32(value(c)));
+            let q = self.values(codes);
             let v = [
                 q[0] * w.x + q[1] * w.y + q[2] * w.z,
                 q[3] * w.x + q[4] * w.y + q[5] * w.z,
