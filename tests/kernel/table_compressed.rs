@@ -51,8 +51,8 @@ fn part(t: &mut TinyTable, surface: bool) -> &mut palpate::table::compress::Code
 
 #[test]
 fn f16_decode_matches_hand_computed_bit_patterns() {
-    // (code, value), from sign, exponent (bias 15) and fraction by hand.
-    let cases: [(u16, f32); 12] = [
+    // (code, value), from sign, exponent (bias 15) and fraction by hand; exact in f64 (and f32).
+    let cases: [(u16, f64); 12] = [
         (0x0000, 0.0),                       // +0
         (0x3c00, 1.0),                       // e = 15, f = 0
         (0xc000, -2.0),                      // sign, e = 16
@@ -67,7 +67,11 @@ fn f16_decode_matches_hand_computed_bit_patterns() {
         (0x8001, -5.960_464_477_539_063e-8), // its negative
     ];
     for (code, value) in cases {
-        assert_eq!(f16_to_f32(code).to_bits(), value.to_bits(), "{code:#06x}");
+        assert_eq!(
+            f64::from(f16_to_f32(code)).to_bits(),
+            value.to_bits(),
+            "{code:#06x}"
+        );
     }
     assert_eq!(f16_to_f32(0x8000).to_bits(), (-0.0f32).to_bits());
     assert_eq!(f16_to_f32(0x7c00), f32::INFINITY);
