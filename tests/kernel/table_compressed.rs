@@ -106,7 +106,7 @@ fn kept_rank_counts_the_bits_before() {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
-            state % 3 != 0
+            !state.is_multiple_of(3)
         })
         .collect();
     let kept = kept_bitmap(&flags);
