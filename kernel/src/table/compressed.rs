@@ -175,7 +175,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
 
 impl<T: Real> CodedBlocks<'_, T> {
     /// The decoded values of one stored block, before its column's scale.
-    #[inline(never)]
+    #[inline]
     fn values(&self, codes: &[u16; 9]) -> [T; 9] {
         match self.code {
             Code::F16 => codes.map(|c| T::of_f32(format::f16_to_f32(c))),
@@ -200,30 +200,19 @@ impl<T: Real> CodedBlocks<'_, T> {
         })
     }
 
-    /// See [`ComplianceBlocks::add_products`]: `out[i] += scale · (Q_i w)`,
-    /// the decoded codes times `w`, then the column's scale once per row.
+    /// See [`ComplianceBlocks::add_products`]: `out[i] += Q_i (s w)`, the
+    /// decoded codes times the scaled `w` (`s` the column's scale).
     fn add_products(&self, first: usize, column: usize, w: &Vector3<T>, out: &mut [[T; 3]]) {
         let Some(&scale) = self.scales.get(column) else {
             return;
         };
-        let add = |codes: &[u16; 9], u: &mut [T; 3]| {
-            let q = self.values(codes);
-            let v = [
-                q[0] * w.x + q[1] * w.y + q[2] * w.z,
-                q[3] * w.x + q[4] * w.y + q[5] * w.z,
-                q[6] * w.x + q[7] * w.y + q[8] * w.z,
-            ];
-            *u = [
-                u[0] + scale * v[0],
-                u[1] + scale * v[1],
-                u[2] + scale * v[2],
-            ];
-        };
+        let w = w * scale;
         match self.kept {
             None => {
                 if let Some(codes) = self.codes.get(first..first + out.len()) {
-                    for (codes, u) in codes.iter().zip(out) {
-                        add(codes, u);
+                    match self.code {
+                        Code::F16 => add_coded_products(codes, format::f16_to_f32, &w, out),
+                        Code::Q16 => add_coded_products(codes, q16_value, &w, out),
                     }
                 }
             }
@@ -236,13 +225,34 @@ impl<T: Real> CodedBlocks<'_, T> {
                 for (j, u) in (first..).zip(out) {
                     if is_kept(kept, j) {
                         if let Some(codes) = self.codes.get(next) {
-                            add(codes, u);
+                            let q = self.values(codes);
+                            *u = [
+                                u[0] + (q[0] * w.x + q[1] * w.y + q[2] * w.z),
+                                u[1] + (q[3] * w.x + q[4] * w.y + q[5] * w.z),
+                                u[2] + (q[6] * w.x + q[7] * w.y + q[8] * w.z),
+                            ];
                         }
                         next += 1;
                     }
                 }
             }
         }
+    }
+}
+
+/// `out[i] += Q_i w` for the blocks of 16-bit `codes` decoded by `value`,
+/// written as [`add_products`] is, one output float per row of 3 codes.
+#[inline(always)]
+fn add_coded_products<T: Real>(
+    codes: &[[u16; 9]],
+    value: impl Fn(u16) -> f32,
+    w: &Vector3<T>,
+    out: &mut [[T; 3]],
+) {
+    let (rows, _) = codes.as_flattened().as_chunks::<3>();
+    let q = |c: u16| T::of_f32(value(c));
+    for (r, u) in rows.iter().zip(out.as_flattened_mut()) {
+        *u += q(r[0]) * w.x + q(r[1]) * w.y + q(r[2]) * w.z;
     }
 }
 
