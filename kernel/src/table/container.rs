@@ -9,6 +9,21 @@ use super::format::{
 };
 use crate::Real;
 
+/// The slot in [`Container`]'s sections of each [`SectionKind`], by its
+/// value: its index in [`SectionKind::ALL`] (a table, so that looking a
+/// section up is one load, not a search). Evaluated at compile time: an
+/// index out of range here is a compile error, never a run-time panic.
+#[allow(clippy::indexing_slicing)]
+const SLOT_OF_KIND: [u8; 64] = {
+    let mut slots = [u8::MAX; 64];
+    let mut i = 0;
+    while i < SectionKind::ALL.len() {
+        slots[SectionKind::ALL[i] as usize] = i as u8;
+        i += 1;
+    }
+    slots
+};
+
 /// A table whose header, directory and checksum are valid, with every section
 /// located (bounds and alignment checked) but not yet viewed.
 pub(crate) struct Container<'a> {
@@ -39,8 +54,8 @@ impl<'a> Container<'a> {
     }
 
     fn raw(&self, kind: SectionKind) -> Option<&'a [u8]> {
-        let slot = SectionKind::ALL.iter().position(|k| *k == kind)?;
-        self.sections.get(slot).copied().flatten()
+        let slot = *SLOT_OF_KIND.get(kind as usize)?;
+        self.sections.get(usize::from(slot)).copied().flatten()
     }
 
     /// `true` if the section `kind` is present.
