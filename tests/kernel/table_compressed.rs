@@ -267,7 +267,7 @@ fn bad_kept_blocks_are_refused() {
             kind: SectionKind::InteriorCodes
         })
     );
-    // Without a bitmap, every block must be stored.
+    // Without a bitmap, every block is stored or none.
     let mut t = tiny(BlockCode::F16);
     part(&mut t, true).codes.pop();
     assert_eq!(
@@ -275,6 +275,19 @@ fn bad_kept_blocks_are_refused() {
         Err(LoadError::SectionSize {
             kind: SectionKind::SurfaceCodes
         })
+    );
+    let mut t = tiny(BlockCode::F16);
+    part(&mut t, false).codes.clear();
+    let file = TableFile::from_bytes(&t.bytes());
+    let table = PrecomputedTable::<f32>::load(file.bytes()).expect("every interior block dropped");
+    let interior = table.interior_blocks();
+    assert_eq!((interior.len(), interior.stored_len()), (4, 0));
+    assert!((0..4).all(|k| !interior.is_stored(k) && interior.block(k, k) == Some([0.0; 9])));
+    let mut t = tiny(BlockCode::Q16);
+    part(&mut t, true).codes.clear();
+    assert_eq!(
+        load32(&t.bytes()),
+        Err(LoadError::DroppedDiagonal { touchable: 0 })
     );
     // A diagonal block dropped: C_22 is surface block 5.
     let mut t = tiny(BlockCode::Q16);

@@ -159,7 +159,8 @@ pub struct CodedPart {
     pub scales: Vec<f64>,
     /// The kept blocks' codes.
     pub codes: Vec<[u16; 9]>,
-    /// `[bits, rank]` words over the dense layout, when blocks were dropped.
+    /// `[bits, rank]` words over the dense layout, when some blocks were
+    /// dropped, not all.
     pub kept: Option<Vec<[u32; 2]>>,
 }
 
@@ -299,7 +300,9 @@ fn code_part(
             codes.push(block.map(|x| code.code(x, scale)));
         }
     }
-    let kept = (codes.len() < blocks).then(|| kept_bitmap(&flags));
+    // A bitmap only when some blocks, not all, were dropped (the format's
+    // rule: without one, every block is stored or none).
+    let kept = (!codes.is_empty() && codes.len() < blocks).then(|| kept_bitmap(&flags));
     Ok(CodedPart {
         scales,
         codes,

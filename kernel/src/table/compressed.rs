@@ -49,7 +49,8 @@ pub enum ComplianceBlocks<'a, T: Real> {
 /// kept. Invariants from [`load_parts`]: the scales are finite and `> 0`,
 /// no code is an infinity or NaN (f16) or −32768 (q16), the kept-block
 /// bitmap is consistent and counts exactly the stored codes (without one,
-/// every block is stored).
+/// every block is stored, or none: the codes are then empty, and a block's
+/// position is past them).
 #[derive(Clone, Copy, Debug)]
 pub struct CodedBlocks<'a, T: Real> {
     code: Code,
@@ -108,9 +109,11 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
     pub fn is_stored(&self, j: usize) -> bool {
         match self {
             ComplianceBlocks::Dense(blocks) => j < blocks.len(),
-            ComplianceBlocks::Coded(coded) => {
-                j < coded.blocks && coded.kept.is_none_or(|kept| is_kept(kept, j))
-            }
+            ComplianceBlocks::Coded(coded) => match coded.kept {
+                // Without a bitmap: every block stored, or none.
+                None => j < coded.codes.len(),
+                Some(kept) => j < coded.blocks && is_kept(kept, j),
+            },
         }
     }
 
@@ -391,11 +394,12 @@ fn load_part<'a, T: Real>(
             column: column as u32,
         });
     }
-    let stored = match kept {
-        Some(kept) => check_kept(part.kept, kept, blocks)?,
-        None => blocks,
+    let count_ok = match kept {
+        Some(kept) => codes.len() == check_kept(part.kept, kept, blocks)?,
+        // Every block stored, or every one dropped.
+        None => codes.len() == blocks || codes.is_empty(),
     };
-    if codes.len() != stored {
+    if !count_ok {
         return Err(size);
     }
     let bad = |codes: &[u16; 9]| match code {

@@ -62,8 +62,9 @@
 //!   `decode` is the IEEE 754 binary16 value of the code ([`f16_to_f32`];
 //!   infinities and NaNs are refused at load); for Q16 it is the code as a
 //!   two's complement `i16` in `−32767..=32767` (`−32768` is refused);
-//! - `X-kept` (only when blocks were dropped): which blocks of the dense
-//!   layout are stored, one bit per block (bit `j % 32` of word `j / 32`,
+//! - `X-kept` (only when some blocks were dropped, not all: without it
+//!   `X-codes` holds every block, or none when all were dropped): which
+//!   blocks of the dense layout are stored, one bit per block (bit `j % 32` of word `j / 32`,
 //!   least significant first), each word followed by the number of bits set
 //!   in the words before it (a rank directory, so a block is found in
 //!   constant time: [`kept_position`]). A dropped block is zero. Bits past

@@ -5,7 +5,8 @@
 //!
 //! A table is bytes until [`PrecomputedTable::load`] has checked it once
 //! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
-//! diagonal blocks); afterwards the step path trusts it, and indexes it with
+//! diagonal blocks, a compressed compliance's scales, codes and kept blocks:
+//! [`ComplianceBlocks`]); afterwards the step path trusts it, and indexes it with
 //! the checked indices the views hand out ([`VertexIndex`],
 //! [`TriangleIndex`], [`TetIndex`], [`EdgeIndex`], [`FreeIndex`]) instead of
 //! raw `u32`s: the format's sentinels stay inside this module.
