@@ -428,10 +428,11 @@ impl BlockEncoding {
         Self::ALL.into_iter().find(|e| *e as u32 == value)
     }
 
-    /// Human-readable name, for `tables info`: `f32/f64`, `f16`, `q16`.
+    /// Human-readable name, for `tables info`: `uncompressed` (the table
+    /// scalar), `f16`, `q16`.
     pub const fn name(self) -> &'static str {
         match self {
-            BlockEncoding::Scalar => "table scalar",
+            BlockEncoding::Scalar => "uncompressed",
             BlockEncoding::F16 => "f16",
             BlockEncoding::Q16 => "q16",
         }
