@@ -39,6 +39,7 @@ mod host {
     mod session_tools;
     mod session_trajectory_tools;
     mod stability;
+    mod table_compress;
 }
 
 mod kernel {
@@ -52,6 +53,7 @@ mod kernel {
     mod stvk;
     mod stvk_terms;
     mod table;
+    mod table_compressed;
     mod tensor_mass;
 }
 

@@ -6,6 +6,10 @@
 #
 #   tools/firmware-check.sh            the pre-computed model: box-table.sh's table,
 #                                      sequence.txt, vs `palpate precomputed replay`
+#   tools/firmware-check.sh --compress CODE
+#                                      the same with the table compressed (CODE f16 or
+#                                      q16; `box-table.sh --compress CODE`): the kernel
+#                                      decodes it on the fly on both sides
 #   tools/firmware-check.sh --hybrid   the hybrid (RR-3510 §6.2): hybrid-tables.sh's three
 #                                      tables, hybrid-sequence.txt, firmware built with
 #                                      `--features hybrid`, vs `palpate scene replay-hybrid`
@@ -144,7 +148,12 @@ if [[ "${1:-}" == --hybrid ]]; then
     build=(env PALPATE_HYBRID_TABLES="$tables" cargo build -q --release --features hybrid)
 else
     mode=precomputed
-    table="$(tools/box-table.sh)" # host CLI, dev profile; prints the table path
+    compress=()
+    if [[ "${1:-}" == --compress ]]; then
+        compress=(--compress "${2:?usage: tools/firmware-check.sh --compress f16|q16}")
+        mode="precomputed-$2"
+    fi
+    table="$(tools/box-table.sh "${compress[@]}")" # host CLI, dev profile; prints the table path
     sequence="$root/tools/firmware-m4f/sequence.txt"
     host=(precomputed replay "$table" "$sequence")
     build=(env PALPATE_TABLE="$table" cargo build -q --release)

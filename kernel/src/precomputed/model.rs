@@ -306,7 +306,8 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// [`crate::table::format`]): rows `n ≤ k` from column `k` of the packed
     /// surface part, rows `k < n < S` as `C_knᵀ` from column `n`, interior
     /// rows from column `k` of the interior part. Rows outside `0..F` are
-    /// skipped.
+    /// skipped. A compressed part is decoded on the fly (a dropped block adds
+    /// nothing); the work is the same `F` blocks per column either way.
     fn add_column_rows(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
         let s = self.table.touchable_count();
         let f = self.table.free_count();
@@ -317,29 +318,21 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             let (a, b) = (first.max(lo), end.min(hi));
             (a < b).then(|| (a, a - first..b - first))
         };
-        if let Some((a, rows)) = window(0, k + 1) {
-            let start = surface_block_index(a, k);
-            let blocks = surface.get(start..start + rows.len());
-            if let (Some(blocks), Some(out)) = (blocks, out.get_mut(rows)) {
-                add_products(blocks, w, out);
-            }
+        if let Some((a, rows)) = window(0, k + 1)
+            && let Some(out) = out.get_mut(rows)
+        {
+            surface.add_products(surface_block_index(a, k), k, w, out);
         }
         if let Some((a, rows)) = window(k + 1, s)
             && let Some(out) = out.get_mut(rows)
         {
-            for (n, u) in (a..).zip(out) {
-                if let Some(c) = surface.get(surface_block_index(k, n)) {
-                    let v = mul_transposed(c, w);
-                    *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
-                }
-            }
+            surface.add_transposed_products(k, a, w, out);
         }
-        if let Some((a, rows)) = window(s, f) {
+        if let Some((a, rows)) = window(s, f)
+            && let Some(out) = out.get_mut(rows)
+        {
             let start = k * (f - s) + (a - s);
-            let blocks = self.table.interior_blocks().get(start..start + rows.len());
-            if let (Some(blocks), Some(out)) = (blocks, out.get_mut(rows)) {
-                add_products(blocks, w, out);
-            }
+            self.table.interior_blocks().add_products(start, k, w, out);
         }
     }
 }
@@ -356,17 +349,6 @@ fn check_length<E>(expected: usize, out: &[E]) -> Result<(), DisplacementError> 
     }
 }
 
-/// `out[i] += C_i w` for row-major 3×3 blocks `C_i`, written as a product of
-/// the `3F × 3` matrix of their rows with `w` so that it vectorizes (one
-/// output float per row of 3).
-#[inline(always)]
-fn add_products<T: Real>(blocks: &[[T; 9]], w: &Vector3<T>, out: &mut [[T; 3]]) {
-    let (rows, _) = blocks.as_flattened().as_chunks::<3>();
-    for (r, u) in rows.iter().zip(out.as_flattened_mut()) {
-        *u += r[0] * w.x + r[1] * w.y + r[2] * w.z;
-    }
-}
-
 /// Two vertex contacts on one vertex make the system exactly singular; name them.
 fn check_duplicates<T: Real>(contacts: &[impl AsConstraint<T>]) -> Result<(), ContactError> {
     use ContactPoint::Vertex;
@@ -380,14 +362,4 @@ fn check_duplicates<T: Real>(contacts: &[impl AsConstraint<T>]) -> Result<(), Co
         }
     }
     Ok(())
-}
-
-/// Transpose of a row-major 3×3 block times a vector.
-#[inline(always)]
-fn mul_transposed<T: Real>(c: &[T; 9], w: &Vector3<T>) -> [T; 3] {
-    [
-        c[0] * w.x + c[3] * w.y + c[6] * w.z,
-        c[1] * w.x + c[4] * w.y + c[7] * w.z,
-        c[2] * w.x + c[5] * w.y + c[8] * w.z,
-    ]
 }
