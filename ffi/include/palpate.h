@@ -334,6 +334,34 @@ enum palpate_status
    */
   PALPATE_STATUS_TABLE_NOT_POSITIVE_DEFINITE = 128,
   /*
+   Compressed table: the compliance-encoding record is malformed (`LoadError::BadCompressionRecord`).
+   */
+  PALPATE_STATUS_TABLE_BAD_COMPRESSION_RECORD = 129,
+  /*
+   Compressed table: unknown block encoding (`LoadError::UnknownEncoding`).
+   */
+  PALPATE_STATUS_TABLE_UNKNOWN_ENCODING = 130,
+  /*
+   Table section not used by its compliance encoding (`LoadError::UnexpectedSection`).
+   */
+  PALPATE_STATUS_TABLE_UNEXPECTED_SECTION = 131,
+  /*
+   Compressed table: a column scale is not finite and > 0 (`LoadError::BadScale`).
+   */
+  PALPATE_STATUS_TABLE_BAD_SCALE = 132,
+  /*
+   Compressed table: a fixed-point code is -32768 (`LoadError::BadCode`).
+   */
+  PALPATE_STATUS_TABLE_BAD_CODE = 133,
+  /*
+   Compressed table: kept-block bitmap inconsistent (`LoadError::BadKeptBlocks`).
+   */
+  PALPATE_STATUS_TABLE_BAD_KEPT_BLOCKS = 134,
+  /*
+   Compressed table: a diagonal compliance block was dropped (`LoadError::DroppedDiagonal`).
+   */
+  PALPATE_STATUS_TABLE_DROPPED_DIAGONAL = 135,
+  /*
    More contacts than `PALPATE_MAX_CONTACTS`.
    */
   PALPATE_STATUS_CONTACT_TOO_MANY = 200,

@@ -105,6 +105,20 @@ pub enum Status {
     TableBadTetMaterial = 127,
     /// A diagonal compliance block is not symmetric positive definite.
     TableNotPositiveDefinite = 128,
+    /// Compressed table: the compliance-encoding record is malformed (`LoadError::BadCompressionRecord`).
+    TableBadCompressionRecord = 129,
+    /// Compressed table: unknown block encoding (`LoadError::UnknownEncoding`).
+    TableUnknownEncoding = 130,
+    /// Table section not used by its compliance encoding (`LoadError::UnexpectedSection`).
+    TableUnexpectedSection = 131,
+    /// Compressed table: a column scale is not finite and > 0 (`LoadError::BadScale`).
+    TableBadScale = 132,
+    /// Compressed table: a fixed-point code is -32768 (`LoadError::BadCode`).
+    TableBadCode = 133,
+    /// Compressed table: kept-block bitmap inconsistent (`LoadError::BadKeptBlocks`).
+    TableBadKeptBlocks = 134,
+    /// Compressed table: a diagonal compliance block was dropped (`LoadError::DroppedDiagonal`).
+    TableDroppedDiagonal = 135,
 
     // Contacts (`palpate_precomputed_solve`, `..._displacements`): the
     // kernel's `ContactError` and `DisplacementError`.
@@ -219,6 +233,17 @@ impl Status {
             Self::TableBadConnection => c"invalid connection node in the interface table",
             Self::TableBadTetMaterial => c"tet material out of range in the table",
             Self::TableNotPositiveDefinite => c"table compliance block not positive definite",
+            Self::TableBadCompressionRecord => {
+                c"compressed table: the compliance-encoding record is malformed"
+            }
+            Self::TableUnknownEncoding => c"compressed table: unknown block encoding",
+            Self::TableUnexpectedSection => c"table section not used by its compliance encoding",
+            Self::TableBadScale => c"compressed table: a column scale is not finite and > 0",
+            Self::TableBadCode => c"compressed table: a fixed-point code is -32768",
+            Self::TableBadKeptBlocks => c"compressed table: kept-block bitmap inconsistent",
+            Self::TableDroppedDiagonal => {
+                c"compressed table: a diagonal compliance block was dropped"
+            }
             Self::ContactTooMany => c"more contacts than PALPATE_MAX_CONTACTS",
             Self::ContactVertexOutOfRange => c"contact vertex out of range",
             Self::ContactFixedVertex => c"contact on a fixed vertex",
@@ -284,6 +309,13 @@ impl From<LoadError> for Status {
             LoadError::BadConnection { .. } => Self::TableBadConnection,
             LoadError::BadTetMaterial { .. } => Self::TableBadTetMaterial,
             LoadError::NotPositiveDefinite { .. } => Self::TableNotPositiveDefinite,
+            LoadError::BadCompressionRecord => Self::TableBadCompressionRecord,
+            LoadError::UnknownEncoding { .. } => Self::TableUnknownEncoding,
+            LoadError::UnexpectedSection { .. } => Self::TableUnexpectedSection,
+            LoadError::BadScale { .. } => Self::TableBadScale,
+            LoadError::BadCode { .. } => Self::TableBadCode,
+            LoadError::BadKeptBlocks { .. } => Self::TableBadKeptBlocks,
+            LoadError::DroppedDiagonal { .. } => Self::TableDroppedDiagonal,
         }
     }
 }
@@ -409,7 +441,7 @@ impl From<FieldError> for Status {
 /// raw number, and the tests).
 ///
 /// cbindgen:ignore
-pub const ALL: [Status; 65] = [
+pub const ALL: [Status; 72] = [
     Status::Ok,
     Status::NullPointer,
     Status::Misaligned,
@@ -446,6 +478,13 @@ pub const ALL: [Status; 65] = [
     Status::TableBadConnection,
     Status::TableBadTetMaterial,
     Status::TableNotPositiveDefinite,
+    Status::TableBadCompressionRecord,
+    Status::TableUnknownEncoding,
+    Status::TableUnexpectedSection,
+    Status::TableBadScale,
+    Status::TableBadCode,
+    Status::TableBadKeptBlocks,
+    Status::TableDroppedDiagonal,
     Status::ContactTooMany,
     Status::ContactVertexOutOfRange,
     Status::ContactFixedVertex,

@@ -488,6 +488,7 @@ pub fn firmware_box_tables() -> &'static FirmwareBoxTables {
             .expect("hybrid tables"),
         }
     })
+}
 
 /// A pre-computed table with hand-set contents (a 5-vertex mesh, vertex 0
 /// fixed), so that each structural check of the loader can be hit behind a

@@ -628,8 +628,10 @@ fn precomputed(
     let w32: Vec<f32> = weights.iter().map(|&x| x as f32).collect();
     let mut out64 = vec![0.0f64; rows];
     let mut out32 = vec![0.0f32; rows];
-    let direction =
-        quasi.and_then(|_| QuasiNonLinear::direction(loads.iter().map(|f| Vector3::from(*f))));
+    let direction = quasi.and_then(|_| {
+        let total: Vector3<f64> = loads.iter().map(|f| Vector3::from(*f)).sum();
+        QuasiNonLinear::direction(&total)
+    });
     let total = direction.map_or(0.0, |d| {
         loads.iter().map(|f| Vector3::from(*f).dot(&d)).sum::<f64>()
     });

@@ -13,7 +13,8 @@
 //! selector at each call:
 //! - table validation, `PrecomputedTable::load` (not the step path, but it runs
 //!   on bytes from flash or a file, so it is checked too);
-//! - the haptic force path, `PrecomputedModel::contact_forces::<MAX_CONTACTS>`;
+//! - the haptic force path, `PrecomputedModel::contact_forces::<MAX_CONTACTS>`,
+//!   linear or quasi-non-linear (`with_remap`, on volatile coefficients);
 //! - the displacement updates, `PrecomputedModel::free_displacements` and
 //!   `PrecomputedModel::displacements`.
 //!
@@ -124,7 +125,7 @@ use palpate_kernel::haptic::{
     DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop,
     SafetyLimits, ToolAction, ToolInput,
 };
-use palpate_kernel::precomputed::{Constraint, PrecomputedTissue};
+use palpate_kernel::precomputed::{Constraint, PrecomputedTissue, QuasiNonLinear, Remap};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
@@ -184,6 +185,10 @@ struct Inputs {
     vertex_len: usize,
     /// Entries passed to `free_displacements` (clamped to `VERTICES`).
     free_len: usize,
+    /// The quasi-non-linear remap's coefficients (radial `c_1..c_5`, its
+    /// range, force `c_1..c_5`, its range); used when `Remap::new` accepts
+    /// them, so the remapped force and field paths are in the proof.
+    remap: [f32; 12],
 }
 
 /// A contact set, opaque to the optimiser.
@@ -244,6 +249,7 @@ static mut INPUTS: Inputs = Inputs {
     contacts: NO_CONTACTS,
     vertex_len: VERTICES,
     free_len: VERTICES,
+    remap: [0.0; 12],
 };
 
 /// Where the results go, written with `write_volatile` only: the device force
@@ -686,6 +692,14 @@ fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
         return;
     };
     let model = PrecomputedModel::new(table);
+    let [r @ .., r_max, f1, f2, f3, f4, f5, f_max] = inputs.remap;
+    let model = match (
+        Remap::new(r, r_max),
+        Remap::new([f1, f2, f3, f4, f5], f_max),
+    ) {
+        (Ok(radial), Ok(force)) => model.with_remap(QuasiNonLinear { radial, force }),
+        _ => model,
+    };
 
     let contacts = inputs.contacts.constraints();
     let set = contact_set(&contacts, inputs.contacts.count);
