@@ -196,8 +196,10 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 let d = contact.displacement_m();
                 if let Some(direction) = QuasiNonLinear::direction(&d) {
                     *g = remap.force(&direction, *g);
-                    if d.norm() > largest {
-                        largest = d.norm();
+                    // `direction` is `d / |d|`, so `d·direction` is `|d|`.
+                    let length = d.dot(&direction);
+                    if length > largest {
+                        largest = length;
                         solution.direction = Some(direction);
                     }
                 }
