@@ -215,17 +215,17 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         Ok(solution)
     }
 
-    /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N).
+    /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N): at most nine
+    /// stored blocks, each read once and accumulated in place.
     fn point_compliance(&self, p: &ResolvedPoint<T>, q: &ResolvedPoint<T>) -> Matrix3<T> {
-        let mut c = Matrix3::zeros();
+        let mut c = [T::zero(); 9];
         for (a, beta_a) in p.terms() {
             for (b, beta_b) in q.terms() {
-                if let Some(block) = self.table.touchable_block_of(a, b) {
-                    c += block * (beta_a * beta_b);
-                }
+                self.table
+                    .add_touchable_block(a, b, beta_a * beta_b, &mut c);
             }
         }
-        c
+        Matrix3::from_row_slice(&c)
     }
 
     /// The displacement of every free vertex for a solved contact set, m, by
