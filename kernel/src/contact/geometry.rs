@@ -352,7 +352,10 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let to_in = within(to_m, &reach);
         let sweep = from_m.map(|from_m| {
             let from_in = within(from_m, &reach);
-            let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
+            let ([a, b, c], [x, y, z]) = (self.index.cell_of(from_m), self.index.cell_of(to_m));
+            // Corner by corner: an array comparison is a `memcmp` call on
+            // the firmware target.
+            let same_cell = a == x && b == y && c == z;
             // The swept segment, clipped to the reach of the grid when
             // exactly one end lies outside it (both outside: no candidate).
             let (start_m, end_m) = match (from_in, to_in) {
@@ -539,7 +542,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// not the plane the sphere reaches, is the nearest, and the tool is
     /// outside (beyond a thin flap, nearer its other face). The second pass
     /// of [`Self::detect`]'s penetration test, over the same candidates in
-    /// the same order, only when such a plane exists.
+    /// the same order, only when such a plane exists (out of line: its
+    /// visited set is only set up when it runs).
+    #[inline(never)]
     fn covered(
         &self,
         tip_m: &Vector3<T>,

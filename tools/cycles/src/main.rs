@@ -266,10 +266,11 @@ fn split_runs(emulation: &emulate::Emulation) -> Result<Vec<Run<'_>>, String> {
     Ok(runs)
 }
 
-/// For each run, the worst tick (cycles at zero wait states) and the worst
+/// For each run, the worst tick (cycles at zero wait states), the worst
 /// steady tick (every point in contact, no triangle tested, no edge
-/// crossed: the tracked contacts' solve alone), each by class and with its
-/// `top` functions by cycles. `work` is every tick's, in run order.
+/// crossed: the tracked contacts' solve alone) and the worst hovering tick
+/// (no contact, triangles tested: detection alone), each by class and with
+/// its `top` functions by cycles. `work` is every tick's, in run order.
 fn profile(program: &elf::Program, runs: &[Run<'_>], work: &[Work], top: usize, w: u32) -> String {
     let mut text = String::new();
     let mut first = 0;
@@ -280,14 +281,20 @@ fn profile(program: &elf::Program, runs: &[Run<'_>], work: &[Work], top: usize, 
             work.get(k)
                 .is_some_and(|t| t.contacts == u64::from(run.points) && t.tests == 0 && t.walk == 0)
         };
-        let worst = run.ticks.iter().enumerate().max_by_key(|(_, c)| c.cycles);
-        let worst_steady = run
-            .ticks
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| steady(*k))
-            .max_by_key(|(_, c)| c.cycles);
-        for (what, tick) in [("", worst), ("steady ", worst_steady)] {
+        let hovering = |k: usize| work.get(k).is_some_and(|t| t.contacts == 0 && t.tests > 0);
+        let worst_where = |keep: &dyn Fn(usize) -> bool| {
+            run.ticks
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| keep(*k))
+                .max_by_key(|(_, c)| c.cycles)
+        };
+        let worst = worst_where(&|_| true);
+        for (what, tick) in [
+            ("", worst),
+            ("steady ", worst_where(&steady)),
+            ("hovering ", worst_where(&hovering)),
+        ] {
             if let Some((k, c)) = tick {
                 profile_tick(&mut text, program, run, what, k, c, top, w);
             }
