@@ -124,33 +124,44 @@ struct Nearest<T> {
 /// visit meets a triangle once per corner in those cells, and tests it
 /// once. A power of two; a detection on the built-in block tests at most
 /// 48 (`tools/cycles-check.sh`, the triangles tested per tick), and a
-/// larger candidate set is still correct, with repeated tests beyond this.
+/// larger candidate set is still correct, with repeated tests beyond the
+/// set's three quarters.
 const VISITED_CAPACITY: usize = 128;
 
 /// The triangles a detection has tested: an open-addressed set on the
-/// stack (linear probing). A full set lets a triangle through again, which
-/// changes nothing: every test keeps the first of equals.
+/// stack (linear probing), filled to at most three quarters so that a
+/// look-up ends after a few probes. Past that a triangle is let through
+/// again, with no probe, which changes nothing: every test keeps the first
+/// of equals.
 struct Visited {
     slots: [u32; VISITED_CAPACITY],
+    len: usize,
 }
 
 impl Visited {
     const EMPTY: u32 = u32::MAX;
+    /// Most triangles remembered.
+    const MAX_LEN: usize = VISITED_CAPACITY / 4 * 3;
     /// Bits of the multiplicative hash's slot index.
     const SHIFT: u32 = {
-        assert!(VISITED_CAPACITY.is_power_of_two() && VISITED_CAPACITY > 1);
+        assert!(VISITED_CAPACITY.is_power_of_two() && VISITED_CAPACITY >= 4);
         32 - VISITED_CAPACITY.trailing_zeros()
     };
 
     fn new() -> Self {
         Self {
             slots: [Self::EMPTY; VISITED_CAPACITY],
+            len: 0,
         }
     }
 
     /// `true` the first time `t` is offered (or when the set is full),
-    /// `false` after. At most `VISITED_CAPACITY` probes.
+    /// `false` after. At most `VISITED_CAPACITY` probes, a few at the
+    /// set's load.
     fn first_visit(&mut self, t: TriangleIndex) -> bool {
+        if self.len >= Self::MAX_LEN {
+            return true;
+        }
         let key = t.get() as u32;
         // Fibonacci hashing: the top bits of the product.
         let mut i = (key.wrapping_mul(0x9E37_79B9) >> Self::SHIFT) as usize;
@@ -163,6 +174,7 @@ impl Visited {
             }
             if *slot == Self::EMPTY {
                 *slot = key;
+                self.len += 1;
                 return true;
             }
             i = (i + 1) % VISITED_CAPACITY;
