@@ -120,6 +120,49 @@ struct Nearest<T> {
     order: u32,
 }
 
+/// Planes the penetration test kept that the sphere does not reach.
+const UNREACHED_CAPACITY: usize = 16;
+
+/// The penetration test's planes within the depth reach that the sphere
+/// does not reach (signed distance at least the radius): their nearest
+/// distance, and the first [`UNREACHED_CAPACITY`] of them with their place
+/// in the test order, so that the check of [`SurfaceGeometry::detect`]
+/// (is one of them over the centre, nearer than the nearest reached?)
+/// needs no second pass unless more came.
+struct Unreached<T> {
+    nearest_m: Option<T>,
+    planes: heapless::Vec<(TriangleIndex, Vector3<T>, T, u32), UNREACHED_CAPACITY>,
+    overflowed: bool,
+}
+
+impl<T: Real> Unreached<T> {
+    fn new() -> Self {
+        Self {
+            nearest_m: None,
+            planes: heapless::Vec::new(),
+            overflowed: false,
+        }
+    }
+
+    /// Notes triangle `t` (unit `normal`), `distance_m` from the centre,
+    /// the `order`-th tested.
+    fn note(&mut self, t: TriangleIndex, normal: Vector3<T>, distance_m: T, order: u32) {
+        if self.nearest_m.is_none_or(|u| distance_m < u) {
+            self.nearest_m = Some(distance_m);
+        }
+        if self.planes.push((t, normal, distance_m, order)).is_err() {
+            self.overflowed = true;
+        }
+    }
+
+    /// Whether a plane `distance_m` away, the `k`-th tested, comes before
+    /// the nearest reached plane (`bound_m` away, the `order`-th): nearer,
+    /// or as near and tested first.
+    fn nearer(distance_m: T, k: u32, bound_m: T, order: u32) -> bool {
+        distance_m < bound_m || (distance_m == bound_m && k < order)
+    }
+}
+
 /// Distinct triangles one detection remembers having tested: the 27-cell
 /// visit meets a triangle once per corner in those cells, and tests it
 /// once. A power of two; a detection on the built-in block tests at most
@@ -348,10 +391,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// that is the contact, pushed out along its outward normal, with
     /// [`Contact::entry_gap_m`] its penetration; else there is none (also
     /// when the nearest is a rigid support). A barycentric test is spent
-    /// only on planes the sphere reaches, and on the others only in a
-    /// second pass when one of them is nearer than the nearest reached
-    /// ([`Self::covered`]): a tool hovering within the depth reach costs
-    /// three dot products per candidate.
+    /// only on planes the sphere reaches, and on the others only when one
+    /// of them is nearer than the nearest reached ([`Unreached`], or a
+    /// second pass, [`Self::covered`], when more than it keeps came): a
+    /// tool hovering within the depth reach costs three dot products per
+    /// candidate.
     pub fn detect(
         &self,
         tool: usize,
@@ -384,7 +428,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         // nearest distance of the planes it does not reach, which only
         // matter if one of them lies over the centre nearer than that one.
         let mut reached = None;
-        let mut unreached_m: Option<T> = None;
+        let mut unreached = Unreached::new();
         let mut visited = Visited::new();
         if to_in {
             let mut order = 0u32;
@@ -397,8 +441,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 if distance.abs() <= depth_m && normal != Vector3::zeros() {
                     if distance < radius_m {
                         self.nearest_test(t, normal, distance, to_m, order, &mut reached);
-                    } else if unreached_m.is_none_or(|u| distance < u) {
-                        unreached_m = Some(distance);
+                    } else {
+                        unreached.note(t, normal, distance, order);
                     }
                 }
                 order = order.wrapping_add(1);
@@ -420,10 +464,19 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             weights,
             order,
         } = reached?;
-        if unreached_m.is_some_and(|u| u <= distance_m.abs())
-            && self.covered(to_m, radius_m, depth_m, distance_m.abs(), order, work)
-        {
-            return None;
+        let bound_m = distance_m.abs();
+        if unreached.nearest_m.is_some_and(|u| u <= bound_m) {
+            let covered = if unreached.overflowed {
+                self.covered(to_m, radius_m, depth_m, bound_m, order, work)
+            } else {
+                unreached.planes.iter().any(|&(t, normal, distance, k)| {
+                    Unreached::nearer(distance, k, bound_m, order)
+                        && self.over(t, &normal, distance, to_m)
+                })
+            };
+            if covered {
+                return None;
+            }
         }
         let face = self.face(triangle)?;
         if face.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
@@ -554,8 +607,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// not the plane the sphere reaches, is the nearest, and the tool is
     /// outside (beyond a thin flap, nearer its other face). The second pass
     /// of [`Self::detect`]'s penetration test, over the same candidates in
-    /// the same order, only when such a plane exists (out of line: its
-    /// visited set is only set up when it runs).
+    /// the same order, only when such a plane exists and the first pass
+    /// could not keep them all ([`Unreached`]; out of line: its visited set
+    /// is only set up when it runs).
     #[inline(never)]
     fn covered(
         &self,
@@ -571,17 +625,28 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let mut covered = false;
         self.visit(tip_m, &mut visited, work, |t, normal, offset| {
             let distance = normal.dot(tip_m) - offset;
-            let nearer = distance < bound_m || (distance == bound_m && k < order);
+            let nearer = Unreached::nearer(distance, k, bound_m, order);
             k = k.wrapping_add(1);
-            if covered || !(distance >= radius_m && distance <= depth_m && nearer) {
-                return;
-            }
-            if let Some(f) = self.corners(t) {
-                let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance));
-                covered = w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE);
+            if !covered && distance >= radius_m && distance <= depth_m && nearer {
+                covered = self.over(t, &normal, distance, tip_m);
             }
         });
         covered
+    }
+
+    /// Whether the centre `tip_m` projects into triangle `t` (unit
+    /// `normal`, its plane `distance_m` from the centre).
+    fn over(
+        &self,
+        t: TriangleIndex,
+        normal: &Vector3<T>,
+        distance_m: T,
+        tip_m: &Vector3<T>,
+    ) -> bool {
+        self.corners(t).is_some_and(|f| {
+            let w = barycentric(&f.corners, normal, &(tip_m - normal * distance_m));
+            w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE)
+        })
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
