@@ -55,9 +55,21 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     if let Ok(style) = ProgressStyle::with_template("chart {bar:40} {pos}/{len} ({eta}) {msg}") {
         bar.set_style(style);
     }
+    // Without a terminal (CI, a redirected run) the bar is hidden: one line
+    // per step instead, with the time since the start.
+    let lines = bar.is_hidden();
+    let start = std::time::Instant::now();
     let mut tick = |message: &str| {
-        bar.set_message(message.to_string());
         bar.inc(1);
+        if lines {
+            eprintln!(
+                "chart {}/{total} {:7.1} s {message}",
+                bar.position(),
+                start.elapsed().as_secs_f64()
+            );
+        } else {
+            bar.set_message(message.to_string());
+        }
     };
     let study = chart::run(&matrix, &mut tick)?;
     // Picinbono's table 2 on the bent cylinder: the small one in --quick.
