@@ -21,7 +21,7 @@ pub const TRIAL_STEPS: usize = 2000;
 /// `1/(1 − (ωΔt/2)²)`), while an unstable mode grows without bound.
 pub const ENERGY_GROWTH_LIMIT: f64 = 1e6;
 /// Bisection halvings of the bracket (relative width 2⁻³⁰ of the start).
-const BISECTIONS: usize = 30;
+pub const BISECTIONS: usize = 30;
 
 /// The JSON object `dynamic critical-dt --json` prints.
 #[derive(Serialize, Debug)]
@@ -125,18 +125,30 @@ pub fn is_stable(
 /// the estimate was ×140 too high on the 2×10 chart cylinder.
 const TANGENT_SCALE: f64 = 1.0 / (1u64 << 30) as f64;
 
-/// `K x` of the tangent stiffness at rest, as the elastic forces (N) of
-/// the field `x` scaled by [`TANGENT_SCALE`], unscaled: `out = −K x`.
+/// `K x` of the tangent stiffness at rest, `out = −K x` (N per m): the
+/// elastic forces of the field `x` scaled by [`TANGENT_SCALE`], less
+/// `at_rest` (the forces of the zero field: a hybrid's passed force),
+/// unscaled.
 fn rest_tangent_forces(
     model: &TensorMassModel<'_, '_, f64>,
+    at_rest: &[[f64; 3]],
     x: &mut [[f64; 3]],
     out: &mut [[f64; 3]],
 ) {
     x.iter_mut().for_each(|v| *v = v.map(|c| c * TANGENT_SCALE));
     model.elastic_forces_of(x, out);
     x.iter_mut().for_each(|v| *v = v.map(|c| c / TANGENT_SCALE));
-    out.iter_mut()
-        .for_each(|v| *v = v.map(|c| c / TANGENT_SCALE));
+    for (f, f0) in out.iter_mut().zip(at_rest) {
+        *f = [0, 1, 2].map(|k| (f[k] - f0[k]) / TANGENT_SCALE);
+    }
+}
+
+/// The elastic forces (N) of the zero displacement field.
+fn forces_at_rest(model: &TensorMassModel<'_, '_, f64>) -> Vec<[f64; 3]> {
+    let n = model.modes().len();
+    let mut f = vec![[0.0; 3]; n];
+    model.elastic_forces_of(&vec![[0.0; 3]; n], &mut f);
+    f
 }
 
 /// `ω_max = sqrt(λ_max(M⁻¹K))` by power iteration (500 iterations from the
@@ -158,9 +170,10 @@ pub fn omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
         })
         .collect();
     let mut f = vec![[0.0; 3]; n];
+    let at_rest = forces_at_rest(model);
     let mut lambda = 0.0;
     for _ in 0..500 {
-        rest_tangent_forces(model, &mut x, &mut f);
+        rest_tangent_forces(model, &at_rest, &mut x, &mut f);
         let mut norm = 0.0;
         for v in 0..n {
             let y = if free[v] {
@@ -503,12 +516,13 @@ pub fn lanczos_omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut ritz: Vec<f64> = Vec::new();
     let mut beta_previous = 0.0;
+    let at_rest = forces_at_rest(model);
     for _ in 0..LANCZOS_MAX_STEPS {
         // w = M^{-1/2} K M^{-1/2} q, with K u = -(elastic forces of u).
         for v in 0..n {
             x[v] = q[v].map(|c| c * inv_sqrt_mass[v]);
         }
-        rest_tangent_forces(model, &mut x, &mut w);
+        rest_tangent_forces(model, &at_rest, &mut x, &mut w);
         for v in 0..n {
             w[v] = w[v].map(|c| -c * inv_sqrt_mass[v]);
         }
