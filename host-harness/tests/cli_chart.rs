@@ -29,6 +29,10 @@ fn quick_chart_writes_report_charts_and_json() {
         let meta = std::fs::metadata(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(meta.len() > 1000, "{file}: {} bytes", meta.len());
     }
+    // The SVG's text is glyph outlines: no <text>, no font named.
+    let svg = std::fs::read_to_string(dir.join("pareto-press-1.svg")).unwrap();
+    assert!(!svg.contains("<text") && !svg.contains("font-family"));
+    assert!(svg.matches("<path d=\"M").count() > 10);
     let png = std::fs::read(dir.join("cost-mesh.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let press = &json["summary"]["press-1"];

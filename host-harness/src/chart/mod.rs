@@ -33,6 +33,7 @@ pub mod plot;
 pub mod report;
 pub mod select;
 pub mod stability;
+pub mod svg_text;
 pub mod timing;
 pub mod trajectory;
 

@@ -1,7 +1,8 @@
 //! The charts of `palpate chart`, drawn with `plotters` in SVG and PNG
 //! (the PNG encoded by the `png` crate), text in DejaVu Sans embedded in
-//! the binary (`assets/fonts`, Bitstream Vera licence). Files are written
-//! atomically.
+//! the binary (`assets/fonts`, Bitstream Vera licence): rasterized in the
+//! PNGs, glyph outlines in the SVGs ([`super::svg_text`]), so neither needs
+//! a font where it is viewed. Files are written atomically.
 
 use std::path::Path;
 use std::sync::Once;
@@ -45,6 +46,7 @@ macro_rules! render {
             $chart(&root)?;
             root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
         }
+        let svg = super::svg_text::outline_text(&svg, FONT)?;
         write_file(&$dir.join(format!("{}.svg", $name)), svg.as_bytes())?;
         let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
         {
