@@ -478,6 +478,8 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
         .map_err(err)?;
     chart
         .configure_mesh()
+        .x_labels(6)
+        .y_labels(6)
         .x_desc("Young's modulus E, Pa")
         .y_desc("time step, s")
         .x_label_formatter(&|v| format!("{v:.0e}"))
@@ -533,7 +535,7 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerLeft)
+        .position(SeriesLabelPosition::UpperRight)
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;
