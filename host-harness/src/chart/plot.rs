@@ -231,7 +231,7 @@ fn pareto<DB: DrawingBackend>(
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;
@@ -353,7 +353,7 @@ fn trajectory_chart<DB: DrawingBackend>(
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;
@@ -415,7 +415,9 @@ fn cost_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, study: &Study) -
         .map_err(err)?;
     chart
         .configure_mesh()
+        .x_labels(6)
         .x_desc("vertices")
+        .x_label_formatter(&|v| format!("{v:.0}"))
         .y_desc("time per step, s (f64)")
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
