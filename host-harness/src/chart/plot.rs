@@ -331,7 +331,7 @@ fn trajectory_chart<DB: DrawingBackend>(
     }
     // The shapes' legend (no points of their own).
     let grey = RGBColor(120, 120, 120);
-    let none = || std::iter::empty::<Circle<(f64, f64), i32>>();
+    let none = || core::iter::empty::<Circle<(f64, f64), i32>>();
     chart
         .draw_series(none())
         .map_err(err)?
