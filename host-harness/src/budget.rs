@@ -105,18 +105,19 @@ pub const HOST_IR: UnitCosts = UnitCosts {
 /// from every tick of `tools/cycles-check.sh --all` (the release build of
 /// `tools/cycles-m4f`: the kernel as firmware links it, every generated
 /// trajectory with 1 to 4 probes on the three scenes it records), the
-/// largest over the three models, rounded up: an idle tick 4682 (the
-/// hybrid's; 2336 pre-computed), a triangle tested 582, an edge crossed
-/// 3922 (the dynamic model's, its base not separable: every idle tick there
-/// tests triangles), a tracked contact with its solve 1971 (pre-computed)
-/// and 3381 (dynamic), a solve 819 per `M³` (hybrid; 520 pre-computed) and
+/// largest over the three models, rounded up (2026-11-25, after the
+/// detection's visited set): an idle tick 4987 (the hybrid's; 2362
+/// pre-computed), a triangle tested 492 (dynamic), an edge crossed 3838
+/// (the dynamic model's, its base not separable: every idle tick there
+/// tests triangles), a tracked contact with its solve 2193 (pre-computed)
+/// and 3333 (dynamic), a solve 915 per `M³` (hybrid; 540 pre-computed) and
 /// 821 per `M` (dynamic).
 pub const M4F_CYCLES: UnitCosts = UnitCosts {
     base: 5000,
     triangle: 600,
     walk: 4000,
-    track: 2000,
-    solve_per_m3: 850,
+    track: 2200,
+    solve_per_m3: 950,
     dynamic_track: 3500,
     dynamic_solve: 900,
 };

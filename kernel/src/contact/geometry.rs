@@ -131,7 +131,9 @@ const UNREACHED_CAPACITY: usize = 16;
 /// needs no second pass unless more came.
 struct Unreached<T> {
     nearest_m: Option<T>,
-    planes: heapless::Vec<(TriangleIndex, Vector3<T>, T, u32), UNREACHED_CAPACITY>,
+    /// Each kept plane's triangle and place in the test order (its
+    /// distance is computed again from the stored plane, bit for bit).
+    planes: heapless::Vec<(TriangleIndex, u32), UNREACHED_CAPACITY>,
     overflowed: bool,
 }
 
@@ -144,13 +146,13 @@ impl<T: Real> Unreached<T> {
         }
     }
 
-    /// Notes triangle `t` (unit `normal`), `distance_m` from the centre,
-    /// the `order`-th tested.
-    fn note(&mut self, t: TriangleIndex, normal: Vector3<T>, distance_m: T, order: u32) {
+    /// Notes triangle `t`, its plane `distance_m` from the centre, the
+    /// `order`-th tested.
+    fn note(&mut self, t: TriangleIndex, distance_m: T, order: u32) {
         if self.nearest_m.is_none_or(|u| distance_m < u) {
             self.nearest_m = Some(distance_m);
         }
-        if self.planes.push((t, normal, distance_m, order)).is_err() {
+        if self.planes.push((t, order)).is_err() {
             self.overflowed = true;
         }
     }
@@ -442,7 +444,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                     if distance < radius_m {
                         self.nearest_test(t, normal, distance, to_m, order, &mut reached);
                     } else {
-                        unreached.note(t, normal, distance, order);
+                        unreached.note(t, distance, order);
                     }
                 }
                 order = order.wrapping_add(1);
@@ -469,9 +471,12 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             let covered = if unreached.overflowed {
                 self.covered(to_m, radius_m, depth_m, bound_m, order, work)
             } else {
-                unreached.planes.iter().any(|&(t, normal, distance, k)| {
-                    Unreached::nearer(distance, k, bound_m, order)
-                        && self.over(t, &normal, distance, to_m)
+                unreached.planes.iter().any(|&(t, k)| {
+                    self.index.plane(t).is_some_and(|(normal, offset)| {
+                        let distance = normal.dot(to_m) - offset;
+                        Unreached::nearer(distance, k, bound_m, order)
+                            && self.over(t, &normal, distance, to_m)
+                    })
                 })
             };
             if covered {
