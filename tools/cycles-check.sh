@@ -18,6 +18,8 @@
 #                                 its N costliest functions
 #   tools/cycles-check.sh --model M   only model M (precomputed, dynamic or
 #                                 hybrid; repeatable)
+#   tools/cycles-check.sh --compress CODE   the pre-computed table compressed
+#                                 (f16 or q16, as `tables build --compress`)
 #   tools/cycles-check.sh --target-report-only   report a pre-computed 4-contact
 #                                 tick above TARGET_CYCLES without failing
 #                                 (.ci/run, until the kernel meets it)
@@ -35,6 +37,7 @@ WAIT_STATES=5
 
 all=0
 only_models=()
+compress=()
 profile=()
 target_flag=--limit
 while [ $# -gt 0 ]; do
@@ -42,8 +45,9 @@ while [ $# -gt 0 ]; do
         --all) all=1 ;;
         --profile) profile=(--profile "$2"); shift ;;
         --model) only_models+=("$2"); shift ;;
+        --compress) compress=(--compress "$2"); shift ;;
         --target-report-only) target_flag=--warn-limit ;;
-        *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--model M]... [--target-report-only]" >&2; exit 2 ;;
+        *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--model M]... [--compress CODE] [--target-report-only]" >&2; exit 2 ;;
     esac
     shift
 done
@@ -82,10 +86,12 @@ for spec in "${models[@]}"; do
     if [ "$model" != precomputed ] && [ "$all" = 0 ]; then
         only=(--trajectory poke --trajectory strike)
     fi
+    table=()
+    [ "$model" = precomputed ] && table=("${compress[@]}")
     rm -rf "${out:?}/$model"
     dirs=()
     for m in 1 2 3 4; do
-        "$palpate" budget "$scene" --points "$m" --record "$out/$model/m$m" "${only[@]}" >/dev/null
+        "$palpate" budget "$scene" --points "$m" --record "$out/$model/m$m" "${only[@]}" "${table[@]}" >/dev/null
         dirs+=("$out/$model/m$m")
     done
     feature=()

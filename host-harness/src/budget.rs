@@ -63,6 +63,7 @@ use crate::session::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, Tool
 use crate::session::stability::check_stable_step;
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
 use crate::session::{Scene, Trajectory};
+use crate::table::compress::Compression;
 
 /// The unit costs of the static tick bound, in one unit: x86-64
 /// instructions for the host ([`HOST_IR`], measured with callgrind) or
@@ -192,9 +193,10 @@ pub fn budget_table(
     mesh: &TetMesh,
     report: &MeshReport,
     costs: &UnitCosts,
+    compression: Option<Compression>,
 ) -> anyhow::Result<(SceneTables, u64)> {
     let points = scene.tool.kernel_points() as u64;
-    let tables = SceneModel::of(scene, mesh, report)?.tables(scene, mesh, report)?;
+    let tables = SceneModel::of(scene, mesh, report)?.tables(scene, mesh, report, compression)?;
     let load = |e| anyhow::anyhow!("table: {e}");
     let bound = match &tables {
         SceneTables::Precomputed(file) => {
@@ -350,13 +352,18 @@ pub const RECORD_RUNS: &str = "runs.txt";
 /// `<trajectory> <ticks> <bound>`, with the tick's static bound in
 /// Cortex-M4F cycles ([`M4F_CYCLES`]). Only the trajectories named in
 /// `only`, if any (each must be one of the scene's). Returns the runs' lines.
-pub fn record(scene: &Scene, dir: &Path, only: &[String]) -> anyhow::Result<Vec<String>> {
+pub fn record(
+    scene: &Scene,
+    dir: &Path,
+    only: &[String],
+    compression: Option<Compression>,
+) -> anyhow::Result<Vec<String>> {
     let chosen = chosen_trajectories(scene, only)?;
     let (mesh, report) = scene.load_mesh()?;
     check_scene_table(scene, &mesh, &report)?;
     check_stable_step(scene, &mesh, &report)?;
     std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-    let (tables, bound) = budget_table(scene, &mesh, &report, &M4F_CYCLES)?;
+    let (tables, bound) = budget_table(scene, &mesh, &report, &M4F_CYCLES, compression)?;
     tables.write(&dir.join(RECORD_TABLE))?;
     let load = |e| anyhow::anyhow!("table: {e}");
     let dynamic = match &tables {

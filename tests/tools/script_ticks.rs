@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 use palpate::budget::{RECORD_RUNS, RECORD_TABLE, record};
 use palpate::session::Scene;
 use palpate::session::scene::{DEFAULT_TOOL_RADIUS_M, ToolSpec};
+use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{LoopConfig, PrecomputedLoop, SafetyLimits, ToolAction, ToolInput};
 use palpate_kernel::precomputed::PrecomputedTissue;
@@ -155,14 +156,30 @@ fn a_malformed_recording_is_refused_with_its_reason() {
 /// `palpate budget --record` on the built-in scene with four probes (the
 /// press-hold, each probe on its site): the recording, replayed on the
 /// host's kernel through the loop its header describes, prints the recorded
-/// host lines exactly; the probes make four simultaneous contacts.
+/// host lines exactly; the probes make four simultaneous contacts. The same
+/// with the table compressed (`--compress q16`, what `tools/cycles-check.sh
+/// --compress q16` counts): the recorded table is the compressed one.
 #[test]
 fn a_recorded_press_with_four_probes_replays_to_the_host_lines() {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("record-built-in-4");
+    let q16 = Compression {
+        code: BlockCode::Q16,
+        drop_below: 0.0,
+        contact: ContactBlocks::Coded,
+    };
+    for (name, compression) in [
+        ("record-built-in-4", None),
+        ("record-built-in-4-q16", Some(q16)),
+    ] {
+        replays_to_the_host_lines(name, compression);
+    }
+}
+
+fn replays_to_the_host_lines(dir_name: &str, compression: Option<Compression>) {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(dir_name);
     let _ = std::fs::remove_dir_all(&dir);
     let mut scene = Scene::built_in();
     scene.tool = ToolSpec::probes(4, DEFAULT_TOOL_RADIUS_M);
-    let runs = record(&scene, &dir, &["press-hold".to_string()]).unwrap();
+    let runs = record(&scene, &dir, &["press-hold".to_string()], compression).unwrap();
     assert_eq!(runs.len(), 1);
     let list = std::fs::read_to_string(dir.join(RECORD_RUNS)).unwrap();
     let [name, ticks, bound] = list.split_whitespace().collect::<Vec<_>>()[..] else {
@@ -171,6 +188,7 @@ fn a_recorded_press_with_four_probes_replays_to_the_host_lines() {
     assert_eq!(name, "press-hold");
     let table_bytes = std::fs::read(dir.join(RECORD_TABLE)).unwrap();
     let table = PrecomputedTable::<f32>::load(&table_bytes).unwrap();
+    assert_eq!(table.compression().is_some(), compression.is_some());
     let recorded = std::fs::read(dir.join("press-hold.ticks")).unwrap();
     let recording = Recording::parse(&recorded).unwrap();
     let header = *recording.header();
@@ -196,4 +214,24 @@ fn a_recorded_press_with_four_probes_replays_to_the_host_lines() {
     let expected = std::fs::read_to_string(dir.join("press-hold.expected")).unwrap();
     assert_eq!(lines, expected);
     assert_eq!(most, 4);
+}
+
+/// `--compress` is the pre-computed model's: a dynamic scene refuses it,
+/// naming the scene.
+#[test]
+fn a_compressed_recording_of_a_dynamic_scene_is_refused() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("record-dynamic-q16");
+    let scene = Scene::named("built-in-dynamic").unwrap();
+    let q16 = Compression {
+        code: BlockCode::Q16,
+        drop_below: 0.0,
+        contact: ContactBlocks::Coded,
+    };
+    let error = record(&scene, &dir, &["poke".to_string()], Some(q16)).unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .contains("--compress applies to a pre-computed scene"),
+        "{error:#}"
+    );
 }

@@ -14,6 +14,7 @@ use palpate::session::run::check_scene_table;
 use palpate::session::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
 use palpate::session::stability::check_stable_step;
 use palpate::session::{MeshSource, Scene, Trajectory};
+use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 
 use super::stdout;
 
@@ -44,6 +45,11 @@ pub struct BudgetArgs {
     /// (`tools/cycles-check.sh`; the scene's own mesh only).
     #[arg(long, value_name = "DIR", conflicts_with_all = ["json", "probe"])]
     record: Option<PathBuf>,
+    /// With --record: the pre-computed scene's table compressed with this
+    /// code (`tables build --compress`, nothing dropped, the contact blocks
+    /// coded), for the cycle count of the compressed decode.
+    #[arg(long, value_name = "CODE", requires = "record")]
+    compress: Option<BlockCode>,
     /// Internal: run the ticks of this trajectory on this table, built for
     /// the scene's mesh size SIZE (0 the coarse box, or the scene's own)
     /// (the process callgrind measures).
@@ -61,6 +67,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         only,
         points,
         record: record_dir,
+        compress,
         probe: probe_paths,
     } = args;
     let mut scene = Scene::named(scene_arg)?;
@@ -68,7 +75,12 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         with_probes(&mut scene, points)?;
     }
     if let Some(dir) = record_dir {
-        let runs = record(&scene, dir, only)?;
+        let compression = compress.map(|code| Compression {
+            code,
+            drop_below: 0.0,
+            contact: ContactBlocks::Coded,
+        });
+        let runs = record(&scene, dir, only, compression)?;
         let mut text = format!("recorded in {}:\n", dir.display());
         for run in runs {
             let _ = writeln!(text, "  {run}");
@@ -119,7 +131,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
         let (mesh, report) = scene.load_mesh()?;
-        let (tables, bound) = budget_table(&scene, &mesh, &report, &HOST_IR)?;
+        let (tables, bound) = budget_table(&scene, &mesh, &report, &HOST_IR, None)?;
         let table_path = work_dir.join(format!("table-{s}.bin"));
         tables.write(&table_path)?;
         for (name, trajectory) in &chosen {

@@ -17,6 +17,7 @@ use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
 use crate::table::build::build;
+use crate::table::compress::Compression;
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
 use std::io::Write as _;
@@ -105,20 +106,29 @@ impl SceneModel {
 
     /// The f32 tables of the model (the scene's materials per tet, density
     /// and supports), built in memory with the pipeline of `palpate tables
-    /// build`.
+    /// build`; a pre-computed model's compliance compressed with
+    /// `compression` (`tables build --compress`; refused for the others).
     pub fn tables(
         self,
         scene: &Scene,
         mesh: &TetMesh,
         report: &MeshReport,
+        compression: Option<Compression>,
     ) -> anyhow::Result<SceneTables> {
+        if compression.is_some() && !matches!(self, Self::Precomputed) {
+            bail!(
+                "{}: --compress applies to a pre-computed scene (its compliance table)",
+                scene.source
+            );
+        }
         let single = |options| -> anyhow::Result<TableFile> {
             let built = build(mesh, report, &options).with_context(|| scene.source.clone())?;
             Ok(TableFile::from_bytes(&built.bytes))
         };
         Ok(match self {
             Self::Precomputed => {
-                SceneTables::Precomputed(single(precomputed_options(scene, mesh, report)?)?)
+                let options = precomputed_options(scene, mesh, report)?;
+                SceneTables::Precomputed(single(options.with_compression(compression))?)
             }
             Self::Dynamic(spec) => {
                 SceneTables::Dynamic(single(tensor_mass_options(scene, mesh, report)?)?, spec)

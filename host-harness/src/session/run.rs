@@ -386,7 +386,7 @@ pub fn run_session_into(
         tick_s: scene.tick_s(),
         every: scene.rates.physics_every.max(1) as usize,
     };
-    let tables = SceneModel::of(scene, &mesh, &report)?.tables(scene, &mesh, &report)?;
+    let tables = SceneModel::of(scene, &mesh, &report)?.tables(scene, &mesh, &report, None)?;
     let load = |e| anyhow::anyhow!("session table: {e}");
     let tissue = match &tables {
         SceneTables::Precomputed(file) => SessionTissue::Precomputed(

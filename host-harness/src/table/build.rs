@@ -91,6 +91,22 @@ impl BuildOptions {
         }
     }
 
+    /// The same options with the compliance stored compressed
+    /// (`compression`, [`super::compress`]); nothing changes for a
+    /// tensor-mass table or `None`.
+    pub fn with_compression(self, compression: Option<Compression>) -> Self {
+        match self.kind {
+            TableKindOptions::Precomputed { solver, .. } => Self {
+                kind: TableKindOptions::Precomputed {
+                    solver,
+                    compression,
+                },
+                ..self
+            },
+            TableKindOptions::TensorMass { .. } => self,
+        }
+    }
+
     /// A tensor-mass table of `material` and density `density_kg_m3`
     /// (kg/m³) with the `fix` predicates, stored in `precision`.
     pub fn tensor_mass(
