@@ -8,12 +8,15 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use palpate::chart::{self, Matrix, plot, report};
+use palpate::chart::{self, GivenMesh, Matrix, plot, report};
 use palpate::experiment::scenes;
 use palpate::experiment::volume_bend::{self, Protocol};
+use palpate::fix::FixPredicate;
 use palpate::limits::MAX_CHART_TET_STEPS;
+use palpate::mesh::read_mesh;
 use palpate::output::atomic::write_file;
 
+use super::args::{MaterialArgs, parse_fix};
 use super::stdout;
 
 /// `palpate chart` arguments.
@@ -29,6 +32,49 @@ pub struct ChartArgs {
     /// Print the study as one JSON object instead of the summary.
     #[arg(long)]
     json: bool,
+    /// Run the matrix on this mesh (m; any format the mesh readers take) at
+    /// its own resolution, instead of the cylinder's refinements.
+    #[arg(long, requires_all = ["young", "poisson", "fix"])]
+    mesh: Option<PathBuf>,
+    /// Young's modulus of `--mesh`, Pa.
+    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    young: Option<f64>,
+    /// Poisson ratio of `--mesh`, in [0, 0.5).
+    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    poisson: Option<f64>,
+    /// Fixed vertices of `--mesh`: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
+    #[arg(long = "fix", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
+    fix: Vec<FixPredicate>,
+    /// Loaded vertices of `--mesh`, same syntax (repeatable; default: the
+    /// face farthest from the supports).
+    #[arg(long = "load-on", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
+    load_on: Vec<FixPredicate>,
+}
+
+impl ChartArgs {
+    /// The user's mesh of `--mesh`, if given.
+    fn given(&self) -> anyhow::Result<Option<GivenMesh>> {
+        let Some(path) = &self.mesh else {
+            return Ok(None);
+        };
+        let (mesh, report) = read_mesh(path)?;
+        let material = MaterialArgs {
+            young: self.young.context("--young")?,
+            poisson: self.poisson.context("--poisson")?,
+        }
+        .material()?;
+        Ok(Some(GivenMesh {
+            label: path.file_name().map_or_else(
+                || path.display().to_string(),
+                |f| f.to_string_lossy().into(),
+            ),
+            mesh,
+            report,
+            fix: self.fix.clone(),
+            load_on: self.load_on.clone(),
+            material,
+        }))
+    }
 }
 
 /// Runs `palpate chart`.
@@ -38,7 +84,16 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     } else {
         Matrix::full()
     };
-    let protocols = [Protocol::PaperLoads, Protocol::Tilt];
+    let matrix = match args.given()? {
+        Some(given) => matrix.on(given),
+        None => matrix,
+    };
+    // Picinbono's table 2 is the cylinder's experiment: not run on a given mesh.
+    let protocols: &[Protocol] = if matrix.given.is_some() {
+        &[]
+    } else {
+        &[Protocol::PaperLoads, Protocol::Tilt]
+    };
     // Picinbono's table 2 on the bent cylinder: the small one in --quick;
     // its relaxations capped as the study's.
     let scene = if args.quick {
@@ -56,7 +111,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
          references), {} stability trials, {} trajectories (each against its Δt/{}), {} volume \
          experiments: {total} steps of progress",
-        matrix.meshes.len(),
+        matrix.mesh_count(),
         matrix.loads.len(),
         matrix.levels.len(),
         chart::Model::ALL.len(),
@@ -68,7 +123,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         protocols.len(),
     );
     // The work bound, checked before anything runs, and its time here.
-    let bodies = matrix.bodies();
+    let bodies = matrix.bodies()?;
     let volume_relaxations: usize = protocols
         .iter()
         .map(|&p| volume_bend::relaxations_bound(&scene, p, &controls))
@@ -113,7 +168,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     };
     let study = chart::run(&matrix, &mut tick)?;
     let mut volume = Vec::new();
-    for protocol in protocols {
+    for &protocol in protocols {
         volume.push(volume_bend::run_scene(&scene, protocol, &controls, |_| {})?);
         tick(&format!("volume {protocol:?}"));
     }
