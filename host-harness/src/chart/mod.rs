@@ -34,6 +34,7 @@ pub mod report;
 pub mod select;
 pub mod stability;
 pub mod svg_text;
+pub mod ticks;
 pub mod timing;
 pub mod trajectory;
 
@@ -289,6 +290,9 @@ pub struct Matrix {
     pub max_relax_steps: usize,
     /// The trajectories' extent.
     pub trajectory: trajectory::TrajectoryExtent,
+    /// Whether to count the haptic tick's instructions under callgrind
+    /// ([`ticks`]).
+    pub tick_counts: bool,
 }
 
 impl Matrix {
@@ -302,6 +306,7 @@ impl Matrix {
             stability: stability::MapExtent::full(),
             max_relax_steps: MAX_RELAX_STEPS,
             trajectory: trajectory::TrajectoryExtent::full(),
+            tick_counts: true,
         }
     }
 
@@ -315,6 +320,7 @@ impl Matrix {
             stability: stability::MapExtent::quick(),
             max_relax_steps: QUICK_RELAX_STEPS,
             trajectory: trajectory::TrajectoryExtent::quick(),
+            tick_counts: false,
         }
     }
 
@@ -508,6 +514,9 @@ pub struct Study {
     pub stability: Vec<stability::Map>,
     /// The dynamic runs' trajectory errors.
     pub trajectories: Vec<trajectory::Trajectory>,
+    /// Per-tick instructions of the pre-computed models' haptic tick
+    /// ([`ticks`]; measured by the command, after [`run`]).
+    pub ticks: ticks::TickCounts,
 }
 
 /// The mean rest position of `vertices`, m; `None` for none.
@@ -829,6 +838,9 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
         remap,
         stability,
         trajectories,
+        ticks: ticks::TickCounts::Skipped {
+            reason: "not measured".into(),
+        },
     })
 }
 

@@ -5,6 +5,7 @@ use core::fmt::Write;
 use super::plot::{cost_series, log_slope};
 use super::select::{cheapest_within, pareto_front};
 use super::stability::Outcome;
+use super::ticks::TickCounts;
 use super::trajectory::{REFINEMENT, Trajectory};
 use super::{Load, Model, Run, Study};
 
@@ -71,6 +72,39 @@ pub fn pareto_members(study: &Study, load: Load, level: f64) -> Vec<String> {
         .filter(|(_, f)| *f)
         .map(|(r, _)| format!("{} on {}", r.model.name(), r.mesh))
         .collect()
+}
+
+/// The section of the haptic tick's instruction counts.
+fn tick_counts(out: &mut String, study: &Study) {
+    let _ = writeln!(out, "\n## Per-tick instructions of the haptic tick\n");
+    match &study.ticks {
+        TickCounts::Skipped { reason } => {
+            let _ = writeln!(out, "Not measured: {reason}.");
+        }
+        TickCounts::Measured { mesh, counts } => {
+            let _ = writeln!(
+                out,
+                "Callgrind instructions (Ir) of one haptic tick (`palpate budget`'s measurement) on \
+                 the built-in block scene ({mesh}), its `{}` trajectory with 1 to 4 probes held \
+                 pressed (one contact each), f32; the quasi-non-linear tissue with the remap fitted \
+                 above.\n",
+                super::ticks::TICK_TRAJECTORY
+            );
+            let _ = writeln!(out, "| model | contacts | ticks | mean Ir | max Ir |");
+            let _ = writeln!(out, "|---|---|---|---|---|");
+            for c in counts {
+                let _ = writeln!(
+                    out,
+                    "| {} | {} | {} | {:.0} | {} |",
+                    c.model.name(),
+                    c.contacts,
+                    c.ticks,
+                    c.mean_ir,
+                    c.max_ir
+                );
+            }
+        }
+    }
 }
 
 /// The report in Markdown; `charts` are the chart names (PNG beside it).
@@ -165,6 +199,7 @@ pub fn markdown(
             r.fault.as_deref().unwrap_or("")
         );
     }
+    tick_counts(&mut out, study);
     trajectories(&mut out, study, loads);
     let _ = writeln!(out, "\n## Where the methods fail\n");
     for line in failures(study) {
