@@ -141,7 +141,7 @@ fn chart_runs_on_a_given_mesh() {
 
 /// A 2×2×6-cell box, 2 × 2 × 6 cm, six tets per cell, as legacy VTK.
 fn write_box(path: &std::path::Path) {
-    use std::fmt::Write as _;
+    use core::fmt::Write as _;
     let (n, size) = ([2usize, 2, 6], [0.02, 0.02, 0.06]);
     let index = |i: usize, j: usize, k: usize| i + (n[0] + 1) * (j + (n[1] + 1) * k);
     let mut s = String::from("# vtk DataFile Version 3.0\nbox\nASCII\nDATASET UNSTRUCTURED_GRID\n");
