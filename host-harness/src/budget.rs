@@ -44,7 +44,7 @@ use palpate_kernel::contact::{MAX_WALK_STEPS, Tissue};
 use palpate_kernel::haptic::{
     ForceOutput, HapticLoop, PhysicsTissue, PrecomputedLoop, TickCounters, ToolInput,
 };
-use palpate_kernel::precomputed::PrecomputedTissue;
+use palpate_kernel::precomputed::{PrecomputedTissue, QuasiNonLinear};
 use palpate_kernel::table::TensorMassTable;
 
 use palpate_script::ticks::{Header, Settings, tool_words, write_tick};
@@ -237,12 +237,25 @@ pub fn probe(
     scene: &Scene,
     trajectory: &Trajectory,
 ) -> anyhow::Result<Probe> {
+    probe_remapped(tables, scene, trajectory, None)
+}
+
+/// [`probe`], the pre-computed tissue made quasi-non-linear by `remap`
+/// when given (Cotin 1999 TVCG §3; `palpate chart`'s tick counts). A remap
+/// on another model's tables is an error.
+pub fn probe_remapped(
+    tables: &SceneTables,
+    scene: &Scene,
+    trajectory: &Trajectory,
+    remap: Option<QuasiNonLinear<f32>>,
+) -> anyhow::Result<Probe> {
     with_tool_points(
         scene.tool.kernel_points(),
         ProbeRun {
             tables,
             scene,
             trajectory,
+            remap,
         },
     )
 }
@@ -265,13 +278,14 @@ struct ProbeRun<'a> {
     tables: &'a SceneTables,
     scene: &'a Scene,
     trajectory: &'a Trajectory,
+    remap: Option<QuasiNonLinear<f32>>,
 }
 
 impl ForToolPoints for ProbeRun<'_> {
     type Output = anyhow::Result<Probe>;
 
     fn call<const P: usize>(self) -> anyhow::Result<Probe> {
-        probe_with::<P>(self.tables, self.scene, self.trajectory)
+        probe_with::<P>(self.tables, self.scene, self.trajectory, self.remap)
     }
 }
 
@@ -279,16 +293,22 @@ fn probe_with<const P: usize>(
     tables: &SceneTables,
     scene: &Scene,
     trajectory: &Trajectory,
+    remap: Option<QuasiNonLinear<f32>>,
 ) -> anyhow::Result<Probe> {
     let load = |e| anyhow::anyhow!("table: {e}");
+    if remap.is_some() && !matches!(tables, SceneTables::Precomputed(_)) {
+        bail!("the quasi-non-linear remap is an option of the pre-computed model only");
+    }
     match tables {
         SceneTables::Precomputed(file) => {
             let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
-            let mut haptic = PrecomputedLoop::<f32, P, P>::new(
-                PrecomputedTissue::new(&table),
-                loop_config(scene),
-            )
-            .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
+            let tissue = PrecomputedTissue::new(&table);
+            let tissue = match remap {
+                Some(remap) => tissue.with_remap(remap),
+                None => tissue,
+            };
+            let mut haptic = PrecomputedLoop::<f32, P, P>::new(tissue, loop_config(scene))
+                .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
             probe_ticks(&mut haptic, scene, trajectory, |_| {})
         }
         SceneTables::Dynamic(file, spec) => {

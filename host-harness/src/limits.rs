@@ -22,8 +22,9 @@ use std::path::Path;
 ///
 /// A St Venant-Kirchhoff step with the penalty costs about 20–60 ns per tet (measured on the
 /// chart's 3×15 cylinder, f64), so the bound is 7–20 minutes of worst case on one core; the
-/// full matrix's bound is under a third of it, and its relaxations settle far below their cap.
-/// A matrix made larger in code (more meshes, finer ones) is refused before it starts.
+/// full matrix's bound is under half of it (9.38·10⁹ with the hybrid), and its relaxations settle
+/// far below their cap. A matrix made larger in code (more meshes, finer ones), or a `--mesh` whose
+/// tet count makes it larger, is refused before it starts.
 pub const MAX_CHART_TET_STEPS: u64 = 20_000_000_000;
 
 /// Largest haptic rate a scene accepts (`[rates] haptic_hz`), Hz.

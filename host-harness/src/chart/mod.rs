@@ -34,6 +34,7 @@ pub mod report;
 pub mod select;
 pub mod stability;
 pub mod svg_text;
+pub mod ticks;
 pub mod timing;
 pub mod trajectory;
 
@@ -55,8 +56,11 @@ use crate::fem::llt::SparseLlt;
 use crate::fem::material::{Material, TetMaterials};
 use crate::fem::newton::{NewtonOptions, StaticProblem, solve_stvk};
 use crate::fem::static_solve::solve_loaded;
-use crate::mesh::TetMesh;
+use crate::fix::{FixPredicate, fixed_vertices};
+use crate::hybrid::owned::with_hybrid;
+use crate::hybrid::{HybridOptions, build_hybrid};
 use crate::mesh::generate::cylinder_mesh;
+use crate::mesh::{MeshReport, TetMesh};
 use crate::remap::fit::{FittedModel, fit_curves};
 use crate::remap::sample::{Sample, linear_response, stvk_curves};
 use crate::table::file::Precision;
@@ -93,6 +97,9 @@ pub const RELAX_TOLERANCE: f64 = 1e-5;
 const NEWTON_STEPS_PER_PERCENT: f64 = 0.5;
 /// Density of the tensor-mass tables, kg/m³ (the static studies').
 const DENSITY_KG_M3: f64 = 1000.0;
+/// The hybrid's tensor-mass region: this fraction of the body's length at
+/// its loaded end ([`Body::hybrid_dynamic_tets`]).
+pub const HYBRID_DYNAMIC_FRACTION: f64 = 1.0 / 3.0;
 
 /// Which loads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -134,33 +141,42 @@ pub enum Model {
     Stvk,
     /// Tensor-mass, St Venant-Kirchhoff + incompressibility penalty.
     StvkPenalty,
+    /// The hybrid (RR-3510 §6.2): St Venant-Kirchhoff tensor-mass in the
+    /// region at the loaded end ([`Body::hybrid_dynamic_tets`]), the rest
+    /// pre-computed linear, condensed onto the connection nodes.
+    Hybrid,
 }
 
 impl Model {
     /// Every model, cheapest family first.
-    pub const ALL: [Model; 5] = [
+    pub const ALL: [Model; 6] = [
         Model::PrecomputedLinear,
         Model::PrecomputedQuasi,
         Model::TensorMassLinear,
         Model::Stvk,
         Model::StvkPenalty,
+        Model::Hybrid,
     ];
 
     /// The tensor-mass law and incompressibility penalty (N) of the model
-    /// on `body`; `None` for the pre-computed models.
+    /// on `body`; `None` for the pre-computed models and the hybrid.
     pub fn tensor_mass(self, body: &Body) -> Option<(ElasticLaw, Option<f64>)> {
         let stvk = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
         match self {
-            Model::PrecomputedLinear | Model::PrecomputedQuasi => None,
+            Model::PrecomputedLinear | Model::PrecomputedQuasi | Model::Hybrid => None,
             Model::TensorMassLinear => Some((ElasticLaw::Linear, None)),
             Model::Stvk => Some((stvk, None)),
             Model::StvkPenalty => Some((stvk, Some(penalty_n(&body.mesh, &body.material)))),
         }
     }
 
-    /// A tensor-mass model (relaxed, integrated), not a pre-computed one.
+    /// A tensor-mass model (relaxed, integrated), not a pre-computed one
+    /// nor the hybrid.
     pub fn is_tensor_mass(self) -> bool {
-        !matches!(self, Model::PrecomputedLinear | Model::PrecomputedQuasi)
+        matches!(
+            self,
+            Model::TensorMassLinear | Model::Stvk | Model::StvkPenalty
+        )
     }
 
     /// Name used in the JSON, the charts and the report.
@@ -171,6 +187,7 @@ impl Model {
             Model::TensorMassLinear => "tensor-mass-linear",
             Model::Stvk => "stvk",
             Model::StvkPenalty => "stvk-penalty",
+            Model::Hybrid => "hybrid",
         }
     }
 }
@@ -180,11 +197,89 @@ fn tensor_mass_models() -> usize {
     Model::ALL.iter().filter(|m| m.is_tensor_mass()).count()
 }
 
+/// How many of [`Model::ALL`] are relaxed to rest: the tensor-mass models
+/// and the hybrid (whose tensor-mass region has at most the mesh's tets).
+fn relaxed_models() -> usize {
+    tensor_mass_models() + 1
+}
+
+/// A user's mesh for the study (`palpate chart --mesh`): run at its own
+/// resolution only (no refinement series).
+#[derive(Clone, Debug)]
+pub struct GivenMesh {
+    /// The file name, the mesh's label in the study.
+    pub label: String,
+    /// The rest mesh, m.
+    pub mesh: TetMesh,
+    /// Its reader report.
+    pub report: MeshReport,
+    /// The supports.
+    pub fix: Vec<FixPredicate>,
+    /// The loaded vertices (any predicate matching); empty: the face
+    /// farthest from the supports ([`GivenMesh::loaded_vertices`]).
+    pub load_on: Vec<FixPredicate>,
+    /// Material.
+    pub material: Material,
+}
+
+/// Of the extent along the axis, the depth of the face loaded by default.
+pub const LOADED_FACE_DEPTH: f64 = 1e-3;
+
+impl GivenMesh {
+    /// The loaded vertices: those matching [`GivenMesh::load_on`], or by
+    /// default the face farthest from the supports: the vertices within
+    /// [`LOADED_FACE_DEPTH`] of the mesh's extent of the farthest one along
+    /// the direction from the supports' centroid to the mesh's vertex
+    /// centroid. Fixed and unreferenced vertices are never loaded.
+    pub fn loaded_vertices(&self) -> anyhow::Result<Vec<u32>> {
+        let positions = &self.mesh.positions;
+        let (fixed, _) = fixed_vertices(positions, &self.fix, &self.report.unreferenced_vertices);
+        let candidates = (0..positions.len() as u32).filter(|&v| !fixed[v as usize]);
+        if !self.load_on.is_empty() {
+            let p = |v: u32| positions[v as usize];
+            let loaded: Vec<u32> = candidates
+                .filter(|&v| self.load_on.iter().any(|f| f.matches(&p(v))))
+                .collect();
+            anyhow::ensure!(!loaded.is_empty(), "--load-on matches no free vertex");
+            return Ok(loaded);
+        }
+        let supports = centroid(positions, (0..positions.len()).filter(|&v| fixed[v]))
+            .context("no vertex matches the supports (--fix)")?;
+        let all = centroid(positions, 0..positions.len()).context("an empty mesh")?;
+        let direction = (all - supports)
+            .try_normalize(1e-12)
+            .context("the supports are centred on the mesh: give the loaded face with --load-on")?;
+        let along = |v: u32| (Vector3::from(positions[v as usize]) - supports).dot(&direction);
+        let (lo, hi) = (0..positions.len() as u32)
+            .map(along)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+        let depth = LOADED_FACE_DEPTH * (hi - lo);
+        Ok(candidates.filter(|&v| along(v) >= hi - depth).collect())
+    }
+
+    /// The study's body.
+    pub fn body(&self) -> anyhow::Result<Body> {
+        Body::with_loaded_vertices(
+            self.label.clone(),
+            self.mesh.clone(),
+            self.report.clone(),
+            self.fix.clone(),
+            self.loaded_vertices()?,
+            self.material,
+        )
+    }
+}
+
 /// The study's extent.
 #[derive(Clone, Debug)]
 pub struct Matrix {
-    /// Refinements, coarsest first; the last one carries the reference.
+    /// Refinements of the cylinder, coarsest first; the last one carries
+    /// the reference. Ignored with [`Matrix::given`].
     pub meshes: Vec<(usize, usize)>,
+    /// A user's mesh instead of the cylinders.
+    pub given: Option<GivenMesh>,
     /// Loads.
     pub loads: Vec<Load>,
     /// Levels (fractions of the height).
@@ -195,6 +290,9 @@ pub struct Matrix {
     pub max_relax_steps: usize,
     /// The trajectories' extent.
     pub trajectory: trajectory::TrajectoryExtent,
+    /// Whether to count the haptic tick's instructions under callgrind
+    /// ([`ticks`]).
+    pub tick_counts: bool,
 }
 
 impl Matrix {
@@ -202,11 +300,13 @@ impl Matrix {
     pub fn full() -> Self {
         Self {
             meshes: FULL_MESHES.to_vec(),
+            given: None,
             loads: Load::ALL.to_vec(),
             levels: LEVELS.to_vec(),
             stability: stability::MapExtent::full(),
             max_relax_steps: MAX_RELAX_STEPS,
             trajectory: trajectory::TrajectoryExtent::full(),
+            tick_counts: true,
         }
     }
 
@@ -214,11 +314,13 @@ impl Matrix {
     pub fn quick() -> Self {
         Self {
             meshes: QUICK_MESHES.to_vec(),
+            given: None,
             loads: vec![Load::Press, Load::Bend],
             levels: QUICK_LEVELS.to_vec(),
             stability: stability::MapExtent::quick(),
             max_relax_steps: QUICK_RELAX_STEPS,
             trajectory: trajectory::TrajectoryExtent::quick(),
+            tick_counts: false,
         }
     }
 
@@ -226,18 +328,58 @@ impl Matrix {
     /// reference per load and level.
     pub fn static_runs(&self) -> usize {
         let cases = self.loads.len() * self.levels.len();
-        cases * (self.meshes.len() * Model::ALL.len() + 1)
+        cases * (self.mesh_count() * Model::ALL.len() + 1)
     }
 
-    /// The bodies of [`Matrix::meshes`].
-    pub fn bodies(&self) -> Vec<Body> {
-        self.meshes.iter().map(|&m| Body::cylinder(m)).collect()
+    /// The same study on `given` instead of the cylinders.
+    pub fn on(self, given: GivenMesh) -> Self {
+        Self {
+            given: Some(given),
+            ..self
+        }
+    }
+
+    /// Meshes in the study: the given one, or the cylinders.
+    pub fn mesh_count(&self) -> usize {
+        if self.given.is_some() {
+            1
+        } else {
+            self.meshes.len()
+        }
+    }
+
+    /// The bodies: the given mesh's, or the cylinders of [`Matrix::meshes`].
+    pub fn bodies(&self) -> anyhow::Result<Vec<Body>> {
+        match &self.given {
+            Some(given) => Ok(vec![given.body()?]),
+            None => Ok(self.meshes.iter().map(|&m| Body::cylinder(m)).collect()),
+        }
+    }
+
+    /// What the body is, for the report.
+    pub fn description(&self) -> String {
+        match &self.given {
+            Some(g) => format!(
+                "The given mesh {} ({} vertices, {} tets) at its own resolution (no refinement \
+                 series), supports {}, loaded {}",
+                g.label,
+                g.mesh.positions.len(),
+                g.mesh.tets.len(),
+                list(&g.fix),
+                if g.load_on.is_empty() {
+                    "on the face farthest from the supports".to_string()
+                } else {
+                    format!("on {}", list(&g.load_on))
+                }
+            ),
+            None => "Cylinder (radius H/5), base fixed, dead loads on the top face".into(),
+        }
     }
 
     /// Trajectories: per trajectory mesh, load, tensor-mass model,
     /// integrator and time step.
     pub fn trajectories(&self) -> usize {
-        self.meshes.len().min(self.trajectory.meshes)
+        self.mesh_count().min(self.trajectory.meshes)
             * self.loads.len()
             * tensor_mass_models()
             * Integrator::ALL.len()
@@ -255,7 +397,7 @@ impl Matrix {
         let cases = (self.loads.len() * self.levels.len()) as u64;
         let relaxations: u64 = bodies
             .iter()
-            .map(|b| tets(b) * cases * tensor_mass_models() as u64 * self.max_relax_steps as u64)
+            .map(|b| tets(b) * cases * relaxed_models() as u64 * self.max_relax_steps as u64)
             .sum();
         let evaluations: u64 = Integrator::ALL
             .iter()
@@ -352,6 +494,10 @@ pub struct Reference {
 /// The study's results.
 #[derive(Clone, Debug, Serialize)]
 pub struct Study {
+    /// What the body is (the report's first line).
+    pub body: String,
+    /// Per mesh, the hybrid's tensor-mass region: `(mesh, its tets, all tets)`.
+    pub hybrid_region: Vec<(String, usize, usize)>,
     /// Height of the body, m.
     pub height_m: f64,
     /// Young's modulus, Pa, and Poisson ratio.
@@ -368,37 +514,135 @@ pub struct Study {
     pub stability: Vec<stability::Map>,
     /// The dynamic runs' trajectory errors.
     pub trajectories: Vec<trajectory::Trajectory>,
+    /// Per-tick instructions of the pre-computed models' haptic tick
+    /// ([`ticks`]; measured by the command, after [`run`]).
+    pub ticks: ticks::TickCounts,
 }
 
-/// A mesh of the study with its boundary sets.
+/// The mean rest position of `vertices`, m; `None` for none.
+fn centroid(positions: &[[f64; 3]], vertices: impl Iterator<Item = usize>) -> Option<Vector3<f64>> {
+    let (mut sum, mut count) = (Vector3::zeros(), 0usize);
+    for v in vertices {
+        sum += Vector3::from(positions[v]);
+        count += 1;
+    }
+    (count > 0).then(|| sum / count as f64)
+}
+
+/// The predicates `fix`, comma-separated.
+fn list(fix: &[FixPredicate]) -> String {
+    fix.iter()
+        .map(|f| f.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A mesh of the study with its boundary sets and load geometry.
 pub struct Body {
-    /// `"RxH"`.
+    /// `"RxH"` for a cylinder, the file name for a given mesh.
     pub label: String,
     /// The rest mesh.
     pub mesh: TetMesh,
-    /// Base vertices (fixed).
+    /// The mesh's reader report (the hybrid's tables are built from it).
+    pub report: MeshReport,
+    /// The support predicates ([`Body::fixed`] is what they match).
+    pub fix: Vec<FixPredicate>,
+    /// Fixed vertices.
     pub fixed: Vec<bool>,
-    /// Top-face vertices.
+    /// The loaded vertices (the cylinder's top face).
     pub top: Vec<u32>,
     /// Material.
     pub material: Material,
+    /// Unit vector from the supports to the loaded end (the press pushes
+    /// along `−axis`, the twist turns about it).
+    pub axis: Vector3<f64>,
+    /// Unit vector orthogonal to `axis`: the bend's direction.
+    pub lateral: Vector3<f64>,
+    /// Centroid of the loaded vertices, m (the twist's axis passes through it).
+    pub centre: Vector3<f64>,
+    /// Extent of the mesh along `axis`, m: the length the levels are
+    /// fractions of.
+    pub length_m: f64,
+    /// Largest distance of a loaded vertex from the axis through
+    /// [`Body::centre`], m: the remap sample's radius.
+    pub radius_m: f64,
 }
 
 impl Body {
     /// The cylinder of `(radial, height)` cells.
     pub fn cylinder((radial, height): (usize, usize)) -> Self {
         let mesh = cylinder_mesh(HEIGHT_M, radial, height);
-        let fixed = mesh.positions.iter().map(|p| p[2] == 0.0).collect();
+        let label = format!("{radial}x{height}");
+        let fix = vec!["z<=0".parse().expect("a valid predicate")];
         let top = (0..mesh.positions.len() as u32)
             .filter(|&v| mesh.positions[v as usize][2] == HEIGHT_M)
             .collect();
+        let report = MeshReport {
+            source: format!("generated cylinder {label}"),
+            ..MeshReport::default()
+        };
+        let body = Self::with_loaded_vertices(label, mesh, report, fix, top, tissue())
+            .expect("the cylinder is fixed at its base and loaded on its top");
+        // The exact axes (the centroids agree with them to rounding).
         Self {
-            label: format!("{radial}x{height}"),
-            mesh,
-            fixed,
-            top,
-            material: tissue(),
+            axis: Vector3::z(),
+            lateral: Vector3::x(),
+            centre: Vector3::new(0.0, 0.0, HEIGHT_M),
+            radius_m: HEIGHT_M / 5.0,
+            ..body
         }
+    }
+
+    /// A given mesh with its supports `fix`, its loaded vertices `top`
+    /// (not all fixed) and `material`. The axis runs from the fixed
+    /// vertices' centroid to the loaded ones'; the bend is along the
+    /// coordinate axis most orthogonal to it, made orthogonal.
+    pub fn with_loaded_vertices(
+        label: String,
+        mesh: TetMesh,
+        report: MeshReport,
+        fix: Vec<FixPredicate>,
+        top: Vec<u32>,
+        material: Material,
+    ) -> anyhow::Result<Self> {
+        let (fixed, _) = fixed_vertices(&mesh.positions, &fix, &report.unreferenced_vertices);
+        let supports = centroid(&mesh.positions, (0..fixed.len()).filter(|&v| fixed[v]))
+            .context("no vertex matches the supports (--fix)")?;
+        let loaded: Vec<u32> = top.into_iter().filter(|&v| !fixed[v as usize]).collect();
+        let centre = centroid(&mesh.positions, loaded.iter().map(|&v| v as usize))
+            .context("no free vertex to load")?;
+        let axis = (centre - supports)
+            .try_normalize(1e-12)
+            .context("the loaded vertices' centroid is the supports' centroid: no axis")?;
+        let least = (0..3)
+            .min_by(|&a, &b| axis[a].abs().total_cmp(&axis[b].abs()))
+            .unwrap_or(0);
+        let lateral = (Vector3::ith(least, 1.0) - axis * axis[least]).normalize();
+        let along = mesh.positions.iter().map(|p| Vector3::from(*p).dot(&axis));
+        let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
+        let radius_m = loaded
+            .iter()
+            .map(|&v| {
+                let r = Vector3::from(mesh.positions[v as usize]) - centre;
+                (r - axis * r.dot(&axis)).norm()
+            })
+            .fold(0.0, f64::max);
+        Ok(Self {
+            radius_m,
+            label,
+            mesh,
+            report,
+            fix,
+            fixed,
+            top: loaded,
+            material,
+            axis,
+            lateral,
+            centre,
+            length_m: hi - lo,
+        })
     }
 
     /// Nodal loads of `load` with total force (press, bend) or torque
@@ -407,18 +651,45 @@ impl Body {
         let mut f = vec![[0.0; 3]; self.mesh.positions.len()];
         let share = magnitude / self.top.len() as f64;
         let arm = |v: u32| {
-            let p = self.mesh.positions[v as usize];
-            Vector3::new(p[0], p[1], 0.0)
+            let r = Vector3::from(self.mesh.positions[v as usize]) - self.centre;
+            r - self.axis * r.dot(&self.axis)
         };
         let polar: f64 = self.top.iter().map(|&v| arm(v).norm_squared()).sum();
         for &v in &self.top {
             f[v as usize] = match load {
-                Load::Press => [0.0, 0.0, -share],
-                Load::Bend => [share, 0.0, 0.0],
-                Load::Twist => (Vector3::z().cross(&arm(v)) * (magnitude / polar)).into(),
+                Load::Press => (-share * self.axis).into(),
+                Load::Bend => (share * self.lateral).into(),
+                Load::Twist => (self.axis.cross(&arm(v)) * (magnitude / polar)).into(),
             };
         }
         f
+    }
+
+    /// The hybrid's tensor-mass region: the tets whose centroid lies in the
+    /// [`HYBRID_DYNAMIC_FRACTION`] of the length nearest the loaded end,
+    /// and every tet with a loaded vertex (so the load acts on the
+    /// tensor-mass region). That is where the rotations of the bend and the
+    /// twist are largest (they grow from the supports to the loaded end)
+    /// and where a tool would touch and cut.
+    pub fn hybrid_dynamic_tets(&self) -> Vec<bool> {
+        let end = self.centre.dot(&self.axis);
+        let from = end - HYBRID_DYNAMIC_FRACTION * self.length_m;
+        let mut loaded = vec![false; self.mesh.positions.len()];
+        for &v in &self.top {
+            loaded[v as usize] = true;
+        }
+        self.mesh
+            .tets
+            .iter()
+            .map(|tet| {
+                let centroid: Vector3<f64> = tet
+                    .iter()
+                    .map(|&v| Vector3::from(self.mesh.positions[v as usize]))
+                    .sum::<Vector3<f64>>()
+                    / 4.0;
+                centroid.dot(&self.axis) >= from || tet.iter().any(|&v| loaded[v as usize])
+            })
+            .collect()
     }
 
     fn materials(&self) -> TetMaterials {
@@ -474,15 +745,16 @@ impl<F: FnMut(&str)> Progress for F {
 
 /// Runs the static part and the stability maps of `matrix`.
 pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study> {
-    anyhow::ensure!(!matrix.meshes.is_empty(), "no mesh in the matrix");
-    let bodies = matrix.bodies();
+    anyhow::ensure!(matrix.mesh_count() > 0, "no mesh in the matrix");
+    let bodies = matrix.bodies()?;
     let finest = bodies.last().context("no mesh")?;
     let material = finest.material;
+    let height_m = finest.length_m;
 
     // The quasi-non-linear fit: the compression sample of the body's
     // aspect (radius H/5) and material, 25 % compression in 8 steps, cubic
     // (the `palpate remap fit` defaults).
-    let sample = Sample::new(HEIGHT_M, HEIGHT_M / 5.0, material)?;
+    let sample = Sample::new(finest.length_m, finest.radius_m, material)?;
     let curves = stvk_curves(&sample, 0.25, 8).context("remap sample curves")?;
     let remap = fit_curves(&curves, &linear_response(&sample)?, 3)?;
     let quasi = (remap.kernel::<f64>()?, remap.kernel::<f32>()?);
@@ -502,9 +774,9 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
             &unit,
         )?;
         let tip_per_unit = tip_m(&unit, &u_unit);
-        trajectory_loads.push((load, matrix.trajectory.level * HEIGHT_M / tip_per_unit));
+        trajectory_loads.push((load, matrix.trajectory.level * height_m / tip_per_unit));
         for &level in &matrix.levels {
-            let magnitude = level * HEIGHT_M / tip_per_unit;
+            let magnitude = level * height_m / tip_per_unit;
             let reference = reference(finest, load, level, magnitude);
             progress.tick(&format!(
                 "reference {} {:.0} %: {}",
@@ -547,8 +819,18 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
     let stability = stability::maps(&bodies[0], &matrix.stability, progress)?;
     let trajectories =
         trajectory::trajectories(&bodies, &trajectory_loads, &matrix.trajectory, progress)?;
+    let hybrid_region = bodies
+        .iter()
+        .map(|b| {
+            let tets = b.hybrid_dynamic_tets();
+            let dynamic = tets.iter().filter(|&&d| d).count();
+            (b.label.clone(), dynamic, tets.len())
+        })
+        .collect();
     Ok(Study {
-        height_m: HEIGHT_M,
+        body: matrix.description(),
+        hybrid_region,
+        height_m,
         material: (material.young_pa, material.poisson),
         reference_mesh: finest.label.clone(),
         references,
@@ -556,6 +838,9 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
         remap,
         stability,
         trajectories,
+        ticks: ticks::TickCounts::Skipped {
+            reason: "not measured".into(),
+        },
     })
 }
 
@@ -651,6 +936,7 @@ fn run_model(
     let outcome = match (model, model.tensor_mass(body)) {
         (_, Some((law, penalty))) => dynamic(body, &loads, law, penalty, max_steps)?,
         (Model::PrecomputedQuasi, None) => precomputed(body, &loads, Some(quasi))?,
+        (Model::Hybrid, None) => hybrid(body, &loads, max_steps)?,
         (_, None) => precomputed(body, &loads, None)?,
     };
     let alive = vec![true; body.mesh.tets.len()];
@@ -861,24 +1147,14 @@ fn dynamic(
         .map(|f| Vector3::from(*f).norm())
         .fold(0.0, f64::max);
     let mut u = vec![[0.0; 3]; n];
-    let (fault, steps) = match relax(
+    let (fault, steps) = relax_outcome(relax(
         &mut model,
         loads,
         dt_s,
         RELAX_TOLERANCE * largest,
         max_steps,
         &mut u,
-    ) {
-        Ok(r) if r.converged => (None, r.steps),
-        Ok(r) => (
-            Some(format!(
-                "not settled in {} steps (residual {:.2e} N)",
-                r.steps, r.residual_n
-            )),
-            r.steps,
-        ),
-        Err(e) => (Some(format!("diverged: {e}")), 0),
-    };
+    ));
     // Time per step: the law's step from the state reached (reset if it
     // faulted, so the step runs).
     if model.fault().is_some() {
@@ -895,6 +1171,130 @@ fn dynamic(
         step_f32_s: Some(step_f32_s),
         steps,
     })
+}
+
+/// The hybrid of `body` ([`Model::Hybrid`]) under the nodal `loads` (all
+/// on its tensor-mass region), relaxed to rest as [`dynamic`] relaxes the
+/// tensor-mass models (the condensed region's force is part of every force
+/// evaluation, so the residual is the whole body's); time per step of the
+/// coupled step in f64 at the equilibrium and in f32 from rest.
+fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<Outcome> {
+    let dynamic_tet = body.hybrid_dynamic_tets();
+    let options =
+        |precision| HybridOptions::new(body.material, DENSITY_KG_M3, body.fix.clone(), precision);
+    let n = body.mesh.positions.len();
+    // A mesh whose loaded end is all of it (or none) has no hybrid: a
+    // fault of the run, not of the study.
+    let tables = match build_hybrid(
+        &body.mesh,
+        &body.report,
+        &dynamic_tet,
+        &options(Precision::F64),
+    ) {
+        Ok(tables) => tables,
+        Err(e) => {
+            return Ok(Outcome {
+                u: vec![[0.0; 3]; n],
+                fault: Some(format!("no hybrid of this mesh: {e:#}")),
+                step_s: f64::NAN,
+                step_f32_s: None,
+                steps: 0,
+            });
+        }
+    };
+    let split = &tables.split;
+    let mut local = vec![[0.0; 3]; split.dynamic_vertex.len()];
+    for (v, f) in loads.iter().enumerate() {
+        if f.iter().any(|&x| x != 0.0) {
+            let l =
+                split.dynamic_index[v].context("a loaded vertex outside the tensor-mass region")?;
+            local[l as usize] = *f;
+        }
+    }
+    let largest = loads
+        .iter()
+        .map(|f| Vector3::from(*f).norm())
+        .fold(0.0, f64::max);
+    let bound = 100.0 * diagonal(&body.mesh.positions);
+    let law = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
+    let params = DynamicParams::linear(0.0, bound).with_law(law);
+    let (u, fault, steps, step_s, dt_s) = with_hybrid(&tables, params, |h| {
+        let dt_s = 0.5 / omega_max(h.dynamic_mut());
+        h.reset();
+        for (l, f) in local.iter().enumerate() {
+            if f.iter().any(|&x| x != 0.0) {
+                h.dynamic_mut()
+                    .set_external_force(l as u32, Vector3::from(*f))?;
+            }
+        }
+        let mut last = vec![[0.0; 3]; local.len()];
+        let relaxed = relax(
+            h.dynamic_mut(),
+            &local,
+            dt_s,
+            RELAX_TOLERANCE * largest,
+            max_steps,
+            &mut last,
+        );
+        let (fault, steps) = relax_outcome(relaxed);
+        let mut u = vec![[0.0; 3]; n];
+        if fault.is_none() {
+            h.update_background(usize::MAX)?;
+            h.displacements::<1>(None, &mut u)?;
+        }
+        if h.dynamic().fault().is_some() {
+            h.reset();
+        }
+        let step_s = timing::median_time_s(|| {
+            let _ = core::hint::black_box(h.step(Integrator::SymplecticEuler, dt_s));
+        });
+        anyhow::Ok((u, fault, steps, step_s, dt_s))
+    })??;
+    let tables32 = build_hybrid(
+        &body.mesh,
+        &body.report,
+        &dynamic_tet,
+        &options(Precision::F32),
+    )?;
+    let params32 = DynamicParams::linear(0.0f32, bound as f32).with_law(law);
+    let step_f32_s = with_hybrid(&tables32, params32, |h| {
+        for (l, f) in local.iter().enumerate() {
+            if f.iter().any(|&x| x != 0.0) {
+                h.dynamic_mut()
+                    .set_external_force(l as u32, Vector3::from(f.map(|x| x as f32)))?;
+            }
+        }
+        anyhow::Ok(timing::median_time_s(|| {
+            if h.dynamic().fault().is_some() {
+                h.reset();
+            }
+            let _ = core::hint::black_box(h.step(Integrator::SymplecticEuler, dt_s as f32));
+        }))
+    })??;
+    Ok(Outcome {
+        u,
+        fault,
+        step_s,
+        step_f32_s: Some(step_f32_s),
+        steps,
+    })
+}
+
+/// The fault (`None` when settled) and the steps of a relaxation.
+fn relax_outcome(
+    relaxed: Result<crate::experiment::relax::Relaxation, palpate_kernel::tensor_mass::StepError>,
+) -> (Option<String>, usize) {
+    match relaxed {
+        Ok(r) if r.converged => (None, r.steps),
+        Ok(r) => (
+            Some(format!(
+                "not settled in {} steps (residual {:.2e} N)",
+                r.steps, r.residual_n
+            )),
+            r.steps,
+        ),
+        Err(e) => (Some(format!("diverged: {e}")), 0),
+    }
 }
 
 /// Median time of one f32 symplectic-Euler step of the same model, s.

@@ -83,6 +83,7 @@ pub fn model_colour(model: Model) -> RGBColor {
         Model::TensorMassLinear => RGBColor(255, 127, 14),
         Model::Stvk => RGBColor(214, 39, 40),
         Model::StvkPenalty => RGBColor(44, 160, 44),
+        Model::Hybrid => RGBColor(148, 103, 189),
     }
 }
 

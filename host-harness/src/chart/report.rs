@@ -5,6 +5,7 @@ use core::fmt::Write;
 use super::plot::{cost_series, log_slope};
 use super::select::{cheapest_within, pareto_front};
 use super::stability::Outcome;
+use super::ticks::TickCounts;
 use super::trajectory::{REFINEMENT, Trajectory};
 use super::{Load, Model, Run, Study};
 
@@ -73,6 +74,39 @@ pub fn pareto_members(study: &Study, load: Load, level: f64) -> Vec<String> {
         .collect()
 }
 
+/// The section of the haptic tick's instruction counts.
+fn tick_counts(out: &mut String, study: &Study) {
+    let _ = writeln!(out, "\n## Per-tick instructions of the haptic tick\n");
+    match &study.ticks {
+        TickCounts::Skipped { reason } => {
+            let _ = writeln!(out, "Not measured: {reason}.");
+        }
+        TickCounts::Measured { mesh, counts } => {
+            let _ = writeln!(
+                out,
+                "Callgrind instructions (Ir) of one haptic tick (`palpate budget`'s measurement) on \
+                 the built-in block scene ({mesh}), its `{}` trajectory with 1 to 4 probes held \
+                 pressed (one contact each), f32; the quasi-non-linear tissue with the remap fitted \
+                 above.\n",
+                super::ticks::TICK_TRAJECTORY
+            );
+            let _ = writeln!(out, "| model | contacts | ticks | mean Ir | max Ir |");
+            let _ = writeln!(out, "|---|---|---|---|---|");
+            for c in counts {
+                let _ = writeln!(
+                    out,
+                    "| {} | {} | {} | {:.0} | {} |",
+                    c.model.name(),
+                    c.contacts,
+                    c.ticks,
+                    c.mean_ir,
+                    c.max_ir
+                );
+            }
+        }
+    }
+}
+
 /// The report in Markdown; `charts` are the chart names (PNG beside it).
 pub fn markdown(
     study: &Study,
@@ -85,10 +119,25 @@ pub fn markdown(
     let _ = writeln!(out, "# Speed against accuracy: palpate chart\n");
     let _ = writeln!(
         out,
-        "Cylinder of height {} m (radius H/5), E = {} Pa, ν = {}, base fixed, dead loads on the top \
-         face. Reference: Newton St Venant-Kirchhoff on mesh {}. Error: the top-face displacement \
-         (work-conjugate mean) against the reference; cost: median time of one step (f64).\n",
-        study.height_m, study.material.0, study.material.1, study.reference_mesh
+        "{}, length {} m, E = {} Pa, ν = {}. Reference: Newton St Venant-Kirchhoff on mesh {}. \
+         Error: the loaded face's displacement (work-conjugate mean) against the reference; cost: \
+         median time of one step (f64).\n",
+        study.body, study.height_m, study.material.0, study.material.1, study.reference_mesh
+    );
+    let regions: Vec<String> = study
+        .hybrid_region
+        .iter()
+        .map(|(mesh, dynamic, all)| format!("{dynamic} of {all} tets on {mesh}"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "The hybrid: St Venant-Kirchhoff tensor-mass on the tets within {:.0} % of the length from \
+         the loaded end (and every tet touching a loaded vertex): {}; the rest pre-computed linear, \
+         condensed onto the connection nodes. The bend's and twist's rotations grow towards the \
+         loaded end, where a tool would also touch and cut; the largest strains of the bend are at \
+         the supports, in the linear region.\n",
+        100.0 * super::HYBRID_DYNAMIC_FRACTION,
+        regions.join(", ")
     );
     let _ = writeln!(out, "## Cheapest model within an error bound\n");
     let _ = writeln!(
@@ -150,6 +199,7 @@ pub fn markdown(
             r.fault.as_deref().unwrap_or("")
         );
     }
+    tick_counts(&mut out, study);
     trajectories(&mut out, study, loads);
     let _ = writeln!(out, "\n## Where the methods fail\n");
     for line in failures(study) {

@@ -208,7 +208,7 @@ fn trial(
         &[],
         &unit,
     )?;
-    let scale = 0.05 * super::HEIGHT_M / super::tip_m(&unit, &u_unit);
+    let scale = 0.05 * body.length_m / super::tip_m(&unit, &u_unit);
     let loads: Vec<[f64; 3]> = unit.iter().map(|f| f.map(|x| x * scale)).collect();
     let work: f64 = loads
         .iter()

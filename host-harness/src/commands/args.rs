@@ -46,7 +46,8 @@ pub fn optional_fix(fix: clap::Arg) -> clap::Arg {
     )
 }
 
-fn parse_fix(s: &str) -> Result<FixPredicate, String> {
+/// Parses one `--fix`-syntax predicate (also `chart --load-on`).
+pub fn parse_fix(s: &str) -> Result<FixPredicate, String> {
     s.parse()
 }
 

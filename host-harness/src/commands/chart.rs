@@ -3,17 +3,20 @@
 //! `index.html` and `study.json` into `--out`, prints the summary (or the
 //! JSON).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use palpate::chart::{self, Matrix, plot, report};
+use palpate::chart::{self, GivenMesh, Matrix, plot, report, ticks};
 use palpate::experiment::scenes;
 use palpate::experiment::volume_bend::{self, Protocol};
+use palpate::fix::FixPredicate;
 use palpate::limits::MAX_CHART_TET_STEPS;
+use palpate::mesh::read_mesh;
 use palpate::output::atomic::write_file;
 
+use super::args::{MaterialArgs, parse_fix};
 use super::stdout;
 
 /// `palpate chart` arguments.
@@ -26,19 +29,85 @@ pub struct ChartArgs {
     /// Output folder (created; files in it replaced atomically).
     #[arg(long, default_value = "chart-out")]
     out: PathBuf,
+    /// Count the haptic tick's instructions under callgrind in `--quick`
+    /// too (the full run always does, when valgrind is installed).
+    #[arg(long)]
+    tick_counts: bool,
     /// Print the study as one JSON object instead of the summary.
     #[arg(long)]
     json: bool,
+    /// Run the matrix on this mesh (m; any format the mesh readers take) at
+    /// its own resolution, instead of the cylinder's refinements.
+    #[arg(long, requires_all = ["young", "poisson", "fix"])]
+    mesh: Option<PathBuf>,
+    /// Young's modulus of `--mesh`, Pa.
+    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    young: Option<f64>,
+    /// Poisson ratio of `--mesh`, in [0, 0.5).
+    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    poisson: Option<f64>,
+    /// Fixed vertices of `--mesh`: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
+    #[arg(long = "fix", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
+    fix: Vec<FixPredicate>,
+    /// Loaded vertices of `--mesh`, same syntax (repeatable; default: the
+    /// face farthest from the supports).
+    #[arg(long = "load-on", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
+    load_on: Vec<FixPredicate>,
+    /// Internal: run the haptic ticks of this trajectory on this table of
+    /// the built-in scene with POINTS probes, REMAP the quasi-non-linear
+    /// remap or `linear` (the process callgrind measures).
+    #[arg(long, hide = true, num_args = 4, value_names = ["TABLE", "TRAJECTORY", "POINTS", "REMAP"])]
+    tick_probe: Option<Vec<String>>,
+}
+
+impl ChartArgs {
+    /// The user's mesh of `--mesh`, if given.
+    fn given(&self) -> anyhow::Result<Option<GivenMesh>> {
+        let Some(path) = &self.mesh else {
+            return Ok(None);
+        };
+        let (mesh, report) = read_mesh(path)?;
+        let material = MaterialArgs {
+            young: self.young.context("--young")?,
+            poisson: self.poisson.context("--poisson")?,
+        }
+        .material()?;
+        Ok(Some(GivenMesh {
+            label: path.file_name().map_or_else(
+                || path.display().to_string(),
+                |f| f.to_string_lossy().into(),
+            ),
+            mesh,
+            report,
+            fix: self.fix.clone(),
+            load_on: self.load_on.clone(),
+            material,
+        }))
+    }
 }
 
 /// Runs `palpate chart`.
 pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
+    if let Some([table, trajectory, points, remap]) = args.tick_probe.as_deref() {
+        let points: usize = points.parse().context("--tick-probe POINTS")?;
+        return ticks::probe_child(table.as_ref(), trajectory.as_ref(), points, remap);
+    }
     let matrix = if args.quick {
         Matrix::quick()
     } else {
         Matrix::full()
     };
-    let protocols = [Protocol::PaperLoads, Protocol::Tilt];
+    let mut matrix = match args.given()? {
+        Some(given) => matrix.on(given),
+        None => matrix,
+    };
+    matrix.tick_counts |= args.tick_counts;
+    // Picinbono's table 2 is the cylinder's experiment: not run on a given mesh.
+    let protocols: &[Protocol] = if matrix.given.is_some() {
+        &[]
+    } else {
+        &[Protocol::PaperLoads, Protocol::Tilt]
+    };
     // Picinbono's table 2 on the bent cylinder: the small one in --quick;
     // its relaxations capped as the study's.
     let scene = if args.quick {
@@ -51,12 +120,18 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         ..volume_bend::Controls::default()
     };
     let trials = 4 * matrix.stability.trials();
-    let total = matrix.static_runs() + trials + matrix.trajectories() + protocols.len();
+    // The tick counts need valgrind: without it, skipped (said in the report).
+    let tick_runs = if matrix.tick_counts && ticks::valgrind_available() {
+        ticks::TICK_RUNS
+    } else {
+        0
+    };
+    let total = matrix.static_runs() + trials + matrix.trajectories() + protocols.len() + tick_runs;
     eprintln!(
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
          references), {} stability trials, {} trajectories (each against its Δt/{}), {} volume \
-         experiments: {total} steps of progress",
-        matrix.meshes.len(),
+         experiments, {tick_runs} callgrind runs: {total} steps of progress",
+        matrix.mesh_count(),
         matrix.loads.len(),
         matrix.levels.len(),
         chart::Model::ALL.len(),
@@ -68,7 +143,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         protocols.len(),
     );
     // The work bound, checked before anything runs, and its time here.
-    let bodies = matrix.bodies();
+    let bodies = matrix.bodies()?;
     let volume_relaxations: usize = protocols
         .iter()
         .map(|&p| volume_bend::relaxations_bound(&scene, p, &controls))
@@ -111,9 +186,28 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
             bar.set_message(message.to_string());
         }
     };
-    let study = chart::run(&matrix, &mut tick)?;
+    let mut study = chart::run(&matrix, &mut tick)?;
+    study.ticks = if !matrix.tick_counts {
+        ticks::TickCounts::Skipped {
+            reason: "--quick (eight callgrind runs; `--tick-counts` measures them)".into(),
+        }
+    } else {
+        let exe = std::env::current_exe()?;
+        let child = |table: &Path, trajectory: &Path, points: usize, remap: &str| {
+            vec![
+                "chart".into(),
+                "--tick-probe".into(),
+                table.display().to_string(),
+                trajectory.display().to_string(),
+                points.to_string(),
+                remap.into(),
+            ]
+        };
+        let quasi = study.remap.kernel::<f64>()?;
+        ticks::measure_ticks(&exe, child, &args.out.join("ticks"), &quasi, &mut tick)?
+    };
     let mut volume = Vec::new();
-    for protocol in protocols {
+    for &protocol in protocols {
         volume.push(volume_bend::run_scene(&scene, protocol, &controls, |_| {})?);
         tick(&format!("volume {protocol:?}"));
     }
