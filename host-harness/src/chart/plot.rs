@@ -149,6 +149,49 @@ pub fn draw_all(
     Ok(names)
 }
 
+/// The frame of an error-against-cost chart: log axes over `points`
+/// (`axes`: the x and y descriptions) and the Pareto front (`front`, one
+/// flag per point) joined by a line in the legend.
+fn pareto_frame<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    axes: [&str; 2],
+    points: &[(f64, f64)],
+    front: &[bool],
+) -> anyhow::Result<ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>> {
+    let x = log_range(points.iter().map(|p| p.0));
+    let y = log_range(points.iter().map(|p| p.1));
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    let [x_desc, y_desc] = axes;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(err)?;
+    let mut on_front: Vec<(f64, f64)> = points
+        .iter()
+        .zip(front)
+        .filter(|(_, f)| **f)
+        .map(|(p, _)| *p)
+        .collect();
+    on_front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    chart
+        .draw_series(LineSeries::new(on_front, BLACK.stroke_width(1)))
+        .map_err(err)?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    Ok(chart)
+}
+
 /// Error (tip, against the Newton reference) against time per step for one
 /// load and level, every mesh and model; the Pareto front filled and joined.
 fn pareto<DB: DrawingBackend>(
@@ -168,42 +211,16 @@ fn pareto<DB: DrawingBackend>(
         .map(|r| (r.step_s, r.tip_error.unwrap_or(f64::NAN).max(1e-6)))
         .collect();
     let front = pareto_front(&points);
-    let x = log_range(points.iter().map(|p| p.0));
-    let y = log_range(points.iter().map(|p| p.1));
-    let mut chart = ChartBuilder::on(root)
-        .caption(
-            format!(
-                "{} at {:.0} % of the height: error vs time per step",
-                load.name(),
-                100.0 * level
-            ),
-            ("sans-serif", 20),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("time per step, s (f64)")
-        .y_desc("tip displacement error vs Newton StVK")
-        .x_label_formatter(&|v| format!("{v:.0e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(err)?;
-    let mut on_front: Vec<(f64, f64)> = points
-        .iter()
-        .zip(&front)
-        .filter(|(_, f)| **f)
-        .map(|(p, _)| *p)
-        .collect();
-    on_front.sort_by(|a, b| a.0.total_cmp(&b.0));
-    chart
-        .draw_series(LineSeries::new(on_front, BLACK.stroke_width(1)))
-        .map_err(err)?
-        .label("Pareto front")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    let caption = format!(
+        "{} at {:.0} % of the height: error vs time per step",
+        load.name(),
+        100.0 * level
+    );
+    let axes = [
+        "time per step, s (f64)",
+        "tip displacement error vs Newton StVK",
+    ];
+    let mut chart = pareto_frame(root, &caption, axes, &points, &front)?;
     for model in Model::ALL {
         let colour = model_colour(model);
         let series: Vec<_> = runs
@@ -261,43 +278,17 @@ fn trajectory_chart<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err)?;
     let (runs, points) = trajectory_points(study, load);
     let front = pareto_front(&points);
-    let x = log_range(points.iter().map(|p| p.0));
-    let y = log_range(points.iter().map(|p| p.1));
     let level = runs.first().map_or(0.0, |t| t.level);
-    let mut chart = ChartBuilder::on(root)
-        .caption(
-            format!(
-                "{} at {:.0} %: trajectory error vs Δt/16, against cost",
-                load.name(),
-                100.0 * level
-            ),
-            ("sans-serif", 20),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("compute time per simulated second, s (f64)")
-        .y_desc("trajectory error (relative L2, max over time)")
-        .x_label_formatter(&|v| format!("{v:.0e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(err)?;
-    let mut on_front: Vec<(f64, f64)> = points
-        .iter()
-        .zip(&front)
-        .filter(|(_, f)| **f)
-        .map(|(p, _)| *p)
-        .collect();
-    on_front.sort_by(|a, b| a.0.total_cmp(&b.0));
-    chart
-        .draw_series(LineSeries::new(on_front, BLACK.stroke_width(1)))
-        .map_err(err)?
-        .label("Pareto front")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    let caption = format!(
+        "{} at {:.0} %: trajectory error vs Δt/16, against cost",
+        load.name(),
+        100.0 * level
+    );
+    let axes = [
+        "compute time per simulated second, s (f64)",
+        "trajectory error (relative L2, max over time)",
+    ];
+    let mut chart = pareto_frame(root, &caption, axes, &points, &front)?;
     for integrator in Integrator::ALL.map(Integrator::name) {
         let colour = integrator_colour(integrator);
         let series: Vec<_> = runs

@@ -166,7 +166,7 @@ pub fn measure_ticks(
         mesh.positions.len(),
         mesh.tets.len()
     );
-    let (tables, _) = budget_table(&scene, &mesh, &report, &HOST_IR)?;
+    let (tables, _) = budget_table(&scene, &mesh, &report, &HOST_IR, None)?;
     let table = work_dir.join("table.bin");
     tables.write(&table)?;
     let mut counts = Vec::new();
