@@ -6,6 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
 use crate::math::cholesky::solve_blocks;
+use crate::math::{Dispatch, Portable};
 use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
 use crate::{MAX_CONTACT_CAPACITY, Real};
@@ -195,9 +196,21 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         solution: &ContactSolution<T, M>,
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
+        self.free_displacements_with(Portable, solution, out)
+    }
+
+    /// [`Self::free_displacements`] with its pass over the compliance
+    /// columns run through `dispatch`: a host's run-time CPU-feature
+    /// dispatch ([`crate::math::dispatch`]). Same results.
+    pub fn free_displacements_with<const M: usize>(
+        &self,
+        dispatch: impl Dispatch,
+        solution: &ContactSolution<T, M>,
+        out: &mut [[T; 3]],
+    ) -> Result<(), DisplacementError> {
         check_length(self.table.free_count(), out)?;
         out.fill([T::zero(); 3]);
-        self.add_rows(solution, 0, out);
+        self.add_rows(dispatch, solution, 0, out);
         Ok(())
     }
 
@@ -212,6 +225,17 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         solution: &ContactSolution<T, M>,
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
+        self.displacements_with(Portable, solution, out)
+    }
+
+    /// [`Self::displacements`] with its passes over the compliance columns
+    /// run through `dispatch` (see [`Self::free_displacements_with`]).
+    pub fn displacements_with<const M: usize>(
+        &self,
+        dispatch: impl Dispatch,
+        solution: &ContactSolution<T, M>,
+        out: &mut [[T; 3]],
+    ) -> Result<(), DisplacementError> {
         const CHUNK: usize = 64;
         check_length(self.table.vertex_count(), out)?;
         // Fixed vertices stay zero; a memset is cheaper than picking them out.
@@ -219,7 +243,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         for (chunk, vertices) in self.table.free_vertices().chunks(CHUNK).enumerate() {
             let mut buffer = [[T::zero(); 3]; CHUNK];
             let rows = buffer.get_mut(..vertices.len()).unwrap_or(&mut []);
-            self.add_rows(solution, chunk * CHUNK, rows);
+            self.add_rows(dispatch, solution, chunk * CHUNK, rows);
             for (u, &v) in rows.iter().zip(vertices) {
                 if let Some(o) = out.get_mut(v as usize) {
                     *o = *u;
@@ -230,25 +254,33 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     }
 
     /// `out[i] += Σ_terms C_{first+i, k} w` over the contact terms: free rows
-    /// `first .. first + out.len()`.
+    /// `first .. first + out.len()`, run through `dispatch`.
     fn add_rows<const M: usize>(
         &self,
+        dispatch: impl Dispatch,
         solution: &ContactSolution<T, M>,
         first: usize,
         out: &mut [[T; 3]],
     ) {
-        for (point, g) in solution.resolved() {
-            for (k, beta) in point.terms() {
-                self.add_column_rows(k.get(), &(g * beta), first, out);
-            }
-        }
+        dispatch.run(
+            #[inline(always)]
+            || {
+                for (point, g) in solution.resolved() {
+                    for (k, beta) in point.terms() {
+                        self.add_column_rows(k.get(), &(g * beta), first, out);
+                    }
+                }
+            },
+        );
     }
 
     /// `out[i] += C_{n,k} w` for the free rows `n = first + i` (format in
     /// [`crate::table::format`]): rows `n ≤ k` from column `k` of the packed
     /// surface part, rows `k < n < S` as `C_knᵀ` from column `n`, interior
     /// rows from column `k` of the interior part. Rows outside `0..F` are
-    /// skipped.
+    /// skipped. Always inlined (one caller), so that a [`Dispatch`] compiles
+    /// it where it runs.
+    #[inline(always)]
     fn add_column_rows(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
         let s = self.table.touchable_count();
         let f = self.table.free_count();
