@@ -6,6 +6,7 @@
 
 mod host {
     mod compliance;
+    mod dispatch;
     mod experiment;
     mod fem;
     mod materials;
