@@ -4,13 +4,16 @@
 //! checks whether the CPU has AVX2 and FMA and, if so, runs the kernel's
 //! passes from a function compiled for them ([`HostDispatch::detect`]).
 //!
-//! Which paths use it: `palpate dynamic run` (the tensor-mass step; the
-//! hybrid model's steps stay portable) and `palpate bench` (the step, the
-//! force passes and the pre-computed displacement update). Everything whose
-//! output is compared bit for bit with the firmware (`precomputed replay`,
-//! `scene replay-hybrid`, `tools/firmware-check.sh`), `session run`,
-//! `budget` (whose instruction counts stand for the firmware's) and the
-//! tests' references run [`palpate_kernel::math::Portable`].
+//! Which paths use it: `palpate dynamic run` (the tensor-mass step; a
+//! hybrid scene's steps stay portable), `palpate session run` on a dynamic
+//! scene (the physics updates' steps; a hybrid scene's stay portable) and
+//! `palpate bench` (the steps and the pre-computed displacement update).
+//! Everything whose output is compared bit for bit with the firmware
+//! (`precomputed replay`, `scene replay-hybrid`, `tools/firmware-check.sh`),
+//! `budget` (whose instruction counts stand for the firmware's), the
+//! library's other entry points (`TensorMassModel::step`, the haptic
+//! loops' ticks) and the tests' references run
+//! [`palpate_kernel::math::Portable`].
 //!
 //! The kernel's passes do the same IEEE-754 operations either way (Rust does
 //! not contract `a * b + c` into a fused multiply-add; AVX2 brings wider

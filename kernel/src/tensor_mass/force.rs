@@ -150,13 +150,16 @@ impl<T: Real> Stiffness<'_, T> {
             else {
                 continue;
             };
+            // A copy: `f`'s writes below cannot change it (without the copy,
+            // the compiler reloads `u_i` at every edge).
+            let ui = *ui;
             let mut fi = [T::zero(); 3];
             for (&j, k) in columns.iter().zip(tensors) {
                 let (Some(uj), Some(fj)) = (u.get(j as usize), f.get_mut(j as usize)) else {
                     continue;
                 };
                 let a = mul(k, uj);
-                let b = mul_transposed(k, ui);
+                let b = mul_transposed(k, &ui);
                 fi = [fi[0] - a[0], fi[1] - a[1], fi[2] - a[2]];
                 *fj = [fj[0] - b[0], fj[1] - b[1], fj[2] - b[2]];
             }
