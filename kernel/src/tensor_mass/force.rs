@@ -34,12 +34,6 @@ impl<T: Real> InternalForces<'_, '_, T> {
     /// pass over the mesh runs through `dispatch` ([`Dispatch`]).
     pub(crate) fn forces(&self, dispatch: impl Dispatch, u: &[[T; 3]], f: &mut [[T; 3]]) {
         match self.law {
-            ElasticLaw::Linear => {
-                dispatch.run(
-                    #[inline(always)]
-                    || self.stiffness.elastic_forces(u, f),
-                );
-            }
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
                 f.fill([T::zero(); 3]);
                 dispatch.run(
@@ -47,12 +41,16 @@ impl<T: Real> InternalForces<'_, '_, T> {
                     || self.tets.add_stvk_forces(u, f),
                 );
             }
-            ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
+            // One call site of the (always inlined) linear pass for both
+            // laws that read the tensors: one copy of it in the firmware.
+            law => {
                 dispatch.run(
                     #[inline(always)]
                     || {
                         self.stiffness.elastic_forces(u, f);
-                        self.terms.add_forces(u, f);
+                        if law == ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) {
+                            self.terms.add_forces(u, f);
+                        }
                     },
                 );
             }

@@ -248,47 +248,50 @@ impl<T: Real> TetPass<'_, '_, T> {
     /// `u` (m), in tet order. Bounded by the tet count; a tet whose
     /// references fall outside `u` is skipped (validated at load).
     ///
-    /// The tets are walked by index rather than by a zip of four slices:
-    /// inside a pass a host compiles for more CPU features
-    /// ([`crate::math::Dispatch`]), the compiler left the zip's `next` out
-    /// of line, a call per tet.
+    /// `visit` has one call site, so that inlining it (the passes ask for
+    /// it, for [`crate::math::Dispatch`]) does not copy it. The tets are
+    /// walked by index rather than by a zip of four slices: inside a pass a
+    /// host compiles for more CPU features, the compiler left the zip's
+    /// `next` out of line, a call per tet.
     #[inline(always)]
     fn for_each_block(&self, u: &[[T; 3]], mut visit: impl FnMut(&Block<T>)) {
         let mut block = Block::empty();
         let (tets, shapes) = (self.table.tets(), self.table.tet_shapes());
         let materials = self.table.tet_materials();
-        for t in 0..tets.len() {
-            let (Some(&tet), Some(shape), Some(lame), Some(&alive)) = (
-                tets.get(t),
-                shapes.get(t),
-                materials.get(t),
-                self.tet_alive.get(t),
-            ) else {
-                break;
-            };
-            let (true, Some(u0), Some(u1), Some(u2), Some(u3)) = (
-                alive,
-                u.get(tet[0] as usize),
-                u.get(tet[1] as usize),
-                u.get(tet[2] as usize),
-                u.get(tet[3] as usize),
-            ) else {
-                continue;
-            };
-            block.push(tet, shape, lame, [u0, u1, u2, u3]);
-            if block.used == LANES {
-                visit(&block);
-                block.used = 0;
+        let mut t = 0;
+        loop {
+            while block.used < LANES {
+                let (Some(&tet), Some(shape), Some(lame), Some(&alive)) = (
+                    tets.get(t),
+                    shapes.get(t),
+                    materials.get(t),
+                    self.tet_alive.get(t),
+                ) else {
+                    break;
+                };
+                t += 1;
+                let (true, Some(u0), Some(u1), Some(u2), Some(u3)) = (
+                    alive,
+                    u.get(tet[0] as usize),
+                    u.get(tet[1] as usize),
+                    u.get(tet[2] as usize),
+                    u.get(tet[3] as usize),
+                ) else {
+                    continue;
+                };
+                block.push(tet, shape, lame, [u0, u1, u2, u3]);
             }
-        }
-        if block.used > 0 {
-            // Clear the stale lanes so they compute nothing.
+            if block.used == 0 {
+                return;
+            }
+            // Clear the stale lanes of the last block so they compute nothing.
             for l in block.used..LANES {
                 if let Some(v) = block.volume.get_mut(l) {
                     *v = T::zero();
                 }
             }
             visit(&block);
+            block.used = 0;
         }
     }
 
