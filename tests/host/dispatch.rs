@@ -1,15 +1,16 @@
 //! Run-time CPU-feature dispatch (`host-harness/src/dispatch.rs`): the
-//! kernel's passes run through `HostDispatch::detect()` (AVX2 + FMA on a CPU
-//! that has them) give the same results as the portable passes.
+//! kernel's passes run at every level this CPU has
+//! (`HostDispatch::available()`: AVX2 + FMA, AVX-512) give the same results
+//! as the portable passes.
 //!
 //! Tolerance: none, bit for bit. Rust never contracts `a * b + c` into a
-//! fused multiply-add, so code compiled for AVX2 and FMA performs the same
-//! IEEE-754 operations in the same order, in wider registers; the kernel's
-//! passes have no reductions the compiler may reorder (no fast-math). A
-//! difference here means a pass computes differently when dispatched, which
-//! the firmware comparison (portable on both sides) would not see. On a CPU
-//! without AVX2 and FMA, `detect()` is the portable path and the test
-//! compares it with itself (the CPU is printed).
+//! fused multiply-add, so code compiled for AVX2, FMA or AVX-512 performs
+//! the same IEEE-754 operations in the same order, in wider registers; the
+//! kernel's passes have no reductions the compiler may reorder (no
+//! fast-math). A difference here means a pass computes differently when
+//! dispatched, which the firmware comparison (portable on both sides) would
+//! not see. On a CPU without AVX2 and FMA the only level is the portable one
+//! and the test compares it with itself (the levels are printed).
 
 use nalgebra::Vector3;
 use palpate::dispatch::HostDispatch;
@@ -122,23 +123,31 @@ fn bits<T: Real>(x: T) -> u64 {
 
 #[test]
 fn dispatched_steps_equal_portable_steps_bit_for_bit() {
-    let detected = HostDispatch::detect();
-    println!("dispatch on this CPU: {}", detected.name());
+    let levels = HostDispatch::available();
+    println!(
+        "dispatch levels on this CPU: {:?}",
+        levels.iter().map(|l| l.name()).collect::<Vec<_>>()
+    );
     let mut compared = 0;
-    for mesh in meshes() {
-        compared += check_steps::<f32>(&mesh, Precision::F32, detected);
-        compared += check_steps::<f64>(&mesh, Precision::F64, detected);
+    for &level in &levels {
+        for mesh in meshes() {
+            compared += check_steps::<f32>(&mesh, Precision::F32, level);
+            compared += check_steps::<f64>(&mesh, Precision::F64, level);
+        }
     }
     // 5 laws (linear; St Venant-Kirchhoff per tet and split terms, each
-    // with and without the penalty) × 4 integrators × 2 precisions × 2 meshes.
-    assert_eq!(compared, 5 * 4 * 2 * 2);
+    // with and without the penalty) × 4 integrators × 2 precisions × 2
+    // meshes, per level.
+    assert_eq!(compared, 5 * 4 * 2 * 2 * levels.len());
 }
 
 #[test]
 fn dispatched_displacement_update_equals_the_portable_one_bit_for_bit() {
     let [mesh, _] = meshes();
-    let detected = HostDispatch::detect();
-    for precision in [Precision::F32, Precision::F64] {
+    for (detected, precision) in HostDispatch::available()
+        .into_iter()
+        .flat_map(|level| [(level, Precision::F32), (level, Precision::F64)])
+    {
         let options = BuildOptions::precomputed(
             Material::new(5000.0, 0.4).unwrap(),
             vec!["z<1e-9".parse().unwrap()],

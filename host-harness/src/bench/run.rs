@@ -115,7 +115,7 @@ pub struct What {
     pub contacts: Option<usize>,
     /// `f32` or `f64`.
     pub precision: &'static str,
-    /// Where the measured passes ran: `portable` or `avx2+fma`
+    /// Where the measured passes ran: `portable`, `avx2+fma` or `avx512`
     /// (`portable` for the force path and the tick, which are not
     /// dispatched).
     pub dispatch: &'static str,

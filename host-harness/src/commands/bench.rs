@@ -38,8 +38,9 @@ pub struct BenchArgs {
     #[arg(long, value_enum, default_value = "both")]
     precision: PrecisionChoice,
     /// Where the dispatched passes (steps, displacement update) run: the
-    /// best this CPU has (`auto`), the build's baseline (`portable`), or
-    /// each in turn (`both`).
+    /// best this CPU has (`auto`), the build's baseline (`portable`), both
+    /// in turn (`both`), or every level this CPU has (`all`: portable,
+    /// AVX2 + FMA, AVX-512).
     #[arg(long, value_enum, default_value = "auto")]
     dispatch: DispatchChoice,
     /// Samples kept per measurement.
@@ -70,6 +71,7 @@ enum DispatchChoice {
     Auto,
     Portable,
     Both,
+    All,
 }
 
 /// Runs `palpate bench`.
@@ -84,6 +86,7 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
         DispatchChoice::Portable => vec![HostDispatch::Portable],
         DispatchChoice::Both if detected == HostDispatch::Portable => vec![detected],
         DispatchChoice::Both => vec![HostDispatch::Portable, detected],
+        DispatchChoice::All => HostDispatch::available(),
     };
     let options = BenchOptions {
         material: args.material.material()?,
