@@ -128,7 +128,7 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
     };
     if !args.json {
         stdout::println(&format!(
-            "{:<38} {:<4} {:<9} {:>10}  {:<21} {:>9} {:>10} {:>6}",
+            "{:<44} {:<4} {:<9} {:>10}  {:<21} {:>9} {:>10} {:>6}",
             "measurement", "prec", "dispatch", "median", "q1-q3", "bytes", "copy", "×copy"
         ))?;
     }
@@ -163,7 +163,7 @@ fn row(r: &Record) -> String {
     let ratio = r.ratio_to_copy.map_or(String::new(), |x| format!("{x:.2}"));
     let w = &r.what;
     format!(
-        "{:<38} {:<4} {:<9} {:>10}  {:<21} {:>9} {:>10} {:>6}",
+        "{:<44} {:<4} {:<9} {:>10}  {:<21} {:>9} {:>10} {:>6}",
         w.label(),
         w.precision,
         w.dispatch,
