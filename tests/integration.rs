@@ -5,6 +5,7 @@
 //! `src/lib.rs`.
 
 mod host {
+    mod bench;
     mod compliance;
     mod dispatch;
     mod experiment;

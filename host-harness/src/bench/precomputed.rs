@@ -118,11 +118,6 @@ impl PrecomputedBench {
         self.picks.len()
     }
 
-    /// The tool radius of the haptic tick, m.
-    pub fn radius_m(&self) -> f64 {
-        self.radius_m
-    }
-
     fn file(&self, precision: Precision) -> anyhow::Result<&TableFile> {
         match precision {
             Precision::F32 => self.f32.as_ref(),

@@ -50,18 +50,6 @@ impl BenchModel {
         BenchModel::StvkTensorsIncompressible,
     ];
 
-    /// The CLI name (`stvk-tensors-incompressible`).
-    pub fn name(self) -> &'static str {
-        match self {
-            BenchModel::Precomputed => "precomputed",
-            BenchModel::Linear => "linear",
-            BenchModel::Stvk => "stvk",
-            BenchModel::StvkTensors => "stvk-tensors",
-            BenchModel::StvkIncompressible => "stvk-incompressible",
-            BenchModel::StvkTensorsIncompressible => "stvk-tensors-incompressible",
-        }
-    }
-
     /// The tensor-mass law and whether the penalty is on; `None` for the
     /// pre-computed model.
     fn law(self) -> Option<(ElasticLaw, bool)> {

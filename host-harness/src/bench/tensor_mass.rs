@@ -57,11 +57,6 @@ pub struct StepConfig {
 }
 
 impl StepConfig {
-    /// `model/integrator`, e.g. `stvk-tensors-incompressible/rk4`.
-    pub fn name(&self) -> String {
-        format!("{}/{}", self.model_name(), self.integrator.name())
-    }
-
     /// The law, form and penalty as `palpate bench --models` names them:
     /// `linear`, `stvk`, `stvk-tensors`, `stvk-incompressible`,
     /// `stvk-tensors-incompressible` (a linear law with the penalty is
