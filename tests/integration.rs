@@ -1,8 +1,23 @@
 //! Every workspace integration test, in one binary whose modules mirror the
 //! source tree: `kernel::…` (the `no_std` kernel), `host::…` (the harness),
-//! `tools::…` (the shared script crate). Each module states the independent
+//! `ffi::…` (the C ABI), `tools::…` (the shared script crate, the C
+//! example's sequence). Each module states the independent
 //! truth it checks against; the shared readers of the reference data are in
 //! `src/lib.rs`.
+
+// The C ABI (`ffi/`, crate `palpate-ffi`), called as C calls it: raw
+// pointers to handles and buffers, hence `unsafe` (each call says why it is
+// sound).
+#[allow(unsafe_code)]
+mod ffi {
+    mod dynamic_loop;
+    mod error;
+    mod hybrid_loop;
+    mod precomputed_loop;
+    mod solve;
+    mod status;
+    mod table;
+}
 
 mod host {
     mod bench;
@@ -13,7 +28,9 @@ mod host {
     mod materials;
     mod mesh;
     mod mesh_regions;
+    mod newton;
     mod partition;
+    mod remap;
     mod robustness;
     mod session;
     mod session_generate_tools;
@@ -24,6 +41,7 @@ mod host {
     mod session_tools;
     mod session_trajectory_tools;
     mod stability;
+    mod table_compress;
 }
 
 mod kernel {
@@ -33,12 +51,16 @@ mod kernel {
     mod hybrid;
     mod layers;
     mod precomputed;
+    mod remap;
     mod stvk;
     mod stvk_terms;
     mod table;
+    mod table_compressed;
     mod tensor_mass;
 }
 
 mod tools {
+    mod firmware_c;
     mod script;
+    mod script_ticks;
 }

@@ -7,6 +7,11 @@
 #                                             target/firmware/box-table.bin)
 #   tools/box-table.sh --tensor-mass [OUT]    tensor-mass table, density 1000 kg/m3
 #                                             (default OUT: target/firmware/box-tensor-table.bin)
+#   tools/box-table.sh --compress CODE [OUT]  pre-computed table compressed, CODE f16 or q16,
+#                                             with blocks dropped below 0.2 of their columns'
+#                                             largest in both parts (--contact-blocks dropped),
+#                                             so that both kept-block bitmaps are exercised
+#                                             (default OUT: target/firmware/box-table-CODE.bin)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 kind=(--kind precomputed)
@@ -15,6 +20,11 @@ if [[ "${1:-}" == --tensor-mass ]]; then
     shift
     kind=(--kind tensor-mass --density 1000)
     out_default=target/firmware/box-tensor-table.bin
+elif [[ "${1:-}" == --compress ]]; then
+    code="${2:?usage: tools/box-table.sh --compress f16|q16 [OUT]}"
+    shift 2
+    kind=(--kind precomputed --compress "$code" --drop-below 0.2 --contact-blocks dropped)
+    out_default="target/firmware/box-table-$code.bin"
 fi
 out="${1:-$out_default}"
 mkdir -p "$(dirname "$out")"

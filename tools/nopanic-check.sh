@@ -4,7 +4,8 @@
 # nowhere, so the program links only if no panic is reachable, on volatile
 # (opaque) inputs, from
 # - the pre-computed model: table load, contact forces and the two
-#   displacement updates;
+#   displacement updates, on the f32 table and on its f16 and q16 compressed
+#   versions (blocks dropped in both parts, so both kept-block bitmaps are read);
 # - the tensor-mass model: table load, model construction and reset, the
 #   per-vertex inputs, the step with each of the four integrators and each
 #   elastic law, tet removal, cutting, tearing, the live surface and the
@@ -26,10 +27,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$PWD"
 table="$(tools/box-table.sh)"
+table_f16="$(tools/box-table.sh --compress f16)"
+table_q16="$(tools/box-table.sh --compress q16)"
 tensor_table="$(tools/box-table.sh --tensor-mass)"
 hybrid_tables="$(tools/hybrid-tables.sh)"
-export PALPATE_TABLE="$table" PALPATE_TENSOR_TABLE="$tensor_table" \
-    PALPATE_HYBRID_TABLES="$hybrid_tables"
+export PALPATE_TABLE="$table" PALPATE_TABLE_F16="$table_f16" PALPATE_TABLE_Q16="$table_q16" \
+    PALPATE_TENSOR_TABLE="$tensor_table" PALPATE_HYBRID_TABLES="$hybrid_tables"
 cd tools/nopanic-check
 mkdir -p target
 log="$PWD/target/build.log"
@@ -38,7 +41,7 @@ elf="$PWD/target/thumbv7em-none-eabihf/release/palpate-nopanic-check"
 if cargo build --release 2>"$log"; then
     echo "no-panic check: linked; no panic reachable (volatile inputs) from" \
         "PrecomputedTable::load, contact_forces::<MAX_CONTACTS>, free_displacements," \
-        "displacements; TensorMassTable::load, TensorMassModel::new, reset," \
+        "displacements (f32, f16 and q16 compressed tables); TensorMassTable::load, TensorMassModel::new, reset," \
         "set_external_force, set_velocity, impose, release, clear_external_forces," \
         "step (explicit Euler, symplectic Euler, RK4, central difference; linear and" \
         "St Venant-Kirchhoff, incompressibility on and off), remove_tet, cut_with_tool," \

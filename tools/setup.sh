@@ -7,8 +7,14 @@
 # - llvm-tools (llvm-size, llvm-nm, llvm-objdump for the size report and the
 #   no-panic diagnostics, under $(rustc --print sysroot)/lib/rustlib/*/bin);
 # - qemu-system-arm (runs the firmware) and valgrind (callgrind instruction
-#   counts of `palpate budget` and its test), from apt-get, with sudo when
-#   not root;
+#   counts of `palpate budget` and its test; memcheck of the C ABI's test),
+#   from apt-get, with sudo when not root;
+# - the C toolchains of the C ABI's checks (tools/ffi-check.sh,
+#   tools/firmware-check.sh --c): the host's C compiler and make (gcc, make)
+#   and the Cortex-M one with its C library (gcc-arm-none-eabi,
+#   libnewlib-arm-none-eabi: newlib-nano), from apt-get;
+# - cmake and libclang-dev (apt-get): tools/cycles builds the Unicorn
+#   emulator's C with cmake and its Rust bindings with bindgen (libclang);
 # - cargo-deny (licenses, bans, sources, advisories; `deny.toml`), built from
 #   crates.io with `cargo install --locked` (about 3-5 min the first time).
 # Idempotent; a fast no-op when all is present.
@@ -21,6 +27,16 @@ command -v cargo-deny >/dev/null || cargo install cargo-deny --locked --version 
 missing=()
 command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
 command -v valgrind >/dev/null || missing+=(valgrind)
+command -v cmake >/dev/null || missing+=(cmake)
+ldconfig -p 2>/dev/null | grep -q 'libclang[-0-9.]*\.so\b' || missing+=(libclang-dev)
+command -v cc >/dev/null || missing+=(gcc)
+command -v make >/dev/null || missing+=(make)
+command -v arm-none-eabi-gcc >/dev/null || missing+=(gcc-arm-none-eabi)
+# newlib-nano: the compiler prints the bare name when it has no such library.
+if ! command -v arm-none-eabi-gcc >/dev/null ||
+    [ "$(arm-none-eabi-gcc -print-file-name=libc_nano.a)" = libc_nano.a ]; then
+    missing+=(libnewlib-arm-none-eabi)
+fi
 if [ ${#missing[@]} -gt 0 ]; then
     sudo=""
     if [ "$(id -u)" != 0 ]; then
@@ -36,4 +52,6 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 qemu-system-arm --version | head -1
 valgrind --version
+cmake --version | head -1
+arm-none-eabi-gcc --version | head -1
 cargo deny --version

@@ -28,7 +28,10 @@ fn table_build(c: &mut Criterion) {
     ] {
         let (mesh, report, mut options) = tissue_cube(cells);
         for &solver in solvers {
-            options.kind = TableKindOptions::Precomputed { solver };
+            options.kind = TableKindOptions::Precomputed {
+                solver,
+                compression: None,
+            };
             let name = format!("{solver:?}").to_lowercase();
             let id = BenchmarkId::new(name, format!("{}v", mesh.positions.len()));
             group.bench_with_input(id, &options, |b, options| {

@@ -6,8 +6,11 @@ use nalgebra::Vector3;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
+use palpate::session::Scene;
+use palpate::session::run::precomputed_options;
 use palpate::table::build::{BuildOptions, BuiltTable, TableKindOptions, build};
 use palpate::table::compliance::Solver;
+use palpate::table::compress::Compression;
 use palpate::table::file::Precision;
 use palpate_kernel::haptic::LoopConfig;
 use palpate_kernel::haptic::SafetyLimits;
@@ -29,6 +32,23 @@ pub fn tissue_cube(cells: usize) -> (TetMesh, MeshReport, BuildOptions) {
 /// The f32 table of [`tissue_cube`]`(cells)`.
 pub fn cube_table(cells: usize) -> BuiltTable {
     let (mesh, report, options) = tissue_cube(cells);
+    build(&mesh, &report, &options).expect("table")
+}
+
+/// The f32 pre-computed table of `scene`'s mesh (its materials and
+/// supports, whatever its model), compressed as `compression` says: the
+/// built-in block ([`Scene::built_in`]) and the organ of the built-in hybrid
+/// scene, all pre-computed ([`Scene::built_in_hybrid`]).
+pub fn scene_table(scene: &Scene, compression: Option<Compression>) -> BuiltTable {
+    let (mesh, report) = scene.load_mesh().expect("scene mesh");
+    let options = precomputed_options(scene, &mesh, &report).expect("options");
+    let options = BuildOptions {
+        kind: TableKindOptions::Precomputed {
+            solver: Solver::Cholesky,
+            compression,
+        },
+        ..options
+    };
     build(&mesh, &report, &options).expect("table")
 }
 

@@ -1,6 +1,8 @@
 //! Pre-computed table loader, `PrecomputedTable::<f32>::load` and `::<f64>::load`: no input
-//! panics; a loaded table keeps the invariants `load` documents, its accessors and collision
-//! index answer without panicking, and the contact solve on it does not panic.
+//! panics; a loaded table keeps the invariants `load` documents (a compressed one's blocks
+//! decode finite, its diagonal blocks stored), its accessors and collision index answer
+//! without panicking, and the contact solve on it does not panic. Seeds: f32 and f64 tables,
+//! and the firmware box compressed (f16, q16, blocks dropped in both parts).
 //!
 //! Each input is loaded as given (16-byte aligned), then with its declared length and CRC-32
 //! repaired (so that mutations of a valid table reach the directory and content checks), and
@@ -10,6 +12,7 @@
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Vector3;
 use palpate_fuzz::table_layouts;
+use palpate_kernel::table::format::surface_block_index;
 use palpate_kernel::table::{VertexSlot, within};
 use palpate_kernel::{Constraint, PrecomputedModel, PrecomputedTable, Real};
 
@@ -37,6 +40,27 @@ fn check<T: Real>(table: &PrecomputedTable<'_, T>) {
     assert_eq!(table.surface_blocks().len(), s * (s + 1) / 2);
     assert_eq!(table.interior_blocks().len(), (f - s) * s);
     let _ = (table.young_pa(), table.poisson());
+
+    // Compressed compliance: the record's values in range, every block (stored or dropped)
+    // decodes to finite values, every diagonal block is stored.
+    if let Some(r) = table.compression() {
+        assert!((0.0..1.0).contains(&r.drop_below));
+        assert!(r.max_force_error >= 0.0 && r.max_displacement_error.is_finite());
+    }
+    let (surface, interior) = (table.surface_blocks(), table.interior_blocks());
+    assert!(surface.stored_len() <= surface.len() && interior.stored_len() <= interior.len());
+    for k in 0..s {
+        for n in 0..=k {
+            let j = surface_block_index(n, k);
+            let block = surface.block(j, k).expect("block in the layout");
+            assert!(block.iter().all(|x| x.finite()));
+            assert!(n != k || surface.is_stored(j));
+        }
+        for i in 0..f - s {
+            let block = interior.block(k * (f - s) + i, k).expect("block in the layout");
+            assert!(block.iter().all(|x| x.finite()));
+        }
+    }
 
     // The vertex maps are inverse; the touchable vertices come first, ascending.
     let free = table.free_vertices();

@@ -33,6 +33,7 @@
 //! 1192 Ir over the idle 680, an edge crossed ≤ 564 Ir, a triangle tested
 //! ≤ 113 Ir; the worst tick 12 939 Ir.
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -46,66 +47,126 @@ use palpate_kernel::math::Portable;
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 
+use palpate_script::ticks::{Header, Settings, tool_words, write_tick};
+
 use crate::mesh::{MeshReport, TetMesh};
-use crate::session::generate::{hepatectomy, surgery};
+use crate::output::atomic::AtomicFile;
+use crate::session::generate::{
+    GenerateError, Generator, Keyframe, Pinch, Poke, Press, PressHold, Slide, Strike, hepatectomy,
+    sample_keyframes, surgery,
+};
 use crate::session::hybrid::HybridSetup;
 use crate::session::model::{SceneModel, SceneTables};
+use crate::session::run::check_scene_table;
 use crate::session::run::{DynamicSetup, loop_config, ticks};
-use crate::session::scene::{MeshSource, ToolKind};
+use crate::session::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, ToolKind};
+use crate::session::stability::check_stable_step;
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
 use crate::session::{Scene, Trajectory};
 
-/// Instructions of a tick outside detection, tracking and solves.
-pub const BASE_IR: u64 = 600;
-/// Instructions per candidate triangle tested in a detection.
-pub const TRIANGLE_IR: u64 = 125;
-/// Instructions per triangle edge crossed while sliding.
-pub const WALK_IR: u64 = 700;
-/// Instructions to track one contact (projection, gap).
-pub const TRACK_IR: u64 = 1000;
-/// Instructions per contact solve, per cubed contact capacity (the block
-/// Cholesky is `O(M³)`).
-pub const SOLVE_IR_PER_M3: u64 = 2500;
+/// The unit costs of the static tick bound, in one unit: x86-64
+/// instructions for the host ([`HOST_IR`], measured with callgrind) or
+/// Cortex-M4F cycles for the target ([`M4F_CYCLES`], counted by
+/// `tools/cycles`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnitCosts {
+    /// A tick outside detection, tracking and solves.
+    pub base: u64,
+    /// Per candidate triangle tested in a detection.
+    pub triangle: u64,
+    /// Per triangle edge crossed while sliding.
+    pub walk: u64,
+    /// To track one contact (projection, gap).
+    pub track: u64,
+    /// Per contact solve, per cubed contact capacity (the block Cholesky
+    /// is `O(M³)`).
+    pub solve_per_m3: u64,
+    /// To track one contact on the dynamic model's deforming surface.
+    pub dynamic_track: u64,
+    /// Per contact per solve on the dynamic model (the rest-frame normal,
+    /// the stiffness `k` from 9 tensors and 6 edge look-ups, the
+    /// extrapolated force).
+    pub dynamic_solve: u64,
+}
 
-/// The static per-tick bound (instructions) for `points` tool points and
-/// capacity `capacity` over `table`.
-pub fn tick_bound(table: &PrecomputedTable<'_, f32>, points: u64, capacity: u64) -> u64 {
+/// The host's unit costs, x86-64 instructions (see the module docs).
+pub const HOST_IR: UnitCosts = UnitCosts {
+    base: 600,
+    triangle: 125,
+    walk: 700,
+    track: 1000,
+    solve_per_m3: 2500,
+    dynamic_track: 1000,
+    dynamic_solve: 1500,
+};
+
+/// The Cortex-M4F's unit costs, cycles at zero wait states: the largest
+/// per-unit costs `palpate-cycles --unit-costs` (`tools/cycles`) derived
+/// from every tick of `tools/cycles-check.sh --all` (the release build of
+/// `tools/cycles-m4f`: the kernel as firmware links it, every generated
+/// trajectory with 1 to 4 probes on the three scenes it records), the
+/// largest over the three models, rounded up: an idle tick 4682 (the
+/// hybrid's; 2336 pre-computed), a triangle tested 582, an edge crossed
+/// 3922 (the dynamic model's, its base not separable: every idle tick there
+/// tests triangles), a tracked contact with its solve 1971 (pre-computed)
+/// and 3381 (dynamic), a solve 819 per `M³` (hybrid; 520 pre-computed) and
+/// 821 per `M` (dynamic).
+pub const M4F_CYCLES: UnitCosts = UnitCosts {
+    base: 5000,
+    triangle: 600,
+    walk: 4000,
+    track: 2000,
+    solve_per_m3: 850,
+    dynamic_track: 3500,
+    dynamic_solve: 900,
+};
+
+/// The static per-tick bound (in the unit of `costs`) for `points` tool
+/// points and capacity `capacity` over `table`.
+pub fn tick_bound(
+    costs: &UnitCosts,
+    table: &PrecomputedTable<'_, f32>,
+    points: u64,
+    capacity: u64,
+) -> u64 {
     let detection = 2 * u64::from(table.surface_index().max_query_triangles());
-    BASE_IR
-        + points * (TRIANGLE_IR * detection + WALK_IR * u64::from(MAX_WALK_STEPS) + TRACK_IR)
-        + (points + 1) * SOLVE_IR_PER_M3 * capacity * capacity * capacity
-}
-
-/// Instructions to track one contact on the dynamic model's deforming
-/// surface (projection, gap).
-pub const DYNAMIC_TRACK_IR: u64 = 1000;
-/// Instructions per contact per solve on the dynamic model (the rest-frame
-/// normal, the stiffness `k` from 9 tensors and 6 edge look-ups, the
-/// extrapolated force).
-pub const DYNAMIC_SOLVE_IR: u64 = 1500;
-
-/// The static per-tick bound (instructions) of the dynamic model's tick,
-/// between physics updates, for `points` tool points and capacity
-/// `capacity` over `table`. A detection tests at most every triangle
-/// reference of the surface twice (`2 × 3F`, `F` the mesh's faces,
-/// every one of which a cut may expose): the re-binned grid's buckets
-/// depend on the deformation, so no tighter bound holds for any state.
-pub fn dynamic_tick_bound(table: &TensorMassTable<'_, f32>, points: u64, capacity: u64) -> u64 {
-    let detection = 2 * 3 * table.mesh_triangles().len() as u64;
-    BASE_IR
+    costs.base
         + points
-            * (TRIANGLE_IR * detection + WALK_IR * u64::from(MAX_WALK_STEPS) + DYNAMIC_TRACK_IR)
-        + (points + 1) * DYNAMIC_SOLVE_IR * capacity
+            * (costs.triangle * detection + costs.walk * u64::from(MAX_WALK_STEPS) + costs.track)
+        + (points + 1) * costs.solve_per_m3 * capacity * capacity * capacity
 }
 
-/// The static per-tick bound (instructions) of the hybrid model's tick
-/// (RR-3510 §6.2), between physics updates, for `points` tool points and
-/// capacity `capacity`: a detection tests at most every triangle reference
-/// of the whole surface twice (`2 × 3 (B + F)`, the pre-computed region's
-/// `B` boundary triangles and the tensor-mass region's `F` faces), and each
-/// solve is the pre-computed one (`O(M³)`) and the tensor-mass one
+/// The static per-tick bound (in the unit of `costs`) of the dynamic
+/// model's tick, between physics updates, for `points` tool points and
+/// capacity `capacity` over `table`. A detection tests at most every
+/// triangle reference of the surface twice (`2 × 3F`, `F` the mesh's
+/// faces, every one of which a cut may expose): the re-binned grid's
+/// buckets depend on the deformation, so no tighter bound holds for any
+/// state.
+pub fn dynamic_tick_bound(
+    costs: &UnitCosts,
+    table: &TensorMassTable<'_, f32>,
+    points: u64,
+    capacity: u64,
+) -> u64 {
+    let detection = 2 * 3 * table.mesh_triangles().len() as u64;
+    costs.base
+        + points
+            * (costs.triangle * detection
+                + costs.walk * u64::from(MAX_WALK_STEPS)
+                + costs.dynamic_track)
+        + (points + 1) * costs.dynamic_solve * capacity
+}
+
+/// The static per-tick bound (in the unit of `costs`) of the hybrid
+/// model's tick (RR-3510 §6.2), between physics updates, for `points` tool
+/// points and capacity `capacity`: a detection tests at most every triangle
+/// reference of the whole surface twice (`2 × 3 (B + F)`, the pre-computed
+/// region's `B` boundary triangles and the tensor-mass region's `F` faces),
+/// and each solve is the pre-computed one (`O(M³)`) and the tensor-mass one
 /// (linear) together.
 pub fn hybrid_tick_bound(
+    costs: &UnitCosts,
     precomputed: &PrecomputedTable<'_, f32>,
     dynamic: &TensorMassTable<'_, f32>,
     points: u64,
@@ -113,21 +174,23 @@ pub fn hybrid_tick_bound(
 ) -> u64 {
     let slots = precomputed.surface_triangles().len() + dynamic.mesh_triangles().len();
     let detection = 2 * 3 * slots as u64;
-    BASE_IR
+    costs.base
         + points
-            * (TRIANGLE_IR * detection
-                + WALK_IR * u64::from(MAX_WALK_STEPS)
-                + TRACK_IR.max(DYNAMIC_TRACK_IR))
+            * (costs.triangle * detection
+                + costs.walk * u64::from(MAX_WALK_STEPS)
+                + costs.track.max(costs.dynamic_track))
         + (points + 1)
-            * (SOLVE_IR_PER_M3 * capacity * capacity * capacity + DYNAMIC_SOLVE_IR * capacity)
+            * (costs.solve_per_m3 * capacity * capacity * capacity + costs.dynamic_solve * capacity)
 }
 
 /// The f32 tables of `scene` on `mesh` (pre-computed, tensor-mass or
-/// hybrid, by its model: [`SceneModel`]) and the static bound of its tick.
+/// hybrid, by its model: [`SceneModel`]) and the static bound of its tick
+/// with the unit costs `costs`.
 pub fn budget_table(
     scene: &Scene,
     mesh: &TetMesh,
     report: &MeshReport,
+    costs: &UnitCosts,
 ) -> anyhow::Result<(SceneTables, u64)> {
     let points = scene.tool.kernel_points() as u64;
     let tables = SceneModel::of(scene, mesh, report)?.tables(scene, mesh, report)?;
@@ -135,17 +198,17 @@ pub fn budget_table(
     let bound = match &tables {
         SceneTables::Precomputed(file) => {
             let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
-            tick_bound(&table, points, points)
+            tick_bound(costs, &table, points, points)
         }
         SceneTables::Dynamic(file, _) => {
             let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
-            dynamic_tick_bound(&table, points, points)
+            dynamic_tick_bound(costs, &table, points, points)
         }
         SceneTables::Hybrid(files, _) => {
             let precomputed =
                 PrecomputedTable::<f32>::load(files.precomputed.bytes()).map_err(load)?;
             let dynamic = TensorMassTable::<f32>::load(files.dynamic.bytes()).map_err(load)?;
-            hybrid_tick_bound(&precomputed, &dynamic, points, points)
+            hybrid_tick_bound(costs, &precomputed, &dynamic, points, points)
         }
     };
     Ok((tables, bound))
@@ -185,6 +248,11 @@ pub fn probe(
 pub struct Probe {
     /// Each tick's work counters.
     pub counters: Vec<TickCounters>,
+    /// Each tick's output.
+    pub outputs: Vec<ForceOutput<f32>>,
+    /// Each tick's tool inputs, as the words of a recording
+    /// ([`palpate_script::ticks::tool_words`], tick-major).
+    pub input_words: Vec<u32>,
     /// Wall time inside the ticks, s (physics updates excluded).
     pub ticks_s: f64,
 }
@@ -244,18 +312,109 @@ fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
     mut physics: impl FnMut(&mut HapticLoop<f32, B, P, P>),
 ) -> anyhow::Result<Probe> {
     let every = scene.rates.physics_every.max(1) as usize;
-    let mut counters = Vec::new();
-    let mut ticks_s = 0.0;
+    let mut probe = Probe {
+        counters: Vec::new(),
+        outputs: Vec::new(),
+        input_words: Vec::new(),
+        ticks_s: 0.0,
+    };
     for (k, (_, tool)) in ticks::<P>(trajectory, scene.tick_s(), &scene.tool)?.enumerate() {
         let started = std::time::Instant::now();
-        core::hint::black_box(budget_tick(haptic, &tool));
-        ticks_s += started.elapsed().as_secs_f64();
-        counters.push(*haptic.counters());
+        let output = core::hint::black_box(budget_tick(haptic, &tool));
+        probe.ticks_s += started.elapsed().as_secs_f64();
+        probe.counters.push(*haptic.counters());
+        probe.outputs.push(output);
+        probe.input_words.extend(tool.iter().flat_map(tool_words));
         if (k + 1) % every == 0 {
             physics(haptic);
         }
     }
-    Ok(Probe { counters, ticks_s })
+    Ok(probe)
+}
+
+/// Where [`record`] writes the scene's tables, under its folder: `table`
+/// (pre-computed or tensor-mass), or `table.precomputed`, `table.dynamic`
+/// and `table.interface` for a hybrid ([`SceneTables::write`]).
+pub const RECORD_TABLE: &str = "table";
+/// The list of [`record`]'s runs, under its folder.
+pub const RECORD_RUNS: &str = "runs.txt";
+
+/// Records what `tools/cycles-check.sh` runs on the Cortex-M4F, for
+/// `scene` on its own mesh, into the folder `dir` (created): the scene's f32
+/// tables ([`RECORD_TABLE`]); for each generated trajectory
+/// ([`trajectories`]) its ticks as the loop receives them
+/// (`<trajectory>.ticks`, the format of [`palpate_script::ticks`]) and the
+/// host's line for each tick (`<trajectory>.expected`,
+/// [`palpate_script::ticks::write_tick`]), which the target must print
+/// byte for byte; and [`RECORD_RUNS`], one line per trajectory,
+/// `<trajectory> <ticks> <bound>`, with the tick's static bound in
+/// Cortex-M4F cycles ([`M4F_CYCLES`]). Only the trajectories named in
+/// `only`, if any (each must be one of the scene's). Returns the runs' lines.
+pub fn record(scene: &Scene, dir: &Path, only: &[String]) -> anyhow::Result<Vec<String>> {
+    let chosen = chosen_trajectories(scene, only)?;
+    let (mesh, report) = scene.load_mesh()?;
+    check_scene_table(scene, &mesh, &report)?;
+    check_stable_step(scene, &mesh, &report)?;
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let (tables, bound) = budget_table(scene, &mesh, &report, &M4F_CYCLES)?;
+    tables.write(&dir.join(RECORD_TABLE))?;
+    let load = |e| anyhow::anyhow!("table: {e}");
+    let dynamic = match &tables {
+        SceneTables::Precomputed(_) => None,
+        SceneTables::Dynamic(file, spec) => {
+            let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
+            let setup = DynamicSetup::of(scene, spec, table)?;
+            Some((setup.params(), setup.physics()))
+        }
+        SceneTables::Hybrid(files, spec) => {
+            let setup = HybridSetup::of(scene, spec, files)?;
+            Some((setup.dynamic().params(), setup.dynamic().physics()))
+        }
+    };
+    // The probe runs physics updates on the dynamic and hybrid tissues only.
+    let physics_every = match dynamic {
+        Some(_) => scene.rates.physics_every.max(1),
+        None => 0,
+    };
+    let settings = Settings {
+        loop_config: loop_config(scene),
+        dynamic,
+    };
+    let mut runs = Vec::new();
+    for (name, trajectory) in chosen {
+        let probe = probe(&tables, scene, &trajectory)?;
+        let header = Header {
+            points: scene.tool.kernel_points(),
+            ticks: probe.outputs.len(),
+            physics_every,
+            settings,
+        };
+        let bytes: Vec<u8> = header
+            .words()
+            .into_iter()
+            .chain(probe.input_words.iter().copied())
+            .flat_map(u32::to_le_bytes)
+            .collect();
+        write_whole(&dir.join(format!("{name}.ticks")), &bytes)?;
+        let mut expected = String::new();
+        for (k, (output, counters)) in probe.outputs.iter().zip(&probe.counters).enumerate() {
+            write_tick(&mut expected, k, output, counters)?;
+        }
+        write_whole(&dir.join(format!("{name}.expected")), expected.as_bytes())?;
+        runs.push(format!("{name} {} {bound}", header.ticks));
+    }
+    let mut list = runs.join("\n");
+    list.push('\n');
+    write_whole(&dir.join(RECORD_RUNS), list.as_bytes())?;
+    Ok(runs)
+}
+
+/// Writes `bytes` to `path` whole ([`AtomicFile`]).
+fn write_whole(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let mut out = AtomicFile::create(path)?;
+    out.write_all(bytes)?;
+    out.commit()?;
+    Ok(())
 }
 
 /// Per-tick instruction counts of `args` (a `palpate budget --probe …`
@@ -347,12 +506,54 @@ pub struct BudgetRow {
 /// Cortex-M4F-class controller at 168 MHz, one instruction per cycle.
 pub const M4F_IPS: f64 = 168e6;
 
+/// The generated trajectories of `scene` ([`trajectories`]) named in
+/// `only`, or all of them; an error names an unknown one and the known.
+pub fn chosen_trajectories(
+    scene: &Scene,
+    only: &[String],
+) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
+    let mut chosen = trajectories(scene)?;
+    if let Some(unknown) = only
+        .iter()
+        .find(|name| !chosen.iter().any(|(known, _)| known == name))
+    {
+        let known: Vec<&str> = chosen.iter().map(|(name, _)| *name).collect();
+        bail!(
+            "--trajectory {unknown}: not a generated trajectory of this scene (one of: {})",
+            known.join(", ")
+        );
+    }
+    if !only.is_empty() {
+        chosen.retain(|(name, _)| only.iter().any(|o| o == name));
+    }
+    Ok(chosen)
+}
+
+/// Spacing of the probe sites of a scene with several probes, m: tool
+/// point `k` presses at the default press's point (the built-in block's
+/// top-face centre) moved along y by `PROBE_SITE_SPACING_M` times
+/// `[0, 1, −1, 2][k]` (y = 6, 8, 4 and 10 cm on the built-in block: every
+/// site 2 cm or more from the others and from the edges).
+pub const PROBE_SITE_SPACING_M: f64 = 0.02;
+
+/// The press of tool point `k` (see [`PROBE_SITE_SPACING_M`]): `press`
+/// moved to the point's site.
+fn probe_site(k: usize, press: Press) -> Press {
+    const STEPS: [f64; MAX_TOOL_POINTS] = [0.0, 1.0, -1.0, 2.0];
+    let step = STEPS.get(k).copied().unwrap_or(0.0);
+    let mut surface_m = press.surface_m;
+    surface_m[1] += step * PROBE_SITE_SPACING_M;
+    Press { surface_m, ..press }
+}
+
 /// The generated trajectories a budget runs for `scene`'s tool: for probes
-/// the poke, press-hold, slide and strike (and the pinch with two points);
-/// for a scene with a grasper or a cutter, [`surgery`] (on the built-in
-/// block's top), or [`hepatectomy`] on the generated organ.
+/// the poke, press-hold, slide and strike, each tool point on its own site
+/// ([`PROBE_SITE_SPACING_M`]) moving together, so that `P` probes make up to
+/// `P` simultaneous contacts, and with two or more points the pinch (tool
+/// points 0 and 1; the others press and hold on their sites); for a scene
+/// with a grasper or a cutter, [`surgery`] (on the built-in block's top),
+/// or [`hepatectomy`] on the generated organ.
 pub fn trajectories(scene: &Scene) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
-    use crate::session::{Generator, Pinch, Poke, PressHold, Slide, Strike};
     let err = |e: crate::session::GenerateError| anyhow::anyhow!("{e}");
     let tool = &scene.tool;
     if tool.kinds.iter().any(|k| *k != ToolKind::Probe) {
@@ -363,17 +564,60 @@ pub fn trajectories(scene: &Scene) -> anyhow::Result<Vec<(&'static str, Trajecto
             _ => vec![("surgery", surgery(tool).map_err(err)?)],
         });
     }
+    let points = tool.points.clamp(1, MAX_TOOL_POINTS);
+    // Every tool point's keyframes of one generator, sampled together.
+    let every_point = |keys: &dyn Fn(usize) -> Result<Vec<Keyframe>, GenerateError>| {
+        let mut all = Vec::new();
+        for k in 0..points {
+            all.extend(keys(k)?);
+        }
+        sample_keyframes(&all, DEFAULT_HAPTIC_HZ).map_err(err)
+    };
+    let poke = |k| {
+        Poke {
+            tool: k,
+            press: probe_site(k, Poke::default().press),
+            ..Poke::default()
+        }
+        .keyframes()
+    };
+    let press_hold = |k| {
+        PressHold {
+            tool: k,
+            press: probe_site(k, PressHold::default().press),
+            ..PressHold::default()
+        }
+        .keyframes()
+    };
+    let slide = |k| {
+        Slide {
+            tool: k,
+            press: probe_site(k, Slide::default().press),
+            ..Slide::default()
+        }
+        .keyframes()
+    };
+    let strike = |k| {
+        Strike {
+            tool: k,
+            press: probe_site(k, Strike::default().press),
+            ..Strike::default()
+        }
+        .keyframes()
+    };
     let mut out = vec![
-        ("poke", Poke::default().trajectory().map_err(err)?),
-        (
-            "press-hold",
-            PressHold::default().trajectory().map_err(err)?,
-        ),
-        ("slide", Slide::default().trajectory().map_err(err)?),
-        ("strike", Strike::default().trajectory().map_err(err)?),
+        ("poke", every_point(&poke)?),
+        ("press-hold", every_point(&press_hold)?),
+        ("slide", every_point(&slide)?),
+        ("strike", every_point(&strike)?),
     ];
-    if tool.points >= 2 {
-        out.push(("pinch", Pinch::default().trajectory().map_err(err)?));
+    if points >= 2 {
+        let pinch = |k| match k {
+            0 => Pinch::default().keyframes(),
+            1 => Ok(Vec::new()),
+            _ => press_hold(k),
+        };
+        out.push(("pinch", every_point(&pinch)?));
     }
     Ok(out)
 }

@@ -9,6 +9,7 @@
 
 pub mod bench;
 pub mod budget;
+pub mod chart;
 pub mod demo;
 pub mod dispatch;
 pub mod experiment;
@@ -20,6 +21,7 @@ pub mod mesh;
 pub mod output;
 pub mod partition;
 pub mod precomputed;
+pub mod remap;
 pub mod replay;
 pub mod session;
 pub mod table;

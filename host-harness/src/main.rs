@@ -12,7 +12,8 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 mod commands;
 
 use commands::{
-    bench, budget, demo, dynamic, experiment, precomputed, scene, session, stvk, tables,
+    bench, budget, chart, demo, dynamic, experiment, precomputed, remap, scene, session, stvk,
+    tables,
 };
 
 #[derive(Parser)]
@@ -43,6 +44,9 @@ enum Command {
     /// Experiments that reproduce the papers' figures.
     #[command(subcommand)]
     Experiment(experiment::ExperimentCommand),
+    /// The quasi-non-linear pre-computed model's remaps (Cotin 1999 TVCG §3).
+    #[command(subcommand)]
+    Remap(remap::RemapCommand),
     /// Haptic sessions: the kernel's fixed-timestep loop driven by a trajectory.
     #[command(subcommand)]
     Session(session::SessionCommand),
@@ -55,6 +59,9 @@ enum Command {
     /// Per-tick instruction counts (callgrind) of every generated trajectory
     /// against the static bound from the table sizes and capacities.
     Budget(budget::BudgetArgs),
+    /// The speed/accuracy study: every model against the Newton St
+    /// Venant-Kirchhoff reference, timed; charts and a report.
+    Chart(chart::ChartArgs),
     /// Built-in scene: two-probe press and release, forces, timings, VTK series.
     Demo(demo::DemoArgs),
 }
@@ -88,10 +95,12 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
         Command::Dynamic(command) => dynamic::run(command),
         Command::Stvk(command) => stvk::run(command),
         Command::Experiment(command) => experiment::run(command),
+        Command::Remap(command) => remap::run(command),
         Command::Session(command) => session::run(command),
         Command::Scene(command) => scene::run(command),
         Command::Bench(args) => bench::run_bench(&args),
         Command::Budget(args) => budget::run(&args),
+        Command::Chart(args) => chart::run(&args),
         Command::Demo(args) => demo::run(&args),
     }
 }

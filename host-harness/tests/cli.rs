@@ -3,7 +3,9 @@
 
 mod common;
 
-use common::{assert_one_line_error, build_cube_table, fresh_dir, palpate, reference, temp};
+use common::{
+    assert_one_line_error, build_cube, build_cube_table, fresh_dir, palpate, reference, temp,
+};
 use std::process::Output;
 
 #[test]
@@ -98,6 +100,94 @@ fn build_tensor_mass_table_needs_density() {
     assert_one_line_error(&out, &["--kind tensor-mass needs --density"]);
     let out = palpate(&[&base[..], &["--density", "1000"]].concat());
     assert_one_line_error(&out, &["--density applies to --kind tensor-mass only"]);
+}
+
+/// `tables build --compress q16 --drop-below REL`: a table about half the f32 one that
+/// `tables info` reports (its flash footprint by section, the encoding and the errors measured
+/// at build) and that `precomputed solve` reads; the flags' refusals, one line each.
+#[test]
+fn build_compressed_table_and_report_it() {
+    let (f32_table, q16_table) = (temp("cube-f32.tbl"), temp("cube-q16.tbl"));
+    build_cube_table(&f32_table, &[]);
+    build_cube_table(&q16_table, &["--compress", "q16", "--drop-below", "0.05"]);
+    let f32_len = std::fs::metadata(&f32_table).unwrap().len();
+    let q16_len = std::fs::metadata(&q16_table).unwrap().len();
+    // 16 of 36 bytes per block saved, 4 % of the interior blocks dropped, the rest unchanged.
+    assert!(q16_len * 2 < f32_len + 20_000, "{q16_len} vs {f32_len}");
+    let info = palpate(&["tables", "info", &q16_table.display().to_string()]);
+    assert!(info.status.success());
+    let text = String::from_utf8_lossy(&info.stdout);
+    for needle in [
+        &format!("flash footprint: {q16_len} bytes"),
+        "section surface-codes: 6786 x 18 bytes = 122148 bytes",
+        "section interior-kept:",
+        "compression: contact (surface) blocks q16, interior blocks q16, dropped below 0.05",
+        "over 580 contact sets",
+        "max force error",
+        "validation: ok",
+    ] {
+        assert!(text.contains(needle), "missing '{needle}' in\n{text}");
+    }
+    let info = palpate(&["tables", "info", &f32_table.display().to_string()]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        text.contains("section compliance-surface: 6786 x 36 bytes")
+            && !text.contains("compression:"),
+        "{text}"
+    );
+    let solve = |table: &std::path::Path| {
+        let out = palpate(&[
+            "precomputed",
+            "solve",
+            &table.display().to_string(),
+            "--contact",
+            "194:0,0,-0.01",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        json["contact_forces"][0][2].as_f64().unwrap()
+    };
+    let (want, got) = (solve(&f32_table), solve(&q16_table));
+    assert!((got - want).abs() <= 1e-3 * want.abs(), "{got} vs {want}");
+
+    let out = |extra: &[&str]| build_cube(&temp("cube-bad.tbl"), "5000", extra);
+    assert_one_line_error(
+        &out(&["--drop-below", "0.1"]),
+        &["--drop-below", "--compress"],
+    );
+    assert_one_line_error(
+        &out(&["--contact-blocks", "f32"]),
+        &["--contact-blocks", "--compress"],
+    );
+    assert_one_line_error(
+        &out(&["--compress", "q16", "--drop-below", "1.5"]),
+        &["--drop-below 1.5", "[0, 1)"],
+    );
+    assert_one_line_error(
+        &out(&["--compress", "f16", "--precision", "f64"]),
+        &["--compress applies to f32 tables"],
+    );
+    assert_one_line_error(
+        &out(&[
+            "--compress",
+            "q16",
+            "--kind",
+            "tensor-mass",
+            "--density",
+            "1000",
+        ]),
+        &["--compress applies to --kind precomputed only"],
+    );
+    // An unknown code: clap's refusal, which lists the codes.
+    let bad_code = out(&["--compress", "q8"]);
+    let err = String::from_utf8_lossy(&bad_code.stderr);
+    assert_eq!(bad_code.status.code(), Some(2), "{err}");
+    assert!(err.contains("'q8'") && err.contains("f16, q16"), "{err}");
 }
 
 #[test]

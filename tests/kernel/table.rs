@@ -1,12 +1,11 @@
 //! Table loading (`palpate_kernel::table`): round trip, corruption detection,
 //! and every structural error a well-formed checksum cannot hide.
 
-use palpate::table::collision::collision_index;
-use palpate::table::file::{Precision, TableContents, write_table};
+use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate_kernel::table::format::{HEADER_LEN, SECTION_ENTRY_LEN, SectionKind};
 use palpate_kernel::{LoadError, PrecomputedTable};
-use palpate_tests::reference_cube_table;
+use palpate_tests::{TinyTable, reference_cube_table};
 
 fn load32(bytes: &[u8]) -> Result<(), LoadError> {
     let file = TableFile::from_bytes(bytes);
@@ -87,65 +86,11 @@ fn misaligned_buffer_is_refused() {
     assert!(matches!(err, LoadError::Misaligned { .. }), "{err}");
 }
 
-/// A table built from the 2-tet mesh below, with hand-set contents, so each
-/// structural check can be hit with a valid checksum.
-struct Tiny {
-    vertex_slot: Vec<u32>,
-    free_vertex: Vec<u32>,
-    positions: Vec<[f64; 3]>,
-    triangles: Vec<[u32; 3]>,
-    surface: Vec<[f64; 9]>,
-    interior: Vec<[f64; 9]>,
-    young_pa: f64,
-}
-
-impl Tiny {
-    /// 5 vertices, vertex 0 fixed; free 1..=4 all touchable (S = F = 4).
-    fn new() -> Self {
-        let spd = [2e-4, 1e-5, 0.0, 1e-5, 3e-4, 0.0, 0.0, 0.0, 1e-4];
-        Self {
-            vertex_slot: vec![u32::MAX, 0, 1, 2, 3],
-            free_vertex: vec![1, 2, 3, 4],
-            positions: vec![
-                [0.0; 3],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-                [1.0, 1.0, 1.0],
-            ],
-            triangles: vec![[1, 2, 3]],
-            surface: vec![spd; 10],
-            interior: vec![],
-            young_pa: 1000.0,
-        }
-    }
-
-    fn bytes(&self) -> Vec<u8> {
-        write_table(
-            &TableContents {
-                tet_lame: &[[1.0, 1.0]; 2],
-                young_pa: self.young_pa,
-                poisson: 0.3,
-                mesh_hash: 7,
-                vertex_slot: &self.vertex_slot,
-                free_vertex: &self.free_vertex,
-                touchable_count: 4,
-                positions: &self.positions,
-                triangles: &self.triangles,
-                surface: &self.surface,
-                interior: &self.interior,
-                collision: &collision_index(&self.positions, &self.triangles),
-            },
-            Precision::F32,
-        )
-    }
-}
-
 #[test]
 fn structural_errors_behind_a_valid_checksum() {
-    assert_eq!(load32(&Tiny::new().bytes()), Ok(()));
+    assert_eq!(load32(&TinyTable::new().bytes()), Ok(()));
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.surface[4][8] = f64::NAN;
     assert_eq!(
         load32(&t.bytes()),
@@ -155,35 +100,35 @@ fn structural_errors_behind_a_valid_checksum() {
         })
     );
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.surface[5][0] = -1e-4; // C_22 (index 2·3/2 + 2 = 5) not positive definite
     assert_eq!(
         load32(&t.bytes()),
         Err(LoadError::NotPositiveDefinite { touchable: 2 })
     );
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.surface[0][1] = 5e-5; // C_00 not symmetric
     assert_eq!(
         load32(&t.bytes()),
         Err(LoadError::NotPositiveDefinite { touchable: 0 })
     );
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.free_vertex.swap(0, 1);
     assert_eq!(
         load32(&t.bytes()),
         Err(LoadError::BadVertexMap { vertex: 1 })
     );
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.triangles[0][2] = 5;
     assert_eq!(
         load32(&t.bytes()),
         Err(LoadError::BadTriangle { triangle: 0 })
     );
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.positions[3][1] = f64::INFINITY;
     assert_eq!(
         load32(&t.bytes()),
@@ -193,11 +138,11 @@ fn structural_errors_behind_a_valid_checksum() {
         })
     );
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.young_pa = -1.0;
     assert_eq!(load32(&t.bytes()), Err(LoadError::BadMaterial));
 
-    let mut t = Tiny::new();
+    let mut t = TinyTable::new();
     t.surface.pop();
     assert_eq!(
         load32(&t.bytes()),

@@ -424,3 +424,170 @@ pub fn tensor_difference(
     }
     (worst, scale)
 }
+
+/// The f32 tables of the firmware example's box (`tools/firmware-m4f/mesh/box.*`: 3 × 3 × 3
+/// cells of 1 cm, 64 vertices, 162 tets, base fixed, E = 3 kPa, ν = 0.45), built in memory
+/// exactly as `tools/box-table.sh` (pre-computed; tensor-mass with ρ = 1000 kg/m³) and
+/// `tools/hybrid-tables.sh` (the hybrid of `hybrid-scene.toml`: the top corner cell
+/// tensor-mass) build them: what the C ABI's tests load.
+pub struct FirmwareBoxTables {
+    /// The pre-computed table.
+    pub precomputed: palpate::table::load::TableFile,
+    /// The tensor-mass table.
+    pub tensor_mass: palpate::table::load::TableFile,
+    /// The hybrid's three tables.
+    pub hybrid: palpate::hybrid::HybridTables,
+}
+
+/// [`FirmwareBoxTables`], built once per test binary.
+pub fn firmware_box_tables() -> &'static FirmwareBoxTables {
+    use palpate::fem::material::Material;
+    use palpate::session::model::{SceneModel, hybrid_tables};
+    use palpate::table::build::{BuildOptions, build};
+    use palpate::table::compliance::Solver;
+    use palpate::table::file::Precision;
+    use palpate::table::load::TableFile;
+
+    static TABLES: std::sync::OnceLock<FirmwareBoxTables> = std::sync::OnceLock::new();
+    TABLES.get_or_init(|| {
+        let firmware = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tools/firmware-m4f");
+        let (mesh, report) =
+            palpate::mesh::read_mesh(&firmware.join("mesh/box.node")).expect("box mesh");
+        let material = Material::new(3000.0, 0.45).expect("material");
+        let fix = vec!["z<0.001".parse().expect("predicate")];
+        let table = |options: BuildOptions| {
+            TableFile::from_bytes(&build(&mesh, &report, &options).expect("table").bytes)
+        };
+        let scene = Scene::read(&firmware.join("hybrid-scene.toml")).expect("hybrid scene");
+        let (scene_mesh, scene_report) = scene.load_mesh().expect("scene mesh");
+        let SceneModel::Hybrid { partition, .. } =
+            SceneModel::of(&scene, &scene_mesh, &scene_report).expect("scene model")
+        else {
+            panic!("hybrid-scene.toml is not a hybrid");
+        };
+        FirmwareBoxTables {
+            precomputed: table(BuildOptions::precomputed(
+                material,
+                fix.clone(),
+                Solver::Cholesky,
+                Precision::F32,
+            )),
+            tensor_mass: table(BuildOptions::tensor_mass(
+                material,
+                1000.0,
+                fix,
+                Precision::F32,
+            )),
+            hybrid: hybrid_tables(
+                &scene,
+                &scene_mesh,
+                &scene_report,
+                &partition,
+                Precision::F32,
+            )
+            .expect("hybrid tables"),
+        }
+    })
+}
+
+/// A pre-computed table with hand-set contents (a 5-vertex mesh, vertex 0
+/// fixed), so that each structural check of the loader can be hit behind a
+/// valid checksum; [`TinyTable::bytes`] writes it with the host's writer.
+pub struct TinyTable {
+    /// Each vertex's free index or `u32::MAX` (fixed).
+    pub vertex_slot: Vec<u32>,
+    /// Free index → vertex; the first `touchable_count` are touchable.
+    pub free_vertex: Vec<u32>,
+    /// Touchable vertices (`S`).
+    pub touchable_count: usize,
+    /// Rest positions, m.
+    pub positions: Vec<[f64; 3]>,
+    /// Boundary triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Packed surface compliance blocks, m/N.
+    pub surface: Vec<[f64; 9]>,
+    /// Interior compliance blocks, m/N.
+    pub interior: Vec<[f64; 9]>,
+    /// The compliance compressed, if it is to be written so.
+    pub compressed: Option<palpate::table::compress::CompressedCompliance>,
+    /// Young's modulus, Pa.
+    pub young_pa: f64,
+}
+
+impl TinyTable {
+    /// An SPD compliance block (m/N) every block of the tiny tables holds.
+    pub const SPD: [f64; 9] = [2e-4, 1e-5, 0.0, 1e-5, 3e-4, 0.0, 0.0, 0.0, 1e-4];
+
+    /// 5 vertices, vertex 0 fixed; free 1..=4 all touchable (S = F = 4).
+    pub fn new() -> Self {
+        Self {
+            vertex_slot: vec![u32::MAX, 0, 1, 2, 3],
+            free_vertex: vec![1, 2, 3, 4],
+            touchable_count: 4,
+            positions: vec![
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 1.0, 1.0],
+            ],
+            triangles: vec![[1, 2, 3]],
+            surface: vec![Self::SPD; 10],
+            interior: vec![],
+            compressed: None,
+            young_pa: 1000.0,
+        }
+    }
+
+    /// [`TinyTable::new`] with a sixth vertex, free and interior (S = 4,
+    /// F = 5): one interior block per column, the compliance falling off
+    /// with the column `k` as `SPD / (k + 2)`.
+    pub fn with_interior() -> Self {
+        let mut t = Self::new();
+        t.vertex_slot.push(4);
+        t.free_vertex.push(5);
+        t.positions.push([0.5, 0.5, 0.5]);
+        t.interior = (0..4)
+            .map(|k| Self::SPD.map(|x| x / (k as f64 + 2.0)))
+            .collect();
+        t
+    }
+
+    /// The table's compliance as the host computes it.
+    pub fn compliance(&self) -> palpate::table::compliance::Compliance {
+        palpate::table::compliance::Compliance {
+            surface: self.surface.clone(),
+            interior: self.interior.clone(),
+        }
+    }
+
+    /// The table file (f32), compressed as [`TinyTable::compressed`] says.
+    pub fn bytes(&self) -> Vec<u8> {
+        use palpate::table::collision::collision_index;
+        use palpate::table::file::{Precision, TableContents, write_table};
+        write_table(
+            &TableContents {
+                tet_lame: &[[1.0, 1.0]; 2],
+                young_pa: self.young_pa,
+                poisson: 0.3,
+                mesh_hash: 7,
+                vertex_slot: &self.vertex_slot,
+                free_vertex: &self.free_vertex,
+                touchable_count: self.touchable_count,
+                positions: &self.positions,
+                triangles: &self.triangles,
+                surface: &self.surface,
+                interior: &self.interior,
+                compressed: self.compressed.as_ref(),
+                collision: &collision_index(&self.positions, &self.triangles),
+            },
+            Precision::F32,
+        )
+    }
+}
+
+impl Default for TinyTable {
+    fn default() -> Self {
+        Self::new()
+    }
+}

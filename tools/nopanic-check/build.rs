@@ -1,6 +1,8 @@
 //! Puts the firmware example's `memory.x` (QEMU mps2-an386) on the linker
 //! path, and copies the pre-computed table named by `PALPATE_TABLE` to
-//! `$OUT_DIR/table.bin` and the tensor-mass table named by
+//! `$OUT_DIR/table.bin`, its compressed versions named by
+//! `PALPATE_TABLE_F16` and `PALPATE_TABLE_Q16` to `$OUT_DIR/table-f16.bin`
+//! and `$OUT_DIR/table-q16.bin`, and the tensor-mass table named by
 //! `PALPATE_TENSOR_TABLE` to `$OUT_DIR/tensor_table.bin`, and the hybrid's
 //! three tables in the folder `PALPATE_HYBRID_TABLES` to `$OUT_DIR/hybrid/`
 //! (`tools/nopanic-check.sh` builds them all).
@@ -14,6 +16,16 @@ fn main() {
     println!("cargo:rerun-if-changed=../firmware-m4f/memory.x");
     for (var, file, command) in [
         ("PALPATE_TABLE", "table.bin", "`palpate tables build`"),
+        (
+            "PALPATE_TABLE_F16",
+            "table-f16.bin",
+            "`palpate tables build --compress f16`",
+        ),
+        (
+            "PALPATE_TABLE_Q16",
+            "table-q16.bin",
+            "`palpate tables build --compress q16`",
+        ),
         (
             "PALPATE_TENSOR_TABLE",
             "tensor_table.bin",

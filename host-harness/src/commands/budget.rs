@@ -6,9 +6,12 @@ use core::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use palpate::budget::{BudgetRow, M4F_IPS, budget_table, measure, probe, trajectories};
+use palpate::budget::{
+    BudgetRow, HOST_IR, M4F_IPS, budget_table, chosen_trajectories, measure, probe, record,
+};
 use palpate::session::model::{SceneModel, SceneTables};
 use palpate::session::run::check_scene_table;
+use palpate::session::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
 use palpate::session::stability::check_stable_step;
 use palpate::session::{MeshSource, Scene, Trajectory};
 
@@ -30,6 +33,17 @@ pub struct BudgetArgs {
     /// one the scene's tool can run).
     #[arg(long = "trajectory", value_name = "NAME")]
     only: Vec<String>,
+    /// Run the scene with this many probes (1..=4), each on its own site
+    /// of the built-in block's top, instead of its tool (a scene of probes
+    /// only).
+    #[arg(long, value_name = "N")]
+    points: Option<usize>,
+    /// Measure nothing: write the scene's tables, each generated
+    /// trajectory's ticks (`--trajectory`: those only) and the host's output
+    /// of each tick into the folder DIR, for the Cortex-M4F cycle count
+    /// (`tools/cycles-check.sh`; the scene's own mesh only).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["json", "probe"])]
+    record: Option<PathBuf>,
     /// Internal: run the ticks of this trajectory on this table, built for
     /// the scene's mesh size SIZE (0 the coarse box, or the scene's own)
     /// (the process callgrind measures).
@@ -45,9 +59,23 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         work_dir,
         json,
         only,
+        points,
+        record: record_dir,
         probe: probe_paths,
     } = args;
     let mut scene = Scene::named(scene_arg)?;
+    if let Some(points) = *points {
+        with_probes(&mut scene, points)?;
+    }
+    if let Some(dir) = record_dir {
+        let runs = record(&scene, dir, only)?;
+        let mut text = format!("recorded in {}:\n", dir.display());
+        for run in runs {
+            let _ = writeln!(text, "  {run}");
+        }
+        stdout::print(&text)?;
+        return Ok(());
+    }
     let sizes = mesh_sizes(&scene);
     if let Some([table_path, trajectory_path, size]) = probe_paths.as_deref() {
         // The model of the mesh the parent built these tables for.
@@ -77,20 +105,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
     let exe = std::env::current_exe()?;
-    let mut chosen = trajectories(&scene)?;
-    if let Some(unknown) = only
-        .iter()
-        .find(|name| !chosen.iter().any(|(known, _)| known == name))
-    {
-        let known: Vec<&str> = chosen.iter().map(|(name, _)| *name).collect();
-        bail!(
-            "--trajectory {unknown}: not a generated trajectory of this scene (one of: {})",
-            known.join(", ")
-        );
-    }
-    if !only.is_empty() {
-        chosen.retain(|(name, _)| only.iter().any(|o| o == name));
-    }
+    let chosen = chosen_trajectories(&scene, only)?;
     // Every size's table is checked against the build limits before the
     // first is built (the coarse one can take a while).
     for source in &sizes {
@@ -104,7 +119,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
         let (mesh, report) = scene.load_mesh()?;
-        let (tables, bound) = budget_table(&scene, &mesh, &report)?;
+        let (tables, bound) = budget_table(&scene, &mesh, &report, &HOST_IR)?;
         let table_path = work_dir.join(format!("table-{s}.bin"));
         tables.write(&table_path)?;
         for (name, trajectory) in &chosen {
@@ -194,6 +209,23 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             r.bound_ir
         );
     }
+    Ok(())
+}
+
+/// Gives `scene` `points` probes of its radius (`--points`): a scene of
+/// probes only, `points` in `1..=MAX_TOOL_POINTS`.
+fn with_probes(scene: &mut Scene, points: usize) -> anyhow::Result<()> {
+    if !(1..=MAX_TOOL_POINTS).contains(&points) {
+        bail!("--points {points}: expected 1..={MAX_TOOL_POINTS}");
+    }
+    if let Some(kind) = scene.tool.kinds.iter().find(|k| **k != ToolKind::Probe) {
+        bail!(
+            "--points: {} has a {}; only a scene of probes takes --points",
+            scene.source,
+            kind.name()
+        );
+    }
+    scene.tool = ToolSpec::probes(points, scene.tool.radius_m);
     Ok(())
 }
 

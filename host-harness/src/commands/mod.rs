@@ -6,10 +6,12 @@
 pub mod args;
 pub mod bench;
 pub mod budget;
+pub mod chart;
 pub mod demo;
 pub mod dynamic;
 pub mod experiment;
 pub mod precomputed;
+pub mod remap;
 pub mod scene;
 pub mod session;
 pub mod stdout;

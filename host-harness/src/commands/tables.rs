@@ -11,6 +11,7 @@ use palpate::mesh::read_mesh;
 use palpate::output::atomic::{self, AtomicFile};
 use palpate::table::build::{BuildOptions, TableKindOptions, build_with_limits};
 use palpate::table::compliance::Solver;
+use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
@@ -35,6 +36,22 @@ pub enum TablesCommand {
         /// Stored float width: f32 (firmware) or f64 (verification).
         #[arg(long, value_enum, default_value = "f32")]
         precision: Precision,
+        /// Store the compliance in 16 bits per value with a per-column scale
+        /// (f16: binary16; q16: fixed point), about half the f32 table; its
+        /// force and displacement errors against the f32 table are measured
+        /// and stored in the table (`tables info` prints them).
+        #[arg(long, value_enum, value_name = "CODE")]
+        compress: Option<BlockCode>,
+        /// With --compress: leave out each interior compliance block whose
+        /// largest entry is below REL times the largest of its column
+        /// (far-field blocks; they count as zero), REL in [0, 1).
+        #[arg(long, value_name = "REL")]
+        drop_below: Option<f64>,
+        /// With --compress: how the touchable-touchable blocks (the contact
+        /// solve's) are stored: coded (default), f32, or coded with
+        /// --drop-below applied to them too (costs contact force accuracy).
+        #[arg(long, value_enum)]
+        contact_blocks: Option<ContactBlocks>,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -84,6 +101,19 @@ impl From<SolverArg> for Solver {
     }
 }
 
+/// `; compressed …, …` for a compressed table's summary line: its encoding
+/// and the errors measured at build time; empty otherwise.
+fn compression_note(bytes: &[u8]) -> String {
+    let file = TableFile::from_bytes(bytes);
+    match palpate_kernel::PrecomputedTable::<f32>::load(file.bytes()) {
+        Ok(table) => match table.compression() {
+            Some(record) => format!("; {}", palpate::table::load::describe_compression(record)),
+            None => String::new(),
+        },
+        Err(_) => String::new(),
+    }
+}
+
 /// Runs a `tables` command; `matches` are those of `tables` (whether
 /// `--solver` was given is read from them).
 pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
@@ -94,6 +124,9 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             fix,
             solver,
             precision,
+            compress,
+            drop_below,
+            contact_blocks,
             quiet,
             output,
             kind,
@@ -104,6 +137,14 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 .subcommand_matches("build")
                 .and_then(|m| m.value_source("solver"))
                 == Some(ValueSource::CommandLine);
+            if compress.is_none() {
+                if drop_below.is_some() {
+                    bail!("--drop-below applies to a compressed table: add --compress f16|q16");
+                }
+                if contact_blocks.is_some() {
+                    bail!("--contact-blocks applies to a compressed table: add --compress f16|q16");
+                }
+            }
             let kind = match (kind, density) {
                 (TableKindArg::TensorMass, None) => {
                     bail!("--kind tensor-mass needs --density <kg/m3>")
@@ -116,11 +157,19 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 (TableKindArg::TensorMass, Some(_)) if solver_given => {
                     bail!("--solver applies to --kind precomputed only")
                 }
+                (TableKindArg::TensorMass, Some(_)) if compress.is_some() => {
+                    bail!("--compress applies to --kind precomputed only")
+                }
                 (TableKindArg::TensorMass, Some(density_kg_m3)) => {
                     TableKindOptions::TensorMass { density_kg_m3 }
                 }
                 (TableKindArg::Precomputed, None) => TableKindOptions::Precomputed {
                     solver: solver.into(),
+                    compression: compress.map(|code| Compression {
+                        code,
+                        drop_below: drop_below.unwrap_or(0.0),
+                        contact: contact_blocks.unwrap_or_default(),
+                    }),
                 },
             };
             // The output: never one of the inputs, and written whole or not at
@@ -167,10 +216,11 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             match kind {
                 TableKindOptions::Precomputed { .. } => eprintln!(
                     "{source}: {vertices}, {} free, {} touchable; {mesh_notes}; \
-                     compliance in {:.3} s; wrote {bytes} bytes to {output}",
+                     compliance in {:.3} s; wrote {bytes} bytes to {output}{}",
                     built.free_count,
                     built.touchable_count,
-                    built.arrays_time.as_secs_f64()
+                    built.arrays_time.as_secs_f64(),
+                    compression_note(&built.bytes)
                 ),
                 TableKindOptions::TensorMass { density_kg_m3 } => eprintln!(
                     "{source}: tensor-mass table: {vertices}, {} edges, {density_kg_m3} kg/m3; \

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 
-use super::volume_bend::Scene;
+use super::volume_bend::{PaperLoads, Scene};
 use crate::fem::material::Material;
 use crate::mesh::TetMesh;
 use crate::mesh::boundary_surface;
@@ -81,6 +81,10 @@ pub fn cylinder(radial_cells: usize, height_cells: usize) -> Scene {
         measure: Box::new(move |mesh, u| top_tilt_deg(mesh, u, &top_triangles)),
         measure_name: "top-face tilt, degrees",
         targets: TILTS_DEG.to_vec(),
+        paper_loads: PaperLoads {
+            first_volume_change: 0.07,
+            multiples: vec![1.0, 2.0, 3.0],
+        },
         mesh,
     }
 }
@@ -116,6 +120,10 @@ pub fn organ() -> Scene {
         }),
         measure_name: "mean lift of the loaded lobe tip, mm",
         targets: vec![ORGAN_LIFT_MM],
+        paper_loads: PaperLoads {
+            first_volume_change: 0.09,
+            multiples: vec![1.0],
+        },
         mesh,
     }
 }

@@ -5,10 +5,18 @@
 //! relaxation ([`super::relax`]) under the same force, and their relative
 //! volume changes compared.
 //!
-//! A stage is defined on the full non-linear model, St Venant-Kirchhoff +
-//! incompressibility: the force is found (secant iterations) that brings its
-//! [`Scene::measure`] to the stage's target (the cylinder's top-face tilt),
-//! then that force is applied to all three models. Plain St Venant-Kirchhoff
+//! Two protocols define the stages ([`Protocol`]):
+//! - **the paper's loads** ([`Protocol::PaperLoads`]): forces `F`, `2F`,
+//!   `3F` (the multiples of [`Scene::paper_loads`]), with `F` the force that
+//!   gives the linear model the paper's first-stage volume change (7 % on the
+//!   cylinder). Picinbono's table gives the linear model 7 / 28 / 63 %, that
+//!   is 7 × 1², 2², 3²: its loads were in ratio 1 : 2 : 3.
+//! - **tilts** ([`Protocol::Tilt`]): a stage is defined on the full
+//!   non-linear model, St Venant-Kirchhoff + incompressibility: the force is
+//!   found (secant iterations) that brings its [`Scene::measure`] to the
+//!   stage's target (the cylinder's top-face tilt).
+//!
+//! Either way the stage's force is then applied to all three models. Plain St Venant-Kirchhoff
 //! is not used to define stages because it collapses: under strong
 //! compression (stretch below `1/√3`) its stress softens and tets invert
 //! (Picinbono 2001 §3.2, the reason for the penalty); such an equilibrium
@@ -22,10 +30,8 @@ use serde::Serialize;
 
 use super::relax::{Relaxation, relax};
 use crate::fem::material::{Material, TetMaterials};
-use crate::mesh::{TetMesh, boundary_surface};
-use crate::table::file::Precision;
-use crate::table::load::TableFile;
-use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
+use crate::mesh::TetMesh;
+use crate::table::tensor_mass::static_study_table;
 use crate::tensor_mass::OwnedState;
 use crate::tensor_mass::run::{diagonal, volume_change};
 use crate::tensor_mass::stability::omega_max;
@@ -54,8 +60,32 @@ pub struct Scene {
     /// Name and unit of the measure (for the table).
     pub measure_name: &'static str,
     /// Stage targets of the measure, on the St Venant-Kirchhoff +
-    /// incompressibility model.
+    /// incompressibility model ([`Protocol::Tilt`]).
     pub targets: Vec<f64>,
+    /// The paper's loads ([`Protocol::PaperLoads`]).
+    pub paper_loads: PaperLoads,
+}
+
+/// Picinbono 2001 table 2's loading: multiples of a force `F` defined by
+/// the linear model's relative volume change at `F`.
+#[derive(Clone, Debug)]
+pub struct PaperLoads {
+    /// `(V − V₀)/V₀` of the linear model at `F` (the paper's first stage:
+    /// 0.07 for the cylinder, 0.09 for the organ).
+    pub first_volume_change: f64,
+    /// The stages' forces in units of `F` (1, 2, 3 for the cylinder).
+    pub multiples: Vec<f64>,
+}
+
+/// How the stages' forces are chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Protocol {
+    /// Forces `k F` ([`PaperLoads`]); a stage's `target` is `k`.
+    PaperLoads,
+    /// Forces bringing the penalized model to [`Scene::targets`]; a
+    /// stage's `target` is the measure's.
+    Tilt,
 }
 
 /// One model's equilibrium at a stage.
@@ -79,7 +109,9 @@ pub struct Equilibrium {
 /// One stage: the force and the three equilibria.
 #[derive(Clone, Debug, Serialize)]
 pub struct Stage {
-    /// Target of the measure on the St Venant-Kirchhoff + incompressibility model.
+    /// [`Protocol::Tilt`]: target of the measure on the penalized St
+    /// Venant-Kirchhoff model; [`Protocol::PaperLoads`]: the force in units
+    /// of `F`.
     pub target: f64,
     /// Total applied force, N.
     pub force_n: f64,
@@ -106,6 +138,8 @@ pub struct SceneResult {
     pub incompressibility_n: f64,
     /// Name and unit of the stage measure.
     pub measure: &'static str,
+    /// How the stages' forces were chosen.
+    pub protocol: Protocol,
     /// The stages.
     pub stages: Vec<Stage>,
 }
@@ -207,22 +241,18 @@ pub fn inverted_tets(mesh: &TetMesh, u: &[[f64; 3]]) -> usize {
         .count()
 }
 
-/// Runs every stage of `scene`; `progress` receives one line per relaxation.
+/// Runs every stage of `scene` under `protocol`; `progress` receives one
+/// line per relaxation.
 pub fn run_scene(
     scene: &Scene,
+    protocol: Protocol,
     controls: &Controls,
     mut progress: impl FnMut(&str),
 ) -> anyhow::Result<SceneResult> {
     // The fixed flags are the scene's own (no predicates): the arrays and
     // the writer of the table build, without its predicate stage.
     let materials = TetMaterials::uniform(scene.material, scene.mesh.tets.len());
-    let arrays = TensorMassArrays::new(&scene.mesh, &materials, 1000.0, scene.fixed.clone());
-    let file = TableFile::from_bytes(&write_tensor_mass_table(
-        &scene.mesh,
-        &boundary_surface(&scene.mesh).triangles,
-        &arrays,
-        Precision::F64,
-    ));
+    let file = static_study_table(&scene.mesh, &materials, scene.fixed.clone());
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let n = scene.mesh.positions.len();
 
@@ -266,17 +296,27 @@ pub fn run_scene(
         bail!("three models expected");
     };
 
+    let (targets, unit_force_n) = match protocol {
+        Protocol::Tilt => (&scene.targets, 0.0),
+        Protocol::PaperLoads => (
+            &scene.paper_loads.multiples,
+            paper_force(scene, linear, controls, &mut progress)?,
+        ),
+    };
     let mut stages = Vec::new();
     let mut force_n = 0.0;
-    for &target in &scene.targets {
-        force_n = find_force(
-            scene,
-            incompressible,
-            target,
-            force_n,
-            controls,
-            &mut progress,
-        )?;
+    for &target in targets {
+        force_n = match protocol {
+            Protocol::Tilt => find_force(
+                scene,
+                incompressible,
+                target,
+                force_n,
+                controls,
+                &mut progress,
+            )?,
+            Protocol::PaperLoads => target * unit_force_n,
+        };
         let mut solve = |body: &mut Body<'_>, name: &str| -> anyhow::Result<Equilibrium> {
             let e = body.equilibrium(scene, force_n, controls)?;
             progress(&format!(
@@ -306,8 +346,62 @@ pub fn run_scene(
         lame_pa: scene.material.lame(),
         incompressibility_n: scene.incompressibility_n,
         measure: scene.measure_name,
+        protocol,
         stages,
     })
+}
+
+/// The paper's unit force `F` (N): the force under which the linear model's
+/// `(V − V₀)/V₀` is [`PaperLoads::first_volume_change`]. The linear model's
+/// equilibrium under `sP` is `s` times its equilibrium `u` under `P`, so one
+/// relaxation at a probe force `P` and a bisection on `s` of the volume
+/// change of `s u` (exact, no further relaxation) give `F = sP`.
+fn paper_force(
+    scene: &Scene,
+    linear: &mut Body<'_>,
+    controls: &Controls,
+    progress: &mut impl FnMut(&str),
+) -> anyhow::Result<f64> {
+    let probe_n = 1e-3 * scene.material.young_pa * bounding_area(&scene.mesh);
+    let (relaxation, u) = linear.relax(scene, probe_n, controls)?;
+    let alive = vec![true; scene.mesh.tets.len()];
+    let volume = |s: f64| {
+        let scaled: Vec<[f64; 3]> = u.iter().map(|d| d.map(|x| s * x)).collect();
+        volume_change(&scene.mesh, &scaled, &alive)
+    };
+    let target = scene.paper_loads.first_volume_change;
+    // Bracket the scale by doubling, then bisect: 64 halvings of a bracket
+    // at most 2^64 wide reach f64 resolution.
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..64 {
+        if volume(hi) >= target {
+            break;
+        }
+        (lo, hi) = (hi, 2.0 * hi);
+    }
+    if volume(hi) < target {
+        bail!(
+            "{}: the linear model's volume change does not reach {target} below {hi:.3e} × {probe_n:.4e} N",
+            scene.name
+        );
+    }
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if volume(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let force_n = hi * probe_n;
+    progress(&format!(
+        "{} paper loads: F = {force_n:.4e} N gives the linear model ΔV/V₀ = {:+.3} % \
+         (probe {probe_n:.4e} N relaxed in {} steps)",
+        scene.name,
+        100.0 * volume(hi),
+        relaxation.steps
+    ));
+    Ok(force_n)
 }
 
 /// The total force that brings `body`'s measure to
@@ -395,14 +489,27 @@ pub const PAPER_TABLE_2: [(&str, [&[f64]; 3]); 2] = [
 pub fn table(results: &[SceneResult]) -> String {
     use core::fmt::Write;
     let mut out = String::new();
+    let stages = match results.first().map(|r| r.protocol) {
+        Some(Protocol::PaperLoads) => "at the paper's loads F, 2F, 3F",
+        _ => "at the penalized model's tilts",
+    };
     let _ = writeln!(
         out,
-        "relative volume change (V − V₀)/V₀, % (paper: Picinbono 2001 table 2)"
+        "relative volume change (V − V₀)/V₀, %, {stages} (paper: Picinbono 2001 table 2)"
     );
     let _ = writeln!(
         out,
-        "{:<9} {:>8} {:>11} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7}",
-        "scene", "target", "force N", "linear", "paper", "StVK", "paper", "StVK+inc", "paper"
+        "{:<9} {:>8} {:>11} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7} | {:>9}",
+        "scene",
+        "stage",
+        "force N",
+        "linear",
+        "paper",
+        "StVK",
+        "paper",
+        "StVK+inc",
+        "paper",
+        "measure"
     );
     for result in results {
         let paper = PAPER_TABLE_2
@@ -424,11 +531,15 @@ pub fn table(results: &[SceneResult]) -> String {
                 };
                 format!("{:+.3}{mark}", 100.0 * e.volume_change)
             };
+            let stage_label = match result.protocol {
+                Protocol::Tilt => format!("{:.1}", stage.target),
+                Protocol::PaperLoads => format!("{}F", stage.target),
+            };
             let _ = writeln!(
                 out,
-                "{:<9} {:>8.1} {:>11.4e} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7}",
+                "{:<9} {:>8} {:>11.4e} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7} | {:>9.1}",
                 result.name,
-                stage.target,
+                stage_label,
                 stage.force_n,
                 v(&stage.linear),
                 p(0),
@@ -436,18 +547,26 @@ pub fn table(results: &[SceneResult]) -> String {
                 p(1),
                 v(&stage.stvk_incompressible),
                 p(2),
+                stage.stvk_incompressible.measure,
             );
         }
+        let stages = match result.protocol {
+            Protocol::Tilt => "stages: the penalized model's measure",
+            Protocol::PaperLoads => {
+                "stages: multiples of F, the force giving the linear model the paper's first stage"
+            }
+        };
         let _ = writeln!(
             out,
-            "  {}: {} vertices, {} tets, λ = {:.0} Pa, μ = {:.0} Pa, γ = {:.3e} N; target: {}",
+            "  {}: {} vertices, {} tets, λ = {:.0} Pa, μ = {:.0} Pa, γ = {:.3e} N; {stages}; \
+             measure: the penalized model's {}",
             result.name,
             result.vertices,
             result.tets,
             result.lame_pa.0,
             result.lame_pa.1,
             result.incompressibility_n,
-            result.measure
+            result.measure,
         );
     }
     let _ = writeln!(

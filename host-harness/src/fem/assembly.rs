@@ -50,8 +50,28 @@ pub fn assemble_restricted(
     slot: &[Option<u32>],
     slot_count: usize,
 ) -> SparseColMat<usize, f64> {
-    assert_eq!(slot.len(), positions.len(), "one slot per vertex");
     assert_eq!(m.len(), tets.len(), "one material per tet");
+    assemble_restricted_with(positions.len(), tets, slot, slot_count, |t| {
+        element_stiffness(&tets[t].map(|v| positions[v as usize]), &m.per_tet()[t])
+    })
+}
+
+/// [`assemble_restricted`] of any element matrices: `element(t)` gives tet
+/// `t`'s 4×4 blocks of 3×3 (`K[j][k][a][b]`, the stiffness `−∂f_{j,a}/∂x_{k,b}`,
+/// N/m) for the `vertex_count`-vertex mesh `tets`. The Newton reference's
+/// tangent ([`super::newton`]) uses it with the St Venant-Kirchhoff tangent.
+///
+/// # Panics
+/// If `slot.len() != vertex_count`, a slot is `>= slot_count` or a tet
+/// references a vertex `>= vertex_count`.
+pub fn assemble_restricted_with(
+    vertex_count: usize,
+    tets: &[[u32; 4]],
+    slot: &[Option<u32>],
+    slot_count: usize,
+    mut element: impl FnMut(usize) -> [[[[f64; 3]; 3]; 4]; 4],
+) -> SparseColMat<usize, f64> {
+    assert_eq!(slot.len(), vertex_count, "one slot per vertex");
     assert!(
         slot.iter().flatten().all(|&s| (s as usize) < slot_count),
         "slot out of range"
@@ -82,13 +102,12 @@ pub fn assemble_restricted(
         }
     }
     let mut val = vec![0.0f64; row_idx.len()];
-    for (t, material) in tets.iter().zip(m.per_tet()) {
-        let s = t.map(|v| slot[v as usize]);
+    for (t, tet) in tets.iter().enumerate() {
+        let s = tet.map(|v| slot[v as usize]);
         if s.iter().all(Option::is_none) {
             continue;
         }
-        let p = t.map(|v| positions[v as usize]);
-        let ke = element_stiffness(&p, material);
+        let ke = element(t);
         // Block (row j, column k) goes to column slot s[k], neighbour s[j].
         for (k, sk) in s.iter().enumerate() {
             let Some(sk) = *sk else { continue };

@@ -1,4 +1,6 @@
-//! Linear P1 finite elements: element stiffness and global assembly.
+//! Finite elements on the host: the linear P1 element, global assembly and
+//! the direct solves; the St Venant-Kirchhoff element and its Newton static
+//! reference ([`stvk`], [`newton`]).
 //!
 //! Everything here follows `MODELS.md` §1 (the linear P1 tetrahedron) and
 //! Cotin et al., INRIA RR-3510 §4. SI units throughout (m, N, Pa).
@@ -6,6 +8,8 @@
 pub mod assembly;
 pub mod element;
 pub mod material;
+pub mod newton;
 pub mod static_solve;
+pub mod stvk;
 
 pub(crate) mod llt;

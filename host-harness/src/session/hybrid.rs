@@ -41,6 +41,11 @@ impl<'t> HybridSetup<'t> {
         })
     }
 
+    /// The tensor-mass region's setup.
+    pub fn dynamic(&self) -> &DynamicSetup<'t> {
+        &self.dynamic
+    }
+
     /// What the session reads of the tissue, in mesh numbering.
     pub fn view(&self) -> HybridView<'_> {
         HybridView {

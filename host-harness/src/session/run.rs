@@ -543,6 +543,11 @@ impl<'t> DynamicSetup<'t> {
         self.table
     }
 
+    /// The tensor-mass model's parameters.
+    pub fn params(&self) -> DynamicParams<f32> {
+        self.params
+    }
+
     /// The physics settings.
     pub fn physics(&self) -> PhysicsConfig<f32> {
         self.physics

@@ -17,6 +17,7 @@ use palpate_kernel::{LoadError, PrecomputedTable};
 
 use super::collision::collision_index;
 use super::compliance::{Solver, compute_compliance};
+use super::compress::{Compression, encode, measured_record};
 use super::estimate::{SizeLimits, TableEstimate};
 use super::file::{Precision, TableContents, write_table};
 use super::load::TableFile;
@@ -56,6 +57,9 @@ pub enum TableKindOptions {
     Precomputed {
         /// How the compliance columns are solved.
         solver: Solver,
+        /// Store the compliance compressed ([`super::compress`]; `f32`
+        /// tables only), `None` for all of it in the table scalar.
+        compression: Option<Compression>,
     },
     /// The dynamic tensor-mass table (RR-3510 §5). Any predicates, none
     /// included (a free body).
@@ -75,7 +79,10 @@ impl BuildOptions {
         precision: Precision,
     ) -> Self {
         Self {
-            kind: TableKindOptions::Precomputed { solver },
+            kind: TableKindOptions::Precomputed {
+                solver,
+                compression: None,
+            },
             material,
             tet_materials: None,
             fix,
@@ -255,7 +262,15 @@ fn build_unchecked(
     }
     let (fixed, fixed_by_predicate) =
         fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
-    if let TableKindOptions::Precomputed { .. } = options.kind {
+    if let TableKindOptions::Precomputed { compression, .. } = options.kind {
+        if let Some(compression) = compression {
+            compression.check()?;
+            if options.precision != Precision::F32 {
+                bail!(
+                    "--compress applies to f32 tables (the firmware's); its errors are measured                      against the f32 table"
+                );
+            }
+        }
         if fixed_by_predicate == 0 {
             bail!(
                 "{}: no vertex matches the --fix predicates ({}); a free body has a singular stiffness",
@@ -287,7 +302,7 @@ fn build_unchecked(
         arrays_time: Duration::ZERO,
     };
     match options.kind {
-        TableKindOptions::Precomputed { solver } => {
+        TableKindOptions::Precomputed { solver, .. } => {
             let stages = Stages {
                 fixed: &fixed,
                 surface: &surface,
@@ -341,7 +356,10 @@ pub(crate) struct Stages<'a> {
 }
 
 /// The pre-computed stages: the free/touchable ordering, the compliance,
-/// the collision index of the surface, the writer.
+/// the collision index of the surface, the writer. With a compression
+/// (`options.kind`), the `f32` table is written first, then the compressed
+/// one, whose errors against it are measured over the probe set
+/// ([`super::compress::measure`]) and stored in its record.
 pub(crate) fn precomputed(
     mesh: &TetMesh,
     report: &MeshReport,
@@ -368,23 +386,49 @@ pub(crate) fn precomputed(
     .with_context(|| format!("{}: computing the compliance table", report.source))?;
     let arrays_time = start.elapsed();
     let collision = collision_index(&mesh.positions, &surface.triangles);
-    let bytes = write_table(
-        &TableContents {
-            tet_lame: &materials.lame(),
-            young_pa: options.material.young_pa,
-            poisson: options.material.poisson,
-            mesh_hash: mesh.content_hash(),
-            vertex_slot: &ordering.slot_entries(),
-            free_vertex: &ordering.free_vertex,
-            touchable_count: ordering.touchable_count,
-            positions: &mesh.positions,
-            triangles: &surface.triangles,
-            surface: &compliance.surface,
-            interior: &compliance.interior,
-            collision: &collision,
-        },
-        options.precision,
-    );
+    let (tet_lame, vertex_slot) = (materials.lame(), ordering.slot_entries());
+    let contents = TableContents {
+        tet_lame: &tet_lame,
+        young_pa: options.material.young_pa,
+        poisson: options.material.poisson,
+        mesh_hash: mesh.content_hash(),
+        vertex_slot: &vertex_slot,
+        free_vertex: &ordering.free_vertex,
+        touchable_count: ordering.touchable_count,
+        positions: &mesh.positions,
+        triangles: &surface.triangles,
+        surface: &compliance.surface,
+        interior: &compliance.interior,
+        compressed: None,
+        collision: &collision,
+    };
+    let mut bytes = write_table(&contents, options.precision);
+    if let TableKindOptions::Precomputed {
+        compression: Some(compression),
+        ..
+    } = options.kind
+    {
+        let context = || format!("{}: compressing the compliance table", report.source);
+        let mut compressed =
+            encode(&compliance, ordering.touchable_count, &compression).with_context(context)?;
+        let draft = write_table(
+            &TableContents {
+                compressed: Some(&compressed),
+                ..contents
+            },
+            options.precision,
+        );
+        let (record, _) =
+            measured_record(&bytes, &draft, compressed.record).with_context(context)?;
+        compressed.record = record;
+        bytes = write_table(
+            &TableContents {
+                compressed: Some(&compressed),
+                ..contents
+            },
+            options.precision,
+        );
+    }
     Ok(BuiltTable {
         bytes,
         touchable_count: ordering.touchable_count,

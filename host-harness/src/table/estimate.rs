@@ -113,6 +113,9 @@ pub struct TableEstimate {
     pub table_bytes: u64,
     /// The build's peak working memory, bytes (module doc), saturating.
     pub peak_bytes: u64,
+    /// A compressed pre-computed table (`--compress`): [`Self::table_bytes`] is the f32
+    /// table's, a bound of the compressed one's, which the f32 table is built beside.
+    pub compressed: bool,
 }
 
 impl TableEstimate {
@@ -125,12 +128,24 @@ impl TableEstimate {
         fixed: &[bool],
         surface: &Surface,
     ) -> Self {
-        let kind = match options.kind {
-            TableKindOptions::Precomputed { .. } => TableKind::Precomputed,
-            TableKindOptions::TensorMass { .. } => TableKind::TensorMass,
+        let (kind, compressed) = match options.kind {
+            TableKindOptions::Precomputed { compression, .. } => {
+                (TableKind::Precomputed, compression.is_some())
+            }
+            TableKindOptions::TensorMass { .. } => (TableKind::TensorMass, false),
         };
         let counts = TableCounts::of(mesh, report, fixed, surface);
-        Self::new(kind, options.precision, counts)
+        let mut estimate = Self::new(kind, options.precision, counts);
+        if compressed {
+            // The f32 table's size bounds the compressed one's (`describe`
+            // says so); its build also holds the draft, the final table and
+            // the two aligned copies its errors are measured on.
+            estimate.compressed = true;
+            estimate.peak_bytes = estimate
+                .peak_bytes
+                .saturating_add(estimate.table_bytes.saturating_mul(4));
+        }
+        estimate
     }
 
     /// The estimate of a table of `kind` stored in `precision` for `counts`.
@@ -192,6 +207,7 @@ impl TableEstimate {
             },
             table_bytes,
             peak_bytes,
+            compressed: false,
         }
     }
 
@@ -219,8 +235,13 @@ impl TableEstimate {
                 precision_name(self.precision)
             ),
         };
+        let compressed = if self.compressed {
+            " (uncompressed; compressed, about half that or less)"
+        } else {
+            ""
+        };
         format!(
-            "{what} would be {}, and its build needs about {} of memory",
+            "{what} would be {}{compressed}, and its build needs about {} of memory",
             human_bytes(self.table_bytes),
             human_bytes(self.peak_bytes)
         )

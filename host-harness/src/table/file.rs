@@ -3,6 +3,7 @@
 use bytemuck::Zeroable;
 
 use super::collision::CollisionIndex;
+use super::compress::{CodedPart, CompressedCompliance};
 use palpate_kernel::table::format::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
     SectionEntry, SectionKind, TableKind,
@@ -46,13 +47,18 @@ pub struct TableContents<'a> {
     pub surface: &'a [[f64; 9]],
     /// Interior compliance blocks, m/N.
     pub interior: &'a [[f64; 9]],
+    /// The compliance compressed (`tables build --compress`): its parts
+    /// replace [`Self::surface`] and [`Self::interior`] where coded, and
+    /// its record is written; `None` for a table all in the scalar.
+    pub compressed: Option<&'a CompressedCompliance>,
     /// The collision index of `triangles` over `positions`
     /// ([`super::collision::collision_index`]).
     pub collision: &'a CollisionIndex,
 }
 
 /// Serializes a pre-computed table (`TableKind::Precomputed`) with floats
-/// of `precision`.
+/// of `precision`, its compliance compressed as [`TableContents::compressed`]
+/// says.
 pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
     let index = c.collision;
     let header = RawHeader {
@@ -69,13 +75,54 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         mesh_hash: c.mesh_hash,
         ..RawHeader::zeroed()
     };
-    let sections = vec![
+    let mut sections = vec![
         Section::ints(SectionKind::VertexSlot, c.vertex_slot),
         Section::ints(SectionKind::FreeVertex, c.free_vertex),
         Section::floats(SectionKind::RestPositions, c.positions, precision),
         Section::ints(SectionKind::SurfaceTriangles, c.triangles),
-        Section::floats(SectionKind::ComplianceSurface, c.surface, precision),
-        Section::floats(SectionKind::ComplianceInterior, c.interior, precision),
+    ];
+    let (surface, interior) = match c.compressed {
+        Some(compressed) => {
+            sections.push(Section {
+                kind: SectionKind::ComplianceEncoding,
+                count: 1,
+                bytes: bytemuck::bytes_of(&compressed.record).to_vec(),
+            });
+            (compressed.surface.as_ref(), Some(&compressed.interior))
+        }
+        None => (None, None),
+    };
+    sections.extend(match surface {
+        Some(part) => part.sections(
+            [
+                SectionKind::SurfaceScale,
+                SectionKind::SurfaceCodes,
+                SectionKind::SurfaceKept,
+            ],
+            precision,
+        ),
+        None => vec![Section::floats(
+            SectionKind::ComplianceSurface,
+            c.surface,
+            precision,
+        )],
+    });
+    sections.extend(match interior {
+        Some(part) => part.sections(
+            [
+                SectionKind::InteriorScale,
+                SectionKind::InteriorCodes,
+                SectionKind::InteriorKept,
+            ],
+            precision,
+        ),
+        None => vec![Section::floats(
+            SectionKind::ComplianceInterior,
+            c.interior,
+            precision,
+        )],
+    });
+    sections.extend([
         Section::floats(SectionKind::SurfaceGrid, &[index.grid], precision),
         Section::ints(SectionKind::GridDims, &[index.dims]),
         Section::ints(SectionKind::GridCellStart, &index.cell_start),
@@ -87,8 +134,36 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         Section::ints(SectionKind::VertexTriangle, &index.vertex_triangle),
         Section::floats(SectionKind::SurfacePlane, &index.planes, precision),
         Section::floats(SectionKind::TetMaterial, c.tet_lame, precision),
-    ];
+    ]);
     write_container(header, precision, &sections)
+}
+
+impl CodedPart {
+    /// The part's sections: `[scale, codes, kept]` of `kinds`, the bitmap
+    /// only when blocks were dropped.
+    fn sections(
+        &self,
+        [scale, codes, kept]: [SectionKind; 3],
+        precision: Precision,
+    ) -> Vec<Section> {
+        let mut sections = vec![
+            Section::floats(scale, &self.scales, precision),
+            Section {
+                kind: codes,
+                count: self.codes.len() as u64,
+                bytes: self
+                    .codes
+                    .iter()
+                    .flatten()
+                    .flat_map(|c| c.to_le_bytes())
+                    .collect(),
+            },
+        ];
+        if let Some(words) = &self.kept {
+            sections.push(Section::ints(kept, words));
+        }
+        sections
+    }
 }
 
 /// One section's payload, ready to be laid out.

@@ -5,7 +5,10 @@ use std::fs::File;
 use std::path::Path;
 
 use anyhow::{Context, bail};
-use palpate_kernel::table::format::{CRC_LEN, CRC32, HEADER_LEN, RawHeader, TableKind};
+use palpate_kernel::table::format::{
+    BlockEncoding, CRC_LEN, CRC32, CompressionRecord, HEADER_LEN, RawHeader, SECTION_ENTRY_LEN,
+    SectionEntry, SectionKind, TableKind,
+};
 use palpate_kernel::table::{InterfaceTable, LoadError, TensorMassTable};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
@@ -167,6 +170,18 @@ impl TableFile {
         }
     }
 
+    /// The section directory as stored, if the header's section count fits
+    /// the bytes (not validated).
+    pub fn directory(&self, h: &RawHeader) -> Option<Vec<SectionEntry>> {
+        let len = (h.section_count as usize).checked_mul(SECTION_ENTRY_LEN)?;
+        let raw = self.bytes().get(HEADER_LEN..HEADER_LEN.checked_add(len)?)?;
+        Some(
+            raw.chunks_exact(SECTION_ENTRY_LEN)
+                .map(bytemuck::pod_read_unaligned)
+                .collect(),
+        )
+    }
+
     /// The table kind the header declares, if it is one this kernel knows.
     pub fn kind(&self) -> Option<TableKind> {
         match self.raw_header()?.table_kind {
@@ -247,28 +262,33 @@ impl TableFile {
             let _ = writeln!(out, "density: {} kg/m3", h.density_kg_m3);
         }
         let _ = writeln!(out, "mesh hash: {:016x}", h.mesh_hash);
-        // Section sizes follow from a header not yet validated: only for a
-        // scalar size the format has, and with checked arithmetic.
-        let sections = match (kind, h.scalar_bytes) {
-            (Some(kind), 4 | 8) => kind.sections(),
-            _ => &[][..],
-        };
-        for &kind in sections {
-            if let Some(count) = kind.expected_count(&h) {
-                let elem = kind.elem_bytes(h.scalar_bytes);
-                let _ = match count.checked_mul(u64::from(elem)) {
-                    Some(size) => writeln!(
-                        out,
-                        "section {}: {count} x {elem} bytes = {size} bytes",
-                        kind.name()
-                    ),
-                    None => writeln!(
-                        out,
-                        "section {}: {count} x {elem} bytes: overflows 64 bits",
-                        kind.name()
-                    ),
+        match self.directory(&h) {
+            Some(entries) => footprint(&mut out, &h, &entries),
+            None => {
+                // No readable directory: the sizes the header implies, only
+                // for a scalar size the format has, with checked arithmetic.
+                let _ = writeln!(out, "section directory: unreadable");
+                let sections = match (kind, h.scalar_bytes) {
+                    (Some(kind), 4 | 8) => kind.sections(),
+                    _ => &[][..],
                 };
+                for &kind in sections {
+                    if let Some(count) = kind.expected_count(&h) {
+                        section_line(
+                            &mut out,
+                            kind.name(),
+                            count,
+                            kind.elem_bytes(h.scalar_bytes),
+                        );
+                    }
+                }
             }
+        }
+        if kind == Some(TableKind::Precomputed)
+            && let Ok(AnyModel::F32(model)) = self.model()
+            && let Some(record) = model.table().compression()
+        {
+            let _ = writeln!(out, "compression: {}", describe_compression(record));
         }
         let checksum_ok = bytes.len() >= HEADER_LEN + CRC_LEN && {
             let (body, trailer) = bytes.split_at(bytes.len() - CRC_LEN);
@@ -291,4 +311,65 @@ impl TableFile {
             }
         }
     }
+}
+
+/// One `section NAME: COUNT x ELEM bytes = SIZE bytes` line.
+fn section_line(out: &mut String, name: &str, count: u64, elem: u32) {
+    let _ = match count.checked_mul(u64::from(elem)) {
+        Some(size) => writeln!(out, "section {name}: {count} x {elem} bytes = {size} bytes"),
+        None => writeln!(
+            out,
+            "section {name}: {count} x {elem} bytes: overflows 64 bits"
+        ),
+    };
+}
+
+/// The flash footprint of a table (what `include_table!` links): the total,
+/// then the header and directory, each section as the directory declares it,
+/// the alignment padding and the checksum.
+fn footprint(out: &mut String, h: &RawHeader, entries: &[SectionEntry]) {
+    let sections = entries.iter().fold(0u64, |total, e| {
+        total.saturating_add(e.count.saturating_mul(u64::from(e.elem_bytes)))
+    });
+    let header = u64::from(h.header_len);
+    let padding = h
+        .file_len
+        .saturating_sub(header)
+        .saturating_sub(sections)
+        .saturating_sub(CRC_LEN as u64);
+    let _ = writeln!(
+        out,
+        "flash footprint: {} bytes: header and directory {header}, sections {sections}, \
+         alignment padding {padding}, checksum {CRC_LEN}",
+        h.file_len
+    );
+    for e in entries {
+        let name = SectionKind::ALL
+            .iter()
+            .find(|k| **k as u32 == e.kind)
+            .map_or_else(
+                || format!("(unknown kind {})", e.kind),
+                |k| k.name().to_owned(),
+            );
+        section_line(out, &name, e.count, e.elem_bytes);
+    }
+}
+
+/// A compressed table's encoding record for people: how each part is
+/// stored, the drop threshold, and the errors measured at build time.
+pub fn describe_compression(r: &CompressionRecord) -> String {
+    let name = |value: u32| BlockEncoding::of_u32(value).map_or("unknown", BlockEncoding::name);
+    format!(
+        "contact (surface) blocks {}, interior blocks {}, dropped below {} of a column's \
+         largest; measured at build against the f32 table over {} contact sets (a 1 mm press \
+         at every touchable vertex along each axis, and with two partners): max force error \
+         {:.3e}, max displacement error {:.3e} (surface vertices {:.3e}), relative",
+        name(r.surface_encoding),
+        name(r.interior_encoding),
+        r.drop_below,
+        r.probe_count,
+        r.max_force_error,
+        r.max_displacement_error,
+        r.max_surface_displacement_error
+    )
 }

@@ -229,6 +229,24 @@ fn face_neighbours(tets: &[[u32; 4]]) -> Vec<[u32; 4]> {
     neighbours
 }
 
+/// The f64 tensor-mass table of `mesh` (`materials`, `fixed` vertices, its
+/// boundary surface, density 1000 kg/m³) for the static studies (the volume
+/// experiment, the compression sample, the Newton reference's checks): an
+/// equilibrium does not depend on the mass.
+pub fn static_study_table(
+    mesh: &TetMesh,
+    materials: &TetMaterials,
+    fixed: Vec<bool>,
+) -> crate::table::load::TableFile {
+    let arrays = TensorMassArrays::new(mesh, materials, 1000.0, fixed);
+    crate::table::load::TableFile::from_bytes(&write_tensor_mass_table(
+        mesh,
+        &crate::mesh::boundary_surface(mesh).triangles,
+        &arrays,
+        Precision::F64,
+    ))
+}
+
 /// Serializes `arrays` of `mesh` with its boundary `triangles` (outward,
 /// [`boundary_surface`](crate::mesh::boundary_surface)) as a tensor-mass
 /// table (`TableKind::TensorMass`) with floats of `precision`. The free

@@ -27,6 +27,8 @@ pub trait Real:
     fn of_f64(x: f64) -> Self;
     /// Converts to `f64` (exact).
     fn as_f64(self) -> f64;
+    /// Converts from `f32` (exact).
+    fn of_f32(x: f32) -> Self;
     /// `true` if neither NaN nor infinite.
     fn finite(self) -> bool;
 }
@@ -40,6 +42,9 @@ impl Real for f32 {
     }
     fn as_f64(self) -> f64 {
         f64::from(self)
+    }
+    fn of_f32(x: f32) -> Self {
+        x
     }
     fn finite(self) -> bool {
         self.is_finite()
@@ -55,6 +60,9 @@ impl Real for f64 {
     }
     fn as_f64(self) -> f64 {
         self
+    }
+    fn of_f32(x: f32) -> Self {
+        f64::from(x)
     }
     fn finite(self) -> bool {
         self.is_finite()

@@ -12,12 +12,18 @@
 //! path can skip it. Superposing elementary deformations instead would
 //! overshoot (the paper's figure); solving the coupled system does not.
 //!
+//! Optionally quasi-non-linear ([`QuasiNonLinear`], Cotin 1999 TVCG §3):
+//! amplitudes of the linear forces and displacements remapped by fitted
+//! polynomials.
+//!
 //! Depends on [`crate::math`], [`crate::table`] and [`crate::contact`].
 
 mod constraint;
 mod model;
+mod remap;
 mod tissue;
 
 pub use constraint::{AsConstraint, Constraint, ContactError, ContactPoint};
 pub use model::{ContactSolution, DisplacementError, PrecomputedModel};
+pub use remap::{QuasiNonLinear, REMAP_DEGREE, Remap, RemapError};
 pub use tissue::PrecomputedTissue;

@@ -5,6 +5,7 @@ use core::fmt;
 use nalgebra::{Matrix3, Vector3};
 
 use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
+use super::remap::QuasiNonLinear;
 use crate::math::cholesky::solve_blocks;
 use crate::math::{Dispatch, Portable};
 use crate::table::PrecomputedTable;
@@ -14,9 +15,11 @@ use crate::{MAX_CONTACT_CAPACITY, Real};
 /// The pre-computed model over a validated table (RR-3510 §4, MODELS.md §2).
 /// Holds no mutable state: every query is a pure function of the table and
 /// the contact set, so it is trivially deterministic and re-entrant.
+/// Optionally quasi-non-linear ([`Self::with_remap`], Cotin 1999 TVCG §3).
 #[derive(Clone, Copy, Debug)]
 pub struct PrecomputedModel<'a, T: Real> {
     table: PrecomputedTable<'a, T>,
+    remap: Option<QuasiNonLinear<T>>,
 }
 
 /// Contact forces for one contact set: the output of the haptic path, and the
@@ -26,7 +29,14 @@ pub struct PrecomputedModel<'a, T: Real> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactSolution<T: Real, const M: usize> {
     points: [ResolvedPoint<T>; M],
+    /// The forces on the tool's side: the linear `g`, remapped when the
+    /// model is quasi-non-linear.
     forces_n: [Vector3<T>; M],
+    /// The linear `g`, which the displacement update superposes.
+    linear_forces_n: [Vector3<T>; M],
+    /// `d̂` of a quasi-non-linear model's field: the direction of the
+    /// contact with the largest imposed displacement (`None`: linear).
+    direction: Option<Vector3<T>>,
     len: usize,
 }
 
@@ -42,7 +52,8 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
     }
 
     /// `g_p`: the force the tool applies to the tissue at each contact, N, in
-    /// the order the contacts were given.
+    /// the order the contacts were given (with its colinear amplitude
+    /// remapped by `ψ` when the model is quasi-non-linear).
     pub fn contact_forces_n(&self) -> &[Vector3<T>] {
         self.forces_n.get(..self.len).unwrap_or(&[])
     }
@@ -56,8 +67,12 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
             .fold(Vector3::zeros(), |acc, g| acc - g)
     }
 
+    /// The contact points with their linear forces.
     pub(crate) fn resolved(&self) -> impl Iterator<Item = (&ResolvedPoint<T>, &Vector3<T>)> {
-        self.points.iter().zip(self.forces_n.iter()).take(self.len)
+        self.points
+            .iter()
+            .zip(self.linear_forces_n.iter())
+            .take(self.len)
     }
 }
 
@@ -85,7 +100,22 @@ impl core::error::Error for DisplacementError {}
 impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// A model over a table validated by [`PrecomputedTable::load`].
     pub fn new(table: PrecomputedTable<'a, T>) -> Self {
-        Self { table }
+        Self { table, remap: None }
+    }
+
+    /// The quasi-non-linear model (Cotin 1999 TVCG §3, [`QuasiNonLinear`]):
+    /// contact forces and displacements are the linear ones with their
+    /// amplitudes remapped.
+    pub fn with_remap(self, remap: QuasiNonLinear<T>) -> Self {
+        Self {
+            remap: Some(remap),
+            ..self
+        }
+    }
+
+    /// The remap, `None` for the linear model.
+    pub fn remap(&self) -> Option<&QuasiNonLinear<T>> {
+        self.remap.as_ref()
     }
 
     /// The table this model reads.
@@ -120,12 +150,14 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         let mut solution = ContactSolution {
             points: [ResolvedPoint::empty(); M],
             forces_n: [Vector3::zeros(); M],
+            linear_forces_n: [Vector3::zeros(); M],
+            direction: None,
             len: m,
         };
         for (p, ((contact, point), d)) in contacts
             .iter()
             .zip(solution.points.iter_mut())
-            .zip(solution.forces_n.iter_mut())
+            .zip(solution.linear_forces_n.iter_mut())
             .enumerate()
         {
             *point = resolve(&self.table, p, contact)?;
@@ -156,8 +188,24 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
         }
-        solve_blocks(&mut blocks, &mut solution.forces_n, m, min_pivot)
+        solve_blocks(&mut blocks, &mut solution.linear_forces_n, m, min_pivot)
             .map_err(|contact| ContactError::IllConditioned { contact })?;
+        solution.forces_n = solution.linear_forces_n;
+        if let Some(remap) = &self.remap {
+            let mut largest = T::zero();
+            for (g, contact) in solution.forces_n.iter_mut().zip(contacts).take(m) {
+                let d = contact.displacement_m();
+                if let Some(direction) = QuasiNonLinear::direction(&d) {
+                    *g = remap.force(&direction, *g);
+                    // `direction` is `d / |d|`, so `d·direction` is `|d|`.
+                    let length = d.dot(&direction);
+                    if length > largest {
+                        largest = length;
+                        solution.direction = Some(direction);
+                    }
+                }
+            }
+        }
         if !solution
             .contact_forces_n()
             .iter()
@@ -211,6 +259,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         check_length(self.table.free_count(), out)?;
         out.fill([T::zero(); 3]);
         self.add_rows(dispatch, solution, 0, out);
+        self.remap_rows(solution, out);
         Ok(())
     }
 
@@ -244,6 +293,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             let mut buffer = [[T::zero(); 3]; CHUNK];
             let rows = buffer.get_mut(..vertices.len()).unwrap_or(&mut []);
             self.add_rows(dispatch, solution, chunk * CHUNK, rows);
+            self.remap_rows(solution, rows);
             for (u, &v) in rows.iter().zip(vertices) {
                 if let Some(o) = out.get_mut(v as usize) {
                     *o = *u;
@@ -251,6 +301,16 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             }
         }
         Ok(())
+    }
+
+    /// The quasi-non-linear model's displacement remap of `rows` (m), in
+    /// place; nothing for the linear model or a set without direction.
+    fn remap_rows<const M: usize>(&self, solution: &ContactSolution<T, M>, rows: &mut [[T; 3]]) {
+        if let (Some(remap), Some(direction)) = (&self.remap, &solution.direction) {
+            for u in rows {
+                *u = remap.displacement(direction, Vector3::from(*u)).into();
+            }
+        }
     }
 
     /// `out[i] += Σ_terms C_{first+i, k} w` over the contact terms: free rows
@@ -278,8 +338,10 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// [`crate::table::format`]): rows `n ≤ k` from column `k` of the packed
     /// surface part, rows `k < n < S` as `C_knᵀ` from column `n`, interior
     /// rows from column `k` of the interior part. Rows outside `0..F` are
-    /// skipped. Always inlined (one caller), so that a [`Dispatch`] compiles
-    /// it where it runs.
+    /// skipped. A compressed part is decoded on the fly (a dropped block adds
+    /// nothing); the work is the same `F` blocks per column either way.
+    /// Always inlined (one caller), so that a [`Dispatch`] compiles it where
+    /// it runs.
     #[inline(always)]
     fn add_column_rows(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
         let s = self.table.touchable_count();
@@ -291,29 +353,21 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             let (a, b) = (first.max(lo), end.min(hi));
             (a < b).then(|| (a, a - first..b - first))
         };
-        if let Some((a, rows)) = window(0, k + 1) {
-            let start = surface_block_index(a, k);
-            let blocks = surface.get(start..start + rows.len());
-            if let (Some(blocks), Some(out)) = (blocks, out.get_mut(rows)) {
-                add_products(blocks, w, out);
-            }
+        if let Some((a, rows)) = window(0, k + 1)
+            && let Some(out) = out.get_mut(rows)
+        {
+            surface.add_products(surface_block_index(a, k), k, w, out);
         }
         if let Some((a, rows)) = window(k + 1, s)
             && let Some(out) = out.get_mut(rows)
         {
-            for (n, u) in (a..).zip(out) {
-                if let Some(c) = surface.get(surface_block_index(k, n)) {
-                    let v = mul_transposed(c, w);
-                    *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
-                }
-            }
+            surface.add_transposed_products(k, a, w, out);
         }
-        if let Some((a, rows)) = window(s, f) {
+        if let Some((a, rows)) = window(s, f)
+            && let Some(out) = out.get_mut(rows)
+        {
             let start = k * (f - s) + (a - s);
-            let blocks = self.table.interior_blocks().get(start..start + rows.len());
-            if let (Some(blocks), Some(out)) = (blocks, out.get_mut(rows)) {
-                add_products(blocks, w, out);
-            }
+            self.table.interior_blocks().add_products(start, k, w, out);
         }
     }
 }
@@ -330,17 +384,6 @@ fn check_length<E>(expected: usize, out: &[E]) -> Result<(), DisplacementError> 
     }
 }
 
-/// `out[i] += C_i w` for row-major 3×3 blocks `C_i`, written as a product of
-/// the `3F × 3` matrix of their rows with `w` so that it vectorizes (one
-/// output float per row of 3).
-#[inline(always)]
-fn add_products<T: Real>(blocks: &[[T; 9]], w: &Vector3<T>, out: &mut [[T; 3]]) {
-    let (rows, _) = blocks.as_flattened().as_chunks::<3>();
-    for (r, u) in rows.iter().zip(out.as_flattened_mut()) {
-        *u += r[0] * w.x + r[1] * w.y + r[2] * w.z;
-    }
-}
-
 /// Two vertex contacts on one vertex make the system exactly singular; name them.
 fn check_duplicates<T: Real>(contacts: &[impl AsConstraint<T>]) -> Result<(), ContactError> {
     use ContactPoint::Vertex;
@@ -354,14 +397,4 @@ fn check_duplicates<T: Real>(contacts: &[impl AsConstraint<T>]) -> Result<(), Co
         }
     }
     Ok(())
-}
-
-/// Transpose of a row-major 3×3 block times a vector.
-#[inline(always)]
-fn mul_transposed<T: Real>(c: &[T; 9], w: &Vector3<T>) -> [T; 3] {
-    [
-        c[0] * w.x + c[3] * w.y + c[6] * w.z,
-        c[1] * w.x + c[4] * w.y + c[7] * w.z,
-        c[2] * w.x + c[5] * w.y + c[8] * w.z,
-    ]
 }

@@ -5,7 +5,7 @@
 
 use nalgebra::Vector3;
 
-use super::{ContactSolution, PrecomputedModel};
+use super::{ContactSolution, PrecomputedModel, QuasiNonLinear};
 use crate::contact::{ContactSet, Refusal, SurfaceGeometry, Tissue};
 use crate::table::PrecomputedTable;
 use crate::{MAX_CONTACTS, Real};
@@ -26,6 +26,14 @@ impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
             model: PrecomputedModel::new(*table),
             table,
             solution: None,
+        }
+    }
+
+    /// The quasi-non-linear tissue ([`PrecomputedModel::with_remap`]).
+    pub fn with_remap(self, remap: QuasiNonLinear<T>) -> Self {
+        Self {
+            model: self.model.with_remap(remap),
+            ..self
         }
     }
 

@@ -9,6 +9,21 @@ use super::format::{
 };
 use crate::Real;
 
+/// The slot in [`Container`]'s sections of each [`SectionKind`], by its
+/// value: its index in [`SectionKind::ALL`] (a table, so that looking a
+/// section up is one load, not a search). Evaluated at compile time: an
+/// index out of range here is a compile error, never a run-time panic.
+#[allow(clippy::indexing_slicing)]
+const SLOT_OF_KIND: [u8; 64] = {
+    let mut slots = [u8::MAX; 64];
+    let mut i = 0;
+    while i < SectionKind::ALL.len() {
+        slots[SectionKind::ALL[i] as usize] = i as u8;
+        i += 1;
+    }
+    slots
+};
+
 /// A table whose header, directory and checksum are valid, with every section
 /// located (bounds and alignment checked) but not yet viewed.
 pub(crate) struct Container<'a> {
@@ -22,14 +37,16 @@ impl<'a> Container<'a> {
     /// Checks, in order: length, magic, version, declared length, CRC-32,
     /// table kind, scalar width, header counts, material, and the section
     /// directory (known kinds, no duplicates, sizes implied by the header,
-    /// bounds, alignment), and that every section `kind` requires is present.
+    /// bounds, alignment), and that every section `kind` requires is present
+    /// (but for the compliance sections an encoding may replace,
+    /// [`SectionKind::encodable`]: the pre-computed view checks those).
     pub(crate) fn parse<T: Real>(bytes: &'a [u8], kind: TableKind) -> Result<Self, LoadError> {
         let header = read_header(bytes)?;
         let checksum = check_header::<T>(&header, bytes, kind)?;
         let mut container = locate_sections::<T>(header, bytes)?;
         container.checksum = checksum;
         for &required in kind.sections() {
-            if container.raw(required).is_none() {
+            if !required.encodable() && !container.has(required) {
                 return Err(LoadError::MissingSection { kind: required });
             }
         }
@@ -37,8 +54,25 @@ impl<'a> Container<'a> {
     }
 
     fn raw(&self, kind: SectionKind) -> Option<&'a [u8]> {
-        let slot = SectionKind::ALL.iter().position(|k| *k == kind)?;
-        self.sections.get(slot).copied().flatten()
+        let slot = *SLOT_OF_KIND.get(kind as usize)?;
+        self.sections.get(usize::from(slot)).copied().flatten()
+    }
+
+    /// `true` if the section `kind` is present.
+    pub(crate) fn has(&self, kind: SectionKind) -> bool {
+        self.raw(kind).is_some()
+    }
+
+    /// The section `kind` viewed in place as elements `E`, `None` if absent.
+    pub(crate) fn optional_section<E: bytemuck::Pod>(
+        &self,
+        kind: SectionKind,
+    ) -> Result<Option<&'a [E]>, LoadError> {
+        if self.has(kind) {
+            self.section(kind).map(Some)
+        } else {
+            Ok(None)
+        }
     }
 
     /// The section `kind` viewed in place as elements `E`.
@@ -100,13 +134,14 @@ fn check_header<T: Real>(h: &RawHeader, bytes: &[u8], kind: TableKind) -> Result
             actual: bytes.len(),
         });
     }
-    let body_len = bytes.len() - CRC_LEN;
-    let (body, trailer) = bytes.split_at(body_len);
-    let stored = u32::from_le_bytes(
-        trailer
-            .try_into()
-            .map_err(|_| LoadError::TooShort { len: bytes.len() })?,
-    );
+    // Checked, not `split_at`: the length check is in `read_header`, which
+    // the optimiser may not see, and a C caller's bytes are opaque (the C
+    // ABI's link-time no-panic proof, `tools/ffi-check.sh`).
+    let (body, trailer) = bytes
+        .split_last_chunk::<CRC_LEN>()
+        .ok_or(LoadError::TooShort { len: bytes.len() })?;
+    let body_len = body.len();
+    let stored = u32::from_le_bytes(*trailer);
     let computed = crc::Crc::<u32>::new(&format::CRC32).checksum(body);
     if stored != computed {
         return Err(LoadError::ChecksumMismatch { stored, computed });
@@ -162,7 +197,12 @@ fn locate_sections<T: Real>(h: RawHeader, bytes: &[u8]) -> Result<Container<'_>,
             .find(|(_, k)| **k as u32 == entry.kind)
             .ok_or(LoadError::UnknownSection { kind: entry.kind })?;
         let expected = kind.expected_count(&h);
-        if entry.elem_bytes != kind.elem_bytes(T::BYTES) || expected != Some(entry.count) {
+        let count_ok = if kind.count_is_declared() {
+            expected.is_some_and(|most| entry.count <= most)
+        } else {
+            expected == Some(entry.count)
+        };
+        if entry.elem_bytes != kind.elem_bytes(T::BYTES) || !count_ok {
             return Err(LoadError::SectionSize { kind: *kind });
         }
         let bounds = LoadError::SectionBounds { kind: *kind };

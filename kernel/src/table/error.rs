@@ -174,6 +174,55 @@ pub enum LoadError {
         /// Touchable index `k` (free index; the vertex is `free-vertex[k]`).
         touchable: u32,
     },
+    /// The [`SectionKind::ComplianceEncoding`] record is malformed: a drop
+    /// threshold outside `[0, 1)`, a measured error that is negative or not
+    /// finite, or a reserved field that is not zero.
+    BadCompressionRecord,
+    /// The compliance-encoding record names an encoding this kernel does
+    /// not know for a compliance part.
+    UnknownEncoding {
+        /// The part: [`SectionKind::ComplianceSurface`] or
+        /// [`SectionKind::ComplianceInterior`].
+        part: SectionKind,
+        /// The value found.
+        found: u32,
+    },
+    /// A section the table's compliance encoding does not use is present
+    /// (a part stored both dense and coded, coded sections without the
+    /// encoding record, a kept-block bitmap of a dense part).
+    UnexpectedSection {
+        /// The section.
+        kind: SectionKind,
+    },
+    /// A per-column scale of a coded compliance part is not finite and > 0.
+    BadScale {
+        /// The scale section.
+        kind: SectionKind,
+        /// Column (touchable index `k`).
+        column: u32,
+    },
+    /// A 16-bit fixed-point code is −32768, outside the format's symmetric
+    /// range `−32767..=32767`.
+    BadCode {
+        /// The codes section.
+        kind: SectionKind,
+        /// Stored block index within it.
+        index: u64,
+    },
+    /// A kept-block bitmap is inconsistent: a word's rank is not the number
+    /// of bits set before it, or a bit is set past the block count.
+    BadKeptBlocks {
+        /// The bitmap section.
+        kind: SectionKind,
+        /// Word index.
+        word: u64,
+    },
+    /// A diagonal compliance block `C_kk` was dropped from a coded surface
+    /// part (the contact solve needs every one).
+    DroppedDiagonal {
+        /// Touchable index `k`.
+        touchable: u32,
+    },
 }
 
 impl fmt::Display for LoadError {
@@ -276,6 +325,38 @@ impl fmt::Display for LoadError {
             LoadError::NotPositiveDefinite { touchable } => write!(
                 f,
                 "compliance block C_kk of touchable index {touchable} is not symmetric positive definite"
+            ),
+            LoadError::BadCompressionRecord => f.write_str(
+                "compliance-encoding record malformed (drop threshold outside [0, 1), a measured error negative or not finite, or reserved bits set)",
+            ),
+            LoadError::UnknownEncoding { part, found } => write!(
+                f,
+                "compliance-encoding: unknown block encoding {found} for {}",
+                part.name()
+            ),
+            LoadError::UnexpectedSection { kind } => write!(
+                f,
+                "section {} is not used by the table's compliance encoding",
+                kind.name()
+            ),
+            LoadError::BadScale { kind, column } => write!(
+                f,
+                "section {} column {column}: scale not finite and > 0",
+                kind.name()
+            ),
+            LoadError::BadCode { kind, index } => write!(
+                f,
+                "section {} block {index}: q16 code -32768 outside -32767..=32767",
+                kind.name()
+            ),
+            LoadError::BadKeptBlocks { kind, word } => write!(
+                f,
+                "section {} word {word}: rank not the bits set before it, or a bit past the block count",
+                kind.name()
+            ),
+            LoadError::DroppedDiagonal { touchable } => write!(
+                f,
+                "compliance block C_kk of touchable index {touchable} was dropped (every diagonal block must be stored)"
             ),
         }
     }

@@ -39,6 +39,37 @@
 //! `poisson` stay as the scene's default `[material]` (informative: every
 //! model reads the per-tet section). A version-2 table is refused
 //! ([`super::LoadError::UnsupportedVersion`]), never misread.
+//!
+//! ## Compressed compliance (version 3, additive)
+//!
+//! A pre-computed table may store its compliance blocks compressed, to fit a
+//! microcontroller's flash. It is the same table kind and version: the
+//! [`SectionKind::ComplianceEncoding`] section (one [`CompressionRecord`])
+//! says, for each of the two compliance parts, which [`BlockEncoding`]
+//! stores it. Without that section (every table written before it existed)
+//! both parts are [`BlockEncoding::Scalar`]. A kernel that predates it
+//! refuses a compressed table (`unknown section kind 50`), never misreads it.
+//!
+//! A part stored as [`BlockEncoding::Scalar`] is the section above
+//! ([`SectionKind::ComplianceSurface`], [`SectionKind::ComplianceInterior`]).
+//! A part stored as [`BlockEncoding::F16`] or [`BlockEncoding::Q16`] replaces
+//! it by three sections (`X` = surface or interior):
+//! - `X-scale`: one scale per column `k` (touchable vertex), m/N, finite and
+//!   `> 0`, in the table scalar;
+//! - `X-codes`: `[u16; 9]` per *stored* block, in the dense layout's block
+//!   order (column by column as above) with the dropped blocks left out.
+//!   Block entry `e` of column `k` is `decode(code) · scale[k]`: for F16,
+//!   `decode` is the IEEE 754 binary16 value of the code ([`f16_to_f32`];
+//!   infinities and NaNs are refused at load); for Q16 it is the code as a
+//!   two's complement `i16` in `−32767..=32767` (`−32768` is refused);
+//! - `X-kept` (only when some blocks were dropped, not all: without it
+//!   `X-codes` holds every block, or none when all were dropped): which
+//!   blocks of the dense layout are stored, one bit per block (bit `j % 32` of word `j / 32`,
+//!   least significant first), each word followed by the number of bits set
+//!   in the words before it (a rank directory, so a block is found in
+//!   constant time: [`kept_position`]). A dropped block is zero. Bits past
+//!   the block count are zero, the ranks are exact, the bits set are the
+//!   `X-codes` count, and every diagonal block `C_kk` is kept.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -346,6 +377,180 @@ pub enum SectionKind {
     /// three tables of a hybrid are one build (same mesh, partition and
     /// materials), checked where they meet.
     RegionChecksums = 46,
+    // ---- Compressed compliance (module docs): 50..=56. ----
+    /// [`CompressionRecord`] × 1: how the compliance parts are stored and
+    /// the error measured at build time. Absent: both parts in the table
+    /// scalar.
+    ComplianceEncoding = 50,
+    /// `scalar` × S: the per-column scale of a coded surface part, m/N.
+    SurfaceScale = 51,
+    /// `[u16; 9]` × (at most S(S+1)/2): the stored blocks of a coded surface
+    /// part; the count is the directory's (the blocks kept).
+    SurfaceCodes = 52,
+    /// `[u32; 2]` × ⌈S(S+1)/2 / 32⌉: the kept-block bitmap of a coded
+    /// surface part that dropped blocks.
+    SurfaceKept = 53,
+    /// `scalar` × S: the per-column scale of a coded interior part, m/N.
+    InteriorScale = 54,
+    /// `[u16; 9]` × (at most (F−S)·S): the stored blocks of a coded
+    /// interior part.
+    InteriorCodes = 55,
+    /// `[u32; 2]` × ⌈(F−S)·S / 32⌉: the kept-block bitmap of a coded
+    /// interior part that dropped blocks.
+    InteriorKept = 56,
+}
+
+/// How one compliance part (surface or interior) is stored: the values of
+/// [`CompressionRecord::surface_encoding`] and
+/// [`CompressionRecord::interior_encoding`] (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum BlockEncoding {
+    /// Every block in the table scalar (`f32` or `f64`), the dense section.
+    Scalar = 0,
+    /// IEEE 754 binary16 codes times a per-column scale; blocks may be dropped.
+    F16 = 1,
+    /// 16-bit fixed point (`i16` in `−32767..=32767`) times a per-column
+    /// scale (the quantum); blocks may be dropped.
+    Q16 = 2,
+}
+
+impl BlockEncoding {
+    /// Every encoding, in value order.
+    pub const ALL: [BlockEncoding; 3] = [
+        BlockEncoding::Scalar,
+        BlockEncoding::F16,
+        BlockEncoding::Q16,
+    ];
+
+    /// The encoding of a record's value, `None` if unknown.
+    pub fn of_u32(value: u32) -> Option<Self> {
+        Self::ALL.into_iter().find(|e| *e as u32 == value)
+    }
+
+    /// Human-readable name, for `tables info`: `uncompressed` (the table
+    /// scalar), `f16`, `q16`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            BlockEncoding::Scalar => "uncompressed",
+            BlockEncoding::F16 => "f16",
+            BlockEncoding::Q16 => "q16",
+        }
+    }
+}
+
+/// Identifies the probe set of [`CompressionRecord::probe_set`]: at every
+/// touchable vertex `k`, a press of 1 mm along each axis alone (three
+/// solves), and two two-contact presses of 1 mm along `−z`, `k` with the
+/// nearest other touchable vertex and `k` with touchable vertex
+/// `(k + ⌊S/2⌋) mod S` (`5S` contact sets in all, the vertex contacts of the
+/// `precomputed solve` command).
+pub const PROBE_SET_EVERY_TOUCHABLE: u32 = 1;
+
+/// The one element of [`SectionKind::ComplianceEncoding`]: how the
+/// compliance is stored, and the error that cost, measured by the host at
+/// build time against the `f32` table of the same compliance.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct CompressionRecord {
+    /// A [`BlockEncoding`] value: how the touchable–touchable blocks (the
+    /// contact solve's) are stored.
+    pub surface_encoding: u32,
+    /// A [`BlockEncoding`] value: how the interior blocks are stored.
+    pub interior_encoding: u32,
+    /// The drop threshold the writer applied, relative, in `[0, 1)`: a block
+    /// `C_nk` (`n ≠ k`) of a part with a kept-block bitmap was dropped when
+    /// its largest entry was below this fraction of the largest entry of
+    /// both its columns `n` and `k` (of column `k` for an interior row).
+    /// Zero: none dropped.
+    pub drop_below: f64,
+    /// Largest relative contact-force error over the probe set, against the
+    /// `f32` table: per contact set `max_p |g_p − g'_p| / max_p |g'_p|`.
+    /// Finite, `≥ 0`.
+    pub max_force_error: f64,
+    /// Largest relative displacement error over the probe set, against the
+    /// `f32` table, over every free vertex: per contact set
+    /// `max_n |u_n − u'_n| / max_n |u'_n|`. Finite, `≥ 0`.
+    pub max_displacement_error: f64,
+    /// The same over the touchable (surface) vertices only, what a surface
+    /// renderer shows: `max_{n<S} |u_n − u'_n| / max_n |u'_n|`. Finite,
+    /// `≥ 0`.
+    pub max_surface_displacement_error: f64,
+    /// Contact sets in the probe set.
+    pub probe_count: u64,
+    /// Which probe set: [`PROBE_SET_EVERY_TOUCHABLE`].
+    pub probe_set: u32,
+    /// Zero.
+    pub reserved: u32,
+}
+
+/// Size of [`CompressionRecord`] in bytes.
+pub const COMPRESSION_RECORD_LEN: usize = core::mem::size_of::<CompressionRecord>();
+const _: () = assert!(COMPRESSION_RECORD_LEN == 56);
+
+/// The value of an IEEE 754 binary16 code (1 sign, 5 exponent bits biased
+/// by 15, 10 fraction bits), exactly: `(−1)^s · 2^(e−15) · (1 + f/1024)`
+/// for `e` in `1..=30`, `(−1)^s · f · 2^−24` for `e = 0` (zero and the
+/// subnormals). `e = 31` (infinities, NaNs) gives the `f32` infinity or a
+/// quiet NaN with the same payload; a coded table holding one is refused at
+/// load, so the step path never decodes one. Every binary16 value is an
+/// `f32`, so the result is exact; no rounding mode or flush-to-zero setting
+/// of the FPU enters (the subnormals are computed as `f · 2^−24`, a normal
+/// `f32`).
+#[inline]
+pub fn f16_to_f32(code: u16) -> f32 {
+    let sign = u32::from(code & 0x8000) << 16;
+    let exponent = u32::from(code >> 10) & 0x1f;
+    let fraction = u32::from(code & 0x03ff);
+    let magnitude = match exponent {
+        // 2^-24 is exact in f32; f < 2^10 converts exactly.
+        0 => fraction as f32 * (1.0 / 16_777_216.0),
+        31 => f32::from_bits(0x7f80_0000 | (fraction << 13)),
+        // Re-biased from 15 to 127.
+        _ => f32::from_bits(((exponent + 112) << 23) | (fraction << 13)),
+    };
+    f32::from_bits(magnitude.to_bits() | sign)
+}
+
+/// Blocks per word of a kept-block bitmap ([`SectionKind::SurfaceKept`],
+/// [`SectionKind::InteriorKept`]).
+pub const KEPT_BITS: usize = 32;
+
+/// Words of a kept-block bitmap over `blocks` blocks, `None` on overflow.
+pub fn kept_words(blocks: u64) -> Option<u64> {
+    Some(blocks.checked_add(KEPT_BITS as u64 - 1)? / KEPT_BITS as u64)
+}
+
+/// The number of blocks kept before block `j` of the dense layout, in a
+/// part whose kept-block bitmap is `kept` (`[bits, rank]` words, module
+/// docs): the rank of the word plus the bits set below `j` in it. `None` if
+/// `j` lies beyond the bitmap. Constant time.
+#[inline]
+pub fn kept_rank(kept: &[[u32; 2]], j: usize) -> Option<usize> {
+    let [bits, rank] = *kept.get(j / KEPT_BITS)?;
+    let below = (1u32 << (j % KEPT_BITS)) - 1;
+    Some(rank as usize + (bits & below).count_ones() as usize)
+}
+
+/// `true` if block `j` of the dense layout is kept in a part whose
+/// kept-block bitmap is `kept`; `false` if it was dropped or lies beyond.
+#[inline]
+pub fn is_kept(kept: &[[u32; 2]], j: usize) -> bool {
+    kept.get(j / KEPT_BITS)
+        .is_some_and(|[bits, _]| bits & (1u32 << (j % KEPT_BITS)) != 0)
+}
+
+/// Where block `j` of the dense layout is stored (its index among the
+/// stored blocks) in a part whose kept-block bitmap is `kept`: `None` if it
+/// was dropped or lies beyond the bitmap. Constant time: one word, one
+/// population count.
+#[inline]
+pub fn kept_position(kept: &[[u32; 2]], j: usize) -> Option<usize> {
+    if is_kept(kept, j) {
+        kept_rank(kept, j)
+    } else {
+        None
+    }
 }
 
 /// The vertex pairs of a tet's six edges, in [`SectionKind::TetEdge`] order:
@@ -382,7 +587,7 @@ pub const TET_MATERIAL_LEN: usize = 2;
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 36] = [
+    pub const ALL: [SectionKind; 43] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -419,7 +624,32 @@ impl SectionKind {
         SectionKind::LoadForce,
         SectionKind::DynamicVertex,
         SectionKind::RegionChecksums,
+        SectionKind::ComplianceEncoding,
+        SectionKind::SurfaceScale,
+        SectionKind::SurfaceCodes,
+        SectionKind::SurfaceKept,
+        SectionKind::InteriorScale,
+        SectionKind::InteriorCodes,
+        SectionKind::InteriorKept,
     ];
+
+    /// `true` for the sections whose element count the directory declares
+    /// (the blocks a compressed part kept): the header's counts give only
+    /// the most they may hold ([`Self::expected_count`]).
+    pub const fn count_is_declared(self) -> bool {
+        matches!(self, SectionKind::SurfaceCodes | SectionKind::InteriorCodes)
+    }
+
+    /// `true` for the compliance sections a [`CompressionRecord`] may
+    /// replace by coded ones: required by [`TableKind::sections`], but
+    /// checked by the pre-computed view against the record, not by the
+    /// container.
+    pub const fn encodable(self) -> bool {
+        matches!(
+            self,
+            SectionKind::ComplianceSurface | SectionKind::ComplianceInterior
+        )
+    }
 
     /// Bytes per element for a table whose floats have `scalar_bytes` bytes.
     pub const fn elem_bytes(self, scalar_bytes: u32) -> u32 {
@@ -455,10 +685,16 @@ impl SectionKind {
             SectionKind::TriangleTerms => TRIANGLE_TERMS_LEN as u32 * scalar_bytes,
             SectionKind::TetTerms => TET_TERMS_LEN as u32 * scalar_bytes,
             SectionKind::TetMaterial => TET_MATERIAL_LEN as u32 * scalar_bytes,
+            SectionKind::ComplianceEncoding => COMPRESSION_RECORD_LEN as u32,
+            SectionKind::SurfaceScale | SectionKind::InteriorScale => scalar_bytes,
+            SectionKind::SurfaceCodes | SectionKind::InteriorCodes => 18,
+            SectionKind::SurfaceKept | SectionKind::InteriorKept => 8,
         }
     }
 
-    /// Number of elements the header's counts require, `None` on overflow.
+    /// Number of elements the header's counts require, `None` on overflow;
+    /// for a section whose count the directory declares
+    /// ([`Self::count_is_declared`]), the most it may hold.
     pub fn expected_count(self, h: &RawHeader) -> Option<u64> {
         let n = u64::from(h.vertex_count);
         let f = u64::from(h.free_count);
@@ -498,8 +734,20 @@ impl SectionKind {
             SectionKind::VertexTriangle => u64::from(h.triangle_count).checked_mul(3),
             SectionKind::SurfacePlane => Some(u64::from(h.triangle_count)),
             SectionKind::SurfaceTriangles => Some(u64::from(h.triangle_count)),
-            SectionKind::ComplianceSurface => s.checked_mul(s.checked_add(1)?).map(|x| x / 2),
-            SectionKind::ComplianceInterior => f.checked_sub(s)?.checked_mul(s),
+            SectionKind::ComplianceSurface | SectionKind::SurfaceCodes => {
+                s.checked_mul(s.checked_add(1)?).map(|x| x / 2)
+            }
+            SectionKind::ComplianceInterior | SectionKind::InteriorCodes => {
+                f.checked_sub(s)?.checked_mul(s)
+            }
+            SectionKind::ComplianceEncoding => Some(1),
+            SectionKind::SurfaceScale | SectionKind::InteriorScale => Some(s),
+            SectionKind::SurfaceKept => {
+                kept_words(SectionKind::ComplianceSurface.expected_count(h)?)
+            }
+            SectionKind::InteriorKept => {
+                kept_words(SectionKind::ComplianceInterior.expected_count(h)?)
+            }
         }
     }
 
@@ -542,6 +790,13 @@ impl SectionKind {
             SectionKind::LoadForce => "load-force",
             SectionKind::DynamicVertex => "dynamic-vertex",
             SectionKind::RegionChecksums => "region-checksums",
+            SectionKind::ComplianceEncoding => "compliance-encoding",
+            SectionKind::SurfaceScale => "surface-scale",
+            SectionKind::SurfaceCodes => "surface-codes",
+            SectionKind::SurfaceKept => "surface-kept",
+            SectionKind::InteriorScale => "interior-scale",
+            SectionKind::InteriorCodes => "interior-codes",
+            SectionKind::InteriorKept => "interior-kept",
         }
     }
 }

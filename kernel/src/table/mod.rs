@@ -5,12 +5,14 @@
 //!
 //! A table is bytes until [`PrecomputedTable::load`] has checked it once
 //! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
-//! diagonal blocks); afterwards the step path trusts it, and indexes it with
+//! diagonal blocks, a compressed compliance's scales, codes and kept blocks:
+//! [`ComplianceBlocks`]); afterwards the step path trusts it, and indexes it with
 //! the checked indices the views hand out ([`VertexIndex`],
 //! [`TriangleIndex`], [`TetIndex`], [`EdgeIndex`], [`FreeIndex`]) instead of
 //! raw `u32`s: the format's sentinels stay inside this module.
 
 mod collision;
+mod compressed;
 mod container;
 mod error;
 pub mod format;
@@ -21,6 +23,7 @@ mod tensor_mass;
 
 pub(crate) use collision::BuiltLists;
 pub use collision::{DEAD_TRIANGLE, Grid, SurfaceIndex, max_row, within};
+pub use compressed::{CodedBlocks, ComplianceBlocks};
 pub use error::LoadError;
 pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};

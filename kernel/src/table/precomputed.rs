@@ -4,8 +4,11 @@ use nalgebra::Matrix3;
 
 use super::LoadError;
 use super::collision::{SurfaceIndex, SurfaceSections};
+use super::compressed::{ComplianceBlocks, load_parts};
 use super::container::{Container, check_finite, check_tet_materials};
-use super::format::{self, FIXED_SLOT, RawHeader, SectionKind, TET_MATERIAL_LEN, TableKind};
+use super::format::{
+    self, CompressionRecord, FIXED_SLOT, RawHeader, SectionKind, TET_MATERIAL_LEN, TableKind,
+};
 use super::index::{FreeIndex, VertexIndex, VertexSlot};
 use crate::Real;
 use crate::math::cholesky::cholesky3;
@@ -17,8 +20,10 @@ use crate::math::cholesky::cholesky3;
 /// - `vertex_slot` and `free_vertex` are inverse maps between the `N` vertices
 ///   and the `F` free indices; free indices `0..S` are the touchable vertices;
 /// - every surface triangle's vertices are `< N`;
-/// - every float is finite and every diagonal block `C_kk` is symmetric
-///   positive definite;
+/// - every float is finite and every diagonal block `C_kk` is stored and
+///   symmetric positive definite;
+/// - a compressed compliance part (format docs, "Compressed compliance") has
+///   finite positive scales, finite codes and a consistent kept-block index;
 /// - every tet's Lamé coefficients have `μ > 0` and `λ > −2μ/3`;
 /// - section lengths match the header's counts exactly.
 #[derive(Clone, Copy, Debug)]
@@ -29,8 +34,9 @@ pub struct PrecomputedTable<'a, T: Real> {
     free_vertex: &'a [u32],
     rest_positions: &'a [[T; 3]],
     triangles: &'a [[u32; 3]],
-    surface: &'a [[T; 9]],
-    interior: &'a [[T; 9]],
+    compression: Option<CompressionRecord>,
+    surface: ComplianceBlocks<'a, T>,
+    interior: ComplianceBlocks<'a, T>,
     surface_index: SurfaceIndex<'a, T>,
     tet_materials: &'a [[T; TET_MATERIAL_LEN]],
 }
@@ -40,7 +46,8 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// [`super::format`]): the container checks (length, magic, version,
     /// declared length, CRC-32, table kind, scalar width, header counts,
     /// material, section directory), then vertex maps, triangle indices,
-    /// finite floats and SPD diagonal compliance blocks.
+    /// finite floats, the compliance encoding (dense, or coded with its
+    /// scales, codes and kept blocks) and SPD diagonal compliance blocks.
     ///
     /// Cost: linear in the table size. Not for the step path.
     pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
@@ -59,6 +66,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             vertex_triangle: c.section(SectionKind::VertexTriangle)?,
             planes: c.section(SectionKind::SurfacePlane)?,
         };
+        let parts = load_parts(&c)?;
         let table = Self {
             header: c.header,
             checksum: c.checksum,
@@ -66,14 +74,13 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             free_vertex: c.section(SectionKind::FreeVertex)?,
             rest_positions,
             triangles,
-            surface: c.section(SectionKind::ComplianceSurface)?,
-            interior: c.section(SectionKind::ComplianceInterior)?,
+            compression: parts.record,
+            surface: parts.surface,
+            interior: parts.interior,
             surface_index: SurfaceIndex::new(&sections, rest_positions, triangles)?,
             tet_materials: c.section(SectionKind::TetMaterial)?,
         };
         table.check_vertex_maps()?;
-        check_finite(SectionKind::ComplianceSurface, table.surface)?;
-        check_finite(SectionKind::ComplianceInterior, table.interior)?;
         table.check_diagonal_blocks()?;
         check_tet_materials(table.tet_materials)?;
         log::debug!(
@@ -188,14 +195,23 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         self.triangles
     }
 
-    /// Packed touchable–touchable compliance blocks, m/N (layout in [`super::format`]).
-    pub fn surface_blocks(&self) -> &'a [[T; 9]] {
+    /// Packed touchable–touchable compliance blocks, m/N (layout in
+    /// [`super::format`]), dense or coded.
+    pub fn surface_blocks(&self) -> ComplianceBlocks<'a, T> {
         self.surface
     }
 
-    /// Interior–touchable compliance blocks, m/N (layout in [`super::format`]).
-    pub fn interior_blocks(&self) -> &'a [[T; 9]] {
+    /// Interior–touchable compliance blocks, m/N (layout in
+    /// [`super::format`]), dense or coded.
+    pub fn interior_blocks(&self) -> ComplianceBlocks<'a, T> {
         self.interior
+    }
+
+    /// How the compliance is stored and the error measured at build time
+    /// (format docs, "Compressed compliance"); `None` for a table whose
+    /// compliance is all in the table scalar without a record.
+    pub fn compression(&self) -> Option<&CompressionRecord> {
+        self.compression.as_ref()
     }
 
     /// `C_nk` for two touchable free indices `n`, `k` (either order; the
@@ -214,8 +230,8 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         }
         let raw = self
             .surface
-            .get(format::surface_block_index(lo.get(), hi.get()))?;
-        let block = Matrix3::from_row_slice(raw);
+            .block(format::surface_block_index(lo.get(), hi.get()), hi.get())?;
+        let block = Matrix3::from_row_slice(&raw);
         Some(if n <= k { block } else { block.transpose() })
     }
 
@@ -247,12 +263,17 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         Ok(())
     }
 
-    /// Every `C_kk` must be symmetric (to 1e-4 relative, well above f32
-    /// rounding) and positive definite (a 3×3 Cholesky with positive pivots):
-    /// a compliance of an elastic body with fixed vertices is SPD.
+    /// Every `C_kk` must be stored, symmetric (to 1e-4 relative, well above
+    /// f32 rounding and the 16-bit codes' rounding, which the writer applies
+    /// to a symmetrized block) and positive definite (a 3×3 Cholesky with
+    /// positive pivots): a compliance of an elastic body with fixed vertices
+    /// is SPD.
     fn check_diagonal_blocks(&self) -> Result<(), LoadError> {
         for k in 0..self.touchable_count() {
             let touchable = k as u32;
+            if !self.surface.is_stored(format::surface_block_index(k, k)) {
+                return Err(LoadError::DroppedDiagonal { touchable });
+            }
             let bad = LoadError::NotPositiveDefinite { touchable };
             let c = self.touchable_block(touchable, touchable).ok_or(bad)?;
             let scale = c.abs().max();

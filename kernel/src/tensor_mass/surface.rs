@@ -81,8 +81,15 @@ pub struct SurfaceLengths {
 impl<T> SurfaceBuffers<'_, T> {
     /// The lengths for `model`'s table with room for `cells` grid cells.
     pub fn lengths<R: Real>(model: &TensorMassModel<'_, '_, R>, cells: usize) -> SurfaceLengths {
-        let n = model.table().vertex_count();
-        let t = model.table().mesh_triangles().len();
+        Self::table_lengths(model.table(), cells)
+    }
+
+    /// The lengths for `table` with room for `cells` grid cells (before a
+    /// model exists: a caller sizing one memory block for the state and
+    /// the surface).
+    pub fn table_lengths<R: Real>(table: &TensorMassTable<'_, R>, cells: usize) -> SurfaceLengths {
+        let n = table.vertex_count();
+        let t = table.mesh_triangles().len();
         SurfaceLengths {
             vertices: n,
             triangles: t,

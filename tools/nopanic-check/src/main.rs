@@ -7,10 +7,14 @@
 //! proves that no panic is reachable in what `main` calls.
 //!
 //! The pre-computed model (RR-3510 §4), on the f32 table of the firmware
-//! example's box (`$OUT_DIR/table.bin`, from `PALPATE_TABLE`):
+//! example's box (`$OUT_DIR/table.bin`, from `PALPATE_TABLE`) and on its two
+//! compressed versions (`table-f16.bin`, `table-q16.bin`: 16-bit codes, blocks
+//! dropped in both compliance parts), one of the three picked by a volatile
+//! selector at each call:
 //! - table validation, `PrecomputedTable::load` (not the step path, but it runs
 //!   on bytes from flash or a file, so it is checked too);
-//! - the haptic force path, `PrecomputedModel::contact_forces::<MAX_CONTACTS>`;
+//! - the haptic force path, `PrecomputedModel::contact_forces::<MAX_CONTACTS>`,
+//!   linear or quasi-non-linear (`with_remap`, on volatile coefficients);
 //! - the displacement updates, `PrecomputedModel::free_displacements` and
 //!   `PrecomputedModel::displacements`.
 //!
@@ -34,7 +38,8 @@
 //! `tick_tools` with every action `Touch`, so it is covered too) with, for
 //! each of two tool points, a volatile position, a volatile action selector
 //! (`ToolAction::Touch`, `Grip` or `Cut`) and a volatile blade vector:
-//! - over the pre-computed table, `HapticLoop::new` (configuration and limits
+//! - over the pre-computed tables (the same volatile selector),
+//!   `HapticLoop::new` (configuration and limits
 //!   from volatile inputs) and `tick_tools` (contact detection in the
 //!   collision grid from the motion segment or the penetration, sliding,
 //!   grips closing, holding and opening, the contact solve with releases and
@@ -120,7 +125,7 @@ use palpate_kernel::haptic::{
     DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop,
     SafetyLimits, ToolAction, ToolInput,
 };
-use palpate_kernel::precomputed::{Constraint, PrecomputedTissue};
+use palpate_kernel::precomputed::{Constraint, PrecomputedTissue, QuasiNonLinear, Remap};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
@@ -137,6 +142,27 @@ use palpate_kernel::{ContactSolution, MAX_CONTACTS, PrecomputedModel, Precompute
 /// as `load` requires.
 static TABLE: &[u8] = palpate_kernel::include_table!(concat!(env!("OUT_DIR"), "/table.bin"));
 
+/// The same table compressed (`tools/box-table.sh --compress f16`): f16
+/// codes, blocks dropped in both compliance parts.
+static TABLE_F16: &[u8] =
+    palpate_kernel::include_table!(concat!(env!("OUT_DIR"), "/table-f16.bin"));
+
+/// The same table compressed (`tools/box-table.sh --compress q16`): q16
+/// codes, blocks dropped in both compliance parts.
+static TABLE_Q16: &[u8] =
+    palpate_kernel::include_table!(concat!(env!("OUT_DIR"), "/table-q16.bin"));
+
+/// One of the three pre-computed tables by a volatile selector (any value:
+/// taken modulo 3; 0 the f32 table, 1 f16, 2 q16), so that the dense and
+/// both coded compliance paths are all reachable from each call.
+fn precomputed_table(selector: u8) -> &'static [u8] {
+    match selector % 3 {
+        0 => TABLE,
+        1 => TABLE_F16,
+        _ => TABLE_Q16,
+    }
+}
+
 /// Capacity of the displacement buffers, vertices: the checked table has 64,
 /// and the lengths actually passed are volatile inputs below that bound.
 const VERTICES: usize = 64;
@@ -149,7 +175,9 @@ const SLOTS: usize = MAX_CONTACTS + 1;
 /// docs). Integers stand in for booleans so that any byte a debugger writes is
 /// a valid value.
 struct Inputs {
-    /// Bytes of `TABLE` passed to `load` (clamped to the table length).
+    /// Which table ([`precomputed_table`]).
+    table: u8,
+    /// Bytes of the table passed to `load` (clamped to the table length).
     table_len: usize,
     /// The contact set.
     contacts: ContactInputs,
@@ -157,6 +185,10 @@ struct Inputs {
     vertex_len: usize,
     /// Entries passed to `free_displacements` (clamped to `VERTICES`).
     free_len: usize,
+    /// The quasi-non-linear remap's coefficients (radial `c_1..c_5`, its
+    /// range, force `c_1..c_5`, its range); used when `Remap::new` accepts
+    /// them, so the remapped force and field paths are in the proof.
+    remap: [f32; 12],
 }
 
 /// A contact set, opaque to the optimiser.
@@ -212,10 +244,12 @@ fn contact_set(contacts: &[Constraint<f32>; SLOTS], count: usize) -> &[Constrain
 
 /// The inputs, read with `read_volatile` only.
 static mut INPUTS: Inputs = Inputs {
+    table: 0,
     table_len: usize::MAX,
     contacts: NO_CONTACTS,
     vertex_len: VERTICES,
     free_len: VERTICES,
+    remap: [0.0; 12],
 };
 
 /// Where the results go, written with `write_volatile` only: the device force
@@ -275,7 +309,9 @@ const TOOL_POINTS: usize = 2;
 
 /// Everything the haptic loop takes, opaque to the optimiser.
 struct HapticInputs {
-    /// Bytes of `TABLE` passed to `load` (clamped to the table length).
+    /// Which table ([`precomputed_table`]).
+    table: u8,
+    /// Bytes of the table passed to `load` (clamped to the table length).
     table_len: usize,
     /// Tool sphere radius (m), haptic period (s), force clamp (N), slew (N/s).
     config: [f32; 4],
@@ -334,6 +370,7 @@ impl ToolInputs {
 
 /// The haptic inputs, read with `read_volatile` only.
 static mut HAPTIC_INPUTS: HapticInputs = HapticInputs {
+    table: 0,
     table_len: usize::MAX,
     config: [0.002, 1e-3, 4.0, 2000.0],
     ticks: 1,
@@ -382,7 +419,8 @@ fn loop_config([radius_m, dt_s, max_force_n, max_slew_n_per_s]: [f32; 4]) -> Loo
 /// Load, build the loop, then tick on volatile tool positions and actions
 /// (`reset` on a volatile flag), publishing every output.
 fn haptic_step(inputs: &HapticInputs) {
-    let bytes = TABLE.get(..inputs.table_len).unwrap_or(TABLE);
+    let table = precomputed_table(inputs.table);
+    let bytes = table.get(..inputs.table_len).unwrap_or(table);
     let Ok(table) = PrecomputedTable::<f32>::load(bytes) else {
         refused();
         return;
@@ -647,12 +685,21 @@ fn publish_removed(removed: &[u32]) {
 /// One tick of the pre-computed model: load, contact forces, both
 /// displacement updates, on `inputs`.
 fn precomputed_step(inputs: &Inputs, displacements: &mut [[f32; 3]; VERTICES]) {
-    let bytes = TABLE.get(..inputs.table_len).unwrap_or(TABLE);
+    let table = precomputed_table(inputs.table);
+    let bytes = table.get(..inputs.table_len).unwrap_or(table);
     let Ok(table) = PrecomputedTable::<f32>::load(bytes) else {
         refused();
         return;
     };
     let model = PrecomputedModel::new(table);
+    let [r @ .., r_max, f1, f2, f3, f4, f5, f_max] = inputs.remap;
+    let model = match (
+        Remap::new(r, r_max),
+        Remap::new([f1, f2, f3, f4, f5], f_max),
+    ) {
+        (Ok(radial), Ok(force)) => model.with_remap(QuasiNonLinear { radial, force }),
+        _ => model,
+    };
 
     let contacts = inputs.contacts.constraints();
     let set = contact_set(&contacts, inputs.contacts.count);

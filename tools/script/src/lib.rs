@@ -33,6 +33,7 @@
 pub mod hybrid;
 mod parse;
 mod replay;
+pub mod ticks;
 
 pub use parse::{
     ParseError, StepContacts, parse_contact, parse_step, parse_vector, parse_vertex_vector, steps,

@@ -1,0 +1,832 @@
+//! `palpate chart`: the speed/accuracy study. Every model of the harness is
+//! run on the same loaded body at several refinements and loads, measured
+//! against the Newton St Venant-Kirchhoff equilibrium on the finest mesh
+//! ([`crate::fem::newton`]) and timed; [`plot`] draws the charts, [`report`]
+//! writes the report.
+//!
+//! The body: the generated cylinder ([`cylinder_mesh`], height
+//! [`HEIGHT_M`], radius `H/5`, E = 5 kPa, ν = 0.4), base fixed, loaded on its
+//! top face by dead loads (one force per top vertex):
+//! - **press**: equal shares of an axial force `−F ẑ`;
+//! - **bend**: equal shares of a lateral force `F x̂`;
+//! - **twist**: tangential forces `T (ẑ × r_v)/Σ|r_v|²` (a torque `T` about
+//!   the axis, `r_v` the vertex's distance vector from it).
+//!
+//! Each load has three levels: the force for which the linear FEM solution
+//! on the finest mesh has a top-face displacement ([`tip_m`]) of 1 %, 5 %
+//! and 20 % of the height.
+//!
+//! Models: the pre-computed linear model (the linear FEM solution of the
+//! load, `fem::static_solve`; its step is the compliance product `u = C f`
+//! the kernel's pre-computed update does), the same with the
+//! quasi-non-linear remap (Cotin 1999 TVCG §3, fitted by
+//! [`crate::remap::fit`] on the St Venant-Kirchhoff compression sample of
+//! the same material and aspect), and the tensor-mass models (linear, St
+//! Venant-Kirchhoff, St Venant-Kirchhoff + incompressibility penalty)
+//! relaxed to rest by [`crate::experiment::relax`].
+//!
+//! Bounded: at most [`FULL_MESHES`] × 3 loads × [`LEVELS`] × 5 models
+//! (135) static runs of at most [`MAX_RELAX_STEPS`] steps each, and the
+//! stability map's [`stability`] trials.
+
+pub mod plot;
+pub mod report;
+pub mod select;
+pub mod stability;
+pub mod timing;
+
+use anyhow::Context;
+use faer::Mat;
+use nalgebra::Vector3;
+use palpate_kernel::precomputed::QuasiNonLinear;
+use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::{
+    DynamicParams, ElasticLaw, Integrator, StvkForm, TensorMassModel,
+};
+use serde::Serialize;
+
+use crate::experiment::relax::relax;
+use crate::experiment::scenes::{penalty_n, tissue};
+use crate::experiment::volume_bend::inverted_tets;
+use crate::fem::assembly::assemble_restricted;
+use crate::fem::llt::SparseLlt;
+use crate::fem::material::{Material, TetMaterials};
+use crate::fem::newton::{NewtonOptions, StaticProblem, solve_stvk};
+use crate::fem::static_solve::solve_loaded;
+use crate::mesh::TetMesh;
+use crate::mesh::generate::cylinder_mesh;
+use crate::remap::fit::{FittedModel, fit_curves};
+use crate::remap::sample::{Sample, linear_response, stvk_curves};
+use crate::table::file::Precision;
+use crate::table::tensor_mass::{TensorMassArrays, static_study_table, write_tensor_mass_table};
+use crate::tensor_mass::OwnedState;
+use crate::tensor_mass::run::{diagonal, volume_change};
+use crate::tensor_mass::stability::omega_max;
+
+/// Cylinder height, m.
+pub const HEIGHT_M: f64 = 0.1;
+/// The refinements of the full run, (radial, height) cells of
+/// [`cylinder_mesh`]; the last is the reference's.
+pub const FULL_MESHES: [(usize, usize); 3] = [(1, 5), (2, 10), (3, 15)];
+/// The refinements of `--quick` (the reference on the last).
+pub const QUICK_MESHES: [(usize, usize); 2] = [(1, 5), (2, 10)];
+/// Load levels: the linear FEM tip displacement on the finest mesh as a
+/// fraction of the height.
+pub const LEVELS: [f64; 3] = [0.01, 0.05, 0.20];
+/// Levels of `--quick`.
+pub const QUICK_LEVELS: [f64; 2] = [0.01, 0.05];
+/// Steps of one relaxation at most (full run).
+pub const MAX_RELAX_STEPS: usize = 200_000;
+/// Steps of one relaxation at most in `--quick`.
+pub const QUICK_RELAX_STEPS: usize = 20_000;
+/// Relaxation tolerance: largest residual force over the largest load on
+/// a vertex (the volume experiment's).
+pub const RELAX_TOLERANCE: f64 = 1e-3;
+/// Newton load increments of the reference per 1 % of tip displacement
+/// (at least one).
+const NEWTON_STEPS_PER_PERCENT: f64 = 0.5;
+/// Density of the tensor-mass tables, kg/m³ (the static studies').
+const DENSITY_KG_M3: f64 = 1000.0;
+
+/// Which loads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Load {
+    /// Axial compression of the top face.
+    Press,
+    /// Lateral dead load on the top face.
+    Bend,
+    /// Torque as tangential loads on the top face.
+    Twist,
+}
+
+impl Load {
+    /// Every load.
+    pub const ALL: [Load; 3] = [Load::Press, Load::Bend, Load::Twist];
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Load::Press => "press",
+            Load::Bend => "bend",
+            Load::Twist => "twist",
+        }
+    }
+}
+
+/// The models compared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Model {
+    /// Pre-computed linear (linear FEM).
+    PrecomputedLinear,
+    /// Pre-computed with the quasi-non-linear remap.
+    PrecomputedQuasi,
+    /// Tensor-mass, linear law.
+    TensorMassLinear,
+    /// Tensor-mass, St Venant-Kirchhoff.
+    Stvk,
+    /// Tensor-mass, St Venant-Kirchhoff + incompressibility penalty.
+    StvkPenalty,
+}
+
+impl Model {
+    /// Every model, cheapest family first.
+    pub const ALL: [Model; 5] = [
+        Model::PrecomputedLinear,
+        Model::PrecomputedQuasi,
+        Model::TensorMassLinear,
+        Model::Stvk,
+        Model::StvkPenalty,
+    ];
+
+    /// Name used in the JSON, the charts and the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::PrecomputedLinear => "precomputed-linear",
+            Model::PrecomputedQuasi => "precomputed-quasi",
+            Model::TensorMassLinear => "tensor-mass-linear",
+            Model::Stvk => "stvk",
+            Model::StvkPenalty => "stvk-penalty",
+        }
+    }
+}
+
+/// The study's extent.
+#[derive(Clone, Debug)]
+pub struct Matrix {
+    /// Refinements, coarsest first; the last one carries the reference.
+    pub meshes: Vec<(usize, usize)>,
+    /// Loads.
+    pub loads: Vec<Load>,
+    /// Levels (fractions of the height).
+    pub levels: Vec<f64>,
+    /// The stability map's extent.
+    pub stability: stability::MapExtent,
+    /// Steps of one relaxation at most.
+    pub max_relax_steps: usize,
+}
+
+impl Matrix {
+    /// The full study.
+    pub fn full() -> Self {
+        Self {
+            meshes: FULL_MESHES.to_vec(),
+            loads: Load::ALL.to_vec(),
+            levels: LEVELS.to_vec(),
+            stability: stability::MapExtent::full(),
+            max_relax_steps: MAX_RELAX_STEPS,
+        }
+    }
+
+    /// The reduced study of `--quick`: two meshes, press and bend, two levels.
+    pub fn quick() -> Self {
+        Self {
+            meshes: QUICK_MESHES.to_vec(),
+            loads: vec![Load::Press, Load::Bend],
+            levels: QUICK_LEVELS.to_vec(),
+            stability: stability::MapExtent::quick(),
+            max_relax_steps: QUICK_RELAX_STEPS,
+        }
+    }
+
+    /// Static runs: one per mesh, load, level and model, plus one Newton
+    /// reference per load and level.
+    pub fn static_runs(&self) -> usize {
+        let cases = self.loads.len() * self.levels.len();
+        cases * (self.meshes.len() * Model::ALL.len() + 1)
+    }
+}
+
+/// One model's run on one mesh at one load.
+#[derive(Clone, Debug, Serialize)]
+pub struct Run {
+    /// `"RxH"` cells of the mesh.
+    pub mesh: String,
+    /// Vertices of the mesh.
+    pub vertices: usize,
+    /// Tets of the mesh.
+    pub tets: usize,
+    /// The load.
+    pub load: Load,
+    /// The level (fraction of the height).
+    pub level: f64,
+    /// The model.
+    pub model: Model,
+    /// `null`, or why the run has no equilibrium (divergence, refusal).
+    pub fault: Option<String>,
+    /// Top-face displacement [`tip_m`], m.
+    pub tip_m: f64,
+    /// `|tip − tip_ref| / |tip_ref|` against the reference (`null` without one).
+    pub tip_error: Option<f64>,
+    /// Error of the force the model needs for the reference's tip
+    /// displacement (its secant stiffness at the tool): `|tip_ref/tip − 1|`.
+    pub force_error: Option<f64>,
+    /// On the reference's mesh: `‖u − u_ref‖₂ / ‖u_ref‖₂` over all vertices.
+    pub l2_error: Option<f64>,
+    /// On the reference's mesh: largest `|u_v − u_ref,v|`, m.
+    pub max_error_m: Option<f64>,
+    /// `(V − V₀)/V₀`.
+    pub volume_change: f64,
+    /// Tets with negative volume.
+    pub inverted_tets: usize,
+    /// Median time of one step, f64, s.
+    pub step_s: f64,
+    /// The same in f32, s.
+    pub step_f32_s: Option<f64>,
+    /// Steps to reach the equilibrium (1 for the pre-computed models).
+    pub steps_to_settle: usize,
+    /// `steps_to_settle × step_s`, s.
+    pub settle_s: f64,
+}
+
+/// The reference of one load and level.
+#[derive(Clone, Debug, Serialize)]
+pub struct Reference {
+    /// The load.
+    pub load: Load,
+    /// The level.
+    pub level: f64,
+    /// Total force (N) or torque (N·m) of the load.
+    pub magnitude: f64,
+    /// `null`, or why Newton failed (St Venant-Kirchhoff's collapse).
+    pub fault: Option<String>,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Tip displacement, m.
+    pub tip_m: f64,
+    /// `(V − V₀)/V₀`.
+    pub volume_change: f64,
+}
+
+/// The study's results.
+#[derive(Clone, Debug, Serialize)]
+pub struct Study {
+    /// Height of the body, m.
+    pub height_m: f64,
+    /// Young's modulus, Pa, and Poisson ratio.
+    pub material: (f64, f64),
+    /// The reference mesh, `"RxH"`.
+    pub reference_mesh: String,
+    /// One per load and level.
+    pub references: Vec<Reference>,
+    /// Every run.
+    pub runs: Vec<Run>,
+    /// The quasi-non-linear fit used.
+    pub remap: FittedModel,
+    /// The stability maps.
+    pub stability: Vec<stability::Map>,
+}
+
+/// A mesh of the study with its boundary sets.
+pub struct Body {
+    /// `"RxH"`.
+    pub label: String,
+    /// The rest mesh.
+    pub mesh: TetMesh,
+    /// Base vertices (fixed).
+    pub fixed: Vec<bool>,
+    /// Top-face vertices.
+    pub top: Vec<u32>,
+    /// Material.
+    pub material: Material,
+}
+
+impl Body {
+    /// The cylinder of `(radial, height)` cells.
+    pub fn cylinder((radial, height): (usize, usize)) -> Self {
+        let mesh = cylinder_mesh(HEIGHT_M, radial, height);
+        let fixed = mesh.positions.iter().map(|p| p[2] == 0.0).collect();
+        let top = (0..mesh.positions.len() as u32)
+            .filter(|&v| mesh.positions[v as usize][2] == HEIGHT_M)
+            .collect();
+        Self {
+            label: format!("{radial}x{height}"),
+            mesh,
+            fixed,
+            top,
+            material: tissue(),
+        }
+    }
+
+    /// Nodal loads of `load` with total force (press, bend) or torque
+    /// (twist) `magnitude`, N or N·m.
+    pub fn loads(&self, load: Load, magnitude: f64) -> Vec<[f64; 3]> {
+        let mut f = vec![[0.0; 3]; self.mesh.positions.len()];
+        let share = magnitude / self.top.len() as f64;
+        let arm = |v: u32| {
+            let p = self.mesh.positions[v as usize];
+            Vector3::new(p[0], p[1], 0.0)
+        };
+        let polar: f64 = self.top.iter().map(|&v| arm(v).norm_squared()).sum();
+        for &v in &self.top {
+            f[v as usize] = match load {
+                Load::Press => [0.0, 0.0, -share],
+                Load::Bend => [share, 0.0, 0.0],
+                Load::Twist => (Vector3::z().cross(&arm(v)) * (magnitude / polar)).into(),
+            };
+        }
+        f
+    }
+
+    fn materials(&self) -> TetMaterials {
+        TetMaterials::uniform(self.material, self.mesh.tets.len())
+    }
+}
+
+/// The top-face displacement measured for a load: the work-conjugate mean
+/// `Σ f_v·u_v / Σ |f_v|` over the loaded vertices (m): the mean axial
+/// shortening under press, the mean lateral deflection under bend, the
+/// force-weighted mean tangential displacement under twist.
+pub fn tip_m(loads: &[[f64; 3]], u: &[[f64; 3]]) -> f64 {
+    let (mut work, mut total) = (0.0, 0.0);
+    for (f, d) in loads.iter().zip(u) {
+        let f = Vector3::from(*f);
+        work += f.dot(&Vector3::from(*d));
+        total += f.norm();
+    }
+    if total > 0.0 { work / total } else { 0.0 }
+}
+
+/// The study's progress: one tick per run, and a message.
+pub trait Progress {
+    /// One run done.
+    fn tick(&mut self, message: &str);
+}
+
+impl<F: FnMut(&str)> Progress for F {
+    fn tick(&mut self, message: &str) {
+        self(message);
+    }
+}
+
+/// Runs the static part and the stability maps of `matrix`.
+pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study> {
+    anyhow::ensure!(!matrix.meshes.is_empty(), "no mesh in the matrix");
+    let bodies: Vec<Body> = matrix.meshes.iter().map(|&m| Body::cylinder(m)).collect();
+    let finest = bodies.last().context("no mesh")?;
+    let material = finest.material;
+
+    // The quasi-non-linear fit: the compression sample of the body's
+    // aspect (radius H/5) and material, 25 % compression in 8 steps, cubic
+    // (the `palpate remap fit` defaults).
+    let sample = Sample::new(HEIGHT_M, HEIGHT_M / 5.0, material)?;
+    let curves = stvk_curves(&sample, 0.25, 8).context("remap sample curves")?;
+    let remap = fit_curves(&curves, &linear_response(&sample)?, 3)?;
+    let quasi = (remap.kernel::<f64>()?, remap.kernel::<f32>()?);
+
+    let mut references = Vec::new();
+    let mut runs = Vec::new();
+    for &load in &matrix.loads {
+        // Unit-load linear response on the finest mesh: scales the levels.
+        let unit = finest.loads(load, 1.0);
+        let (u_unit, _) = solve_loaded(
+            &finest.mesh.positions,
+            &finest.mesh.tets,
+            &finest.materials(),
+            &finest.fixed,
+            &[],
+            &unit,
+        )?;
+        let tip_per_unit = tip_m(&unit, &u_unit);
+        for &level in &matrix.levels {
+            let magnitude = level * HEIGHT_M / tip_per_unit;
+            let reference = reference(finest, load, level, magnitude);
+            progress.tick(&format!(
+                "reference {} {:.0} %: {}",
+                load.name(),
+                100.0 * level,
+                reference
+                    .0
+                    .fault
+                    .clone()
+                    .unwrap_or_else(|| format!("{} Newton iterations", reference.0.iterations))
+            ));
+            for body in &bodies {
+                let same_mesh = core::ptr::eq(body, finest);
+                for model in Model::ALL {
+                    let (mut run, u) = run_model(
+                        body,
+                        model,
+                        load,
+                        (level, magnitude),
+                        &quasi,
+                        matrix.max_relax_steps,
+                    )
+                    .with_context(|| {
+                        format!("{} on {} {}", model.name(), body.label, load.name())
+                    })?;
+                    score(&mut run, &u, &reference, same_mesh);
+                    progress.tick(&format!(
+                        "{} {} {:.0} % {}",
+                        body.label,
+                        load.name(),
+                        100.0 * level,
+                        model.name()
+                    ));
+                    runs.push(run);
+                }
+            }
+            references.push(reference.0);
+        }
+    }
+    let stability = stability::maps(&bodies[0], &matrix.stability, progress)?;
+    Ok(Study {
+        height_m: HEIGHT_M,
+        material: (material.young_pa, material.poisson),
+        reference_mesh: finest.label.clone(),
+        references,
+        runs,
+        remap,
+        stability,
+    })
+}
+
+/// The Newton St Venant-Kirchhoff equilibrium of `load` at `magnitude` on
+/// `body`, and its displacement field (`None` when Newton failed).
+fn reference(
+    body: &Body,
+    load: Load,
+    level: f64,
+    magnitude: f64,
+) -> (Reference, Option<Vec<[f64; 3]>>) {
+    let loads = body.loads(load, magnitude);
+    let materials = body.materials();
+    let problem = StaticProblem {
+        positions: &body.mesh.positions,
+        tets: &body.mesh.tets,
+        materials: &materials,
+        fixed: &body.fixed,
+        prescribed: &[],
+        loads_n: &loads,
+    };
+    let options = NewtonOptions {
+        load_steps: ((100.0 * level * NEWTON_STEPS_PER_PERCENT).ceil() as usize).max(1),
+        max_iterations: 40,
+        tolerance: 1e-10,
+    };
+    let alive = vec![true; body.mesh.tets.len()];
+    match solve_stvk(&problem, &options) {
+        Ok(e) => (
+            Reference {
+                load,
+                level,
+                magnitude,
+                fault: None,
+                iterations: e.iterations,
+                tip_m: tip_m(&loads, &e.u),
+                volume_change: volume_change(&body.mesh, &e.u, &alive),
+            },
+            Some(e.u),
+        ),
+        Err(e) => (
+            Reference {
+                load,
+                level,
+                magnitude,
+                fault: Some(format!("{e:#}")),
+                iterations: 0,
+                tip_m: f64::NAN,
+                volume_change: f64::NAN,
+            },
+            None,
+        ),
+    }
+}
+
+/// Fills the errors of `run` (displacements `u`) against `reference`
+/// (full fields when `same_mesh`, the reference's mesh).
+fn score(
+    run: &mut Run,
+    u: &[[f64; 3]],
+    reference: &(Reference, Option<Vec<[f64; 3]>>),
+    same_mesh: bool,
+) {
+    let (reference, field) = reference;
+    if run.fault.is_some() || reference.fault.is_some() || !run.tip_m.is_finite() {
+        return;
+    }
+    run.tip_error = Some((run.tip_m - reference.tip_m).abs() / reference.tip_m.abs());
+    run.force_error = Some((reference.tip_m / run.tip_m - 1.0).abs());
+    if let (true, Some(field)) = (same_mesh, field) {
+        let (mut diff, mut norm, mut max) = (0.0, 0.0, 0.0f64);
+        for (a, b) in u.iter().zip(field) {
+            let d = (Vector3::from(*a) - Vector3::from(*b)).norm();
+            diff += d * d;
+            norm += Vector3::from(*b).norm_squared();
+            max = max.max(d);
+        }
+        run.l2_error = Some((diff / norm).sqrt());
+        run.max_error_m = Some(max);
+    }
+}
+
+/// One model's run (errors filled by [`score`]) and its displacements, m.
+fn run_model(
+    body: &Body,
+    model: Model,
+    load: Load,
+    (level, magnitude): (f64, f64),
+    quasi: &(QuasiNonLinear<f64>, QuasiNonLinear<f32>),
+    max_steps: usize,
+) -> anyhow::Result<(Run, Vec<[f64; 3]>)> {
+    let loads = body.loads(load, magnitude);
+    let stvk = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
+    let outcome = match model {
+        Model::PrecomputedLinear => precomputed(body, &loads, None)?,
+        Model::PrecomputedQuasi => precomputed(body, &loads, Some(quasi))?,
+        Model::TensorMassLinear => dynamic(body, &loads, ElasticLaw::Linear, None, max_steps)?,
+        Model::Stvk => dynamic(body, &loads, stvk, None, max_steps)?,
+        Model::StvkPenalty => dynamic(
+            body,
+            &loads,
+            stvk,
+            Some(penalty_n(&body.mesh, &body.material)),
+            max_steps,
+        )?,
+    };
+    let alive = vec![true; body.mesh.tets.len()];
+    let run = Run {
+        mesh: body.label.clone(),
+        vertices: body.mesh.positions.len(),
+        tets: body.mesh.tets.len(),
+        load,
+        level,
+        model,
+        fault: outcome.fault,
+        tip_m: tip_m(&loads, &outcome.u),
+        tip_error: None,
+        force_error: None,
+        l2_error: None,
+        max_error_m: None,
+        volume_change: volume_change(&body.mesh, &outcome.u, &alive),
+        inverted_tets: inverted_tets(&body.mesh, &outcome.u),
+        step_s: outcome.step_s,
+        step_f32_s: outcome.step_f32_s,
+        steps_to_settle: outcome.steps,
+        settle_s: outcome.steps as f64 * outcome.step_s,
+    };
+    Ok((run, outcome.u))
+}
+
+/// What a model's run gives.
+struct Outcome {
+    u: Vec<[f64; 3]>,
+    fault: Option<String>,
+    step_s: f64,
+    step_f32_s: Option<f64>,
+    steps: usize,
+}
+
+/// The pre-computed model under the nodal `loads`: the compliance columns
+/// `C` of the loaded DOFs (one sparse Cholesky factorization, one solve per
+/// column; the columns the pre-computed table stores), the step `u = C f`
+/// over the free vertices, and with `quasi` the remap of each vertex's
+/// displacement ([`quasi_displacements`]). Timed in f64 and f32.
+fn precomputed(
+    body: &Body,
+    loads: &[[f64; 3]],
+    quasi: Option<&(QuasiNonLinear<f64>, QuasiNonLinear<f32>)>,
+) -> anyhow::Result<Outcome> {
+    let n = body.mesh.positions.len();
+    let mut slot = vec![None; n];
+    let mut free = Vec::new();
+    for (v, s) in slot.iter_mut().enumerate() {
+        if !body.fixed[v] {
+            *s = Some(free.len() as u32);
+            free.push(v);
+        }
+    }
+    let loaded: Vec<usize> = (0..n)
+        .filter(|&v| loads[v].iter().any(|&x| x != 0.0))
+        .collect();
+    let k = assemble_restricted(
+        &body.mesh.positions,
+        &body.mesh.tets,
+        &body.materials(),
+        &slot,
+        free.len(),
+    );
+    let llt = SparseLlt::new(k.as_ref()).context("stiffness of the free vertices")?;
+    let rows = 3 * free.len();
+    let mut columns = Mat::<f64>::zeros(rows, 3 * loaded.len());
+    let mut weights = Vec::with_capacity(3 * loaded.len());
+    for (j, &v) in loaded.iter().enumerate() {
+        let s = slot[v].context("a loaded vertex is fixed")? as usize;
+        for c in 0..3 {
+            columns[(3 * s + c, 3 * j + c)] = 1.0;
+            weights.push(loads[v][c]);
+        }
+    }
+    llt.solve_in_place(columns.as_mut());
+    // Column-major dense compliance, the kernel's layout of a column walk.
+    let c64: Vec<f64> = (0..weights.len())
+        .flat_map(|j| (0..rows).map(move |i| (i, j)))
+        .map(|(i, j)| columns[(i, j)])
+        .collect();
+    let c32: Vec<f32> = c64.iter().map(|&x| x as f32).collect();
+    let w32: Vec<f32> = weights.iter().map(|&x| x as f32).collect();
+    let mut out64 = vec![0.0f64; rows];
+    let mut out32 = vec![0.0f32; rows];
+    let direction = quasi.and_then(|_| {
+        let total: Vector3<f64> = loads.iter().map(|f| Vector3::from(*f)).sum();
+        QuasiNonLinear::direction(&total)
+    });
+    let total = direction.map_or(0.0, |d| {
+        loads.iter().map(|f| Vector3::from(*f).dot(&d)).sum::<f64>()
+    });
+    let direction32 = direction.map(|d| d.map(|x| x as f32));
+    let step_s = timing::median_time_s(|| {
+        compliance_product(&c64, &weights, &mut out64);
+        if let (Some((q, _)), Some(d)) = (quasi, &direction) {
+            remap_rows(q, d, 1.0, &mut out64);
+        }
+        core::hint::black_box(&out64);
+    });
+    let step_f32_s = timing::median_time_s(|| {
+        compliance_product(&c32, &w32, &mut out32);
+        if let (Some((_, q)), Some(d)) = (quasi, &direction32) {
+            remap_rows(q, d, 1.0, &mut out32);
+        }
+        core::hint::black_box(&out32);
+    });
+    compliance_product(&c64, &weights, &mut out64);
+    if let (Some((q, _)), Some(d)) = (quasi, &direction) {
+        remap_rows(q, d, axial_scale(q, total), &mut out64);
+    }
+    let mut u = vec![[0.0; 3]; n];
+    for (s, &v) in free.iter().enumerate() {
+        u[v] = [out64[3 * s], out64[3 * s + 1], out64[3 * s + 2]];
+    }
+    Ok(Outcome {
+        u,
+        fault: None,
+        step_s,
+        step_f32_s: Some(step_f32_s),
+        steps: 1,
+    })
+}
+
+/// `out = Σ_j w_j C_j` over the columns `C_j` of the column-major `c`.
+fn compliance_product<T: palpate_kernel::Real>(c: &[T], w: &[T], out: &mut [T]) {
+    out.fill(T::zero());
+    for (column, &wj) in c.chunks_exact(out.len()).zip(w) {
+        for (o, &cij) in out.iter_mut().zip(column) {
+            *o += cij * wj;
+        }
+    }
+}
+
+/// Each vertex's displacement of `rows` (xyz triples) scaled by `scale`,
+/// then its part orthogonal to `direction` remapped by φ
+/// ([`QuasiNonLinear::displacement`]).
+fn remap_rows<T: palpate_kernel::Real>(
+    quasi: &QuasiNonLinear<T>,
+    direction: &Vector3<T>,
+    scale: T,
+    rows: &mut [T],
+) {
+    for r in rows.chunks_exact_mut(3) {
+        let u = Vector3::new(r[0], r[1], r[2]) * scale;
+        let q = quasi.displacement(direction, u);
+        r.copy_from_slice(q.as_slice());
+    }
+}
+
+/// The quasi-non-linear model under a dead load of total colinear force
+/// `force_n`: the compression the remapped force law `ψ` needs to carry
+/// it, over the linear one (`ψ⁻¹(F)/F`, by bisection on the monotone ψ);
+/// 1 for no force.
+fn axial_scale(quasi: &QuasiNonLinear<f64>, force_n: f64) -> f64 {
+    if force_n == 0.0 {
+        return 1.0;
+    }
+    let target = force_n.abs();
+    let (mut lo, mut hi) = (0.0, target);
+    for _ in 0..64 {
+        if quasi.force.apply(hi) >= target {
+            break;
+        }
+        (lo, hi) = (hi, 2.0 * hi);
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if quasi.force.apply(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi / target
+}
+
+/// A tensor-mass model of `body` under the nodal `loads`, relaxed to rest
+/// (symplectic Euler at `0.5/ω_max` with kinetic damping,
+/// [`relax`]); time per step measured in f64 at the equilibrium and in f32
+/// from rest.
+fn dynamic(
+    body: &Body,
+    loads: &[[f64; 3]],
+    law: ElasticLaw,
+    incompressibility_n: Option<f64>,
+    max_steps: usize,
+) -> anyhow::Result<Outcome> {
+    let n = body.mesh.positions.len();
+    let file = static_study_table(&body.mesh, &body.materials(), body.fixed.clone());
+    let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
+    let mut state = OwnedState::for_table(&table);
+    let bound = 100.0 * diagonal(&body.mesh.positions);
+    let params = DynamicParams::linear(0.0, bound)
+        .with_law(law)
+        .with_incompressibility(incompressibility_n);
+    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    let dt_s = 0.5 / omega_max(&mut model);
+    model.reset();
+    let loaded: Vec<u32> = (0..n as u32)
+        .filter(|&v| loads[v as usize].iter().any(|&x| x != 0.0))
+        .collect();
+    for &v in &loaded {
+        model.set_external_force(v, Vector3::from(loads[v as usize]))?;
+    }
+    let largest = loads
+        .iter()
+        .map(|f| Vector3::from(*f).norm())
+        .fold(0.0, f64::max);
+    let mut u = vec![[0.0; 3]; n];
+    let (fault, steps) = match relax(
+        &mut model,
+        loads,
+        dt_s,
+        RELAX_TOLERANCE * largest,
+        max_steps,
+        &mut u,
+    ) {
+        Ok(r) if r.converged => (None, r.steps),
+        Ok(r) => (
+            Some(format!(
+                "not settled in {} steps (residual {:.2e} N)",
+                r.steps, r.residual_n
+            )),
+            r.steps,
+        ),
+        Err(e) => (Some(format!("diverged: {e}")), 0),
+    };
+    // Time per step: the law's step from the state reached (reset if it
+    // faulted, so the step runs).
+    if model.fault().is_some() {
+        model.reset();
+    }
+    let step_s = timing::median_time_s(|| {
+        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt_s));
+    });
+    let step_f32_s = dynamic_f32_step(body, loads, law, incompressibility_n, dt_s)?;
+    Ok(Outcome {
+        u,
+        fault,
+        step_s,
+        step_f32_s: Some(step_f32_s),
+        steps,
+    })
+}
+
+/// Median time of one f32 symplectic-Euler step of the same model, s.
+fn dynamic_f32_step(
+    body: &Body,
+    loads: &[[f64; 3]],
+    law: ElasticLaw,
+    incompressibility_n: Option<f64>,
+    dt_s: f64,
+) -> anyhow::Result<f64> {
+    let arrays = TensorMassArrays::new(
+        &body.mesh,
+        &body.materials(),
+        DENSITY_KG_M3,
+        body.fixed.clone(),
+    );
+    let bytes = write_tensor_mass_table(
+        &body.mesh,
+        &crate::mesh::boundary_surface(&body.mesh).triangles,
+        &arrays,
+        Precision::F32,
+    );
+    let file = crate::table::load::TableFile::from_bytes(&bytes);
+    let table = TensorMassTable::<f32>::load(file.bytes()).context("f32 tensor-mass table")?;
+    let mut state = OwnedState::for_table(&table);
+    let bound = 100.0 * diagonal(&body.mesh.positions);
+    let params = DynamicParams::linear(0.0f32, bound as f32)
+        .with_law(law)
+        .with_incompressibility(incompressibility_n.map(|g| g as f32));
+    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    for (v, f) in loads.iter().enumerate() {
+        if f.iter().any(|&x| x != 0.0) {
+            model.set_external_force(v as u32, Vector3::from(f.map(|x| x as f32)))?;
+        }
+    }
+    let dt = dt_s as f32;
+    Ok(timing::median_time_s(|| {
+        if model.fault().is_some() {
+            model.reset();
+        }
+        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt));
+    }))
+}

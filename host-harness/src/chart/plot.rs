@@ -1,0 +1,512 @@
+//! The charts of `palpate chart`, drawn with `plotters` in SVG and PNG
+//! (the PNG encoded by the `png` crate), text in DejaVu Sans embedded in
+//! the binary (`assets/fonts`, Bitstream Vera licence). Files are written
+//! atomically.
+
+use std::path::Path;
+use std::sync::Once;
+
+use anyhow::Context;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::select::pareto_front;
+use super::stability::{Map, Outcome};
+use super::{Load, Model, Study};
+use crate::experiment::volume_bend::{Protocol, SceneResult};
+use crate::output::atomic::write_file;
+
+/// DejaVu Sans, registered as plotters' `sans-serif`.
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+/// Chart size, px.
+const SIZE: (u32, u32) = (800, 560);
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The embedded font parses (checked by the chart tests).
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// Error type of the drawing calls.
+type Drawn = anyhow::Result<()>;
+
+/// Draws `chart` into `dir/name.svg` and `dir/name.png`.
+macro_rules! render {
+    ($dir:expr, $name:expr, $chart:expr) => {{
+        register_font();
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+            $chart(&root)?;
+            root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+        }
+        write_file(&$dir.join(format!("{}.svg", $name)), svg.as_bytes())?;
+        let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+            $chart(&root)?;
+            root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+        }
+        write_file(&$dir.join(format!("{}.png", $name)), &encode_png(&rgb)?)?;
+        Ok::<(), anyhow::Error>(())
+    }};
+}
+
+/// PNG bytes of an RGB buffer of [`SIZE`].
+fn encode_png(rgb: &[u8]) -> anyhow::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, SIZE.0, SIZE.1);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().context("png header")?;
+    writer.write_image_data(rgb).context("png data")?;
+    writer.finish().context("png end")?;
+    Ok(out)
+}
+
+fn err(e: impl core::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("drawing: {e}")
+}
+
+/// A colour per model.
+pub fn model_colour(model: Model) -> RGBColor {
+    match model {
+        Model::PrecomputedLinear => RGBColor(31, 119, 180),
+        Model::PrecomputedQuasi => RGBColor(23, 190, 207),
+        Model::TensorMassLinear => RGBColor(255, 127, 14),
+        Model::Stvk => RGBColor(214, 39, 40),
+        Model::StvkPenalty => RGBColor(44, 160, 44),
+    }
+}
+
+/// `[lo, hi]` widened by a factor for a log axis, from positive values.
+fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo.is_finite() {
+        (lo / 2.0, hi * 2.0)
+    } else {
+        (1e-6, 1.0)
+    }
+}
+
+/// The file names of the charts written, without extension.
+pub fn draw_all(
+    study: &Study,
+    volume: &[SceneResult],
+    dir: &Path,
+    loads: &[Load],
+    levels: &[f64],
+) -> anyhow::Result<Vec<String>> {
+    let mut names = Vec::new();
+    for &load in loads {
+        for &level in levels {
+            let name = format!("pareto-{}-{}", load.name(), (100.0 * level).round());
+            render!(dir, name, |root: &DrawingArea<_, Shift>| pareto(
+                root, study, load, level
+            ))?;
+            names.push(name);
+        }
+    }
+    render!(dir, "cost-mesh", |root: &DrawingArea<_, Shift>| cost_mesh(
+        root, study
+    ))?;
+    names.push("cost-mesh".into());
+    for map in &study.stability {
+        let name = format!("stability-{}", map.integrator);
+        render!(dir, name, |root: &DrawingArea<_, Shift>| stability(
+            root, map
+        ))?;
+        names.push(name);
+    }
+    if !volume.is_empty() {
+        render!(dir, "volume", |root: &DrawingArea<_, Shift>| volume_chart(
+            root, volume
+        ))?;
+        names.push("volume".into());
+    }
+    Ok(names)
+}
+
+/// Error (tip, against the Newton reference) against time per step for one
+/// load and level, every mesh and model; the Pareto front filled and joined.
+fn pareto<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    study: &Study,
+    load: Load,
+    level: f64,
+) -> Drawn {
+    root.fill(&WHITE).map_err(err)?;
+    let runs: Vec<_> = study
+        .runs
+        .iter()
+        .filter(|r| r.load == load && r.level == level && r.tip_error.is_some())
+        .collect();
+    let points: Vec<(f64, f64)> = runs
+        .iter()
+        .map(|r| (r.step_s, r.tip_error.unwrap_or(f64::NAN).max(1e-6)))
+        .collect();
+    let front = pareto_front(&points);
+    let x = log_range(points.iter().map(|p| p.0));
+    let y = log_range(points.iter().map(|p| p.1));
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!(
+                "{} at {:.0} % of the height: error vs time per step",
+                load.name(),
+                100.0 * level
+            ),
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time per step, s (f64)")
+        .y_desc("tip displacement error vs Newton StVK")
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(err)?;
+    let mut on_front: Vec<(f64, f64)> = points
+        .iter()
+        .zip(&front)
+        .filter(|(_, f)| **f)
+        .map(|(p, _)| *p)
+        .collect();
+    on_front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    chart
+        .draw_series(LineSeries::new(on_front, BLACK.stroke_width(1)))
+        .map_err(err)?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    for model in Model::ALL {
+        let colour = model_colour(model);
+        let series: Vec<_> = runs
+            .iter()
+            .zip(&points)
+            .zip(&front)
+            .filter(|((r, _), _)| r.model == model)
+            .map(|((r, p), f)| (*p, *f, r.mesh.clone()))
+            .collect();
+        chart
+            .draw_series(series.into_iter().map(|(p, f, mesh)| {
+                let style = if f {
+                    colour.filled()
+                } else {
+                    colour.stroke_width(2)
+                };
+                EmptyElement::at(p)
+                    + Circle::new((0, 0), 6, style)
+                    + Text::new(mesh, (8, -6), ("sans-serif", 11))
+            }))
+            .map_err(err)?
+            .label(model.name())
+            .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Least-squares slope of `log y` against `log x`.
+pub fn log_slope(points: &[(f64, f64)]) -> f64 {
+    let logs: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+        .map(|p| (p.0.ln(), p.1.ln()))
+        .collect();
+    let n = logs.len() as f64;
+    let mx = logs.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = logs.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = logs.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+    sxy / sxx
+}
+
+/// Per model, the median time per step on each mesh against its vertex count.
+pub fn cost_series(study: &Study, model: Model) -> Vec<(f64, f64)> {
+    let mut meshes: Vec<(usize, Vec<f64>)> = Vec::new();
+    for r in study.runs.iter().filter(|r| r.model == model) {
+        match meshes.iter_mut().find(|m| m.0 == r.vertices) {
+            Some(m) => m.1.push(r.step_s),
+            None => meshes.push((r.vertices, vec![r.step_s])),
+        }
+    }
+    meshes.sort_by_key(|m| m.0);
+    meshes
+        .into_iter()
+        .map(|(v, mut t)| {
+            t.sort_by(f64::total_cmp);
+            (v as f64, t[t.len() / 2])
+        })
+        .collect()
+}
+
+/// Time per step against vertices, log-log, slope in the legend.
+fn cost_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, study: &Study) -> Drawn {
+    root.fill(&WHITE).map_err(err)?;
+    let series: Vec<(Model, Vec<(f64, f64)>)> = Model::ALL
+        .iter()
+        .map(|&m| (m, cost_series(study, m)))
+        .collect();
+    let x = log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.0)));
+    let y = log_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.1)));
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            "cost against mesh size (median over loads)",
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("vertices")
+        .y_desc("time per step, s (f64)")
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(err)?;
+    for (model, points) in series {
+        let colour = model_colour(model);
+        let slope = log_slope(&points);
+        chart
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+            .map_err(err)?
+            .label(format!("{} (slope {slope:.2})", model.name()))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
+        chart
+            .draw_series(
+                points
+                    .into_iter()
+                    .map(|p| Circle::new(p, 4, colour.filled())),
+            )
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Colour of a stability outcome.
+fn outcome_colour(outcome: Outcome) -> RGBColor {
+    match outcome {
+        Outcome::Stable => RGBColor(44, 160, 44),
+        Outcome::Diverged => RGBColor(214, 39, 40),
+        Outcome::Inverted => RGBColor(148, 103, 189),
+        Outcome::EnergyGrowth => RGBColor(255, 127, 14),
+    }
+}
+
+/// One integrator's map: time step against E, coloured by outcome, with the
+/// measured critical step and `2/ω_max` (both ∝ `1/√E`).
+fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Drawn {
+    root.fill(&WHITE).map_err(err)?;
+    let x = log_range(map.cells.iter().map(|c| c.young_pa));
+    let y = log_range(map.cells.iter().map(|c| c.dt_s));
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!(
+                "{}: stability on cylinder {} (damping {} 1/s)",
+                map.integrator, map.mesh, map.damping_per_s
+            ),
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("Young's modulus E, Pa")
+        .y_desc("time step, s")
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(err)?;
+    let curve = |dt0: f64| -> Vec<(f64, f64)> {
+        (0..=40)
+            .map(|k| {
+                let e = x.0 * (x.1 / x.0).powf(f64::from(k) / 40.0);
+                (e, dt0 * (map.reference_young_pa / e).sqrt())
+            })
+            .collect()
+    };
+    chart
+        .draw_series(LineSeries::new(
+            curve(map.critical_dt_s),
+            BLACK.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label("measured critical step (linear)")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+    let blue = RGBColor(31, 119, 180);
+    chart
+        .draw_series(DashedLineSeries::new(
+            curve(map.two_over_omega_s),
+            6,
+            4,
+            blue.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label("2/ω_max")
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], blue.stroke_width(2)));
+    for outcome in [
+        Outcome::Stable,
+        Outcome::Diverged,
+        Outcome::Inverted,
+        Outcome::EnergyGrowth,
+    ] {
+        let colour = outcome_colour(outcome);
+        chart
+            .draw_series(
+                map.cells
+                    .iter()
+                    .filter(|c| c.outcome == outcome)
+                    .map(|c| Rectangle::new(square((c.young_pa, c.dt_s)), colour.filled())),
+            )
+            .map_err(err)?
+            .label(format!("{outcome:?}").to_lowercase())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerLeft)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// A small square around a log-log point (±8 %).
+fn square((x, y): (f64, f64)) -> [(f64, f64); 2] {
+    [(x / 1.08, y / 1.08), (x * 1.08, y * 1.08)]
+}
+
+/// Volume change against load, per model and protocol (Picinbono 2001
+/// table 2).
+fn volume_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    results: &[SceneResult],
+) -> Drawn {
+    root.fill(&WHITE).map_err(err)?;
+    let force = results
+        .iter()
+        .flat_map(|r| r.stages.iter().map(|s| s.force_n))
+        .fold(0.0f64, f64::max);
+    let volumes = results.iter().flat_map(|r| {
+        r.stages.iter().flat_map(|s| {
+            [&s.linear, &s.stvk, &s.stvk_incompressible].map(|e| 100.0 * e.volume_change)
+        })
+    });
+    let (lo, hi) = volumes
+        .filter(|v| v.is_finite())
+        .fold((0.0f64, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            "Picinbono 2001 table 2: volume change of the bent cylinder",
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.05 * force, (lo - 5.0)..(hi + 5.0))
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("total lateral force, N")
+        .y_desc("(V − V₀)/V₀, %")
+        .draw()
+        .map_err(err)?;
+    let models = [
+        (
+            "linear",
+            Model::TensorMassLinear,
+            (|s: &crate::experiment::volume_bend::Stage| &s.linear) as fn(_) -> _,
+        ),
+        ("StVK", Model::Stvk, |s| &s.stvk),
+        ("StVK + penalty", Model::StvkPenalty, |s| {
+            &s.stvk_incompressible
+        }),
+    ];
+    for result in results {
+        let (protocol, dashed) = match result.protocol {
+            Protocol::PaperLoads => ("paper loads", false),
+            Protocol::Tilt => ("tilts", true),
+        };
+        for (name, model, pick) in &models {
+            let colour = model_colour(*model);
+            let mut points = vec![(0.0, 0.0)];
+            points.extend(
+                result
+                    .stages
+                    .iter()
+                    .map(|s| (s.force_n, 100.0 * pick(s).volume_change)),
+            );
+            let label = format!("{name}, {protocol}");
+            if dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        points.clone(),
+                        6,
+                        4,
+                        colour.stroke_width(2),
+                    ))
+                    .map_err(err)?
+                    .label(label)
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 16, y)], colour.mix(0.6).stroke_width(1))
+                    });
+            } else {
+                chart
+                    .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                    .map_err(err)?
+                    .label(label)
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2))
+                    });
+            }
+            chart
+                .draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 4, colour.filled())),
+                )
+                .map_err(err)?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}

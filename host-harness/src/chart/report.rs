@@ -1,0 +1,241 @@
+//! `report.md` and `index.html` of `palpate chart`.
+
+use core::fmt::Write;
+
+use super::plot::{cost_series, log_slope};
+use super::select::{cheapest_within, pareto_front};
+use super::stability::Outcome;
+use super::{Load, Model, Run, Study};
+
+/// Error bounds of the report's "cheapest within" columns.
+pub const BOUNDS: [f64; 3] = [0.01, 0.05, 0.20];
+
+/// The runs of one load and level with an error, as (cost, error) points:
+/// time per step (s) and tip error.
+pub fn points(study: &Study, load: Load, level: f64) -> (Vec<&Run>, Vec<(f64, f64)>) {
+    let runs: Vec<&Run> = study
+        .runs
+        .iter()
+        .filter(|r| r.load == load && r.level == level && r.tip_error.is_some())
+        .collect();
+    let points = runs
+        .iter()
+        .map(|r| (r.step_s, r.tip_error.unwrap_or(f64::NAN)))
+        .collect();
+    (runs, points)
+}
+
+/// `model on mesh` of the cheapest run within `bound`, or `none`.
+pub fn cheapest(study: &Study, load: Load, level: f64, bound: f64) -> Option<String> {
+    let (runs, points) = points(study, load, level);
+    cheapest_within(&points, bound).map(|i| format!("{} on {}", runs[i].model.name(), runs[i].mesh))
+}
+
+/// The Pareto members of one load and level, `model on mesh`.
+pub fn pareto_members(study: &Study, load: Load, level: f64) -> Vec<String> {
+    let (runs, points) = points(study, load, level);
+    runs.iter()
+        .zip(pareto_front(&points))
+        .filter(|(_, f)| *f)
+        .map(|(r, _)| format!("{} on {}", r.model.name(), r.mesh))
+        .collect()
+}
+
+/// The report in Markdown; `charts` are the chart names (PNG beside it).
+pub fn markdown(
+    study: &Study,
+    loads: &[Load],
+    levels: &[f64],
+    charts: &[String],
+    volume_table: &str,
+) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "# Speed against accuracy: palpate chart\n");
+    let _ = writeln!(
+        out,
+        "Cylinder of height {} m (radius H/5), E = {} Pa, ν = {}, base fixed, dead loads on the top \
+         face. Reference: Newton St Venant-Kirchhoff on mesh {}. Error: the top-face displacement \
+         (work-conjugate mean) against the reference; cost: median time of one step (f64).\n",
+        study.height_m, study.material.0, study.material.1, study.reference_mesh
+    );
+    let _ = writeln!(out, "## Cheapest model within an error bound\n");
+    let _ = writeln!(
+        out,
+        "| load | level | within 1 % | within 5 % | within 20 % | Pareto front |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    for &load in loads {
+        for &level in levels {
+            let cell = |b: f64| cheapest(study, load, level, b).unwrap_or_else(|| "none".into());
+            let reference = study
+                .references
+                .iter()
+                .find(|r| r.load == load && r.level == level);
+            let front = match reference.and_then(|r| r.fault.as_ref()) {
+                Some(f) => format!("no reference: {f}"),
+                None => pareto_members(study, load, level).join(", "),
+            };
+            let _ = writeln!(
+                out,
+                "| {} | {:.0} % | {} | {} | {} | {} |",
+                load.name(),
+                100.0 * level,
+                cell(BOUNDS[0]),
+                cell(BOUNDS[1]),
+                cell(BOUNDS[2]),
+                front
+            );
+        }
+    }
+    let _ = writeln!(out, "\n## Every run\n");
+    let _ = writeln!(
+        out,
+        "| load | level | mesh | model | tip error | force error | L2 error | max error mm | ΔV/V₀ % | inverted | step µs f64 | step µs f32 | steps to settle | settle ms | fault |"
+    );
+    let _ = writeln!(
+        out,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    let opt = |x: Option<f64>, scale: f64| x.map_or("-".into(), |x| format!("{:.3}", scale * x));
+    for r in &study.runs {
+        let _ = writeln!(
+            out,
+            "| {} | {:.0} % | {} | {} | {} | {} | {} | {} | {:+.3} | {} | {:.2} | {} | {} | {:.3} | {} |",
+            r.load.name(),
+            100.0 * r.level,
+            r.mesh,
+            r.model.name(),
+            opt(r.tip_error, 1.0),
+            opt(r.force_error, 1.0),
+            opt(r.l2_error, 1.0),
+            opt(r.max_error_m, 1e3),
+            100.0 * r.volume_change,
+            r.inverted_tets,
+            1e6 * r.step_s,
+            opt(r.step_f32_s, 1e6),
+            r.steps_to_settle,
+            1e3 * r.settle_s,
+            r.fault.as_deref().unwrap_or("")
+        );
+    }
+    let _ = writeln!(out, "\n## Where the methods fail\n");
+    for line in failures(study) {
+        let _ = writeln!(out, "- {line}");
+    }
+    let _ = writeln!(out, "\n## Cost against mesh size\n");
+    for model in Model::ALL {
+        let series = cost_series(study, model);
+        if series.len() >= 2 {
+            let _ = writeln!(
+                out,
+                "- {}: time per step ∝ vertices^{:.2}",
+                model.name(),
+                log_slope(&series)
+            );
+        }
+    }
+    if !volume_table.is_empty() {
+        let _ = writeln!(out, "\n## Picinbono 2001 table 2\n\n```\n{volume_table}```");
+    }
+    let _ = writeln!(out, "\n## Charts\n");
+    for name in charts {
+        let _ = writeln!(out, "![{name}]({name}.png)\n");
+    }
+    out
+}
+
+/// The failure regions, in words, from the runs and the maps.
+pub fn failures(study: &Study) -> Vec<String> {
+    let mut lines = Vec::new();
+    for r in &study.references {
+        if let Some(f) = &r.fault {
+            lines.push(format!(
+                "Newton St Venant-Kirchhoff has no equilibrium for {} at {:.0} % (collapse): {f}",
+                r.load.name(),
+                100.0 * r.level
+            ));
+        }
+    }
+    for r in &study.runs {
+        if r.fault.is_some() || r.inverted_tets > 0 {
+            lines.push(format!(
+                "{} on {} under {} at {:.0} %: {}{} inverted tets",
+                r.model.name(),
+                r.mesh,
+                r.load.name(),
+                100.0 * r.level,
+                r.fault
+                    .as_deref()
+                    .map_or(String::new(), |f| format!("{f}; ")),
+                r.inverted_tets
+            ));
+        }
+    }
+    // The linear models' volume gain under rotation: the largest.
+    if let Some(r) = study
+        .runs
+        .iter()
+        .filter(|r| matches!(r.model, Model::PrecomputedLinear | Model::TensorMassLinear))
+        .max_by(|a, b| a.volume_change.total_cmp(&b.volume_change))
+    {
+        lines.push(format!(
+            "linear swelling under rotation: {} gains {:+.2} % volume under {} at {:.0} % on {} \
+             (St Venant-Kirchhoff reference: {:+.2} %)",
+            r.model.name(),
+            100.0 * r.volume_change,
+            r.load.name(),
+            100.0 * r.level,
+            r.mesh,
+            study
+                .references
+                .iter()
+                .find(|x| x.load == r.load && x.level == r.level)
+                .map_or(f64::NAN, |x| 100.0 * x.volume_change)
+        ));
+    }
+    for map in &study.stability {
+        let unstable: Vec<String> = map
+            .cells
+            .iter()
+            .filter(|c| c.outcome != Outcome::Stable)
+            .map(|c| {
+                format!(
+                    "{:?} at E = {} Pa, Δt = {:.2e} s",
+                    c.outcome, c.young_pa, c.dt_s
+                )
+            })
+            .collect();
+        lines.push(format!(
+            "{}: measured critical step {:.3e} s, 2/ω_max {:.3e} s at E = {} Pa; {} of {} trials fail{}",
+            map.integrator,
+            map.critical_dt_s,
+            map.two_over_omega_s,
+            map.reference_young_pa,
+            unstable.len(),
+            map.cells.len(),
+            unstable
+                .first()
+                .map_or(String::new(), |f| format!(" (first: {f})"))
+        ));
+    }
+    lines
+}
+
+/// The HTML page: the report's Markdown in a `<pre>` and the images.
+pub fn html(markdown: &str, charts: &[String]) -> String {
+    let escaped = markdown
+        .replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;");
+    let mut out = String::from(
+        "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>palpate chart</title></head>\n<body>\n",
+    );
+    for name in charts {
+        let _ = writeln!(
+            out,
+            "<figure><img src=\"{name}.svg\" alt=\"{name}\" width=\"800\"><figcaption>{name}</figcaption></figure>"
+        );
+    }
+    let _ = writeln!(out, "<pre>\n{escaped}</pre>\n</body></html>");
+    out
+}

@@ -1,0 +1,50 @@
+//! `palpate chart --quick` (README "Speed against accuracy"): the files it
+//! writes and the JSON's keys; the quasi-non-linear pre-computed model on
+//! the reference mesh is the cheapest within 1 % under the small press and
+//! on its Pareto front (measured: tip error 4e-5 against the Newton St
+//! Venant-Kirchhoff reference, where the linear models are 1.6 % off; the
+//! only other run within 1 % there, St Venant-Kirchhoff relaxed, does not
+//! settle in the quick run's step limit).
+
+mod common;
+
+use common::{fresh_dir, palpate, stderr};
+
+#[test]
+fn quick_chart_writes_report_charts_and_json() {
+    let dir = fresh_dir("chart-quick");
+    let out = palpate(&["chart", "--quick", "--json", "--out", dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for file in [
+        "report.md",
+        "index.html",
+        "study.json",
+        "pareto-press-1.png",
+        "pareto-press-1.svg",
+        "cost-mesh.png",
+        "stability-symplectic.svg",
+        "volume.png",
+    ] {
+        let meta = std::fs::metadata(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(meta.len() > 1000, "{file}: {} bytes", meta.len());
+    }
+    let png = std::fs::read(dir.join("cost-mesh.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let press = &json["summary"]["press-1"];
+    assert_eq!(
+        press["cheapest_within_percent"]["1"],
+        "precomputed-quasi on 2x10"
+    );
+    let front: Vec<&str> = press["pareto"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert!(front.contains(&"precomputed-quasi on 2x10"), "{front:?}");
+    assert_eq!(json["study"]["stability"].as_array().unwrap().len(), 4);
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(report.contains("## Cheapest model within an error bound"));
+    assert!(report.contains("## Where the methods fail"));
+}
