@@ -33,7 +33,6 @@ pub mod plot;
 pub mod report;
 pub mod select;
 pub mod stability;
-pub mod timing;
 
 use anyhow::Context;
 use faer::Mat;
@@ -45,6 +44,8 @@ use palpate_kernel::tensor_mass::{
 };
 use serde::Serialize;
 
+use crate::bench::measure::{Sampling, time};
+use crate::dispatch::HostDispatch;
 use crate::experiment::relax::relax;
 use crate::experiment::scenes::{penalty_n, tissue};
 use crate::experiment::volume_bend::inverted_tets;
@@ -87,6 +88,15 @@ pub const RELAX_TOLERANCE: f64 = 1e-3;
 const NEWTON_STEPS_PER_PERCENT: f64 = 0.5;
 /// Density of the tensor-mass tables, kg/m³ (the static studies').
 const DENSITY_KG_M3: f64 = 1000.0;
+/// How a run's time per step is measured ([`crate::bench::measure`], the
+/// library of `palpate bench`): one warm-up and 7 kept samples of 2 ms,
+/// the median reported. Short, as the matrix times some 300 steps; the
+/// spread is `palpate bench`'s to show.
+const STEP_SAMPLING: Sampling = Sampling {
+    warmup: 1,
+    samples: 7,
+    sample_s: 2e-3,
+};
 
 /// Which loads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -636,14 +646,14 @@ fn precomputed(
         loads.iter().map(|f| Vector3::from(*f).dot(&d)).sum::<f64>()
     });
     let direction32 = direction.map(|d| d.map(|x| x as f32));
-    let step_s = timing::median_time_s(|| {
+    let step_s = median_s(|| {
         compliance_product(&c64, &weights, &mut out64);
         if let (Some((q, _)), Some(d)) = (quasi, &direction) {
             remap_rows(q, d, 1.0, &mut out64);
         }
         core::hint::black_box(&out64);
     });
-    let step_f32_s = timing::median_time_s(|| {
+    let step_f32_s = median_s(|| {
         compliance_product(&c32, &w32, &mut out32);
         if let (Some((_, q)), Some(d)) = (quasi, &direction32) {
             remap_rows(q, d, 1.0, &mut out32);
@@ -665,6 +675,11 @@ fn precomputed(
         step_f32_s: Some(step_f32_s),
         steps: 1,
     })
+}
+
+/// Median time of one call of `call`, s, sampled as [`STEP_SAMPLING`].
+fn median_s(call: impl FnMut()) -> f64 {
+    time(&STEP_SAMPLING, call).median_s
 }
 
 /// `out = Σ_j w_j C_j` over the columns `C_j` of the column-major `c`.
@@ -723,7 +738,8 @@ fn axial_scale(quasi: &QuasiNonLinear<f64>, force_n: f64) -> f64 {
 /// A tensor-mass model of `body` under the nodal `loads`, relaxed to rest
 /// (symplectic Euler at `0.5/ω_max` with kinetic damping,
 /// [`relax`]); time per step measured in f64 at the equilibrium and in f32
-/// from rest.
+/// from rest, with the host's CPU-feature dispatch ([`HostDispatch`], as
+/// `dynamic run` steps).
 fn dynamic(
     body: &Body,
     loads: &[[f64; 3]],
@@ -776,8 +792,9 @@ fn dynamic(
     if model.fault().is_some() {
         model.reset();
     }
-    let step_s = timing::median_time_s(|| {
-        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt_s));
+    let dispatch = HostDispatch::detect();
+    let step_s = median_s(|| {
+        let _ = core::hint::black_box(model.step_with(dispatch, Integrator::SymplecticEuler, dt_s));
     });
     let step_f32_s = dynamic_f32_step(body, loads, law, incompressibility_n, dt_s)?;
     Ok(Outcome {
@@ -823,10 +840,11 @@ fn dynamic_f32_step(
         }
     }
     let dt = dt_s as f32;
-    Ok(timing::median_time_s(|| {
+    let dispatch = HostDispatch::detect();
+    Ok(median_s(|| {
         if model.fault().is_some() {
             model.reset();
         }
-        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt));
+        let _ = core::hint::black_box(model.step_with(dispatch, Integrator::SymplecticEuler, dt));
     }))
 }
