@@ -10,20 +10,25 @@
 //! fast-math). A difference here means a pass computes differently when
 //! dispatched, which the firmware comparison (portable on both sides) would
 //! not see. On a CPU without AVX2 and FMA the only level is the portable one
-//! and the test compares it with itself (the levels are printed).
+//! and the test compares it with itself (the levels are printed). The
+//! pre-computed update is compared on dense and compressed tables (f16,
+//! q16 with dropped blocks: the kernel decodes them inside the dispatched
+//! pass), linear and quasi-non-linear.
 
 use nalgebra::Vector3;
 use palpate::dispatch::HostDispatch;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::{box_mesh, cylinder_mesh};
 use palpate::mesh::{MeshReport, TetMesh};
-use palpate::table::build::{BuildOptions, build};
+use palpate::table::build::{BuildOptions, TableKindOptions, build};
 use palpate::table::compliance::Solver;
+use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate::tensor_mass::OwnedState;
 use palpate::tensor_mass::run::host_params;
 use palpate_kernel::math::{Dispatch, Portable};
+use palpate_kernel::precomputed::{QuasiNonLinear, Remap};
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, TensorMassModel};
 use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel, PrecomputedTable, Real};
@@ -141,33 +146,92 @@ fn dispatched_steps_equal_portable_steps_bit_for_bit() {
     assert_eq!(compared, 5 * 4 * 2 * 2 * levels.len());
 }
 
+/// The pre-computed tables of the update check: dense, and (f32) compressed
+/// with f16 codes, and with q16 codes whose interior blocks below 0.2 of
+/// their column's largest are dropped (the kept-block bitmap read).
+fn update_tables(mesh: &TetMesh, precision: Precision) -> Vec<(String, TableFile)> {
+    let dense = BuildOptions::precomputed(
+        Material::new(5000.0, 0.4).unwrap(),
+        vec!["z<1e-9".parse().unwrap()],
+        Solver::Cholesky,
+        precision,
+    );
+    let coded = [
+        (BlockCode::F16, 0.0, ContactBlocks::Coded),
+        (BlockCode::Q16, 0.2, ContactBlocks::Coded),
+    ];
+    let compressed = coded
+        .into_iter()
+        .filter(|_| precision == Precision::F32)
+        .map(|(code, drop_below, contact)| {
+            let compression = Compression {
+                code,
+                drop_below,
+                contact,
+            };
+            let options = BuildOptions {
+                kind: TableKindOptions::Precomputed {
+                    solver: Solver::Cholesky,
+                    compression: Some(compression),
+                },
+                ..dense.clone()
+            };
+            (format!("{code:?} drop {drop_below}"), options)
+        });
+    core::iter::once(("dense".to_owned(), dense.clone()))
+        .chain(compressed)
+        .map(|(name, options)| {
+            let bytes = build(mesh, &MeshReport::default(), &options).unwrap().bytes;
+            (name, TableFile::from_bytes(&bytes))
+        })
+        .collect()
+}
+
 #[test]
 fn dispatched_displacement_update_equals_the_portable_one_bit_for_bit() {
     let [mesh, _] = meshes();
+    let mut compared = 0;
     for (detected, precision) in HostDispatch::available()
         .into_iter()
         .flat_map(|level| [(level, Precision::F32), (level, Precision::F64)])
     {
-        let options = BuildOptions::precomputed(
-            Material::new(5000.0, 0.4).unwrap(),
-            vec!["z<1e-9".parse().unwrap()],
-            Solver::Cholesky,
-            precision,
-        );
-        let file = TableFile::from_bytes(
-            &build(&mesh, &MeshReport::default(), &options)
-                .unwrap()
-                .bytes,
-        );
-        match precision {
-            Precision::F32 => check_update::<f32>(&file, detected),
-            Precision::F64 => check_update::<f64>(&file, detected),
+        for (name, file) in update_tables(&mesh, precision) {
+            println!("{} {precision:?} {name}", detected.name());
+            if name.starts_with("Q16") {
+                // Blocks are dropped: the pass reads the kept-block bitmap.
+                let table = PrecomputedTable::<f32>::load(file.bytes()).unwrap();
+                let interior = table.interior_blocks();
+                assert!(interior.stored_len() < interior.len());
+            }
+            // Linear, then quasi-non-linear (the remap after the dispatched pass).
+            for remap in [false, true] {
+                match precision {
+                    Precision::F32 => check_update::<f32>(&file, detected, remap),
+                    Precision::F64 => check_update::<f64>(&file, detected, remap),
+                }
+                compared += 1;
+            }
         }
+    }
+    // Per level: dense f32 and f64, f16 and q16 with drops, each linear and remapped.
+    assert_eq!(compared, 2 * 4 * HostDispatch::available().len());
+}
+
+/// A quasi-non-linear remap that changes every displacement it touches:
+/// `φ(x) = x + 50 x²` (m), `ψ(x) = 1.5 x` (N).
+fn remap<T: Real>() -> QuasiNonLinear<T> {
+    let f = T::of_f64;
+    QuasiNonLinear {
+        radial: Remap::new([f(1.0), f(50.0), f(0.0), f(0.0), f(0.0)], f(0.01)).unwrap(),
+        force: Remap::new([f(1.5), f(0.0), f(0.0), f(0.0), f(0.0)], f(1.0)).unwrap(),
     }
 }
 
-fn check_update<T: Real>(file: &TableFile, detected: HostDispatch) {
-    let model = PrecomputedModel::new(PrecomputedTable::<T>::load(file.bytes()).unwrap());
+fn check_update<T: Real>(file: &TableFile, detected: HostDispatch, remapped: bool) {
+    let mut model = PrecomputedModel::new(PrecomputedTable::<T>::load(file.bytes()).unwrap());
+    if remapped {
+        model = model.with_remap(remap());
+    }
     let touchable = &model.table().free_vertices()[..model.table().touchable_count()];
     // Four contacts spread over the touchable vertices.
     let step = touchable.len() / MAX_CONTACTS;
@@ -192,6 +256,14 @@ fn check_update<T: Real>(file: &TableFile, detected: HostDispatch) {
         .free_displacements_with(detected, &solution, &mut b)
         .unwrap();
     assert!(a.iter().flatten().any(|x| *x != T::zero()));
+    if remapped {
+        // The remap did change the field (else the remapped check is the linear one).
+        let linear = PrecomputedModel::new(*model.table());
+        let solution = linear.contact_forces::<MAX_CONTACTS>(&contacts).unwrap();
+        let mut l = vec![[T::zero(); 3]; free];
+        linear.free_displacements(&solution, &mut l).unwrap();
+        assert_ne!(a, l);
+    }
     assert!(
         a.iter()
             .flatten()
