@@ -353,21 +353,24 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             let (a, b) = (first.max(lo), end.min(hi));
             (a < b).then(|| (a, a - first..b - first))
         };
-        if let Some((a, rows)) = window(0, k + 1)
-            && let Some(out) = out.get_mut(rows)
-        {
-            surface.add_products(surface_block_index(a, k), k, w, out);
+        // The rows of the two parts' columns (`n ≤ k` from the packed
+        // surface column, `n ≥ S` from the interior column) through one call
+        // site, so that inlining it for a [`Dispatch`] does not copy it;
+        // the windows are disjoint, so the order adds nothing different.
+        let columns = [
+            window(0, k + 1).map(|(a, rows)| (surface, surface_block_index(a, k), rows)),
+            window(s, f)
+                .map(|(a, rows)| (self.table.interior_blocks(), k * (f - s) + (a - s), rows)),
+        ];
+        for (part, start, rows) in columns.into_iter().flatten() {
+            if let Some(out) = out.get_mut(rows) {
+                part.add_products(start, k, w, out);
+            }
         }
         if let Some((a, rows)) = window(k + 1, s)
             && let Some(out) = out.get_mut(rows)
         {
             surface.add_transposed_products(k, a, w, out);
-        }
-        if let Some((a, rows)) = window(s, f)
-            && let Some(out) = out.get_mut(rows)
-        {
-            let start = k * (f - s) + (a - s);
-            self.table.interior_blocks().add_products(start, k, w, out);
         }
     }
 }
