@@ -16,6 +16,8 @@
 #   tools/cycles-check.sh --all   every trajectory of the three (about 8 minutes)
 #   tools/cycles-check.sh --profile N   also each run's worst tick by class and
 #                                 its N costliest functions
+#   tools/cycles-check.sh --model M   only model M (precomputed, dynamic or
+#                                 hybrid; repeatable)
 #   tools/cycles-check.sh --target-report-only   report a pre-computed 4-contact
 #                                 tick above TARGET_CYCLES without failing
 #                                 (.ci/run, until the kernel meets it)
@@ -32,14 +34,16 @@ TARGET_CYCLES=16800
 WAIT_STATES=5
 
 all=0
+only_models=()
 profile=()
 target_flag=--limit
 while [ $# -gt 0 ]; do
     case "$1" in
         --all) all=1 ;;
         --profile) profile=(--profile "$2"); shift ;;
+        --model) only_models+=("$2"); shift ;;
         --target-report-only) target_flag=--warn-limit ;;
-        *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--target-report-only]" >&2; exit 2 ;;
+        *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--model M]... [--target-report-only]" >&2; exit 2 ;;
     esac
     shift
 done
@@ -55,6 +59,20 @@ models=(
     "dynamic tools/cycles-m4f/dynamic.toml dynamic"
     "hybrid tools/cycles-m4f/hybrid.toml hybrid"
 )
+if [ ${#only_models[@]} -gt 0 ]; then
+    chosen=()
+    for spec in "${models[@]}"; do
+        read -r model _ <<<"$spec"
+        for m in "${only_models[@]}"; do
+            [ "$m" = "$model" ] && chosen+=("$spec")
+        done
+    done
+    if [ ${#chosen[@]} != ${#only_models[@]} ]; then
+        echo "--model: one of precomputed, dynamic, hybrid" >&2
+        exit 2
+    fi
+    models=("${chosen[@]}")
+fi
 
 status=0
 pids=()

@@ -8,9 +8,10 @@
 //! (`Ir`, deterministic: the same binary and input give the same count).
 //!
 //! Bound (instructions): `BASE + P · (TRIANGLE · D + WALK · MAX_WALK_STEPS +
-//! TRACK) + (P + 1) · SOLVE · M³`, with `D = 2 · max_query_triangles` the
+//! TRACK) + (P + 1) · SOLVE · M³`, with `D = 3 · max_query_triangles` the
 //! worst-case triangle tests of one detection (two point queries, the
-//! sweep's and the penetration test's sharing the one at the tool; the
+//! sweep's and the penetration test's sharing the one at the tool, and the
+//! penetration test's second pass at the tool; the
 //! table-declared maximum over all grid cells, computed at load), `P` tool
 //! points, `M` the contact capacity and `P + 1` the most solves a tick can
 //! do. The unit costs are the largest per-unit costs callgrind measured on
@@ -129,7 +130,7 @@ pub fn tick_bound(
     points: u64,
     capacity: u64,
 ) -> u64 {
-    let detection = 2 * u64::from(table.surface_index().max_query_triangles());
+    let detection = 3 * u64::from(table.surface_index().max_query_triangles());
     costs.base
         + points
             * (costs.triangle * detection + costs.walk * u64::from(MAX_WALK_STEPS) + costs.track)

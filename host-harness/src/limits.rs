@@ -13,10 +13,21 @@
 //! - `palpate bench`: [`MAX_BENCH_SAMPLES`] and [`MAX_BENCH_SAMPLE_S`] per measurement, and the
 //!   run's estimated duration against [`MAX_BENCH_ESTIMATE_S`] (`bench::run::check`), before any
 //!   table is built; its pre-computed table is checked as any table build.
+//! - `palpate chart`: its work bound (`chart::Matrix::tet_step_bound` and the volume
+//!   experiments') against [`MAX_CHART_TET_STEPS`].
 
 use std::fs::File;
 use std::io::{self, Read};
 use std::path::Path;
+
+/// Most tet-steps (one tet's force evaluation) `palpate chart` may run, counted with every
+/// relaxation at its step cap: 2·10¹⁰.
+///
+/// A St Venant-Kirchhoff step with the penalty costs about 20–60 ns per tet (measured on the
+/// chart's 3×15 cylinder, f64), so the bound is 7–20 minutes of worst case on one core; the
+/// full matrix's bound is under a third of it, and its relaxations settle far below their cap.
+/// A matrix made larger in code (more meshes, finer ones) is refused before it starts.
+pub const MAX_CHART_TET_STEPS: u64 = 20_000_000_000;
 
 /// Largest haptic rate a scene accepts (`[rates] haptic_hz`), Hz.
 ///

@@ -254,3 +254,52 @@ fn a_far_sample_then_a_return_inside_is_detected() {
         }
     }
 }
+
+/// A tool over a thin flap (4 mm thick, radius 10 mm), found where it
+/// stands (no earlier position, so the penetration test alone decides):
+/// 15 mm above the top face it is outside, although its centre lies within
+/// two radii behind the bottom face's plane (19 mm), because the top face
+/// is the nearer plane over the centre (`SurfaceGeometry::detect`: the
+/// second pass, which runs only for such a nearer plane the sphere does not
+/// reach); 5 mm above the top face it touches the top face, with the entry
+/// gap its penetration, −5 mm.
+#[test]
+fn a_tool_over_a_thin_flap_touches_only_the_face_it_reaches() {
+    use palpate::table::build::{BuildOptions, build};
+    const SIDE_M: f64 = 0.1;
+    const THICKNESS_M: f64 = 0.004;
+    const RADIUS_M: f64 = 0.01;
+    let (positions, tets) = palpate_tests::kuhn_box([4, 4, 1]);
+    let positions = positions
+        .iter()
+        .map(|p| [p[0] * SIDE_M, p[1] * SIDE_M, p[2] * THICKNESS_M])
+        .collect();
+    let (mesh, report) =
+        palpate::mesh::TetMesh::new_validated(positions, tets, "flap").expect("flap mesh");
+    let options = BuildOptions::precomputed(
+        palpate::fem::material::Material::new(5000.0, 0.45).expect("material"),
+        vec!["x<0.001".parse().expect("predicate")],
+        palpate::table::compliance::Solver::Cholesky,
+        Precision::F64,
+    );
+    let built = build(&mesh, &report, &options).expect("build flap table");
+    let file = palpate::table::load::TableFile::from_bytes(&built.bytes);
+    let table = PrecomputedTable::<f64>::load(file.bytes()).expect("flap table");
+    let config = LoopConfig {
+        radius_m: RADIUS_M,
+        ..config()
+    };
+    // Off every vertex and edge of the top face's triangles.
+    let at = |height_m: f64| Vector3::new(0.061, 0.043, THICKNESS_M + height_m);
+    let mut haptic =
+        PrecomputedLoop::<f64, 1, 1>::new(PrecomputedTissue::new(&table), config).expect("loop");
+    let hovering = haptic.tick(&[at(1.5 * RADIUS_M)]);
+    assert_eq!(hovering.contacts, 0, "{:?}", haptic.contacts()[0]);
+    let mut haptic =
+        PrecomputedLoop::<f64, 1, 1>::new(PrecomputedTissue::new(&table), config).expect("loop");
+    let touching = haptic.tick(&[at(0.5 * RADIUS_M)]);
+    assert_eq!(touching.contacts, 1);
+    let c = haptic.contacts()[0].expect("contact");
+    assert!((c.normal - Vector3::z()).norm() < 1e-12, "{c:?}");
+    assert!((c.entry_gap_m + 0.5 * RADIUS_M).abs() < 1e-12, "{c:?}");
+}

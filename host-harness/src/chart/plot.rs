@@ -1,7 +1,8 @@
 //! The charts of `palpate chart`, drawn with `plotters` in SVG and PNG
 //! (the PNG encoded by the `png` crate), text in DejaVu Sans embedded in
-//! the binary (`assets/fonts`, Bitstream Vera licence). Files are written
-//! atomically.
+//! the binary (`assets/fonts`, Bitstream Vera licence): rasterized in the
+//! PNGs, glyph outlines in the SVGs ([`super::svg_text`]), so neither needs
+//! a font where it is viewed. Files are written atomically.
 
 use std::path::Path;
 use std::sync::Once;
@@ -10,6 +11,9 @@ use anyhow::Context;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use palpate_kernel::tensor_mass::Integrator;
+
+use super::report::trajectory_points;
 use super::select::pareto_front;
 use super::stability::{Map, Outcome};
 use super::{Load, Model, Study};
@@ -42,6 +46,7 @@ macro_rules! render {
             $chart(&root)?;
             root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
         }
+        let svg = super::svg_text::outline_text(&svg, FONT)?;
         write_file(&$dir.join(format!("{}.svg", $name)), svg.as_bytes())?;
         let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
         {
@@ -112,6 +117,16 @@ pub fn draw_all(
             ))?;
             names.push(name);
         }
+    }
+    for &load in loads {
+        if !study.trajectories.iter().any(|t| t.load == load) {
+            continue;
+        }
+        let name = format!("trajectory-{}", load.name());
+        render!(dir, name, |root: &DrawingArea<_, Shift>| trajectory_chart(
+            root, study, load
+        ))?;
+        names.push(name);
     }
     render!(dir, "cost-mesh", |root: &DrawingArea<_, Shift>| cost_mesh(
         root, study
@@ -216,7 +231,129 @@ fn pareto<DB: DrawingBackend>(
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// A colour per integrator (by its CLI name).
+fn integrator_colour(name: &str) -> RGBColor {
+    match name {
+        "euler" => RGBColor(214, 39, 40),
+        "symplectic" => RGBColor(31, 119, 180),
+        "rk4" => RGBColor(44, 160, 44),
+        _ => RGBColor(148, 103, 189),
+    }
+}
+
+/// The trajectory error against the compute time per simulated second
+/// for one load: colour by integrator, shape by model (circle linear,
+/// triangle St Venant-Kirchhoff, square with the penalty), the Pareto
+/// front joined. Diverged runs have no point (the report lists them).
+fn trajectory_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    study: &Study,
+    load: Load,
+) -> Drawn {
+    root.fill(&WHITE).map_err(err)?;
+    let (runs, points) = trajectory_points(study, load);
+    let front = pareto_front(&points);
+    let x = log_range(points.iter().map(|p| p.0));
+    let y = log_range(points.iter().map(|p| p.1));
+    let level = runs.first().map_or(0.0, |t| t.level);
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!(
+                "{} at {:.0} %: trajectory error vs Δt/16, against cost",
+                load.name(),
+                100.0 * level
+            ),
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("compute time per simulated second, s (f64)")
+        .y_desc("trajectory error (relative L2, max over time)")
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(err)?;
+    let mut on_front: Vec<(f64, f64)> = points
+        .iter()
+        .zip(&front)
+        .filter(|(_, f)| **f)
+        .map(|(p, _)| *p)
+        .collect();
+    on_front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    chart
+        .draw_series(LineSeries::new(on_front, BLACK.stroke_width(1)))
+        .map_err(err)?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    for integrator in Integrator::ALL.map(Integrator::name) {
+        let colour = integrator_colour(integrator);
+        let series: Vec<_> = runs
+            .iter()
+            .zip(&points)
+            .zip(&front)
+            .filter(|((t, _), _)| t.integrator == integrator)
+            .map(|((t, p), f)| (*p, *f, t.model, t.mesh.clone()))
+            .collect();
+        let label = if series.is_empty() {
+            format!("{integrator} (no run within its limit)")
+        } else {
+            integrator.to_string()
+        };
+        chart
+            .draw_series(series.into_iter().map(|(p, f, model, mesh)| {
+                let style = if f {
+                    colour.filled()
+                } else {
+                    colour.stroke_width(2)
+                };
+                let marker: DynElement<'static, DB, (i32, i32)> = match model {
+                    Model::Stvk => TriangleMarker::new((0, 0), 7, style).into_dyn(),
+                    Model::StvkPenalty => Rectangle::new([(-5, -5), (5, 5)], style).into_dyn(),
+                    _ => Circle::new((0, 0), 5, style).into_dyn(),
+                };
+                EmptyElement::at(p) + marker + Text::new(mesh, (8, -6), ("sans-serif", 11))
+            }))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
+    }
+    // The shapes' legend (no points of their own).
+    let grey = RGBColor(120, 120, 120);
+    let none = || core::iter::empty::<Circle<(f64, f64), i32>>();
+    chart
+        .draw_series(none())
+        .map_err(err)?
+        .label(Model::TensorMassLinear.name())
+        .legend(move |(x, y)| Circle::new((x + 8, y), 5, grey.stroke_width(2)));
+    chart
+        .draw_series(none())
+        .map_err(err)?
+        .label(Model::Stvk.name())
+        .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 7, grey.stroke_width(2)));
+    chart
+        .draw_series(none())
+        .map_err(err)?
+        .label(Model::StvkPenalty.name())
+        .legend(move |(x, y)| {
+            Rectangle::new([(x + 3, y - 5), (x + 13, y + 5)], grey.stroke_width(2))
+        });
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerLeft)
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;
@@ -278,7 +415,9 @@ fn cost_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, study: &Study) -
         .map_err(err)?;
     chart
         .configure_mesh()
+        .x_labels(6)
         .x_desc("vertices")
+        .x_label_formatter(&|v| format!("{v:.0}"))
         .y_desc("time per step, s (f64)")
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
@@ -341,6 +480,8 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
         .map_err(err)?;
     chart
         .configure_mesh()
+        .x_labels(6)
+        .y_labels(6)
         .x_desc("Young's modulus E, Pa")
         .y_desc("time step, s")
         .x_label_formatter(&|v| format!("{v:.0e}"))
@@ -396,7 +537,7 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerLeft)
+        .position(SeriesLabelPosition::UpperRight)
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;

@@ -5,6 +5,7 @@ use core::fmt::Write;
 use super::plot::{cost_series, log_slope};
 use super::select::{cheapest_within, pareto_front};
 use super::stability::Outcome;
+use super::trajectory::{REFINEMENT, Trajectory};
 use super::{Load, Model, Run, Study};
 
 /// Error bounds of the report's "cheapest within" columns.
@@ -23,6 +24,37 @@ pub fn points(study: &Study, load: Load, level: f64) -> (Vec<&Run>, Vec<(f64, f6
         .map(|r| (r.step_s, r.tip_error.unwrap_or(f64::NAN)))
         .collect();
     (runs, points)
+}
+
+/// The trajectories of one load with an error, as (cost, error) points:
+/// compute time per simulated second (s) and trajectory error.
+pub fn trajectory_points(study: &Study, load: Load) -> (Vec<&Trajectory>, Vec<(f64, f64)>) {
+    let runs: Vec<&Trajectory> = study
+        .trajectories
+        .iter()
+        .filter(|t| t.load == load && t.error.is_some())
+        .collect();
+    let points = runs
+        .iter()
+        .map(|t| (t.cost_per_simulated_s, t.error.unwrap_or(f64::NAN)))
+        .collect();
+    (runs, points)
+}
+
+/// The cheapest trajectory of `load` within `bound`, `model, integrator at
+/// Δt on mesh`, or `None`.
+pub fn cheapest_trajectory(study: &Study, load: Load, bound: f64) -> Option<String> {
+    let (runs, points) = trajectory_points(study, load);
+    cheapest_within(&points, bound).map(|i| {
+        let t = runs[i];
+        format!(
+            "{}, {} at {:.2} ms on {}",
+            t.model.name(),
+            t.integrator,
+            1e3 * t.dt_s,
+            t.mesh
+        )
+    })
 }
 
 /// `model on mesh` of the cheapest run within `bound`, or `none`.
@@ -118,6 +150,7 @@ pub fn markdown(
             r.fault.as_deref().unwrap_or("")
         );
     }
+    trajectories(&mut out, study, loads);
     let _ = writeln!(out, "\n## Where the methods fail\n");
     for line in failures(study) {
         let _ = writeln!(out, "- {line}");
@@ -142,6 +175,59 @@ pub fn markdown(
         let _ = writeln!(out, "![{name}]({name}.png)\n");
     }
     out
+}
+
+/// The trajectories' section: the cheapest within each bound per load,
+/// then every trajectory.
+fn trajectories(out: &mut String, study: &Study, loads: &[Load]) {
+    if study.trajectories.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "\n## Dynamic runs: trajectory error against Δt/{REFINEMENT}\n\n\
+         Each tensor-mass model and integrator, the load applied at rest, {} s simulated with \
+         damping {} 1/s, against the same model and integrator at a step {REFINEMENT}× smaller: \
+         error = max over the steps of ‖u − u_ref‖₂ / max ‖u_ref‖₂; cost = time per step / Δt \
+         (compute seconds per simulated second, f64).\n",
+        super::trajectory::DURATION_S,
+        super::stability::DAMPING_PER_S
+    );
+    let _ = writeln!(
+        out,
+        "| load | cheapest within 1 % | within 5 % | within 20 % |\n|---|---|---|---|"
+    );
+    for &load in loads {
+        let cell = |b: f64| cheapest_trajectory(study, load, b).unwrap_or_else(|| "none".into());
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} |",
+            load.name(),
+            cell(BOUNDS[0]),
+            cell(BOUNDS[1]),
+            cell(BOUNDS[2])
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\n| mesh | load | model | integrator | Δt ms | Δt·ω_max/2 | error | step µs | s per simulated s | fault |\n|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for t in &study.trajectories {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {:.3} | {:.2} | {} | {:.2} | {:.3} | {} |",
+            t.mesh,
+            t.load.name(),
+            t.model.name(),
+            t.integrator,
+            1e3 * t.dt_s,
+            t.dt_factor,
+            t.error.map_or("-".into(), |e| format!("{e:.2e}")),
+            1e6 * t.step_s,
+            t.cost_per_simulated_s,
+            t.fault.as_deref().unwrap_or("")
+        );
+    }
 }
 
 /// The failure regions, in words, from the runs and the maps.

@@ -163,19 +163,30 @@ pub fn maps(
     Ok(maps)
 }
 
-/// Builds the f64 model of `body` with `material` and `law` and runs `f`.
+/// Builds the f64 model of `body` with `material` and `law`, damping
+/// [`DAMPING_PER_S`], and runs `f`.
 fn with_model<R>(
     body: &Body,
     material: Material,
     law: ElasticLaw,
     f: impl FnOnce(&mut TensorMassModel<'_, '_, f64>) -> anyhow::Result<R>,
 ) -> anyhow::Result<R> {
+    let params =
+        DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions)).with_law(law);
+    with_params(body, material, params, f)
+}
+
+/// Builds the f64 model of `body` with `material` and `params` and runs `f`.
+pub(super) fn with_params<R>(
+    body: &Body,
+    material: Material,
+    params: DynamicParams<f64>,
+    f: impl FnOnce(&mut TensorMassModel<'_, '_, f64>) -> anyhow::Result<R>,
+) -> anyhow::Result<R> {
     let materials = TetMaterials::uniform(material, body.mesh.tets.len());
     let file = static_study_table(&body.mesh, &materials, body.fixed.clone());
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
-    let params =
-        DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions)).with_law(law);
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     f(&mut model)
 }

@@ -241,6 +241,18 @@ pub fn inverted_tets(mesh: &TetMesh, u: &[[f64; 3]]) -> usize {
         .count()
 }
 
+/// Relaxations [`run_scene`] runs at most (each of at most
+/// `controls.max_steps` steps): under [`Protocol::PaperLoads`] the probe of
+/// the unit force and three models per stage; under [`Protocol::Tilt`] per
+/// stage the force search's two first evaluations and
+/// `controls.max_iterations` secant ones, then three models.
+pub fn relaxations_bound(scene: &Scene, protocol: Protocol, controls: &Controls) -> usize {
+    match protocol {
+        Protocol::PaperLoads => 1 + 3 * scene.paper_loads.multiples.len(),
+        Protocol::Tilt => scene.targets.len() * (controls.max_iterations + 2 + 3),
+    }
+}
+
 /// Runs every stage of `scene` under `protocol`; `progress` receives one
 /// line per relaxation.
 pub fn run_scene(

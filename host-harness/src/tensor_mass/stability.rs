@@ -21,7 +21,7 @@ pub const TRIAL_STEPS: usize = 2000;
 /// `1/(1 − (ωΔt/2)²)`), while an unstable mode grows without bound.
 pub const ENERGY_GROWTH_LIMIT: f64 = 1e6;
 /// Bisection halvings of the bracket (relative width 2⁻³⁰ of the start).
-const BISECTIONS: usize = 30;
+pub const BISECTIONS: usize = 30;
 
 /// The JSON object `dynamic critical-dt --json` prints.
 #[derive(Serialize, Debug)]
@@ -116,8 +116,44 @@ pub fn is_stable(
     true
 }
 
+/// The scale of the displacement fields whose forces give `K x` in
+/// [`omega_max`] and [`lanczos_omega_max`] (`x` has unit norm): `2⁻³⁰`, so a
+/// field of about 1 nm, where a non-linear law (St Venant-Kirchhoff, its
+/// penalty) is its tangent at rest to ~1e-7 relative. A power of two, so a
+/// linear law's `K x` is bit-identical to the unscaled product. At a unit
+/// (metre) scale a St Venant-Kirchhoff model's cubic terms dominated and
+/// the estimate was ×140 too high on the 2×10 chart cylinder.
+const TANGENT_SCALE: f64 = 1.0 / (1u64 << 30) as f64;
+
+/// `K x` of the tangent stiffness at rest, `out = −K x` (N per m): the
+/// elastic forces of the field `x` scaled by [`TANGENT_SCALE`], less
+/// `at_rest` (the forces of the zero field: a hybrid's passed force),
+/// unscaled.
+fn rest_tangent_forces(
+    model: &TensorMassModel<'_, '_, f64>,
+    at_rest: &[[f64; 3]],
+    x: &mut [[f64; 3]],
+    out: &mut [[f64; 3]],
+) {
+    x.iter_mut().for_each(|v| *v = v.map(|c| c * TANGENT_SCALE));
+    model.elastic_forces_of(x, out);
+    x.iter_mut().for_each(|v| *v = v.map(|c| c / TANGENT_SCALE));
+    for (f, f0) in out.iter_mut().zip(at_rest) {
+        *f = [0, 1, 2].map(|k| (f[k] - f0[k]) / TANGENT_SCALE);
+    }
+}
+
+/// The elastic forces (N) of the zero displacement field.
+fn forces_at_rest(model: &TensorMassModel<'_, '_, f64>) -> Vec<[f64; 3]> {
+    let n = model.modes().len();
+    let mut f = vec![[0.0; 3]; n];
+    model.elastic_forces_of(&vec![[0.0; 3]; n], &mut f);
+    f
+}
+
 /// `ω_max = sqrt(λ_max(M⁻¹K))` by power iteration (500 iterations from the
-/// [`perturbation`] pattern), rad/s.
+/// [`perturbation`] pattern), rad/s, `K` the tangent stiffness at rest
+/// ([`rest_tangent_forces`]; the stiffness itself for the linear law).
 pub fn omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     model.reset();
     let n = model.modes().len();
@@ -134,9 +170,10 @@ pub fn omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
         })
         .collect();
     let mut f = vec![[0.0; 3]; n];
+    let at_rest = forces_at_rest(model);
     let mut lambda = 0.0;
     for _ in 0..500 {
-        model.elastic_forces_of(&x, &mut f);
+        rest_tangent_forces(model, &at_rest, &mut x, &mut f);
         let mut norm = 0.0;
         for v in 0..n {
             let y = if free[v] {
@@ -438,8 +475,8 @@ fn rk4_radius(re: f64, im: f64) -> f64 {
 /// [`omega_max`] when the top of the spectrum is clustered, as on a fine
 /// mesh. Stops when the Ritz value grew by at most [`LANCZOS_TOLERANCE`]
 /// over [`LANCZOS_WINDOW`] steps, at an invariant subspace, or after
-/// [`LANCZOS_MAX_STEPS`] steps. `K` is the model's current stiffness (its
-/// elastic forces at rest; use the linear law).
+/// [`LANCZOS_MAX_STEPS`] steps. `K` is the model's tangent stiffness at
+/// rest ([`rest_tangent_forces`]).
 pub fn lanczos_omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     model.reset();
     let n = model.modes().len();
@@ -479,12 +516,13 @@ pub fn lanczos_omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut ritz: Vec<f64> = Vec::new();
     let mut beta_previous = 0.0;
+    let at_rest = forces_at_rest(model);
     for _ in 0..LANCZOS_MAX_STEPS {
         // w = M^{-1/2} K M^{-1/2} q, with K u = -(elastic forces of u).
         for v in 0..n {
             x[v] = q[v].map(|c| c * inv_sqrt_mass[v]);
         }
-        model.elastic_forces_of(&x, &mut w);
+        rest_tangent_forces(model, &at_rest, &mut x, &mut w);
         for v in 0..n {
             w[v] = w[v].map(|c| -c * inv_sqrt_mass[v]);
         }

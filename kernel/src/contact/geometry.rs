@@ -110,6 +110,122 @@ struct Face<T: Real> {
     normal: Vector3<T>,
 }
 
+/// The nearest plane the penetration test found under a sphere's centre.
+struct Nearest<T> {
+    /// Signed distance of the centre from the plane, m.
+    distance_m: T,
+    triangle: TriangleIndex,
+    weights: [T; 3],
+    /// Its place in the order the candidates were tested.
+    order: u32,
+}
+
+/// Planes the penetration test kept that the sphere does not reach.
+const UNREACHED_CAPACITY: usize = 16;
+
+/// The penetration test's planes within the depth reach that the sphere
+/// does not reach (signed distance at least the radius): their nearest
+/// distance, and the first [`UNREACHED_CAPACITY`] of them with their place
+/// in the test order, so that the check of [`SurfaceGeometry::detect`]
+/// (is one of them over the centre, nearer than the nearest reached?)
+/// needs no second pass unless more came.
+struct Unreached<T> {
+    nearest_m: Option<T>,
+    planes: heapless::Vec<(TriangleIndex, Vector3<T>, T, u32), UNREACHED_CAPACITY>,
+    overflowed: bool,
+}
+
+impl<T: Real> Unreached<T> {
+    fn new() -> Self {
+        Self {
+            nearest_m: None,
+            planes: heapless::Vec::new(),
+            overflowed: false,
+        }
+    }
+
+    /// Notes triangle `t` (unit `normal`), `distance_m` from the centre,
+    /// the `order`-th tested.
+    fn note(&mut self, t: TriangleIndex, normal: Vector3<T>, distance_m: T, order: u32) {
+        if self.nearest_m.is_none_or(|u| distance_m < u) {
+            self.nearest_m = Some(distance_m);
+        }
+        if self.planes.push((t, normal, distance_m, order)).is_err() {
+            self.overflowed = true;
+        }
+    }
+
+    /// Whether a plane `distance_m` away, the `k`-th tested, comes before
+    /// the nearest reached plane (`bound_m` away, the `order`-th): nearer,
+    /// or as near and tested first.
+    fn nearer(distance_m: T, k: u32, bound_m: T, order: u32) -> bool {
+        distance_m < bound_m || (distance_m == bound_m && k < order)
+    }
+}
+
+/// Distinct triangles one detection remembers having tested: the 27-cell
+/// visit meets a triangle once per corner in those cells, and tests it
+/// once. A power of two; a detection on the built-in block tests at most
+/// 48 (`tools/cycles-check.sh`, the triangles tested per tick), and a
+/// larger candidate set is still correct, with repeated tests beyond the
+/// set's three quarters.
+const VISITED_CAPACITY: usize = 128;
+
+/// The triangles a detection has tested: an open-addressed set on the
+/// stack (linear probing), filled to at most three quarters so that a
+/// look-up ends after a few probes. Past that a triangle is let through
+/// again, with no probe, which changes nothing: every test keeps the first
+/// of equals.
+struct Visited {
+    slots: [u32; VISITED_CAPACITY],
+    len: usize,
+}
+
+impl Visited {
+    const EMPTY: u32 = u32::MAX;
+    /// Most triangles remembered.
+    const MAX_LEN: usize = VISITED_CAPACITY / 4 * 3;
+    /// Bits of the multiplicative hash's slot index.
+    const SHIFT: u32 = {
+        assert!(VISITED_CAPACITY.is_power_of_two() && VISITED_CAPACITY >= 4);
+        32 - VISITED_CAPACITY.trailing_zeros()
+    };
+
+    fn new() -> Self {
+        Self {
+            slots: [Self::EMPTY; VISITED_CAPACITY],
+            len: 0,
+        }
+    }
+
+    /// `true` the first time `t` is offered (or when the set is full),
+    /// `false` after. At most `VISITED_CAPACITY` probes, a few at the
+    /// set's load.
+    fn first_visit(&mut self, t: TriangleIndex) -> bool {
+        if self.len >= Self::MAX_LEN {
+            return true;
+        }
+        let key = t.get() as u32;
+        // Fibonacci hashing: the top bits of the product.
+        let mut i = (key.wrapping_mul(0x9E37_79B9) >> Self::SHIFT) as usize;
+        for _ in 0..VISITED_CAPACITY {
+            let Some(slot) = self.slots.get_mut(i) else {
+                return true;
+            };
+            if *slot == key {
+                return false;
+            }
+            if *slot == Self::EMPTY {
+                *slot = key;
+                self.len += 1;
+                return true;
+            }
+            i = (i + 1) % VISITED_CAPACITY;
+        }
+        true
+    }
+}
+
 /// Barycentric weights of `x`'s projection onto the plane of `c`.
 fn barycentric<T: Real>(c: &[Vector3<T>; 3], normal: &Vector3<T>, x: &Vector3<T>) -> [T; 3] {
     let [a, b, cc] = c;
@@ -254,10 +370,12 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// Candidates: the triangles around the surface vertices in the 27 grid
     /// cells around `to_m` and, for the sweep, around `from_m` (once when
     /// both are in the same cell; none for a point more than a cell plus
-    /// the radius outside the grid). Bounded by `2 × max_query_triangles`
-    /// triangle tests, most rejected by two dot products with the stored
-    /// plane; the sweep and the penetration test share the visit of the
-    /// cells around `to_m`.
+    /// the radius outside the grid), each tested once however many of its
+    /// corners the cells hold. Bounded by `3 × max_query_triangles`
+    /// triangle tests (the cells around `to_m` and `from_m`, and the
+    /// penetration test's second pass), most rejected by three dot products
+    /// with the stored plane; the sweep and the penetration test share the
+    /// visit of the cells around `to_m`.
     ///
     /// Sweep: an end outside that reach is first moved along the segment to
     /// where the segment leaves it ([`clip_towards`], computed from the end
@@ -268,11 +386,16 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// Penetration (the surface moved onto the tool): among the triangles
     /// around `to_m` whose plane lies within [`PENETRATION_DEPTH_RADII`]
     /// radii of the centre and has the centre's projection inside the
-    /// triangle, the one with the nearest plane (the lowest index of
+    /// triangle, the one with the nearest plane (the first tested of
     /// equals) decides; if the sphere reaches behind it (signed gap < 0)
     /// that is the contact, pushed out along its outward normal, with
     /// [`Contact::entry_gap_m`] its penetration; else there is none (also
-    /// when the nearest is a rigid support).
+    /// when the nearest is a rigid support). A barycentric test is spent
+    /// only on planes the sphere reaches, and on the others only when one
+    /// of them is nearer than the nearest reached ([`Unreached`], or a
+    /// second pass, [`Self::covered`], when more than it keeps came): a
+    /// tool hovering within the depth reach costs three dot products per
+    /// candidate.
     pub fn detect(
         &self,
         tool: usize,
@@ -285,7 +408,10 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let to_in = within(to_m, &reach);
         let sweep = from_m.map(|from_m| {
             let from_in = within(from_m, &reach);
-            let same_cell = self.index.cell_of(from_m) == self.index.cell_of(to_m);
+            let ([a, b, c], [x, y, z]) = (self.index.cell_of(from_m), self.index.cell_of(to_m));
+            // Corner by corner: an array comparison is a `memcmp` call on
+            // the firmware target.
+            let same_cell = a == x && b == y && c == z;
             // The swept segment, clipped to the reach of the grid when
             // exactly one end lies outside it (both outside: no candidate).
             let (start_m, end_m) = match (from_in, to_in) {
@@ -295,40 +421,65 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             };
             (start_m, end_m, (!same_cell && from_in).then_some(*from_m))
         });
+        let depth_m = radius_m * T::of_f64(PENETRATION_DEPTH_RADII);
         let mut hit = None;
-        let mut nearest = None;
-        let mut visit = |around: &Vector3<T>, penetration: bool, work: &mut ContactWork| {
-            for v in self.index.vertices_near(around) {
-                for t in self.index.triangles_of(v) {
-                    work.triangles_tested = work.triangles_tested.saturating_add(1);
-                    let Some((normal, offset)) = self.index.plane(t) else {
-                        continue;
-                    };
-                    if let Some((start_m, end_m, _)) = &sweep {
-                        let segment = [*start_m, *end_m];
-                        self.sweep_test(t, normal, offset, &segment, radius_m, &mut hit);
-                    }
-                    if penetration {
-                        self.nearest_test(t, normal, offset, to_m, radius_m, &mut nearest);
+        // Penetration, in one pass over the candidates: the nearest plane
+        // the sphere reaches (signed distance below the radius), and the
+        // nearest distance of the planes it does not reach, which only
+        // matter if one of them lies over the centre nearer than that one.
+        let mut reached = None;
+        let mut unreached = Unreached::new();
+        let mut visited = Visited::new();
+        if to_in {
+            let mut order = 0u32;
+            self.visit(to_m, &mut visited, work, |t, normal, offset| {
+                if let Some((start_m, end_m, _)) = &sweep {
+                    let segment = [*start_m, *end_m];
+                    self.sweep_test(t, normal, offset, &segment, radius_m, &mut hit);
+                }
+                let distance = normal.dot(to_m) - offset;
+                if distance.abs() <= depth_m && normal != Vector3::zeros() {
+                    if distance < radius_m {
+                        self.nearest_test(t, normal, distance, to_m, order, &mut reached);
+                    } else {
+                        unreached.note(t, normal, distance, order);
                     }
                 }
-            }
-        };
-        if to_in {
-            visit(to_m, true, work);
+                order = order.wrapping_add(1);
+            });
         }
-        if let Some((_, _, Some(from_m))) = &sweep {
-            visit(from_m, false, work);
+        if let Some((start_m, end_m, Some(from_m))) = &sweep {
+            let segment = [*start_m, *end_m];
+            self.visit(from_m, &mut visited, work, |t, normal, offset| {
+                self.sweep_test(t, normal, offset, &segment, radius_m, &mut hit);
+            });
         }
         if let Some((_, triangle, weights)) = hit {
             let face = self.face(triangle)?;
             return Some(self.contact(tool, triangle, &face, weights, to_m, radius_m));
         }
-        let (distance, triangle, weights) = nearest?;
+        let Nearest {
+            distance_m,
+            triangle,
+            weights,
+            order,
+        } = reached?;
+        let bound_m = distance_m.abs();
+        if unreached.nearest_m.is_some_and(|u| u <= bound_m) {
+            let covered = if unreached.overflowed {
+                self.covered(to_m, radius_m, depth_m, bound_m, order, work)
+            } else {
+                unreached.planes.iter().any(|&(t, normal, distance, k)| {
+                    Unreached::nearer(distance, k, bound_m, order)
+                        && self.over(t, &normal, distance, to_m)
+                })
+            };
+            if covered {
+                return None;
+            }
+        }
         let face = self.face(triangle)?;
-        if distance - radius_m >= T::zero()
-            || face.vertices.iter().all(|&v| self.supports.is_fixed(v))
-        {
+        if face.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
             return None;
         }
         let contact = self.contact(tool, triangle, &face, weights, to_m, radius_m);
@@ -338,9 +489,36 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         })
     }
 
+    /// Calls `test(triangle, normal, offset)` once for each surface
+    /// triangle around the surface vertices in the 27 grid cells around
+    /// `around` (m) that `visited` has not met, with its stored plane; a
+    /// triangle is around up to three of the vertices, and is tested at the
+    /// first. Counts the tests in `work`.
+    fn visit(
+        &self,
+        around: &Vector3<T>,
+        visited: &mut Visited,
+        work: &mut ContactWork,
+        mut test: impl FnMut(TriangleIndex, Vector3<T>, T),
+    ) {
+        self.index.for_each_vertex_near(around, |v| {
+            for t in self.index.triangles_of(v) {
+                if !visited.first_visit(t) {
+                    continue;
+                }
+                let Some((normal, offset)) = self.index.plane(t) else {
+                    continue;
+                };
+                work.triangles_tested = work.triangles_tested.saturating_add(1);
+                test(t, normal, offset);
+            }
+        });
+    }
+
     /// The sweep's test of triangle `t` (plane `normal`, `offset`) against
     /// the sphere moving along `segment`: keeps in `best` the earliest hit
     /// from outside, as `(along, triangle, weights)`.
+    #[inline(always)]
     fn sweep_test(
         &self,
         t: TriangleIndex,
@@ -350,17 +528,33 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         radius_m: T,
         best: &mut Option<(T, TriangleIndex, [T; 3])>,
     ) {
-        let tolerance = T::WEIGHT_TOLERANCE;
         // A start exactly touching the surface may round to just inside it.
-        let slack_m = tolerance * self.index.cell_m();
+        let slack_m = T::WEIGHT_TOLERANCE * self.index.cell_m();
         let [start_m, end_m] = segment;
         // The stored plane first: two dot products reject almost all.
         let s0 = normal.dot(start_m) - offset - radius_m;
         let s1 = normal.dot(end_m) - offset - radius_m;
-        if !(s0 >= -slack_m && s1 < T::zero()) {
-            return;
+        if s0 >= -slack_m && s1 < T::zero() {
+            self.sweep_hit(t, normal, [s0, s1], segment, radius_m, best);
         }
-        let s0 = s0.max(T::zero());
+    }
+
+    /// The rest of [`Self::sweep_test`] for a segment that crosses the
+    /// plane (signed distances `s` of its ends from the plane, less the
+    /// radius): the crossing point's barycentric weights.
+    fn sweep_hit(
+        &self,
+        t: TriangleIndex,
+        normal: Vector3<T>,
+        s: [T; 2],
+        segment: &[Vector3<T>; 2],
+        radius_m: T,
+        best: &mut Option<(T, TriangleIndex, [T; 3])>,
+    ) {
+        let tolerance = T::WEIGHT_TOLERANCE;
+        let [start_m, end_m] = segment;
+        let [s0, s1] = s;
+        let s0 = s0.larger(T::zero());
         let along = s0 / (s0 - s1);
         if best.as_ref().is_some_and(|(b, _, _)| *b <= along) {
             return;
@@ -376,35 +570,83 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         }
     }
 
-    /// The penetration test of triangle `t` (plane `normal`, `offset`)
-    /// against a sphere centred at `tip_m`: keeps in `nearest` the triangle
-    /// with the nearest plane under the centre, as `(signed distance of the
-    /// centre, triangle, weights)`.
+    /// The penetration test of triangle `t` (unit `normal`), whose plane
+    /// lies `distance_m` from the centre `tip_m`, the `order`-th tested:
+    /// keeps in `nearest` the triangle with the nearest plane under the
+    /// centre (the first tested of equals).
     fn nearest_test(
         &self,
         t: TriangleIndex,
         normal: Vector3<T>,
-        offset: T,
+        distance_m: T,
         tip_m: &Vector3<T>,
-        radius_m: T,
-        nearest: &mut Option<(T, TriangleIndex, [T; 3])>,
+        order: u32,
+        nearest: &mut Option<Nearest<T>>,
     ) {
-        let distance = normal.dot(tip_m) - offset;
-        // Beyond the depth reach either way: neither a penetration to find
-        // nor nearer than one (one dot product, the cheap reject).
-        if distance.abs() > radius_m * T::of_f64(PENETRATION_DEPTH_RADII)
-            || normal == Vector3::zeros()
-            || nearest
-                .as_ref()
-                .is_some_and(|(d, _, _)| d.abs() <= distance.abs())
+        if nearest
+            .as_ref()
+            .is_some_and(|n| n.distance_m.abs() <= distance_m.abs())
         {
             return;
         }
         let Some(f) = self.corners(t) else { return };
-        let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance));
+        let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance_m));
         if w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE) {
-            *nearest = Some((distance, t, clamp_weights(w)));
+            *nearest = Some(Nearest {
+                distance_m,
+                triangle: t,
+                weights: clamp_weights(w),
+                order,
+            });
         }
+    }
+
+    /// Whether a plane the sphere centred at `tip_m` does not reach (signed
+    /// distance from the radius to `depth_m`) lies over the centre nearer
+    /// than `bound_m`, or as near and tested before the `order`-th: then it,
+    /// not the plane the sphere reaches, is the nearest, and the tool is
+    /// outside (beyond a thin flap, nearer its other face). The second pass
+    /// of [`Self::detect`]'s penetration test, over the same candidates in
+    /// the same order, only when such a plane exists and the first pass
+    /// could not keep them all ([`Unreached`]; out of line: its visited set
+    /// is only set up when it runs).
+    #[inline(never)]
+    fn covered(
+        &self,
+        tip_m: &Vector3<T>,
+        radius_m: T,
+        depth_m: T,
+        bound_m: T,
+        order: u32,
+        work: &mut ContactWork,
+    ) -> bool {
+        let mut visited = Visited::new();
+        let mut k = 0u32;
+        let mut covered = false;
+        self.visit(tip_m, &mut visited, work, |t, normal, offset| {
+            let distance = normal.dot(tip_m) - offset;
+            let nearer = Unreached::nearer(distance, k, bound_m, order);
+            k = k.wrapping_add(1);
+            if !covered && distance >= radius_m && distance <= depth_m && nearer {
+                covered = self.over(t, &normal, distance, tip_m);
+            }
+        });
+        covered
+    }
+
+    /// Whether the centre `tip_m` projects into triangle `t` (unit
+    /// `normal`, its plane `distance_m` from the centre).
+    fn over(
+        &self,
+        t: TriangleIndex,
+        normal: &Vector3<T>,
+        distance_m: T,
+        tip_m: &Vector3<T>,
+    ) -> bool {
+        self.corners(t).is_some_and(|f| {
+            let w = barycentric(&f.corners, normal, &(tip_m - normal * distance_m));
+            w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE)
+        })
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of

@@ -31,6 +31,18 @@ pub trait Real:
     fn of_f32(x: f32) -> Self;
     /// `true` if neither NaN nor infinite.
     fn finite(self) -> bool;
+    /// Converts from `u32` (rounding to nearest for `f32` above 2²⁴), in
+    /// the scalar itself: no `f64` on a target whose FPU has none.
+    fn of_u32(x: u32) -> Self;
+    /// Truncates towards zero to `u32`, saturating (NaN gives 0), in the
+    /// scalar itself.
+    fn trunc_u32(self) -> u32;
+    /// The larger of `self` and `other` by `>` (`other` when either is
+    /// NaN): one compare, where `max` is a `fmaxf` call on a target
+    /// without a maximum instruction (FPv4-SP).
+    fn larger(self, other: Self) -> Self {
+        if self > other { self } else { other }
+    }
 }
 
 impl Real for f32 {
@@ -49,6 +61,12 @@ impl Real for f32 {
     fn finite(self) -> bool {
         self.is_finite()
     }
+    fn of_u32(x: u32) -> Self {
+        x as f32
+    }
+    fn trunc_u32(self) -> u32 {
+        self as u32
+    }
 }
 
 impl Real for f64 {
@@ -66,5 +84,11 @@ impl Real for f64 {
     }
     fn finite(self) -> bool {
         self.is_finite()
+    }
+    fn of_u32(x: u32) -> Self {
+        f64::from(x)
+    }
+    fn trunc_u32(self) -> u32 {
+        self as u32
     }
 }

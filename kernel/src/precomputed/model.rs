@@ -178,9 +178,9 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 .enumerate()
                 .take(q + 1)
             {
-                *block = self.point_compliance(pq, pp);
+                *block = self.point_compliance(pq, pp, p == q);
                 if p == q {
-                    scale = block.diagonal().iter().fold(scale, |s, &c| s.max(c));
+                    scale = block.diagonal().iter().fold(scale, |s, &c| s.larger(c));
                 }
             }
         }
@@ -216,17 +216,29 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         Ok(solution)
     }
 
-    /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N).
-    fn point_compliance(&self, p: &ResolvedPoint<T>, q: &ResolvedPoint<T>) -> Matrix3<T> {
-        let mut c = Matrix3::zeros();
-        for (a, beta_a) in p.terms() {
-            for (b, beta_b) in q.terms() {
-                if let Some(block) = self.table.touchable_block_of(a, b) {
-                    c += block * (beta_a * beta_b);
+    /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N): each stored
+    /// block read once, accumulated in place; for `p = q` (`same`) the
+    /// pair `a ≠ b` is one read of the stored block for both its terms,
+    /// so at most six reads instead of nine.
+    fn point_compliance(
+        &self,
+        p: &ResolvedPoint<T>,
+        q: &ResolvedPoint<T>,
+        same: bool,
+    ) -> Matrix3<T> {
+        let mut sum = [[T::zero(); 9]; 2];
+        for (i, (a, beta_a)) in p.terms().enumerate() {
+            for (j, (b, beta_b)) in q.terms().enumerate() {
+                if same && j < i {
+                    continue;
                 }
+                let both = same && j > i;
+                self.table
+                    .add_touchable_block(a, b, beta_a * beta_b, both, &mut sum);
             }
         }
-        c
+        let [upper, lower] = sum;
+        Matrix3::from_row_slice(&upper) + Matrix3::from_row_slice(&lower).transpose()
     }
 
     /// The displacement of every free vertex for a solved contact set, m, by

@@ -111,12 +111,13 @@ impl<T: Real> Grid<T> {
             .zip(p.iter().zip(self.origin_m.iter()))
             .zip(&self.dims)
         {
-            let f = ((x - o) / self.cell_m).floor();
-            let top = T::of_f64(f64::from(d.saturating_sub(1)));
+            // Truncation is the floor for the positive values it sees.
+            let f = (x - o) / self.cell_m;
+            let top = T::of_u32(d.saturating_sub(1));
             // NaN fails both comparisons and stays at 0.
             *c = if f > T::zero() {
                 let clamped = if f < top { f } else { top };
-                clamped.as_f64() as u32
+                clamped.trunc_u32()
             } else {
                 0
             };
@@ -280,10 +281,10 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             for j in 0..ny {
                 for i in 0..nx {
                     let centre = index.cell_centre([i, j, k]);
-                    let count = index
-                        .vertices_near(&centre)
-                        .map(|v| index.triangles_of(v).len() as u32)
-                        .fold(0u32, u32::saturating_add);
+                    let mut count = 0u32;
+                    index.for_each_vertex_near(&centre, |v| {
+                        count = count.saturating_add(index.triangles_of(v).len() as u32);
+                    });
                     worst = worst.max(count);
                 }
             }
@@ -331,7 +332,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     }
 
     /// The most candidate triangles one point query
-    /// ([`Self::vertices_near`] then [`Self::triangles_of`]) visits, over
+    /// ([`Self::for_each_vertex_near`] then [`Self::triangles_of`]) visits, over
     /// every cell of the grid (computed at load: the exact table-declared
     /// bound of a detection's work, per query point).
     pub fn max_query_triangles(&self) -> u32 {
@@ -383,23 +384,33 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         [origin_m - margin, origin_m + extent + margin]
     }
 
-    /// The surface vertices filed in the 27 cells around the cell of `p`
-    /// (m). Bounded by `27 × max_bucket`.
-    pub fn vertices_near(&self, p: &Vector3<T>) -> impl Iterator<Item = VertexIndex> + '_ {
+    /// Calls `f` with each surface vertex filed in the 27 cells around the
+    /// cell of `p` (m), cell by cell (`x` fastest), each cell's in filing
+    /// order. Bounded by `27 × max_bucket`. A row of up to three cells
+    /// along `x` is one run of the filed list, so the visit is nine slices,
+    /// in plain loops (an iterator of nested `flat_map`s keeps its state in
+    /// memory, a store per step on the firmware target).
+    #[inline]
+    pub fn for_each_vertex_near(&self, p: &Vector3<T>, mut f: impl FnMut(VertexIndex)) {
         let [cx, cy, cz] = self.cell_of(p);
         let [nx, ny, nz] = self.grid.dims;
-        let range = |c: u32, n: u32| c.saturating_sub(1)..=(c + 1).min(n.saturating_sub(1));
-        range(cz, nz).flat_map(move |k| {
-            range(cy, ny).flat_map(move |j| {
-                range(cx, nx).flat_map(move |i| {
-                    let bucket = csr_row(self.cell_start, self.grid.linear([i, j, k]))
-                        .and_then(|row| self.grid_vertex.get(row))
-                        .unwrap_or(&[]);
-                    // Filed vertices are vertices of the surface (invariant).
-                    bucket.iter().map(|&v| VertexIndex::checked(v))
-                })
-            })
-        })
+        let range = |c: u32, n: u32| (c.saturating_sub(1), (c + 1).min(n.saturating_sub(1)));
+        let ((x0, x1), (y0, y1), (z0, z1)) = (range(cx, nx), range(cy, ny), range(cz, nz));
+        for k in z0..=z1 {
+            for j in y0..=y1 {
+                let first = self.grid.linear([x0, j, k]);
+                let last = self.grid.linear([x1, j, k]);
+                let (Some(&start), Some(&end)) =
+                    (self.cell_start.get(first), self.cell_start.get(last + 1))
+                else {
+                    continue;
+                };
+                // Filed vertices are vertices of the surface (invariant).
+                for &v in self.grid_vertex.get(span(start, end)).unwrap_or(&[]) {
+                    f(VertexIndex::checked(v));
+                }
+            }
+        }
     }
 
     /// The vertices of surface triangle `t`; `None` for an index of
@@ -407,11 +418,13 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     pub fn triangle(&self, t: TriangleIndex) -> Option<[VertexIndex; 3]> {
         // Triangle corners are vertices of the surface (invariant), but for
         // an empty slot of a deforming surface.
-        let tri = self.triangles.get(t.get())?;
-        if *tri == DEAD_TRIANGLE {
+        let &[a, b, c] = self.triangles.get(t.get())?;
+        // Compared corner by corner: an array comparison is a `memcmp` call
+        // on the firmware target.
+        if a == u32::MAX && b == u32::MAX && c == u32::MAX {
             return None;
         }
-        Some(tri.map(VertexIndex::checked))
+        Some([a, b, c].map(VertexIndex::checked))
     }
 
     /// The stored plane of surface triangle `t`: unit outward normal and

@@ -226,10 +226,10 @@ fn run() -> Result<bool, String> {
         }
     }
     print!("{text}");
-    if args.profile > 0 {
-        print!("{}", profile(&program, &runs, args.profile, w));
-    }
     let work = tick_work(&emulation.output);
+    if args.profile > 0 {
+        print!("{}", profile(&program, &runs, &work, args.profile, w));
+    }
     if args.unit_costs {
         print!("{}", unit_costs(&runs, &work));
     }
@@ -266,46 +266,85 @@ fn split_runs(emulation: &emulate::Emulation) -> Result<Vec<Run<'_>>, String> {
     Ok(runs)
 }
 
-/// For each run, the worst tick (cycles at zero wait states): cycles and
-/// instructions per class, and the `top` functions by cycles.
-fn profile(program: &elf::Program, runs: &[Run<'_>], top: usize, w: u32) -> String {
+/// For each run, the worst tick (cycles at zero wait states), the worst
+/// steady tick (every point in contact, no triangle tested, no edge
+/// crossed: the tracked contacts' solve alone) and the worst hovering tick
+/// (no contact, triangles tested: detection alone), each by class and with
+/// its `top` functions by cycles. `work` is every tick's, in run order.
+fn profile(program: &elf::Program, runs: &[Run<'_>], work: &[Work], top: usize, w: u32) -> String {
     let mut text = String::new();
+    let mut first = 0;
     for run in runs {
-        let Some((k, worst)) = run.ticks.iter().enumerate().max_by_key(|(_, c)| c.cycles) else {
-            continue;
+        let work = work.get(first..first + run.ticks.len()).unwrap_or(&[]);
+        first += run.ticks.len();
+        let steady = |k: usize| {
+            work.get(k)
+                .is_some_and(|t| t.contacts == u64::from(run.points) && t.tests == 0 && t.walk == 0)
         };
-        let _ = writeln!(
-            text,
-            "\n{} tick {k}: {} instructions, {} cycles ({} at {w} wait states: {} instruction \
-             words fetched, {} words loaded from flash), {} taken branches",
-            run.label,
-            worst.instructions,
-            worst.cycles,
-            worst.cycles_at(w),
-            worst.fetch_words,
-            worst.flash_words,
-            worst.taken
-        );
-        for class in Class::ALL {
-            let (n, c) = (
-                worst.class_instructions[class.index()],
-                worst.class_cycles[class.index()],
-            );
-            if n > 0 {
-                let _ = writeln!(
-                    text,
-                    "  {:<22} {n:>7} instructions {c:>8} cycles",
-                    class.name()
-                );
+        let hovering = |k: usize| work.get(k).is_some_and(|t| t.contacts == 0 && t.tests > 0);
+        let worst_where = |keep: &dyn Fn(usize) -> bool| {
+            run.ticks
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| keep(*k))
+                .max_by_key(|(_, c)| c.cycles)
+        };
+        let worst = worst_where(&|_| true);
+        for (what, tick) in [
+            ("", worst),
+            ("steady ", worst_where(&steady)),
+            ("hovering ", worst_where(&hovering)),
+        ] {
+            if let Some((k, c)) = tick {
+                profile_tick(&mut text, program, run, what, k, c, top, w);
             }
-        }
-        let mut functions = run.functions[k].clone();
-        functions.sort_by_key(|(_, c)| std::cmp::Reverse(*c));
-        for (f, c) in functions.iter().take(top) {
-            let _ = writeln!(text, "  {c:>8} cycles  {}", program.function_name(*f));
         }
     }
     text
+}
+
+/// One tick's profile (see [`profile`]).
+#[allow(clippy::too_many_arguments)]
+fn profile_tick(
+    text: &mut String,
+    program: &elf::Program,
+    run: &Run<'_>,
+    what: &str,
+    k: usize,
+    worst: &emulate::Count,
+    top: usize,
+    w: u32,
+) {
+    let _ = writeln!(
+        text,
+        "\n{} {what}tick {k}: {} instructions, {} cycles ({} at {w} wait states: {} instruction \
+         words fetched, {} words loaded from flash), {} taken branches",
+        run.label,
+        worst.instructions,
+        worst.cycles,
+        worst.cycles_at(w),
+        worst.fetch_words,
+        worst.flash_words,
+        worst.taken
+    );
+    for class in Class::ALL {
+        let (n, c) = (
+            worst.class_instructions[class.index()],
+            worst.class_cycles[class.index()],
+        );
+        if n > 0 {
+            let _ = writeln!(
+                text,
+                "  {:<22} {n:>7} instructions {c:>8} cycles",
+                class.name()
+            );
+        }
+    }
+    let mut functions = run.functions[k].clone();
+    functions.sort_by_key(|(_, c)| std::cmp::Reverse(*c));
+    for (f, c) in functions.iter().take(top) {
+        let _ = writeln!(text, "  {c:>8} cycles  {}", program.function_name(*f));
+    }
 }
 
 /// What a tick's output line says it did: contacts after it, triangles
