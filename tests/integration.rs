@@ -20,7 +20,9 @@ mod ffi {
 }
 
 mod host {
+    mod bench;
     mod compliance;
+    mod dispatch;
     mod experiment;
     mod fem;
     mod materials;

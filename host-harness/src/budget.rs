@@ -44,6 +44,7 @@ use palpate_kernel::contact::{MAX_WALK_STEPS, Tissue};
 use palpate_kernel::haptic::{
     ForceOutput, HapticLoop, PhysicsTissue, PrecomputedLoop, TickCounters, ToolInput,
 };
+use palpate_kernel::math::Portable;
 use palpate_kernel::precomputed::{PrecomputedTissue, QuasiNonLinear};
 use palpate_kernel::table::TensorMassTable;
 
@@ -313,8 +314,9 @@ fn probe_with<const P: usize>(
         }
         SceneTables::Dynamic(file, spec) => {
             let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;
-            DynamicSetup::of(scene, spec, table)?
-                .with_loop::<P, _>(|haptic| probe_ticks(haptic, scene, trajectory, physics_update))
+            DynamicSetup::of(scene, spec, table)?.with_loop::<P, _, _>(Portable, |haptic| {
+                probe_ticks(haptic, scene, trajectory, physics_update)
+            })
         }
         SceneTables::Hybrid(files, spec) => HybridSetup::of(scene, spec, files)?
             .with_loop::<P, _>(|haptic| probe_ticks(haptic, scene, trajectory, physics_update)),

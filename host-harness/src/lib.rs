@@ -7,9 +7,11 @@
 //! [`demo`] / [`replay`] (runs and reports). The host modules are named after
 //! the kernel's (`palpate_kernel::table`, `palpate_kernel::tensor_mass`).
 
+pub mod bench;
 pub mod budget;
 pub mod chart;
 pub mod demo;
+pub mod dispatch;
 pub mod experiment;
 pub mod fem;
 pub mod fix;

@@ -10,6 +10,9 @@
 //!   table through its header first: `table::load::TableFile::read`).
 //! - Table builds: the estimate of `table::estimate` against [`MAX_TABLE_FILE_BYTES`], an optional
 //!   `--max-table-bytes` and the memory available ([`mem_available_bytes`]).
+//! - `palpate bench`: [`MAX_BENCH_SAMPLES`] and [`MAX_BENCH_SAMPLE_S`] per measurement, and the
+//!   run's estimated duration against [`MAX_BENCH_ESTIMATE_S`] (`bench::run::check`), before any
+//!   table is built; its pre-computed table is checked as any table build.
 //! - `palpate chart`: its work bound (`chart::Matrix::tet_step_bound` and the volume
 //!   experiments') against [`MAX_CHART_TET_STEPS`].
 
@@ -73,6 +76,26 @@ pub const MAX_VTK_SERIES_BYTES: u64 = 8 << 30;
 pub fn vtk_frame_bytes(vertices: usize, tets: usize) -> u64 {
     200 + 150 * vertices as u64 + 49 * tets as u64
 }
+
+/// Longest `palpate bench` run, estimated before it starts, s: one hour.
+///
+/// A run times every measurement for about `(calibration + warm-up + samples) × sample` (each
+/// sample at least one call); the estimate takes each call at
+/// `bench::run::ESTIMATE_SECONDS_PER_BYTE` per byte it reads, about three times the slowest pass
+/// measured, so that the estimate is an upper bound. The default run (6 models, 4 integrators,
+/// f32 and f64, 21 samples of 10 ms) is about 60 measurements, 20 s on a 6000-tet mesh; an hour is
+/// reached near 10⁷ tets, or with `--samples` in the thousands. Time fewer `--models`,
+/// `--integrators` or precisions, or fewer samples, above it.
+pub const MAX_BENCH_ESTIMATE_S: f64 = 3600.0;
+
+/// Most samples of one `palpate bench` measurement (`--samples` + `--warmup`): 10 000. A
+/// median and quartiles settle within a few dozen samples; the bound catches a typo before the
+/// estimate multiplies it.
+pub const MAX_BENCH_SAMPLES: usize = 10_000;
+
+/// Longest sample of `palpate bench` (`--sample-ms`), s: 10 s. A sample is a batch of calls
+/// timed together; the default is 10 ms.
+pub const MAX_BENCH_SAMPLE_S: f64 = 10.0;
 
 /// Largest mesh file (each of a TetGen pair), bytes: 2 GiB.
 ///

@@ -12,7 +12,8 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 mod commands;
 
 use commands::{
-    budget, chart, demo, dynamic, experiment, precomputed, remap, scene, session, stvk, tables,
+    bench, budget, chart, demo, dynamic, experiment, precomputed, remap, scene, session, stvk,
+    tables,
 };
 
 #[derive(Parser)]
@@ -52,6 +53,9 @@ enum Command {
     /// What a scene asks of the models: the hybrid partition of its zones (`scene plan`).
     #[command(subcommand)]
     Scene(scene::SceneCommand),
+    /// Timings of the models on a mesh of one's own (the criterion benches
+    /// are the reference figures).
+    Bench(bench::BenchArgs),
     /// Per-tick instruction counts (callgrind) of every generated trajectory
     /// against the static bound from the table sizes and capacities.
     Budget(budget::BudgetArgs),
@@ -94,6 +98,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
         Command::Remap(command) => remap::run(command),
         Command::Session(command) => session::run(command),
         Command::Scene(command) => scene::run(command),
+        Command::Bench(args) => bench::run_bench(&args),
         Command::Budget(args) => budget::run(&args),
         Command::Chart(args) => chart::run(&args),
         Command::Demo(args) => demo::run(&args),

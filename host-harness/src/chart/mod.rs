@@ -35,7 +35,6 @@ pub mod select;
 pub mod stability;
 pub mod svg_text;
 pub mod ticks;
-pub mod timing;
 pub mod trajectory;
 
 use anyhow::Context;
@@ -48,6 +47,8 @@ use palpate_kernel::tensor_mass::{
 };
 use serde::Serialize;
 
+use crate::bench::measure::{Sampling, time};
+use crate::dispatch::HostDispatch;
 use crate::experiment::relax::relax;
 use crate::experiment::scenes::{penalty_n, tissue};
 use crate::experiment::volume_bend::inverted_tets;
@@ -100,6 +101,15 @@ const DENSITY_KG_M3: f64 = 1000.0;
 /// The hybrid's tensor-mass region: this fraction of the body's length at
 /// its loaded end ([`Body::hybrid_dynamic_tets`]).
 pub const HYBRID_DYNAMIC_FRACTION: f64 = 1.0 / 3.0;
+/// How a run's time per step is measured ([`crate::bench::measure`], the
+/// library of `palpate bench`): one warm-up and 7 kept samples of 2 ms,
+/// the median reported. Short, as the matrix times some 300 steps; the
+/// spread is `palpate bench`'s to show.
+const STEP_SAMPLING: Sampling = Sampling {
+    warmup: 1,
+    samples: 7,
+    sample_s: 2e-3,
+};
 
 /// Which loads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -391,7 +401,7 @@ impl Matrix {
     /// the trajectories: every relaxation at [`Matrix::max_relax_steps`],
     /// every trial and trajectory run to its end. Not counted: the Newton
     /// references, the `ω_max` estimates and the timing loops (each about
-    /// 40 ms: [`timing`]).
+    /// 40 ms: [`STEP_SAMPLING`]).
     pub fn tet_step_bound(&self, bodies: &[Body]) -> anyhow::Result<u64> {
         let tets = |b: &Body| b.mesh.tets.len() as u64;
         let cases = (self.loads.len() * self.levels.len()) as u64;
@@ -709,9 +719,11 @@ pub fn seconds_per_tet_step(body: &Body) -> anyhow::Result<f64> {
         .with_law(law)
         .with_incompressibility(penalty);
     let dt_s = 0.5 * trajectory::two_over_omega_s(body)?;
+    let dispatch = HostDispatch::detect();
     let step_s = stability::with_params(body, body.material, params, |model| {
-        Ok(timing::median_time_s(|| {
-            let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt_s));
+        Ok(median_s(|| {
+            let _ =
+                core::hint::black_box(model.step_with(dispatch, Integrator::SymplecticEuler, dt_s));
         }))
     })?;
     Ok(step_s / body.mesh.tets.len() as f64)
@@ -1030,14 +1042,14 @@ fn precomputed(
         loads.iter().map(|f| Vector3::from(*f).dot(&d)).sum::<f64>()
     });
     let direction32 = direction.map(|d| d.map(|x| x as f32));
-    let step_s = timing::median_time_s(|| {
+    let step_s = median_s(|| {
         compliance_product(&c64, &weights, &mut out64);
         if let (Some((q, _)), Some(d)) = (quasi, &direction) {
             remap_rows(q, d, 1.0, &mut out64);
         }
         core::hint::black_box(&out64);
     });
-    let step_f32_s = timing::median_time_s(|| {
+    let step_f32_s = median_s(|| {
         compliance_product(&c32, &w32, &mut out32);
         if let (Some((_, q)), Some(d)) = (quasi, &direction32) {
             remap_rows(q, d, 1.0, &mut out32);
@@ -1059,6 +1071,11 @@ fn precomputed(
         step_f32_s: Some(step_f32_s),
         steps: 1,
     })
+}
+
+/// Median time of one call of `call`, s, sampled as [`STEP_SAMPLING`].
+pub(crate) fn median_s(call: impl FnMut()) -> f64 {
+    time(&STEP_SAMPLING, call).median_s
 }
 
 /// `out = Σ_j w_j C_j` over the columns `C_j` of the column-major `c`.
@@ -1117,7 +1134,8 @@ fn axial_scale(quasi: &QuasiNonLinear<f64>, force_n: f64) -> f64 {
 /// A tensor-mass model of `body` under the nodal `loads`, relaxed to rest
 /// (symplectic Euler at `0.5/ω_max` with kinetic damping,
 /// [`relax`]); time per step measured in f64 at the equilibrium and in f32
-/// from rest.
+/// from rest, with the host's CPU-feature dispatch ([`HostDispatch`], as
+/// `dynamic run` steps).
 fn dynamic(
     body: &Body,
     loads: &[[f64; 3]],
@@ -1160,8 +1178,9 @@ fn dynamic(
     if model.fault().is_some() {
         model.reset();
     }
-    let step_s = timing::median_time_s(|| {
-        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt_s));
+    let dispatch = HostDispatch::detect();
+    let step_s = median_s(|| {
+        let _ = core::hint::black_box(model.step_with(dispatch, Integrator::SymplecticEuler, dt_s));
     });
     let step_f32_s = dynamic_f32_step(body, loads, law, incompressibility_n, dt_s)?;
     Ok(Outcome {
@@ -1245,7 +1264,7 @@ fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<O
         if h.dynamic().fault().is_some() {
             h.reset();
         }
-        let step_s = timing::median_time_s(|| {
+        let step_s = median_s(|| {
             let _ = core::hint::black_box(h.step(Integrator::SymplecticEuler, dt_s));
         });
         anyhow::Ok((u, fault, steps, step_s, dt_s))
@@ -1264,7 +1283,7 @@ fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<O
                     .set_external_force(l as u32, Vector3::from(f.map(|x| x as f32)))?;
             }
         }
-        anyhow::Ok(timing::median_time_s(|| {
+        anyhow::Ok(median_s(|| {
             if h.dynamic().fault().is_some() {
                 h.reset();
             }
@@ -1331,10 +1350,11 @@ fn dynamic_f32_step(
         }
     }
     let dt = dt_s as f32;
-    Ok(timing::median_time_s(|| {
+    let dispatch = HostDispatch::detect();
+    Ok(median_s(|| {
         if model.fault().is_some() {
             model.reset();
         }
-        let _ = core::hint::black_box(model.step(Integrator::SymplecticEuler, dt));
+        let _ = core::hint::black_box(model.step_with(dispatch, Integrator::SymplecticEuler, dt));
     }))
 }

@@ -19,7 +19,8 @@ use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
 use serde::Serialize;
 
 use super::stability::{DAMPING_PER_S, with_params};
-use super::{Body, Load, Model, Progress, timing};
+use super::{Body, Load, Model, Progress, median_s};
+use crate::dispatch::HostDispatch;
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::stability::omega_max;
 
@@ -248,11 +249,12 @@ fn step_time(
 ) -> anyhow::Result<f64> {
     with_params(body, body.material, params, |model| {
         apply(model, loads)?;
-        Ok(timing::median_time_s(|| {
+        let dispatch = HostDispatch::detect();
+        Ok(median_s(|| {
             if model.fault().is_some() {
                 model.reset();
             }
-            let _ = core::hint::black_box(model.step(integrator, dt_s));
+            let _ = core::hint::black_box(model.step_with(dispatch, integrator, dt_s));
         }))
     })
 }

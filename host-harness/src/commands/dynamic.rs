@@ -52,6 +52,11 @@ pub enum DynamicCommand {
         /// --model stvk-incompressible).
         #[arg(long)]
         incompressibility: Option<f64>,
+        /// What the table stores and the step computes in: f64
+        /// (verification) or f32 (the firmware's); the output is the same
+        /// JSON either way. A hybrid scene runs in f64 only.
+        #[arg(long, value_enum, default_value = "f64")]
+        precision: Precision,
     },
     /// Largest stable time step of an integrator (bisection) next to 2/ω_max.
     CriticalDt {
@@ -189,12 +194,22 @@ impl ModelArg {
 }
 
 /// `--integrator`.
-#[derive(Clone, Copy, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum IntegratorArg {
     Euler,
     Symplectic,
     Rk4,
     Central,
+}
+
+impl IntegratorArg {
+    /// Every integrator, in the kernel's order (`Integrator::ALL`).
+    pub const ALL: [IntegratorArg; 4] = [
+        IntegratorArg::Euler,
+        IntegratorArg::Symplectic,
+        IntegratorArg::Rk4,
+        IntegratorArg::Central,
+    ];
 }
 
 impl From<IntegratorArg> for Integrator {
@@ -229,11 +244,16 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             law,
             form,
             incompressibility,
+            precision,
         } => {
             let setup = model.read("run")?;
             let (law, incompressibility_n) = law.law(form, incompressibility)?;
+            if setup.hybrid.is_some() && precision != Precision::F64 {
+                bail!("--precision f32: a hybrid scene runs in f64 only");
+            }
             let options = RunOptions {
                 table: setup.table,
+                precision,
                 damping_per_s: model.damping,
                 law,
                 incompressibility_n,

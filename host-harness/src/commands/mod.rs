@@ -4,6 +4,7 @@
 //! `palpate::output::atomic`.
 
 pub mod args;
+pub mod bench;
 pub mod budget;
 pub mod chart;
 pub mod demo;

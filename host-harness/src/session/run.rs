@@ -32,6 +32,7 @@ use palpate_kernel::haptic::{
     DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop,
     SafetyLimits, ToolInput,
 };
+use palpate_kernel::math::Dispatch;
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
@@ -47,6 +48,7 @@ use super::tool_points::{ForToolPoints, with_tool_points};
 use super::tools::kernel_tools;
 use super::trajectory::ToolState;
 use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
+use crate::dispatch::HostDispatch;
 use crate::fix::fixed_vertices;
 use crate::limits::{
     MAX_HAPTIC_HZ, MAX_SESSION_TICKS, MAX_TRAJECTORY_SPAN_S, MAX_VTK_SERIES_BYTES, vtk_frame_bytes,
@@ -493,15 +495,19 @@ impl<'t> DynamicSetup<'t> {
     }
 
     /// Builds the model, its surface and the loop at rest on heap buffers
-    /// and runs `body` on the loop.
-    pub fn with_loop<const P: usize, R>(
+    /// and runs `body` on the loop, the model's steps through `dispatch`
+    /// (`session run`: [`crate::dispatch::HostDispatch::detect`]; `budget`:
+    /// portable).
+    pub fn with_loop<const P: usize, R, D: Dispatch>(
         &self,
-        body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P>) -> anyhow::Result<R>,
+        dispatch: D,
+        body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P, D>) -> anyhow::Result<R>,
     ) -> anyhow::Result<R> {
         self.with_parts(|model, buffers, forces| {
             let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, self.physics)
-                .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?;
-            let mut haptic = DynamicLoop::<f32, P, P>::new(tissue, self.config)
+                .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?
+                .with_dispatch(dispatch);
+            let mut haptic = DynamicLoop::<f32, P, P, D>::new(tissue, self.config)
                 .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
             body(&mut haptic)
         })
@@ -592,7 +598,10 @@ impl Ticks<'_> {
         setup: &DynamicSetup<'_>,
         session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
-        setup.with_loop::<P, _>(|haptic| self.physics_ticks(haptic, session, &DynamicView))
+        let dispatch = HostDispatch::detect();
+        setup.with_loop::<P, _, _>(dispatch, |haptic| {
+            self.physics_ticks(haptic, session, &DynamicView)
+        })
     }
 
     fn hybrid<const P: usize>(
@@ -644,14 +653,14 @@ pub trait PhysicsView<B> {
 /// The tensor-mass tissue is the whole mesh.
 struct DynamicView;
 
-impl<const P: usize> PhysicsView<DynamicTissue<'_, '_, f32, P>> for DynamicView {
-    fn removed(&self, tissue: &DynamicTissue<'_, '_, f32, P>) -> Vec<u32> {
+impl<const P: usize, D: Dispatch> PhysicsView<DynamicTissue<'_, '_, f32, P, D>> for DynamicView {
+    fn removed(&self, tissue: &DynamicTissue<'_, '_, f32, P, D>) -> Vec<u32> {
         tissue.removed().to_vec()
     }
 
     fn frame(
         &self,
-        tissue: &DynamicTissue<'_, '_, f32, P>,
+        tissue: &DynamicTissue<'_, '_, f32, P, D>,
     ) -> anyhow::Result<(Vec<[f32; 3]>, Vec<bool>)> {
         let model = tissue.model();
         let u = model.displacements_m().unwrap_or(&[]).to_vec();

@@ -1,16 +1,20 @@
-//! `palpate dynamic run`: a tensor-mass table built in memory (f64), a
-//! scripted load, `N` steps of one integrator through the kernel, a JSON
-//! report.
+//! `palpate dynamic run`: a tensor-mass table built in memory (f64, or f32
+//! with `--precision f32`), a scripted load, `N` steps of one integrator
+//! through the kernel (its passes dispatched to the CPU's features,
+//! [`crate::dispatch`]), a JSON report.
 
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
+use palpate_kernel::Real;
+use palpate_kernel::math::Dispatch;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, Integrator, StepError, TensorMassModel,
+    DynamicParams, ElasticLaw, Integrator, StepError, StepReport, TensorMassModel,
 };
 use serde::Serialize;
 
 use super::OwnedState;
+use crate::dispatch::HostDispatch;
 use crate::fem::element::shape_gradients;
 use crate::mesh::{MeshReport, TetMesh};
 use crate::table::build::{BuildOptions, build};
@@ -20,9 +24,12 @@ use crate::table::load::TableFile;
 /// A scripted dynamic run.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
-    /// The tensor-mass table: material, density, fixed vertices (the
-    /// precision is forced to f64).
+    /// The tensor-mass table: material, density, fixed vertices (its
+    /// precision is replaced by [`Self::precision`]).
     pub table: BuildOptions,
+    /// What the table stores and the model computes in: f64 (the default of
+    /// `dynamic run`) or f32 (the firmware's). The output is f64 either way.
+    pub precision: Precision,
     /// Mass-proportional damping, 1/s.
     pub damping_per_s: f64,
     /// The elastic force.
@@ -58,17 +65,45 @@ pub struct RunOutput {
     pub removed_tets: Vec<u32>,
 }
 
-/// Runs `options` on `mesh`. Divergence bound: a displacement larger than the
-/// mesh's bounding-box diagonal (a body that moves more than its own size
-/// has diverged); the kinetic energy is not bounded.
+/// Runs `options` on `mesh`, the step's passes on the best this CPU runs
+/// ([`HostDispatch::detect`]). Divergence bound: a displacement larger than
+/// the mesh's bounding-box diagonal (a body that moves more than its own
+/// size has diverged); the kinetic energy is not bounded.
 pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow::Result<RunOutput> {
-    let file = f64_table(mesh, report, &options.table)?;
-    let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
+    run_with(mesh, report, options, HostDispatch::detect())
+}
+
+/// [`run`] with the step's passes run through `dispatch`.
+pub fn run_with(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &RunOptions,
+    dispatch: impl Dispatch,
+) -> anyhow::Result<RunOutput> {
+    let table = BuildOptions {
+        precision: options.precision,
+        ..options.table.clone()
+    };
+    let file = TableFile::from_bytes(&build(mesh, report, &table)?.bytes);
+    match options.precision {
+        Precision::F32 => run_in::<f32>(mesh, &file, options, dispatch),
+        Precision::F64 => run_in::<f64>(mesh, &file, options, dispatch),
+    }
+}
+
+/// [`run_with`] on the built table `file`, in `T`.
+fn run_in<T: Real>(
+    mesh: &TetMesh,
+    file: &TableFile,
+    options: &RunOptions,
+    dispatch: impl Dispatch,
+) -> anyhow::Result<RunOutput> {
+    let table = TensorMassTable::<T>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
     let params = host_params(&mesh.positions, options.damping_per_s)
         .with_law(options.law)
-        .with_incompressibility(options.incompressibility_n)
-        .with_gravity(Vector3::from(options.gravity_m_s2));
+        .with_incompressibility(options.incompressibility_n.map(T::of_f64))
+        .with_gravity(vector(options.gravity_m_s2));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     for &tet in &options.cut_tets {
         model
@@ -77,23 +112,25 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     }
     for &(vertex, force) in &options.loads {
         model
-            .set_external_force(vertex, Vector3::from(force))
+            .set_external_force(vertex, vector(force))
             .with_context(|| format!("--load {vertex}"))?;
     }
     if !(options.dt_s.is_finite() && options.dt_s > 0.0) {
         bail!("--dt must be finite and > 0 s, got {}", options.dt_s);
     }
+    let dt_s = T::of_f64(options.dt_s);
     let first = model.displacements_m()?.to_vec();
     let (last, kinetic_energy, fault) = run_steps(options.steps, first, |last| {
-        let report = model.step(options.integrator, options.dt_s)?;
+        let report = model.step_with(dispatch, options.integrator, dt_s)?;
         last.copy_from_slice(model.displacements_m().map_err(StepError::Faulted)?);
         Ok(report)
     })?;
+    let last: Vec<[f64; 3]> = last.iter().map(|u| u.map(T::as_f64)).collect();
     let alive = model.tet_alive();
     Ok(RunOutput {
         volume_change: volume_change(mesh, &last, alive),
         displacements: last,
-        kinetic_energy,
+        kinetic_energy: kinetic_energy.as_f64(),
         fault,
         removed_tets: (0..alive.len() as u32)
             .filter(|&t| !alive[t as usize])
@@ -101,25 +138,29 @@ pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow:
     })
 }
 
+/// An f64 triple in `T` (rounded to nearest for f32).
+fn vector<T: Real>(v: [f64; 3]) -> Vector3<T> {
+    Vector3::from(v.map(T::of_f64))
+}
+
 /// Steps `steps` times with `step`, which steps and, on success, writes
 /// the field into its argument; stops at a fault. Returns the last good
 /// field (starting from `last`), its kinetic energy (J) and the fault, if
 /// any: the step loop of `dynamic run`, for the tensor-mass and the hybrid
-/// model.
-pub fn run_steps(
+/// model. One copy of the field per step (the step's own, into a buffer
+/// swapped with the last good one).
+pub fn run_steps<T: Real, E: Clone>(
     steps: usize,
-    mut last: Vec<[f64; 3]>,
-    mut step: impl FnMut(
-        &mut Vec<[f64; 3]>,
-    ) -> Result<palpate_kernel::tensor_mass::StepReport<f64>, StepError>,
-) -> anyhow::Result<(Vec<[f64; 3]>, f64, Option<String>)> {
-    let mut kinetic_energy = 0.0;
+    mut last: Vec<E>,
+    mut step: impl FnMut(&mut Vec<E>) -> Result<StepReport<T>, StepError>,
+) -> anyhow::Result<(Vec<E>, T, Option<String>)> {
+    let mut kinetic_energy = T::zero();
     let mut field = last.clone();
     for _ in 0..steps {
         match step(&mut field) {
             Ok(report) => {
                 kinetic_energy = report.kinetic_energy_j;
-                last.clone_from(&field);
+                core::mem::swap(&mut last, &mut field);
             }
             Err(StepError::Faulted(f)) => return Ok((last, kinetic_energy, Some(f.to_string()))),
             Err(e) => bail!("{e}"),
@@ -146,8 +187,8 @@ pub fn f64_table(
 /// `damping_per_s` (1/s), no gravity,
 /// divergence when a displacement exceeds the bounding-box diagonal of
 /// `positions` (m), kinetic energy unbounded.
-pub fn host_params(positions: &[[f64; 3]], damping_per_s: f64) -> DynamicParams<f64> {
-    DynamicParams::linear(damping_per_s, diagonal(positions))
+pub fn host_params<T: Real>(positions: &[[f64; 3]], damping_per_s: f64) -> DynamicParams<T> {
+    DynamicParams::linear(T::of_f64(damping_per_s), T::of_f64(diagonal(positions)))
 }
 
 /// Bounding-box diagonal, m.

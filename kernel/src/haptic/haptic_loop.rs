@@ -21,6 +21,7 @@ use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervis
 use super::tool::{ToolAction, ToolInput};
 use crate::contact::{Contact, ContactSet, ContactWork, Refusal, Tissue};
 use crate::hybrid::HybridTissue;
+use crate::math::{Dispatch, Portable};
 use crate::precomputed::{ContactSolution, PrecomputedTissue};
 use crate::tensor_mass::{Blade, Blades, DynamicTissue, PhysicsError, StepReport};
 use crate::{MAX_CONTACTS, Real};
@@ -99,8 +100,8 @@ pub type PrecomputedLoop<'a, T, const P: usize, const M: usize> =
     HapticLoop<T, PrecomputedTissue<'a, T, M>, P, M>;
 
 /// The loop over the dynamic tensor-mass model.
-pub type DynamicLoop<'a, 's, T, const P: usize, const M: usize> =
-    HapticLoop<T, DynamicTissue<'a, 's, T, P>, P, M>;
+pub type DynamicLoop<'a, 's, T, const P: usize, const M: usize, D = Portable> =
+    HapticLoop<T, DynamicTissue<'a, 's, T, P, D>, P, M>;
 
 /// The loop over the hybrid model.
 pub type HybridLoop<'a, 's, T, const P: usize, const M: usize> =
@@ -335,7 +336,9 @@ pub trait PhysicsTissue<T: Real, const M: usize>: Tissue<T, M> {
     ) -> Result<StepReport<T>, PhysicsError>;
 }
 
-impl<T: Real, const P: usize, const M: usize> PhysicsTissue<T, M> for DynamicTissue<'_, '_, T, P> {
+impl<T: Real, const P: usize, const M: usize, D: Dispatch> PhysicsTissue<T, M>
+    for DynamicTissue<'_, '_, T, P, D>
+{
     fn update(
         &mut self,
         set: &ContactSet<T, M>,

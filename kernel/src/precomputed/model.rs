@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
 use super::remap::QuasiNonLinear;
 use crate::math::cholesky::solve_blocks;
+use crate::math::{Dispatch, Portable};
 use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
 use crate::{MAX_CONTACT_CAPACITY, Real};
@@ -255,9 +256,21 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         solution: &ContactSolution<T, M>,
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
+        self.free_displacements_with(Portable, solution, out)
+    }
+
+    /// [`Self::free_displacements`] with its pass over the compliance
+    /// columns run through `dispatch`: a host's run-time CPU-feature
+    /// dispatch ([`crate::math::dispatch`]). Same results.
+    pub fn free_displacements_with<const M: usize>(
+        &self,
+        dispatch: impl Dispatch,
+        solution: &ContactSolution<T, M>,
+        out: &mut [[T; 3]],
+    ) -> Result<(), DisplacementError> {
         check_length(self.table.free_count(), out)?;
         out.fill([T::zero(); 3]);
-        self.add_rows(solution, 0, out);
+        self.add_rows(dispatch, solution, 0, out);
         self.remap_rows(solution, out);
         Ok(())
     }
@@ -273,6 +286,17 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         solution: &ContactSolution<T, M>,
         out: &mut [[T; 3]],
     ) -> Result<(), DisplacementError> {
+        self.displacements_with(Portable, solution, out)
+    }
+
+    /// [`Self::displacements`] with its passes over the compliance columns
+    /// run through `dispatch` (see [`Self::free_displacements_with`]).
+    pub fn displacements_with<const M: usize>(
+        &self,
+        dispatch: impl Dispatch,
+        solution: &ContactSolution<T, M>,
+        out: &mut [[T; 3]],
+    ) -> Result<(), DisplacementError> {
         const CHUNK: usize = 64;
         check_length(self.table.vertex_count(), out)?;
         // Fixed vertices stay zero; a memset is cheaper than picking them out.
@@ -280,7 +304,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         for (chunk, vertices) in self.table.free_vertices().chunks(CHUNK).enumerate() {
             let mut buffer = [[T::zero(); 3]; CHUNK];
             let rows = buffer.get_mut(..vertices.len()).unwrap_or(&mut []);
-            self.add_rows(solution, chunk * CHUNK, rows);
+            self.add_rows(dispatch, solution, chunk * CHUNK, rows);
             self.remap_rows(solution, rows);
             for (u, &v) in rows.iter().zip(vertices) {
                 if let Some(o) = out.get_mut(v as usize) {
@@ -302,18 +326,24 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     }
 
     /// `out[i] += Σ_terms C_{first+i, k} w` over the contact terms: free rows
-    /// `first .. first + out.len()`.
+    /// `first .. first + out.len()`, run through `dispatch`.
     fn add_rows<const M: usize>(
         &self,
+        dispatch: impl Dispatch,
         solution: &ContactSolution<T, M>,
         first: usize,
         out: &mut [[T; 3]],
     ) {
-        for (point, g) in solution.resolved() {
-            for (k, beta) in point.terms() {
-                self.add_column_rows(k.get(), &(g * beta), first, out);
-            }
-        }
+        dispatch.run(
+            #[inline(always)]
+            || {
+                for (point, g) in solution.resolved() {
+                    for (k, beta) in point.terms() {
+                        self.add_column_rows(k.get(), &(g * beta), first, out);
+                    }
+                }
+            },
+        );
     }
 
     /// `out[i] += C_{n,k} w` for the free rows `n = first + i` (format in
@@ -322,6 +352,9 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// rows from column `k` of the interior part. Rows outside `0..F` are
     /// skipped. A compressed part is decoded on the fly (a dropped block adds
     /// nothing); the work is the same `F` blocks per column either way.
+    /// Always inlined (one caller), so that a [`Dispatch`] compiles it where
+    /// it runs.
+    #[inline(always)]
     fn add_column_rows(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
         let s = self.table.touchable_count();
         let f = self.table.free_count();
@@ -332,21 +365,24 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             let (a, b) = (first.max(lo), end.min(hi));
             (a < b).then(|| (a, a - first..b - first))
         };
-        if let Some((a, rows)) = window(0, k + 1)
-            && let Some(out) = out.get_mut(rows)
-        {
-            surface.add_products(surface_block_index(a, k), k, w, out);
+        // The rows of the two parts' columns (`n ≤ k` from the packed
+        // surface column, `n ≥ S` from the interior column) through one call
+        // site, so that inlining it for a [`Dispatch`] does not copy it;
+        // the windows are disjoint, so the order adds nothing different.
+        let columns = [
+            window(0, k + 1).map(|(a, rows)| (surface, surface_block_index(a, k), rows)),
+            window(s, f)
+                .map(|(a, rows)| (self.table.interior_blocks(), k * (f - s) + (a - s), rows)),
+        ];
+        for (part, start, rows) in columns.into_iter().flatten() {
+            if let Some(out) = out.get_mut(rows) {
+                part.add_products(start, k, w, out);
+            }
         }
         if let Some((a, rows)) = window(k + 1, s)
             && let Some(out) = out.get_mut(rows)
         {
             surface.add_transposed_products(k, a, w, out);
-        }
-        if let Some((a, rows)) = window(s, f)
-            && let Some(out) = out.get_mut(rows)
-        {
-            let start = k * (f - s) + (a - s);
-            self.table.interior_blocks().add_products(start, k, w, out);
         }
     }
 }

@@ -130,8 +130,11 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
 
     /// `out[i] += C_{first+i} w` (m, for `w` in N) for the blocks
     /// `first .. first + out.len()` of the dense layout, all of column
-    /// `column`. Blocks beyond the layout add nothing.
-    #[inline]
+    /// `column`. Blocks beyond the layout add nothing. Always inlined, as
+    /// its one caller in the step path (the pre-computed update, which a
+    /// host's run-time CPU-feature dispatch compiles where it runs:
+    /// [`crate::math::Dispatch`]).
+    #[inline(always)]
     pub fn add_products(&self, first: usize, column: usize, w: &Vector3<T>, out: &mut [[T; 3]]) {
         match self {
             ComplianceBlocks::Dense(blocks) => {
@@ -146,8 +149,8 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
     /// `out[i] += C_{k,n}ᵀ w` for `n = first + i` (m): the blocks of row `k`
     /// in the packed surface columns `n > k` ([`surface_block_index`]`(k,
     /// n)`, each of its own column `n`), transposed. Blocks beyond the
-    /// layout add nothing.
-    #[inline]
+    /// layout add nothing. Always inlined, as [`Self::add_products`].
+    #[inline(always)]
     pub fn add_transposed_products(
         &self,
         k: usize,
@@ -178,7 +181,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
 
 impl<T: Real> CodedBlocks<'_, T> {
     /// The decoded values of one stored block, before its column's scale.
-    #[inline]
+    #[inline(always)]
     fn values(&self, codes: &[u16; 9]) -> [T; 9] {
         match self.code {
             Code::F16 => codes.map(|c| T::of_f32(format::f16_to_f32(c))),
@@ -204,7 +207,9 @@ impl<T: Real> CodedBlocks<'_, T> {
     }
 
     /// See [`ComplianceBlocks::add_products`]: `out[i] += Q_i (s w)`, the
-    /// decoded codes times the scaled `w` (`s` the column's scale).
+    /// decoded codes times the scaled `w` (`s` the column's scale). Always
+    /// inlined, as [`ComplianceBlocks::add_products`].
+    #[inline(always)]
     fn add_products(&self, first: usize, column: usize, w: &Vector3<T>, out: &mut [[T; 3]]) {
         let Some(&scale) = self.scales.get(column) else {
             return;

@@ -9,6 +9,7 @@ use super::law::{ElasticLaw, StvkForm};
 use super::stvk::TetPass;
 use super::stvk_terms::NonLinearTerms;
 use crate::Real;
+use crate::math::Dispatch;
 use crate::table::span;
 
 /// Everything the internal-force pass of a step reads, for the configured
@@ -29,21 +30,36 @@ pub(crate) struct InternalForces<'b, 'a, T: Real> {
 impl<T: Real> InternalForces<'_, '_, T> {
     /// Overwrites `f` with the internal forces (N) of displacements `u` (m):
     /// the elastic force of the law, plus the incompressibility penalty, plus
-    /// the coupled pre-computed region's force on the connection nodes.
-    pub(crate) fn forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
+    /// the coupled pre-computed region's force on the connection nodes. Each
+    /// pass over the mesh runs through `dispatch` ([`Dispatch`]).
+    pub(crate) fn forces(&self, dispatch: impl Dispatch, u: &[[T; 3]], f: &mut [[T; 3]]) {
         match self.law {
-            ElasticLaw::Linear => self.stiffness.elastic_forces(u, f),
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
                 f.fill([T::zero(); 3]);
-                self.tets.add_stvk_forces(u, f);
+                dispatch.run(
+                    #[inline(always)]
+                    || self.tets.add_stvk_forces(u, f),
+                );
             }
-            ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
-                self.stiffness.elastic_forces(u, f);
-                self.terms.add_forces(u, f);
+            // One call site of the (always inlined) linear pass for both
+            // laws that read the tensors: one copy of it in the firmware.
+            law => {
+                dispatch.run(
+                    #[inline(always)]
+                    || {
+                        self.stiffness.elastic_forces(u, f);
+                        if law == ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) {
+                            self.terms.add_forces(u, f);
+                        }
+                    },
+                );
             }
         }
         if let Some(gamma_n) = self.incompressibility_n {
-            self.tets.add_incompressibility(gamma_n, u, f);
+            dispatch.run(
+                #[inline(always)]
+                || self.tets.add_incompressibility(gamma_n, u, f),
+            );
         }
         if let Some(coupling) = &self.coupling {
             coupling.add_forces(u, f);
@@ -115,6 +131,8 @@ impl<T: Real> Stiffness<'_, T> {
     /// Overwrites `f` with the elastic forces (N) of displacements `u` (m).
     /// Loops: `N` vertices, then `E` edges (lengths validated at load and at
     /// state construction; an out-of-range access is skipped, never a panic).
+    /// Always inlined, so that a [`Dispatch`] compiles it where it runs.
+    #[inline(always)]
     pub(crate) fn elastic_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
         for ((fi, ui), k) in f.iter_mut().zip(u).zip(self.vertex_tensors) {
             let ku = mul(k, ui);
@@ -130,13 +148,16 @@ impl<T: Real> Stiffness<'_, T> {
             else {
                 continue;
             };
+            // A copy: `f`'s writes below cannot change it (without the copy,
+            // the compiler reloads `u_i` at every edge).
+            let ui = *ui;
             let mut fi = [T::zero(); 3];
             for (&j, k) in columns.iter().zip(tensors) {
                 let (Some(uj), Some(fj)) = (u.get(j as usize), f.get_mut(j as usize)) else {
                     continue;
                 };
                 let a = mul(k, uj);
-                let b = mul_transposed(k, ui);
+                let b = mul_transposed(k, &ui);
                 fi = [fi[0] - a[0], fi[1] - a[1], fi[2] - a[2]];
                 *fj = [fj[0] - b[0], fj[1] - b[1], fj[2] - b[2]];
             }

@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 use super::force::{InternalForces, vec3};
 use super::state::VertexMode;
 use crate::Real;
+use crate::math::Dispatch;
 
 /// An explicit time integrator. All four are conditionally stable: the
 /// largest stable step is measured by `palpate dynamic critical-dt`.
@@ -73,24 +74,30 @@ impl<T: Real> Loads<'_, T> {
     /// cut keeps still).
     pub(crate) fn accelerations(
         &self,
+        dispatch: impl Dispatch,
         forces: &InternalForces<'_, '_, T>,
         damping_per_s: T,
         u: &[[T; 3]],
         v: &[[T; 3]],
         a: &mut [[T; 3]],
     ) {
-        forces.forces(u, a);
-        let per_vertex = a
-            .iter_mut()
-            .zip(v)
-            .zip(self.masses_kg)
-            .zip(self.modes)
-            .zip(self.external_force_n);
-        for ((((ai, vi), &m), &mode), fext) in per_vertex {
-            *ai = self
-                .acceleration(ai, vi, m, mode, fext, damping_per_s)
-                .into();
-        }
+        forces.forces(dispatch, u, a);
+        dispatch.run(
+            #[inline(always)]
+            || {
+                let per_vertex = a
+                    .iter_mut()
+                    .zip(v)
+                    .zip(self.masses_kg)
+                    .zip(self.modes)
+                    .zip(self.external_force_n);
+                for ((((ai, vi), &m), &mode), fext) in per_vertex {
+                    *ai = self
+                        .acceleration(ai, vi, m, mode, fext, damping_per_s)
+                        .into();
+                }
+            },
+        );
     }
 
     /// One vertex's acceleration (m/s²) from its elastic force `f` (N),

@@ -13,6 +13,7 @@ use super::state::{Fault, StateBuffers, StateError, VertexMode};
 use super::stvk::TetPass;
 use super::stvk_terms::{NonLinearTerms, TermArraysMut};
 use crate::Real;
+use crate::math::{Dispatch, Portable};
 use crate::table::{InterfaceTable, TensorMassTable};
 
 /// Parameters of the dynamics that are not in the table.
@@ -404,7 +405,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// current stiffness and the configured law and penalty (energy and
     /// eigenvalue estimates, finite-difference checks).
     pub fn elastic_forces_of(&self, u: &[[T; 3]], out: &mut [[T; 3]]) {
-        self.internal_forces().forces(u, out);
+        self.internal_forces().forces(Portable, u, out);
     }
 
     /// The elastic energy (J) of any displacement field `u` (m) under the
@@ -456,6 +457,19 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// in the fault state (returned as [`StepError::Faulted`]); the diverged
     /// state can then not be read.
     pub fn step(&mut self, integrator: Integrator, dt_s: T) -> Result<StepReport<T>, StepError> {
+        self.step_with(Portable, integrator, dt_s)
+    }
+
+    /// [`Self::step`] with its passes over the mesh (force passes and the
+    /// integrator's vertex updates) run through `dispatch`: a host's
+    /// run-time CPU-feature dispatch ([`crate::math::dispatch`]). Same
+    /// results as [`Self::step`].
+    pub fn step_with(
+        &mut self,
+        dispatch: impl Dispatch,
+        integrator: Integrator,
+        dt_s: T,
+    ) -> Result<StepReport<T>, StepError> {
         if let Some(fault) = self.fault {
             return Err(StepError::Faulted(fault));
         }
@@ -464,10 +478,13 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         }
         let outcome = match integrator {
             Integrator::ExplicitEuler | Integrator::SymplecticEuler => {
-                self.step_euler(dt_s, integrator == Integrator::SymplecticEuler)
+                let symplectic = integrator == Integrator::SymplecticEuler;
+                self.step_euler(dispatch, dt_s, symplectic)
             }
-            Integrator::Rk4 => self.step_rk4(dt_s).ok_or(StepError::NoRk4Scratch)?,
-            Integrator::CentralDifference => self.step_central(dt_s),
+            Integrator::Rk4 => self
+                .step_rk4(dispatch, dt_s)
+                .ok_or(StepError::NoRk4Scratch)?,
+            Integrator::CentralDifference => self.step_central(dispatch, dt_s),
         };
         self.previous_valid = integrator == Integrator::CentralDifference;
         match outcome {
@@ -484,7 +501,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
 
     /// Forward (`symplectic == false`) or semi-implicit Euler: one force
     /// pass, then one pass over the vertices that updates and checks each.
-    fn step_euler(&mut self, dt: T, symplectic: bool) -> Result<T, Fault> {
+    fn step_euler(&mut self, dispatch: impl Dispatch, dt: T, symplectic: bool) -> Result<T, Fault> {
         let (forces, loads, s) = split(
             &self.table,
             &mut self.state,
@@ -492,32 +509,38 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             self.coupling.as_ref(),
         );
         let (u, v, f) = (s.displacement_m, s.velocity_m_s, s.force_n);
-        forces.forces(u, f);
+        forces.forces(dispatch, u, f);
         let c = self.params.damping_per_s;
-        let mut watch = Watch::new(&self.params.limits);
-        let rows = u
-            .iter_mut()
-            .zip(v.iter_mut())
-            .zip(&*f)
-            .zip(loads.masses_kg)
-            .zip(loads.modes)
-            .zip(loads.external_force_n);
-        for (vertex, (((((ui, vi), fi), &m), &mode), fext)) in rows.enumerate() {
-            if mode == VertexMode::Free {
-                let v_old = vec3(vi);
-                let v_new = v_old + loads.acceleration(fi, vi, m, mode, fext, c) * dt;
-                let step = if symplectic { v_new } else { v_old };
-                *ui = (vec3(ui) + step * dt).into();
-                *vi = v_new.into();
-            }
-            watch.visit(vertex, ui, vi, m);
-        }
-        watch.finish()
+        let limits = &self.params.limits;
+        dispatch.run(
+            #[inline(always)]
+            || {
+                let mut watch = Watch::new(limits);
+                let rows = u
+                    .iter_mut()
+                    .zip(v.iter_mut())
+                    .zip(&*f)
+                    .zip(loads.masses_kg)
+                    .zip(loads.modes)
+                    .zip(loads.external_force_n);
+                for (vertex, (((((ui, vi), fi), &m), &mode), fext)) in rows.enumerate() {
+                    if mode == VertexMode::Free {
+                        let v_old = vec3(vi);
+                        let v_new = v_old + loads.acceleration(fi, vi, m, mode, fext, c) * dt;
+                        let step = if symplectic { v_new } else { v_old };
+                        *ui = (vec3(ui) + step * dt).into();
+                        *vi = v_new.into();
+                    }
+                    watch.visit(vertex, ui, vi, m);
+                }
+                watch.finish()
+            },
+        )
     }
 
     /// Classical RK4 on `y = (u, v)`, `ẏ = (v, a(u, v))`; `None` without
     /// RK4 scratch.
-    fn step_rk4(&mut self, dt: T) -> Option<Result<T, Fault>> {
+    fn step_rk4(&mut self, dispatch: impl Dispatch, dt: T) -> Option<Result<T, Fault>> {
         let n = self.state.displacement_m.len();
         let (forces, loads, s) = split(
             &self.table,
@@ -544,43 +567,55 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             (T::one(), T::zero()),
         ];
         for (weight, next) in stages {
-            loads.accelerations(&forces, self.params.damping_per_s, su, sv, a);
-            let rows = su
-                .iter_mut()
-                .zip(sv.iter_mut())
-                .zip(du.iter_mut())
-                .zip(dv.iter_mut());
-            for ((((sui, svi), dui), dvi), ((ui, vi), ai)) in
-                rows.zip(u.iter().zip(v.iter()).zip(&*a))
-            {
-                let (ku, kv) = (vec3(svi), vec3(ai));
-                *dui = (vec3(dui) + ku * weight).into();
-                *dvi = (vec3(dvi) + kv * weight).into();
-                *sui = (vec3(ui) + ku * next).into();
-                *svi = (vec3(vi) + kv * next).into();
-            }
+            let c = self.params.damping_per_s;
+            loads.accelerations(dispatch, &forces, c, su, sv, a);
+            dispatch.run(
+                #[inline(always)]
+                || {
+                    let rows = su
+                        .iter_mut()
+                        .zip(sv.iter_mut())
+                        .zip(du.iter_mut())
+                        .zip(dv.iter_mut());
+                    for ((((sui, svi), dui), dvi), ((ui, vi), ai)) in
+                        rows.zip(u.iter().zip(v.iter()).zip(&*a))
+                    {
+                        let (ku, kv) = (vec3(svi), vec3(ai));
+                        *dui = (vec3(dui) + ku * weight).into();
+                        *dvi = (vec3(dvi) + kv * weight).into();
+                        *sui = (vec3(ui) + ku * next).into();
+                        *svi = (vec3(vi) + kv * next).into();
+                    }
+                },
+            );
         }
         let sixth = dt / T::of_f64(6.0);
-        let mut watch = Watch::new(&self.params.limits);
-        let rows = u
-            .iter_mut()
-            .zip(v.iter_mut())
-            .zip(&*du)
-            .zip(&*dv)
-            .zip(loads.modes)
-            .zip(loads.masses_kg);
-        for (vertex, (((((ui, vi), dui), dvi), mode), &m)) in rows.enumerate() {
-            if *mode == VertexMode::Free {
-                *ui = (vec3(ui) + vec3(dui) * sixth).into();
-                *vi = (vec3(vi) + vec3(dvi) * sixth).into();
-            }
-            watch.visit(vertex, ui, vi, m);
-        }
-        Some(watch.finish())
+        let limits = &self.params.limits;
+        Some(dispatch.run(
+            #[inline(always)]
+            || {
+                let mut watch = Watch::new(limits);
+                let rows = u
+                    .iter_mut()
+                    .zip(v.iter_mut())
+                    .zip(&*du)
+                    .zip(&*dv)
+                    .zip(loads.modes)
+                    .zip(loads.masses_kg);
+                for (vertex, (((((ui, vi), dui), dvi), mode), &m)) in rows.enumerate() {
+                    if *mode == VertexMode::Free {
+                        *ui = (vec3(ui) + vec3(dui) * sixth).into();
+                        *vi = (vec3(vi) + vec3(dvi) * sixth).into();
+                    }
+                    watch.visit(vertex, ui, vi, m);
+                }
+                watch.finish()
+            },
+        ))
     }
 
     /// Picinbono 2001 eq. (19), MODELS.md damping sign (see [`Integrator::CentralDifference`]).
-    fn step_central(&mut self, dt: T) -> Result<T, Fault> {
+    fn step_central(&mut self, dispatch: impl Dispatch, dt: T) -> Result<T, Fault> {
         let first = !self.previous_valid;
         let (forces, loads, s) = split(
             &self.table,
@@ -594,38 +629,44 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             s.previous_displacement_m,
             s.force_n,
         );
-        forces.forces(u, f);
+        forces.forces(dispatch, u, f);
         let c_half = self.params.damping_per_s * dt / T::of_f64(2.0);
         let two = T::of_f64(2.0);
-        let mut watch = Watch::new(&self.params.limits);
-        let rows = u
-            .iter_mut()
-            .zip(v.iter_mut())
-            .zip(prev.iter_mut())
-            .zip(&*f)
-            .zip(loads.modes)
-            .zip(loads.masses_kg)
-            .zip(loads.external_force_n);
-        for (vertex, ((((((ui, vi), pi), fi), &mode), &m), fext)) in rows.enumerate() {
-            if mode == VertexMode::Free {
-                // Damping enters through the scheme's coefficients, not the acceleration.
-                let a = loads.acceleration(fi, vi, m, mode, fext, T::zero());
-                let u_now = vec3(ui);
-                // Start-up: u⁻ = u − Δt v (first step, or after another integrator).
-                let u_prev = if first {
-                    u_now - vec3(vi) * dt
-                } else {
-                    vec3(pi)
-                };
-                let u_next = (a * (dt * dt) + u_now * two - u_prev * (T::one() - c_half))
-                    / (T::one() + c_half);
-                *vi = ((u_next - u_prev) / (two * dt)).into();
-                *pi = u_now.into();
-                *ui = u_next.into();
-            }
-            watch.visit(vertex, ui, vi, m);
-        }
-        watch.finish()
+        let limits = &self.params.limits;
+        dispatch.run(
+            #[inline(always)]
+            || {
+                let mut watch = Watch::new(limits);
+                let rows = u
+                    .iter_mut()
+                    .zip(v.iter_mut())
+                    .zip(prev.iter_mut())
+                    .zip(&*f)
+                    .zip(loads.modes)
+                    .zip(loads.masses_kg)
+                    .zip(loads.external_force_n);
+                for (vertex, ((((((ui, vi), pi), fi), &mode), &m), fext)) in rows.enumerate() {
+                    if mode == VertexMode::Free {
+                        // Damping enters through the scheme's coefficients, not the acceleration.
+                        let a = loads.acceleration(fi, vi, m, mode, fext, T::zero());
+                        let u_now = vec3(ui);
+                        // Start-up: u⁻ = u − Δt v (first step, or after another integrator).
+                        let u_prev = if first {
+                            u_now - vec3(vi) * dt
+                        } else {
+                            vec3(pi)
+                        };
+                        let u_next = (a * (dt * dt) + u_now * two - u_prev * (T::one() - c_half))
+                            / (T::one() + c_half);
+                        *vi = ((u_next - u_prev) / (two * dt)).into();
+                        *pi = u_now.into();
+                        *ui = u_next.into();
+                    }
+                    watch.visit(vertex, ui, vi, m);
+                }
+                watch.finish()
+            },
+        )
     }
 }
 

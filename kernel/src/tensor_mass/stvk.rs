@@ -91,13 +91,12 @@ impl<T: Real> Block<T> {
         let l = self.used;
         let [u0, u1, u2, u3] = u;
         // Shape layout: a_0, a_1, a_2, a_3 (3 each), volume; a_0 is implied.
-        let gradients = shape.chunks_exact(3).skip(1);
-        let rows = self.du.iter_mut().zip(self.a.iter_mut());
-        for ((du_j, a_j), (uj, shape_j)) in rows.zip([u1, u2, u3].into_iter().zip(gradients)) {
-            let components = du_j.iter_mut().zip(a_j.iter_mut());
-            for ((du_jr, a_jr), ((&x, &x0), &g)) in components.zip(uj.iter().zip(u0).zip(shape_j)) {
-                if let (Some(d), Some(a)) = (du_jr.get_mut(l), a_jr.get_mut(l)) {
-                    *d = x - x0;
+        // Indices, not iterator adaptors: see `TetPass::for_each_block`.
+        for (j, uj) in [u1, u2, u3].into_iter().enumerate() {
+            for c in 0..3 {
+                let g = shape[3 * (j + 1) + c];
+                if let (Some(d), Some(a)) = (self.du[j][c].get_mut(l), self.a[j][c].get_mut(l)) {
+                    *d = uj[c] - u0[c];
                     *a = g;
                 }
             }
@@ -248,74 +247,102 @@ impl<T: Real> TetPass<'_, '_, T> {
     /// Calls `visit` on blocks of up to [`LANES`] live tets gathered from
     /// `u` (m), in tet order. Bounded by the tet count; a tet whose
     /// references fall outside `u` is skipped (validated at load).
+    ///
+    /// `visit` has one call site, so that inlining it (the passes ask for
+    /// it, for [`crate::math::Dispatch`]) does not copy it. The tets are
+    /// walked by index rather than by a zip of four slices: inside a pass a
+    /// host compiles for more CPU features, the compiler left the zip's
+    /// `next` out of line, a call per tet.
     #[inline(always)]
     fn for_each_block(&self, u: &[[T; 3]], mut visit: impl FnMut(&Block<T>)) {
         let mut block = Block::empty();
-        let tets = self.table.tets().iter().zip(self.table.tet_shapes());
-        let tets = tets.zip(self.table.tet_materials());
-        for (((&tet, shape), lame), &alive) in tets.zip(self.tet_alive) {
-            let (true, Some(u0), Some(u1), Some(u2), Some(u3)) = (
-                alive,
-                u.get(tet[0] as usize),
-                u.get(tet[1] as usize),
-                u.get(tet[2] as usize),
-                u.get(tet[3] as usize),
-            ) else {
-                continue;
-            };
-            block.push(tet, shape, lame, [u0, u1, u2, u3]);
-            if block.used == LANES {
-                visit(&block);
-                block.used = 0;
+        let (tets, shapes) = (self.table.tets(), self.table.tet_shapes());
+        let materials = self.table.tet_materials();
+        let mut t = 0;
+        loop {
+            while block.used < LANES {
+                let (Some(&tet), Some(shape), Some(lame), Some(&alive)) = (
+                    tets.get(t),
+                    shapes.get(t),
+                    materials.get(t),
+                    self.tet_alive.get(t),
+                ) else {
+                    break;
+                };
+                t += 1;
+                let (true, Some(u0), Some(u1), Some(u2), Some(u3)) = (
+                    alive,
+                    u.get(tet[0] as usize),
+                    u.get(tet[1] as usize),
+                    u.get(tet[2] as usize),
+                    u.get(tet[3] as usize),
+                ) else {
+                    continue;
+                };
+                block.push(tet, shape, lame, [u0, u1, u2, u3]);
             }
-        }
-        if block.used > 0 {
-            // Clear the stale lanes so they compute nothing.
+            if block.used == 0 {
+                return;
+            }
+            // Clear the stale lanes of the last block so they compute nothing.
             for l in block.used..LANES {
                 if let Some(v) = block.volume.get_mut(l) {
                     *v = T::zero();
                 }
             }
             visit(&block);
+            block.used = 0;
         }
     }
 
     /// Adds to `f` (N) the St Venant-Kirchhoff forces `f_j = −V F S a_j`
     /// of displacements `u` (m) with each tet's Lamé coefficients (Pa),
-    /// see [`Block::elastic`].
+    /// see [`Block::elastic`]. Always inlined, with its block visit, so that
+    /// a [`crate::math::Dispatch`] compiles it where it runs.
+    #[inline(always)]
     pub(crate) fn add_stvk_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
-        self.for_each_block(u, |block| {
-            let ([r1, r2, r3], _) = block.elastic();
-            for (l, tet) in block.corners.iter().enumerate().take(block.used) {
-                let (g1, g2, g3) = (lane(&r1, l), lane(&r2, l), lane(&r3, l));
-                let g0 = [
-                    -(g1[0] + g2[0] + g3[0]),
-                    -(g1[1] + g2[1] + g3[1]),
-                    -(g1[2] + g2[2] + g3[2]),
-                ];
-                for (&v, gv) in tet.iter().zip([g0, g1, g2, g3]) {
-                    if let Some(out) = f.get_mut(v as usize) {
-                        *out = [out[0] - gv[0], out[1] - gv[1], out[2] - gv[2]];
+        self.for_each_block(
+            u,
+            #[inline(always)]
+            |block| {
+                let ([r1, r2, r3], _) = block.elastic();
+                for (l, tet) in block.corners.iter().enumerate().take(block.used) {
+                    let (g1, g2, g3) = (lane(&r1, l), lane(&r2, l), lane(&r3, l));
+                    let g0 = [
+                        -(g1[0] + g2[0] + g3[0]),
+                        -(g1[1] + g2[1] + g3[1]),
+                        -(g1[2] + g2[2] + g3[2]),
+                    ];
+                    for (&v, gv) in tet.iter().zip([g0, g1, g2, g3]) {
+                        if let Some(out) = f.get_mut(v as usize) {
+                            *out = [out[0] - gv[0], out[1] - gv[1], out[2] - gv[2]];
+                        }
                     }
                 }
-            }
-        });
+            },
+        );
     }
 
     /// Adds to `f` (N) the incompressibility penalty with `gamma_n` (N) at
-    /// displacements `u` (m), see [`Block::penalty`].
+    /// displacements `u` (m), see [`Block::penalty`]. Always inlined, as
+    /// [`Self::add_stvk_forces`].
+    #[inline(always)]
     pub(crate) fn add_incompressibility(&self, gamma_n: T, u: &[[T; 3]], f: &mut [[T; 3]]) {
-        self.for_each_block(u, |block| {
-            let forces = block.penalty(gamma_n);
-            for (l, tet) in block.corners.iter().enumerate().take(block.used) {
-                for (&v, fj) in tet.iter().zip(&forces) {
-                    if let Some(out) = f.get_mut(v as usize) {
-                        let x = lane(fj, l);
-                        *out = [out[0] + x[0], out[1] + x[1], out[2] + x[2]];
+        self.for_each_block(
+            u,
+            #[inline(always)]
+            |block| {
+                let forces = block.penalty(gamma_n);
+                for (l, tet) in block.corners.iter().enumerate().take(block.used) {
+                    for (&v, fj) in tet.iter().zip(&forces) {
+                        if let Some(out) = f.get_mut(v as usize) {
+                            let x = lane(fj, l);
+                            *out = [out[0] + x[0], out[1] + x[1], out[2] + x[2]];
+                        }
                     }
                 }
-            }
-        });
+            },
+        );
     }
 
     /// The St Venant-Kirchhoff energy `Σ V (λ/2 (tr E)² + μ tr E²)` (J) of

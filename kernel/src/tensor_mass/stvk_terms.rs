@@ -379,7 +379,9 @@ impl<'t, T: Real> NonLinearTerms<'t, T> {
     /// `−∂(W₃ + W₄)/∂u` (N; Picinbono eq. 15, terms `F₂` and `F₃`), of
     /// displacements `u` (m) to `f`. One pass over vertices, edges,
     /// triangles and live tets, bounded by the slice lengths; references
-    /// outside `u` or `f` are skipped (validated at load).
+    /// outside `u` or `f` are skipped (validated at load). Always inlined,
+    /// so that a [`crate::math::Dispatch`] compiles it where it runs.
+    #[inline(always)]
     pub fn add_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
         self.pass(u, |v, g| {
             if let Some(out) = f.get_mut(v as usize) {

@@ -78,6 +78,7 @@ use super::cut::TearThresholds;
 use super::surface::{DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers};
 use super::{Integrator, StepError, StepReport, TensorMassModel};
 use crate::contact::{Contact, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue};
+use crate::math::{Dispatch, Portable};
 use crate::table::{TetIndex, TriangleIndex, VertexIndex};
 use crate::{MAX_CONTACTS, Real};
 
@@ -277,8 +278,10 @@ pub struct HeldContact<T> {
 }
 
 /// The dynamic model, its deforming surface and what each of the `P` tool
-/// points holds.
-pub struct DynamicTissue<'a, 's, T: Real, const P: usize> {
+/// points holds; the model's steps run through `D` ([`Dispatch`]: the
+/// kernel's own [`Portable`] unless a host says otherwise with
+/// [`DynamicTissue::with_dispatch`]).
+pub struct DynamicTissue<'a, 's, T: Real, const P: usize, D: Dispatch = Portable> {
     model: TensorMassModel<'a, 's, T>,
     surface: DeformingSurface<'a, 's, T>,
     forces_n: &'s mut [[T; 3]],
@@ -289,11 +292,13 @@ pub struct DynamicTissue<'a, 's, T: Real, const P: usize> {
     /// Ticks since the last update, and in the period before it (≥ 1).
     ticks_since_update: u32,
     period_ticks: u32,
+    dispatch: D,
 }
 
 impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
     /// The tissue of `model` (its current state), with the surface buffers
-    /// and a force scratch buffer of one entry per vertex.
+    /// and a force scratch buffer of one entry per vertex; its steps run
+    /// portable.
     pub fn new(
         model: TensorMassModel<'a, 's, T>,
         surface: SurfaceBuffers<'s, T>,
@@ -332,7 +337,27 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
             fault: None,
             ticks_since_update: 0,
             period_ticks: 1,
+            dispatch: Portable,
         })
+    }
+}
+
+impl<'a, 's, T: Real, const P: usize, D: Dispatch> DynamicTissue<'a, 's, T, P, D> {
+    /// The same tissue with its model's steps run through `dispatch` (a
+    /// host's run-time CPU-feature dispatch; same results).
+    pub fn with_dispatch<E: Dispatch>(self, dispatch: E) -> DynamicTissue<'a, 's, T, P, E> {
+        DynamicTissue {
+            model: self.model,
+            surface: self.surface,
+            forces_n: self.forces_n,
+            physics: self.physics,
+            held: self.held,
+            removed: self.removed,
+            fault: self.fault,
+            ticks_since_update: self.ticks_since_update,
+            period_ticks: self.period_ticks,
+            dispatch,
+        }
     }
 
     /// The tets the last physics update removed (blades, then tearing, each
@@ -711,7 +736,7 @@ impl<'a, 's, T: Real, const P: usize> DynamicTissue<'a, 's, T, P> {
         for _ in 0..self.physics.substeps {
             report = Some(
                 self.model
-                    .step(self.physics.integrator, self.physics.dt_s)
+                    .step_with(self.dispatch, self.physics.integrator, self.physics.dt_s)
                     .map_err(PhysicsError::Step)?,
             );
         }
@@ -803,7 +828,9 @@ fn carried<T: Real, const P: usize>(
         .filter(|h| h.contact.vertices.iter().any(|v| t.vertices.contains(v)))
 }
 
-impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for DynamicTissue<'_, '_, T, P> {
+impl<T: Real, const P: usize, const M: usize, D: Dispatch> Tissue<T, M>
+    for DynamicTissue<'_, '_, T, P, D>
+{
     fn geometry(&self) -> SurfaceGeometry<'_, T> {
         self.surface
             .geometry(Supports::TensorMass(self.model.table()))
