@@ -149,6 +149,9 @@ pub fn draw_all(
     Ok(names)
 }
 
+/// A chart with both axes logarithmic.
+type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
 /// The frame of an error-against-cost chart: log axes over `points`
 /// (`axes`: the x and y descriptions) and the Pareto front (`front`, one
 /// flag per point) joined by a line in the legend.
@@ -158,7 +161,7 @@ fn pareto_frame<'a, DB: DrawingBackend>(
     axes: [&str; 2],
     points: &[(f64, f64)],
     front: &[bool],
-) -> anyhow::Result<ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>> {
+) -> anyhow::Result<LogChart<'a, DB>> {
     let x = log_range(points.iter().map(|p| p.0));
     let y = log_range(points.iter().map(|p| p.1));
     let mut chart = ChartBuilder::on(root)
