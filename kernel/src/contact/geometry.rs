@@ -120,6 +120,48 @@ struct Nearest<T> {
     order: u32,
 }
 
+/// What one pass of [`SurfaceGeometry::detect`] over the candidates does.
+#[derive(Clone, Copy)]
+enum Pass<T> {
+    /// Around the tool: the sweep and the penetration test.
+    Tool,
+    /// Around the motion's start: the sweep only.
+    Start,
+    /// Around the tool again, when more unreached planes came than
+    /// [`Unreached`] keeps: is one over the centre nearer than `bound_m`,
+    /// or as near and tested before the `order`-th? Then it, not the
+    /// nearest plane the sphere reaches, is the nearest, and the tool is
+    /// outside (beyond a thin flap, nearer its other face).
+    Covered {
+        /// Distance of the nearest reached plane, m.
+        bound_m: T,
+        /// Its place in the test order.
+        order: u32,
+    },
+}
+
+/// The state of one detection's passes (see [`SurfaceGeometry::detect`]).
+struct Scan<T> {
+    /// The tool sphere's centre and radius, m.
+    to_m: Vector3<T>,
+    radius_m: T,
+    /// How far behind a plane the centre may lie and be found, m
+    /// ([`PENETRATION_DEPTH_RADII`] radii).
+    depth_m: T,
+    /// The swept segment, `None` without an earlier position.
+    segment: Option<[Vector3<T>; 2]>,
+    /// The sweep's earliest hit: `(along, triangle, weights)`.
+    hit: Option<(T, TriangleIndex, [T; 3])>,
+    /// The nearest plane the sphere reaches, under the centre.
+    reached: Option<Nearest<T>>,
+    /// The planes within the depth it does not reach.
+    unreached: Unreached<T>,
+    /// Candidates tested so far in a [`Pass::Tool`] or [`Pass::Covered`].
+    order: u32,
+    /// The answer of a [`Pass::Covered`].
+    covered: bool,
+}
+
 /// Planes the penetration test kept that the sphere does not reach.
 const UNREACHED_CAPACITY: usize = 16;
 
@@ -128,7 +170,7 @@ const UNREACHED_CAPACITY: usize = 16;
 /// distance, and the first [`UNREACHED_CAPACITY`] of them with their place
 /// in the test order, so that the check of [`SurfaceGeometry::detect`]
 /// (is one of them over the centre, nearer than the nearest reached?)
-/// needs no second pass unless more came.
+/// needs no second pass ([`Pass::Covered`]) unless more came.
 struct Unreached<T> {
     nearest_m: Option<T>,
     /// Each kept plane's triangle and place in the test order (its
@@ -395,7 +437,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// when the nearest is a rigid support). A barycentric test is spent
     /// only on planes the sphere reaches, and on the others only when one
     /// of them is nearer than the nearest reached ([`Unreached`], or a
-    /// second pass, [`Self::covered`], when more than it keeps came): a
+    /// second pass, [`Pass::Covered`], when more than it keeps came): a
     /// tool hovering within the depth reach costs three dot products per
     /// candidate.
     pub fn detect(
@@ -423,40 +465,25 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             };
             (start_m, end_m, (!same_cell && from_in).then_some(*from_m))
         });
-        let depth_m = radius_m * T::of_f64(PENETRATION_DEPTH_RADII);
-        let mut hit = None;
-        // Penetration, in one pass over the candidates: the nearest plane
-        // the sphere reaches (signed distance below the radius), and the
-        // nearest distance of the planes it does not reach, which only
-        // matter if one of them lies over the centre nearer than that one.
-        let mut reached = None;
-        let mut unreached = Unreached::new();
+        let mut scan = Scan {
+            to_m: *to_m,
+            radius_m,
+            depth_m: radius_m * T::of_f64(PENETRATION_DEPTH_RADII),
+            segment: sweep.map(|(start_m, end_m, _)| [start_m, end_m]),
+            hit: None,
+            reached: None,
+            unreached: Unreached::new(),
+            order: 0,
+            covered: false,
+        };
         let mut visited = Visited::new();
         if to_in {
-            let mut order = 0u32;
-            self.visit(to_m, &mut visited, work, |t, normal, offset| {
-                if let Some((start_m, end_m, _)) = &sweep {
-                    let segment = [*start_m, *end_m];
-                    self.sweep_test(t, normal, offset, &segment, radius_m, &mut hit);
-                }
-                let distance = normal.dot(to_m) - offset;
-                if distance.abs() <= depth_m && normal != Vector3::zeros() {
-                    if distance < radius_m {
-                        self.nearest_test(t, normal, distance, to_m, order, &mut reached);
-                    } else {
-                        unreached.note(t, distance, order);
-                    }
-                }
-                order = order.wrapping_add(1);
-            });
+            self.visit(to_m, &mut visited, work, Pass::Tool, &mut scan);
         }
-        if let Some((start_m, end_m, Some(from_m))) = &sweep {
-            let segment = [*start_m, *end_m];
-            self.visit(from_m, &mut visited, work, |t, normal, offset| {
-                self.sweep_test(t, normal, offset, &segment, radius_m, &mut hit);
-            });
+        if let Some((_, _, Some(from_m))) = &sweep {
+            self.visit(from_m, &mut visited, work, Pass::Start, &mut scan);
         }
-        if let Some((_, triangle, weights)) = hit {
+        if let Some((_, triangle, weights)) = scan.hit {
             let face = self.face(triangle)?;
             return Some(self.contact(tool, triangle, &face, weights, to_m, radius_m));
         }
@@ -465,13 +492,18 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             triangle,
             weights,
             order,
-        } = reached?;
+        } = scan.reached.take()?;
         let bound_m = distance_m.abs();
-        if unreached.nearest_m.is_some_and(|u| u <= bound_m) {
-            let covered = if unreached.overflowed {
-                self.covered(to_m, radius_m, depth_m, bound_m, order, work)
+        if scan.unreached.nearest_m.is_some_and(|u| u <= bound_m) {
+            let covered = if scan.unreached.overflowed {
+                // The second pass, over the same candidates in the same order.
+                scan.order = 0;
+                let mut visited = Visited::new();
+                let pass = Pass::Covered { bound_m, order };
+                self.visit(to_m, &mut visited, work, pass, &mut scan);
+                scan.covered
             } else {
-                unreached.planes.iter().any(|&(t, k)| {
+                scan.unreached.planes.iter().any(|&(t, k)| {
                     self.index.plane(t).is_some_and(|(normal, offset)| {
                         let distance = normal.dot(to_m) - offset;
                         Unreached::nearer(distance, k, bound_m, order)
@@ -494,17 +526,19 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         })
     }
 
-    /// Calls `test(triangle, normal, offset)` once for each surface
-    /// triangle around the surface vertices in the 27 grid cells around
-    /// `around` (m) that `visited` has not met, with its stored plane; a
-    /// triangle is around up to three of the vertices, and is tested at the
-    /// first. Counts the tests in `work`.
+    /// Runs `pass` of `scan` once for each surface triangle around the
+    /// surface vertices in the 27 grid cells around `around` (m) that
+    /// `visited` has not met, with its stored plane; a triangle is around
+    /// up to three of the vertices, and is tested at the first. Counts the
+    /// tests in `work`. One function for the three passes (one copy of the
+    /// visit in the firmware's flash).
     fn visit(
         &self,
         around: &Vector3<T>,
         visited: &mut Visited,
         work: &mut ContactWork,
-        mut test: impl FnMut(TriangleIndex, Vector3<T>, T),
+        pass: Pass<T>,
+        scan: &mut Scan<T>,
     ) {
         self.index.for_each_vertex_near(around, |v| {
             for t in self.index.triangles_of(v) {
@@ -515,9 +549,63 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                     continue;
                 };
                 work.triangles_tested = work.triangles_tested.saturating_add(1);
-                test(t, normal, offset);
+                self.test(pass, scan, t, normal, offset);
             }
         });
+    }
+
+    /// One candidate `t` (plane `normal`, `offset`) of `pass`.
+    #[inline(always)]
+    fn test(
+        &self,
+        pass: Pass<T>,
+        scan: &mut Scan<T>,
+        t: TriangleIndex,
+        normal: Vector3<T>,
+        offset: T,
+    ) {
+        let Scan {
+            to_m,
+            radius_m,
+            depth_m,
+            ..
+        } = *scan;
+        match pass {
+            Pass::Start => {
+                if let Some(segment) = &scan.segment {
+                    self.sweep_test(t, normal, offset, segment, radius_m, &mut scan.hit);
+                }
+            }
+            Pass::Tool => {
+                if let Some(segment) = &scan.segment {
+                    self.sweep_test(t, normal, offset, segment, radius_m, &mut scan.hit);
+                }
+                let distance = normal.dot(&to_m) - offset;
+                if distance.abs() <= depth_m && normal != Vector3::zeros() {
+                    if distance < radius_m {
+                        self.nearest_test(
+                            t,
+                            normal,
+                            distance,
+                            &to_m,
+                            scan.order,
+                            &mut scan.reached,
+                        );
+                    } else {
+                        scan.unreached.note(t, distance, scan.order);
+                    }
+                }
+                scan.order = scan.order.wrapping_add(1);
+            }
+            Pass::Covered { bound_m, order } => {
+                let distance = normal.dot(&to_m) - offset;
+                let nearer = Unreached::nearer(distance, scan.order, bound_m, order);
+                scan.order = scan.order.wrapping_add(1);
+                if !scan.covered && distance >= radius_m && distance <= depth_m && nearer {
+                    scan.covered = self.over(t, &normal, distance, &to_m);
+                }
+            }
+        }
     }
 
     /// The sweep's test of triangle `t` (plane `normal`, `offset`) against
@@ -604,39 +692,6 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 order,
             });
         }
-    }
-
-    /// Whether a plane the sphere centred at `tip_m` does not reach (signed
-    /// distance from the radius to `depth_m`) lies over the centre nearer
-    /// than `bound_m`, or as near and tested before the `order`-th: then it,
-    /// not the plane the sphere reaches, is the nearest, and the tool is
-    /// outside (beyond a thin flap, nearer its other face). The second pass
-    /// of [`Self::detect`]'s penetration test, over the same candidates in
-    /// the same order, only when such a plane exists and the first pass
-    /// could not keep them all ([`Unreached`]; out of line: its visited set
-    /// is only set up when it runs).
-    #[inline(never)]
-    fn covered(
-        &self,
-        tip_m: &Vector3<T>,
-        radius_m: T,
-        depth_m: T,
-        bound_m: T,
-        order: u32,
-        work: &mut ContactWork,
-    ) -> bool {
-        let mut visited = Visited::new();
-        let mut k = 0u32;
-        let mut covered = false;
-        self.visit(tip_m, &mut visited, work, |t, normal, offset| {
-            let distance = normal.dot(tip_m) - offset;
-            let nearer = Unreached::nearer(distance, k, bound_m, order);
-            k = k.wrapping_add(1);
-            if !covered && distance >= radius_m && distance <= depth_m && nearer {
-                covered = self.over(t, &normal, distance, tip_m);
-            }
-        });
-        covered
     }
 
     /// Whether the centre `tip_m` projects into triangle `t` (unit
