@@ -417,7 +417,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// the radius outside the grid), each tested once however many of its
     /// corners the cells hold. Bounded by `3 × max_query_triangles`
     /// triangle tests (the cells around `to_m` and `from_m`, and the
-    /// penetration test's second pass), most rejected by three dot products
+    /// penetration test's second pass), most rejected by two dot products
     /// with the stored plane; the sweep and the penetration test share the
     /// visit of the cells around `to_m`.
     ///
@@ -438,7 +438,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// only on planes the sphere reaches, and on the others only when one
     /// of them is nearer than the nearest reached ([`Unreached`], or a
     /// second pass, [`Pass::Covered`], when more than it keeps came): a
-    /// tool hovering within the depth reach costs three dot products per
+    /// tool hovering within the depth reach costs two dot products per
     /// candidate.
     pub fn detect(
         &self,
@@ -573,14 +573,21 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         match pass {
             Pass::Start => {
                 if let Some(segment) = &scan.segment {
-                    self.sweep_test(t, normal, offset, segment, radius_m, &mut scan.hit);
+                    let [_, end_m] = segment;
+                    let end_distance_m = normal.dot(end_m) - offset;
+                    let plane = (normal, offset, end_distance_m);
+                    self.sweep_test(t, plane, segment, radius_m, &mut scan.hit);
                 }
             }
             Pass::Tool => {
-                if let Some(segment) = &scan.segment {
-                    self.sweep_test(t, normal, offset, segment, radius_m, &mut scan.hit);
-                }
                 let distance = normal.dot(&to_m) - offset;
+                // A pass at the tool runs with the tool inside the grid's
+                // reach, so the segment ends at the tool (only a start
+                // outside it is clipped): its end's distance is this one.
+                if let Some(segment) = &scan.segment {
+                    let plane = (normal, offset, distance);
+                    self.sweep_test(t, plane, segment, radius_m, &mut scan.hit);
+                }
                 if distance.abs() <= depth_m && normal != Vector3::zeros() {
                     if distance < radius_m {
                         self.nearest_test(
@@ -608,25 +615,26 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         }
     }
 
-    /// The sweep's test of triangle `t` (plane `normal`, `offset`) against
-    /// the sphere moving along `segment`: keeps in `best` the earliest hit
-    /// from outside, as `(along, triangle, weights)`.
+    /// The sweep's test of triangle `t` (`plane`: unit normal, offset, and
+    /// the signed distance of the segment's end from it, m) against the
+    /// sphere moving along `segment`: keeps in `best` the earliest hit from
+    /// outside, as `(along, triangle, weights)`.
     #[inline(always)]
     fn sweep_test(
         &self,
         t: TriangleIndex,
-        normal: Vector3<T>,
-        offset: T,
+        plane: (Vector3<T>, T, T),
         segment: &[Vector3<T>; 2],
         radius_m: T,
         best: &mut Option<(T, TriangleIndex, [T; 3])>,
     ) {
+        let (normal, offset, end_distance_m) = plane;
         // A start exactly touching the surface may round to just inside it.
         let slack_m = T::WEIGHT_TOLERANCE * self.index.cell_m();
-        let [start_m, end_m] = segment;
+        let [start_m, _] = segment;
         // The stored plane first: two dot products reject almost all.
         let s0 = normal.dot(start_m) - offset - radius_m;
-        let s1 = normal.dot(end_m) - offset - radius_m;
+        let s1 = end_distance_m - radius_m;
         if s0 >= -slack_m && s1 < T::zero() {
             self.sweep_hit(t, normal, [s0, s1], segment, radius_m, best);
         }
