@@ -86,7 +86,7 @@
  writes it; any other version is refused with
  `PALPATE_STATUS_TABLE_UNSUPPORTED_VERSION`).
  */
-#define PALPATE_TABLE_FORMAT_VERSION 3
+#define PALPATE_TABLE_FORMAT_VERSION 4
 
 /*
  Tool points of a haptic loop, at most (a probe tip, a grasper's two
@@ -361,6 +361,11 @@ enum palpate_status
    Compressed table: a diagonal compliance block was dropped (`LoadError::DroppedDiagonal`).
    */
   PALPATE_STATUS_TABLE_DROPPED_DIAGONAL = 135,
+  /*
+   A tet's `tet-lanes` entry differs from its rest shape and material
+   (`LoadError::BadTetLanes`).
+   */
+  PALPATE_STATUS_TABLE_BAD_TET_LANES = 136,
   /*
    More contacts than `PALPATE_MAX_CONTACTS`.
    */

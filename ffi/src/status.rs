@@ -119,6 +119,9 @@ pub enum Status {
     TableBadKeptBlocks = 134,
     /// Compressed table: a diagonal compliance block was dropped (`LoadError::DroppedDiagonal`).
     TableDroppedDiagonal = 135,
+    /// A tet's `tet-lanes` entry differs from its rest shape and material
+    /// (`LoadError::BadTetLanes`).
+    TableBadTetLanes = 136,
 
     // Contacts (`palpate_precomputed_solve`, `..._displacements`): the
     // kernel's `ContactError` and `DisplacementError`.
@@ -244,6 +247,9 @@ impl Status {
             Self::TableDroppedDiagonal => {
                 c"compressed table: a diagonal compliance block was dropped"
             }
+            Self::TableBadTetLanes => {
+                c"table tet-lanes entry differs from the tet's shape or material"
+            }
             Self::ContactTooMany => c"more contacts than PALPATE_MAX_CONTACTS",
             Self::ContactVertexOutOfRange => c"contact vertex out of range",
             Self::ContactFixedVertex => c"contact on a fixed vertex",
@@ -316,6 +322,7 @@ impl From<LoadError> for Status {
             LoadError::BadCode { .. } => Self::TableBadCode,
             LoadError::BadKeptBlocks { .. } => Self::TableBadKeptBlocks,
             LoadError::DroppedDiagonal { .. } => Self::TableDroppedDiagonal,
+            LoadError::BadTetLanes { .. } => Self::TableBadTetLanes,
         }
     }
 }
@@ -441,7 +448,7 @@ impl From<FieldError> for Status {
 /// raw number, and the tests).
 ///
 /// cbindgen:ignore
-pub const ALL: [Status; 72] = [
+pub const ALL: [Status; 73] = [
     Status::Ok,
     Status::NullPointer,
     Status::Misaligned,
@@ -485,6 +492,7 @@ pub const ALL: [Status; 72] = [
     Status::TableBadCode,
     Status::TableBadKeptBlocks,
     Status::TableDroppedDiagonal,
+    Status::TableBadTetLanes,
     Status::ContactTooMany,
     Status::ContactVertexOutOfRange,
     Status::ContactFixedVertex,

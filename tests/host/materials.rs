@@ -346,12 +346,12 @@ fn removing_a_nodule_tet_leaves_the_stiffness_of_the_mesh_without_it() {
     assert!(worst <= 1e-12 * scale, "{}", worst / scale);
 }
 
-/// The `tet-material` section's directory entry in `bytes`.
-fn material_entry(bytes: &[u8]) -> SectionEntry {
+/// The directory entry of section `kind` in `bytes`.
+fn section_entry(bytes: &[u8], kind: SectionKind) -> SectionEntry {
     bytes[HEADER_LEN..]
         .chunks_exact(SECTION_ENTRY_LEN)
         .map(entry_of)
-        .find(|e| e.kind == SectionKind::TetMaterial as u32)
+        .find(|e| e.kind == kind as u32)
         .unwrap()
 }
 
@@ -393,13 +393,13 @@ fn version_2_tables_and_bad_tet_materials_are_refused() {
     println!("{message}");
     assert!(
         message.contains(
-            "table format version 2 is not read by this kernel (version 3): rebuild the table with `palpate tables build`"
+            "table format version 2 is not read by this kernel (version 4): rebuild the table with `palpate tables build`"
         ),
         "{message}"
     );
     assert!(!message.contains('\n'));
 
-    let entry = material_entry(file.bytes());
+    let entry = section_entry(file.bytes(), SectionKind::TetMaterial);
     let mut bad = file.bytes().to_vec();
     // Tet 1's μ (the second f64 of its pair) negative.
     let at = entry.offset as usize + 16 + 8;
@@ -408,6 +408,44 @@ fn version_2_tables_and_bad_tet_materials_are_refused() {
     assert_eq!(
         TensorMassTable::<f64>::load(bad.bytes()).unwrap_err(),
         LoadError::BadTetMaterial { tet: 1 }
+    );
+}
+
+/// The `tet-lanes` section (the St Venant-Kirchhoff pass's rest data by
+/// blocks of 8 tets) must repeat `tet-shape` and `tet-material`: a lane
+/// that differs is refused naming its tet, and so is a non-zero lane past
+/// the last tet (6 tets: lanes 6 and 7 of the one block are padding).
+#[test]
+fn tet_lanes_that_differ_from_their_tets_are_refused() {
+    let mesh = box_mesh([1, 1, 1], [0.02, 0.02, 0.02]);
+    assert_eq!(mesh.tets.len(), 6);
+    let file = tensor_mass_table(&mesh);
+    let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+    let lanes = table.tet_lanes();
+    assert_eq!(lanes.len(), 1);
+    let (a, volume) = table.tet_shape(4).unwrap();
+    assert_eq!(lanes[0][3 * 2 + 1][4], a[3][1], "a_3.y of tet 4");
+    assert_eq!(lanes[0][9][4], volume);
+    assert_eq!(lanes[0][11][4], table.tet_materials()[4][1], "mu of tet 4");
+    assert_eq!(lanes[0][0][6], 0.0);
+
+    let entry = section_entry(file.bytes(), SectionKind::TetLanes);
+    // Row r, lane l of block 0 (f64): byte (8 r + l) · 8.
+    let corrupt = |row: usize, lane: usize, value: f64| {
+        let mut bytes = file.bytes().to_vec();
+        let at = entry.offset as usize + (8 * row + lane) * 8;
+        bytes[at..at + 8].copy_from_slice(&value.to_le_bytes());
+        TableFile::from_bytes(&with_crc(bytes))
+    };
+    let mu_of_tet_1 = corrupt(11, 1, 2.0 * table.tet_materials()[1][1]);
+    assert_eq!(
+        TensorMassTable::<f64>::load(mu_of_tet_1.bytes()).unwrap_err(),
+        LoadError::BadTetLanes { tet: 1 }
+    );
+    let padding = corrupt(0, 7, 1.0);
+    assert_eq!(
+        TensorMassTable::<f64>::load(padding.bytes()).unwrap_err(),
+        LoadError::BadTetLanes { tet: 7 }
     );
 }
 

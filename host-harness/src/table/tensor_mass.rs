@@ -12,9 +12,9 @@ use bytemuck::Zeroable;
 use nalgebra::Vector3;
 use palpate_kernel::math::element::stiffness_block;
 use palpate_kernel::table::format::{
-    EDGE_TERMS_LEN, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS, TET_SHAPE_LEN,
-    TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN, tet_edge_vertices,
-    tet_face_vertices,
+    EDGE_TERMS_LEN, NO_NEIGHBOUR, RawHeader, SectionKind, TET_EDGE_PAIRS, TET_LANE_ROWS, TET_LANES,
+    TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN,
+    tet_edge_vertices, tet_face_vertices,
 };
 use palpate_kernel::tensor_mass::stvk_terms::{TermArraysMut, TetPlace, tet_terms};
 
@@ -170,6 +170,26 @@ impl TensorMassArrays {
     }
 }
 
+/// The `tet-lanes` section of `shapes` and `lame` (per tet): blocks of
+/// [`TET_LANES`] tets, row `r` of a block holding value `r` of each tet's
+/// `a_1, a_2, a_3` (by component), volume, `λ`, `μ` in the tet's lane,
+/// zero past the last tet (format: `SectionKind::TetLanes`).
+fn tet_lanes(
+    shapes: &[[f64; TET_SHAPE_LEN]],
+    lame: &[[f64; 2]],
+) -> Vec<[[f64; TET_LANES]; TET_LANE_ROWS]> {
+    let mut blocks = vec![[[0.0; TET_LANES]; TET_LANE_ROWS]; shapes.len().div_ceil(TET_LANES)];
+    for (t, (shape, &[lambda, mu])) in shapes.iter().zip(lame).enumerate() {
+        let block = &mut blocks[t / TET_LANES];
+        let material = [lambda, mu];
+        let rows = shape[3..].iter().chain(&material);
+        for (row, &x) in block.iter_mut().zip(rows) {
+            row[t % TET_LANES] = x;
+        }
+    }
+    blocks
+}
+
 fn add(target: &mut [f64; 9], block: &[f64; 9]) {
     for (t, b) in target.iter_mut().zip(block) {
         *t += b;
@@ -275,6 +295,7 @@ pub fn write_tensor_mass_table(
         ..RawHeader::zeroed()
     };
     let p = precision;
+    let lame = arrays.materials.lame();
     let sections = [
         Section::ints(SectionKind::VertexSlot, &ordering.slot_entries()),
         Section::floats(SectionKind::RestPositions, &mesh.positions, p),
@@ -294,7 +315,12 @@ pub fn write_tensor_mass_table(
         Section::floats(SectionKind::TriangleTerms, &arrays.triangle_terms, p),
         Section::ints(SectionKind::TetTriangle, &arrays.tet_triangles),
         Section::floats(SectionKind::TetTerms, &arrays.tet_terms, p),
-        Section::floats(SectionKind::TetMaterial, &arrays.materials.lame(), p),
+        Section::floats(SectionKind::TetMaterial, &lame, p),
+        Section::floats(
+            SectionKind::TetLanes,
+            &tet_lanes(&arrays.tet_shapes, &lame),
+            p,
+        ),
     ];
     write_container(header, p, &sections)
 }

@@ -169,6 +169,13 @@ pub enum LoadError {
         /// Tet index.
         tet: u32,
     },
+    /// A tet's lane of the `tet-lanes` section differs from its
+    /// `tet-shape` and `tet-material` entries, or a lane past the last tet
+    /// is not zero.
+    BadTetLanes {
+        /// Tet index (of the lane; `≥ tet_count` for a padding lane).
+        tet: u32,
+    },
     /// A diagonal compliance block `C_kk` is not symmetric positive definite.
     NotPositiveDefinite {
         /// Touchable index `k` (free index; the vertex is `free-vertex[k]`).
@@ -321,6 +328,10 @@ impl fmt::Display for LoadError {
             LoadError::BadTetMaterial { tet } => write!(
                 f,
                 "tet {tet}: Lame coefficients out of range (need mu > 0 and lambda > -2 mu / 3)"
+            ),
+            LoadError::BadTetLanes { tet } => write!(
+                f,
+                "tet {tet}: its tet-lanes entry differs from its tet-shape and tet-material entries (or a lane past the last tet is not zero)"
             ),
             LoadError::NotPositiveDefinite { touchable } => write!(
                 f,

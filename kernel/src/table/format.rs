@@ -1,4 +1,4 @@
-//! The table file format, version 3: one definition shared by the host writer
+//! The table file format, version 4: one definition shared by the host writer
 //! and the kernel reader.
 //!
 //! ```text
@@ -37,7 +37,11 @@
 //! [`SectionKind::TetMaterial`], each tet's own Lamé coefficients, required
 //! in both table kinds (heterogeneous tissue); the header's `young_pa` and
 //! `poisson` stay as the scene's default `[material]` (informative: every
-//! model reads the per-tet section). A version-2 table is refused
+//! model reads the per-tet section). 4 adds [`SectionKind::TetLanes`] to
+//! tensor-mass tables: the rest shapes and Lamé coefficients again, by
+//! blocks of [`TET_LANES`] tets in structure-of-arrays form, which the
+//! St Venant-Kirchhoff pass reads with vector loads instead of gathering
+//! them tet by tet. A table of an earlier version is refused
 //! ([`super::LoadError::UnsupportedVersion`]), never misread.
 //!
 //! ## Compressed compliance (version 3, additive)
@@ -76,7 +80,7 @@ use bytemuck::{Pod, Zeroable};
 /// First 8 bytes of every table.
 pub const MAGIC: [u8; 8] = *b"PALPTBL\0";
 /// The format version this kernel reads and the host writes.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 /// Every section starts at a multiple of this many bytes from the file start.
 pub const SECTION_ALIGN: usize = 16;
 /// Size of the CRC-32 trailer.
@@ -222,6 +226,7 @@ impl TableKind {
                 SectionKind::TetTriangle,
                 SectionKind::TetTerms,
                 SectionKind::TetMaterial,
+                SectionKind::TetLanes,
             ],
             TableKind::Interface => &[
                 SectionKind::ConnectionVertex,
@@ -342,6 +347,16 @@ pub enum SectionKind {
     /// Checked at load: finite, `μ > 0` and `λ > −2μ/3` (a positive bulk
     /// modulus, i.e. `−1 < ν < 0.5`).
     TetMaterial = 31,
+    // ---- Version 4: vectorized St Venant-Kirchhoff (32). ----
+    /// `[[scalar; TET_LANES]; TET_LANE_ROWS]` × ⌈tet_count / TET_LANES⌉
+    /// (tensor-mass tables): tets `8b..8b + 8` of block `b`, one lane each,
+    /// by rows ([`TET_LANE_ROWS`]): the rest gradients `a_1, a_2, a_3`
+    /// (1/m) by component (row `3(j − 1) + c` holds component `c` of
+    /// `a_j`; `a_0 = −(a_1 + a_2 + a_3)` is implied), the rest volume (m³),
+    /// `λ` and `μ` (Pa). The same values as [`SectionKind::TetShape`] and
+    /// [`SectionKind::TetMaterial`], bit for bit, and zero in the lanes
+    /// past the last tet (checked at load).
+    TetLanes = 32,
     /// `[u32; 2]` × c: each connection node `j` of an interface table, as
     /// `[mesh vertex, tensor-mass vertex]`; mesh vertices strictly
     /// ascending, and connection node `j` is tensor-mass vertex `j` (the
@@ -584,10 +599,25 @@ pub const TRIANGLE_TERMS_LEN: usize = 15;
 pub const TET_TERMS_LEN: usize = 3;
 /// Scalars per [`SectionKind::TetMaterial`] element: `(λ, μ)`.
 pub const TET_MATERIAL_LEN: usize = 2;
+/// Tets per [`SectionKind::TetLanes`] element: the lanes of the vectorized
+/// St Venant-Kirchhoff pass (8 `f32` fill an AVX2 register).
+pub const TET_LANES: usize = 8;
+/// Rows per [`SectionKind::TetLanes`] element: 9 gradient components, the
+/// volume, `λ` and `μ`.
+pub const TET_LANE_ROWS: usize = 12;
+/// Rows of a [`SectionKind::TetLanes`] element by what they hold.
+pub mod tet_lane_row {
+    /// Rest volume, m³.
+    pub const VOLUME: usize = 9;
+    /// Lamé `λ`, Pa.
+    pub const LAMBDA: usize = 10;
+    /// Lamé `μ`, Pa.
+    pub const MU: usize = 11;
+}
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 43] = [
+    pub const ALL: [SectionKind; 44] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -617,6 +647,7 @@ impl SectionKind {
         SectionKind::TetTriangle,
         SectionKind::TetTerms,
         SectionKind::TetMaterial,
+        SectionKind::TetLanes,
         SectionKind::ConnectionVertex,
         SectionKind::CondensedStiffness,
         SectionKind::ConnectionResponse,
@@ -685,6 +716,7 @@ impl SectionKind {
             SectionKind::TriangleTerms => TRIANGLE_TERMS_LEN as u32 * scalar_bytes,
             SectionKind::TetTerms => TET_TERMS_LEN as u32 * scalar_bytes,
             SectionKind::TetMaterial => TET_MATERIAL_LEN as u32 * scalar_bytes,
+            SectionKind::TetLanes => (TET_LANES * TET_LANE_ROWS) as u32 * scalar_bytes,
             SectionKind::ComplianceEncoding => COMPRESSION_RECORD_LEN as u32,
             SectionKind::SurfaceScale | SectionKind::InteriorScale => scalar_bytes,
             SectionKind::SurfaceCodes | SectionKind::InteriorCodes => 18,
@@ -725,6 +757,7 @@ impl SectionKind {
             | SectionKind::TetTriangle
             | SectionKind::TetTerms
             | SectionKind::TetMaterial => Some(tets),
+            SectionKind::TetLanes => Some(tets.div_ceil(TET_LANES as u64)),
             SectionKind::MeshTriangle | SectionKind::TriangleTerms => Some(h.mesh_triangle_count),
             SectionKind::FreeVertex => Some(f),
             SectionKind::SurfaceGrid | SectionKind::GridDims => Some(1),
@@ -783,6 +816,7 @@ impl SectionKind {
             SectionKind::TetTriangle => "tet-triangle",
             SectionKind::TetTerms => "tet-terms",
             SectionKind::TetMaterial => "tet-material",
+            SectionKind::TetLanes => "tet-lanes",
             SectionKind::ConnectionVertex => "connection-vertex",
             SectionKind::CondensedStiffness => "condensed-stiffness",
             SectionKind::ConnectionResponse => "connection-response",

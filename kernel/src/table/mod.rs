@@ -29,7 +29,7 @@ pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};
 pub use interface::InterfaceTable;
 pub use precomputed::PrecomputedTable;
-pub use tensor_mass::TensorMassTable;
+pub use tensor_mass::{TensorMassTable, TetLanes};
 
 /// A byte buffer aligned to 16 bytes ([`format::SECTION_ALIGN`]), so that table
 /// sections can be viewed in place. Use [`crate::include_table!`] for tables

@@ -5,9 +5,9 @@ use nalgebra::{Matrix3, Vector3};
 use super::LoadError;
 use super::container::{Container, check_finite, check_tet_materials};
 use super::format::{
-    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_MATERIAL_LEN,
-    TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind, VERTEX_TERMS_LEN,
-    tet_edge_vertices, tet_face_vertices,
+    EDGE_TERMS_LEN, FIXED_SLOT, NO_NEIGHBOUR, RawHeader, SectionKind, TET_LANE_ROWS, TET_LANES,
+    TET_MATERIAL_LEN, TET_SHAPE_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, TableKind,
+    VERTEX_TERMS_LEN, tet_edge_vertices, tet_face_vertices, tet_lane_row,
 };
 use super::index::{EdgeIndex, TetIndex, VertexIndex, csr_row, span};
 use crate::Real;
@@ -28,6 +28,9 @@ use crate::Real;
 ///   (their number equals the distinct faces counted with the neighbours);
 /// - masses are `≥ 0`, vertex tensors symmetric, every float finite;
 /// - every tet's Lamé coefficients have `μ > 0` and `λ > −2μ/3`;
+/// - the `tet-lanes` blocks hold each tet's rest gradients `a_1..a_3`,
+///   volume and Lamé coefficients bit for bit as `tet-shape` and
+///   `tet-material` do, and zeros past the last tet;
 /// - fixed vertices are marked [`FIXED_SLOT`] in the vertex-slot section and
 ///   their number matches the header's free count.
 #[derive(Clone, Copy, Debug)]
@@ -53,7 +56,12 @@ pub struct TensorMassTable<'a, T: Real> {
     tet_triangles: &'a [[u32; 4]],
     tet_terms: &'a [[T; TET_TERMS_LEN]],
     tet_materials: &'a [[T; TET_MATERIAL_LEN]],
+    tet_lanes: &'a [TetLanes<T>],
 }
+
+/// One [`SectionKind::TetLanes`] element: [`TET_LANES`] tets' rest data by
+/// rows ([`tet_lane_row`]), one lane per tet.
+pub type TetLanes<T> = [[T; TET_LANES]; TET_LANE_ROWS];
 
 impl<'a, T: Real> TensorMassTable<'a, T> {
     /// Validates `bytes` once and returns the view (format in
@@ -83,6 +91,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
             tet_triangles: c.section(SectionKind::TetTriangle)?,
             tet_terms: c.section(SectionKind::TetTerms)?,
             tet_materials: c.section(SectionKind::TetMaterial)?,
+            tet_lanes: c.section(SectionKind::TetLanes)?,
         };
         if table.header.mesh_triangle_count > u64::from(u32::MAX) {
             return Err(LoadError::InconsistentHeader);
@@ -104,6 +113,7 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         check_finite(SectionKind::TriangleTerms, table.triangle_terms)?;
         check_finite(SectionKind::TetTerms, table.tet_terms)?;
         check_tet_materials(table.tet_materials)?;
+        table.check_tet_lanes()?;
         table.check_vertices()?;
         table.check_edges()?;
         table.check_tets()?;
@@ -311,6 +321,13 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         self.tet_shapes
     }
 
+    /// The rest gradients, volumes and Lamé coefficients by blocks of
+    /// [`TET_LANES`] tets, structure of arrays (block `b` holds tets
+    /// `8b..8b + 8`; lanes past the last tet are zero).
+    pub fn tet_lanes(&self) -> &'a [TetLanes<T>] {
+        self.tet_lanes
+    }
+
     /// Rest shape-function gradients `a_0..a_3` (1/m) and rest volume (m³)
     /// of `tet`; `None` out of range.
     pub fn tet_shape(&self, tet: usize) -> Option<([Vector3<T>; 4], T)> {
@@ -340,6 +357,37 @@ impl<'a, T: Real> TensorMassTable<'a, T> {
         let k = self.column.get(row)?.binary_search(&hi.as_u32()).ok()?;
         // An edge of the validated CSR list: `< E`.
         Some(EdgeIndex::checked(u32::try_from(start + k).ok()?))
+    }
+
+    /// Each lane of `tet-lanes` against its tet's `tet-shape` (`a_1..a_3`,
+    /// volume) and `tet-material` entries, bit for bit (`==` on finite
+    /// values, checked before), and the lanes past the last tet zero.
+    fn check_tet_lanes(&self) -> Result<(), LoadError> {
+        for (b, block) in self.tet_lanes.iter().enumerate() {
+            for l in 0..TET_LANES {
+                let t = b * TET_LANES + l;
+                let expected = match (self.tet_shapes.get(t), self.tet_materials.get(t)) {
+                    (Some(shape), Some(&[lambda, mu])) => {
+                        let mut rows = [T::zero(); TET_LANE_ROWS];
+                        for (row, &x) in rows.iter_mut().zip(shape.iter().skip(3)) {
+                            *row = x;
+                        }
+                        for (r, x) in [(tet_lane_row::LAMBDA, lambda), (tet_lane_row::MU, mu)] {
+                            if let Some(row) = rows.get_mut(r) {
+                                *row = x;
+                            }
+                        }
+                        rows
+                    }
+                    _ => [T::zero(); TET_LANE_ROWS],
+                };
+                let stored = block.iter().map(|row| row.get(l).copied());
+                if !stored.zip(expected).all(|(s, e)| s == Some(e)) {
+                    return Err(LoadError::BadTetLanes { tet: t as u32 });
+                }
+            }
+        }
+        Ok(())
     }
 
     fn check_vertices(&self) -> Result<(), LoadError> {

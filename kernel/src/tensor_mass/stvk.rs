@@ -13,7 +13,8 @@
 
 use crate::Real;
 use crate::table::TensorMassTable;
-use crate::table::format::{TET_MATERIAL_LEN, TET_SHAPE_LEN};
+use crate::table::TetLanes;
+use crate::table::format::{TET_LANES, tet_lane_row};
 
 /// What the per-tet passes read: the table (tets, rest shapes and
 /// positions) and which tets are alive.
@@ -24,8 +25,9 @@ pub(crate) struct TetPass<'b, 'a, T: Real> {
 
 /// Tets evaluated together: the arithmetic of the per-tet force runs on
 /// `[T; LANES]` arrays, which the compiler turns into SIMD operations (8 f32
-/// per AVX2 register), while gathering and scattering stay per tet.
-const LANES: usize = 8;
+/// per AVX2 register), while gathering and scattering stay per tet. The
+/// table's `tet-lanes` blocks hold the rest data in this layout.
+const LANES: usize = TET_LANES;
 
 /// One value per lane.
 type Lanes<T> = [T; LANES];
@@ -42,18 +44,19 @@ fn lane<T: Real>(rows: &[Lanes<T>; 3], l: usize) -> [T; 3] {
     out
 }
 
-/// Up to [`LANES`] live tets gathered for the force pass: their corners,
-/// edge displacements `u_j − u_0` (m) and rest gradients `a_j` (1/m) for
-/// `j = 1..3` by component, rest volumes (m³) and Lamé coefficients (Pa).
-/// An unused lane has zero volume and gradients, so it computes a zero force.
-struct Block<T> {
+/// The [`LANES`] tets of one `tet-lanes` block for the force pass: their
+/// corners, which lanes hold a live tet, the edge displacements
+/// `u_j − u_0` (m, `j = 1..3`, by component) gathered from the field, and
+/// the block's rest data read in place ([`TetLanes`]: gradients `a_j`
+/// (1/m), volumes (m³), Lamé coefficients (Pa)). A lane without a live tet
+/// (cut, torn, or past the last tet) has zero edge displacements, so
+/// `F = I`, and computes a zero force, energy and penalty; it is not
+/// scattered.
+struct Block<'t, T> {
     corners: [[u32; 4]; LANES],
-    used: usize,
+    live: [bool; LANES],
     du: [[Lanes<T>; 3]; 3],
-    a: [[Lanes<T>; 3]; 3],
-    volume: Lanes<T>,
-    lambda: Lanes<T>,
-    mu: Lanes<T>,
+    rest: &'t TetLanes<T>,
 }
 
 // The lane loops index fixed-size arrays with literals < 3 and loop
@@ -61,56 +64,31 @@ struct Block<T> {
 // proves that no panic is left after inlining.
 #[expect(
     clippy::indexing_slicing,
-    reason = "indices are literals < 3 and loop counters < LANES over fixed-size arrays"
+    reason = "indices are literals < 3, row constants < TET_LANE_ROWS and loop counters < LANES over fixed-size arrays"
 )]
-impl<T: Real> Block<T> {
-    fn empty() -> Self {
-        let z = [T::zero(); LANES];
-        Self {
-            corners: [[0; 4]; LANES],
-            used: 0,
-            du: [[z; 3]; 3],
-            a: [[z; 3]; 3],
-            volume: z,
-            lambda: z,
-            mu: z,
-        }
-    }
-
-    /// Adds a tet with its rest shape, Lamé coefficients `[λ, μ]` (Pa) and
-    /// corner displacements in the next lane (the caller checks
-    /// `used < LANES`).
+impl<'t, T: Real> Block<'t, T> {
+    /// Puts live tet `tet` with corner displacements `u` (m) in lane `l`
+    /// (`< LANES`): its edge displacements `u_j − u_0`.
     #[inline(always)]
-    fn push(
-        &mut self,
-        tet: [u32; 4],
-        shape: &[T; TET_SHAPE_LEN],
-        lame: &[T; TET_MATERIAL_LEN],
-        u: [&[T; 3]; 4],
-    ) {
-        let l = self.used;
+    fn gather(&mut self, l: usize, tet: [u32; 4], u: [&[T; 3]; 4]) {
         let [u0, u1, u2, u3] = u;
-        // Shape layout: a_0, a_1, a_2, a_3 (3 each), volume; a_0 is implied.
-        // Indices, not iterator adaptors: see `TetPass::for_each_block`.
         for (j, uj) in [u1, u2, u3].into_iter().enumerate() {
             for c in 0..3 {
-                let g = shape[3 * (j + 1) + c];
-                if let (Some(d), Some(a)) = (self.du[j][c].get_mut(l), self.a[j][c].get_mut(l)) {
+                if let Some(d) = self.du[j][c].get_mut(l) {
                     *d = uj[c] - u0[c];
-                    *a = g;
                 }
             }
         }
-        if let (Some(v), Some(&volume)) = (self.volume.get_mut(l), shape.get(TET_SHAPE_LEN - 1)) {
-            *v = volume;
+        if let (Some(corners), Some(live)) = (self.corners.get_mut(l), self.live.get_mut(l)) {
+            *corners = tet;
+            *live = true;
         }
-        if let (Some(lambda), Some(mu)) = (self.lambda.get_mut(l), self.mu.get_mut(l)) {
-            [*lambda, *mu] = *lame;
-        }
-        if let Some(c) = self.corners.get_mut(l) {
-            *c = tet;
-        }
-        self.used += 1;
+    }
+
+    /// Gradient component `c` of `a_{j+1}`, per lane.
+    #[inline(always)]
+    fn a(&self, j: usize, c: usize) -> &'t Lanes<T> {
+        &self.rest[3 * j + c]
     }
 
     /// `F = I + Σ_j (u_j − u_0) a_jᵀ` of lane `l`, rows. Written out entry
@@ -118,9 +96,11 @@ impl<T: Real> Block<T> {
     /// vectorizable.
     #[inline(always)]
     fn deformation(&self, l: usize) -> [[T; 3]; 3] {
-        let (du, a, one) = (&self.du, &self.a, T::one());
+        let (du, one) = (&self.du, T::one());
         let g = |r: usize, c: usize| {
-            du[0][r][l] * a[0][c][l] + du[1][r][l] * a[1][c][l] + du[2][r][l] * a[2][c][l]
+            du[0][r][l] * self.a(0, c)[l]
+                + du[1][r][l] * self.a(1, c)[l]
+                + du[2][r][l] * self.a(2, c)[l]
         };
         [
             [g(0, 0) + one, g(0, 1), g(0, 2)],
@@ -142,10 +122,15 @@ impl<T: Real> Block<T> {
         let z = [T::zero(); LANES];
         let mut gradients = [[z; 3]; 3];
         let mut energy = z;
-        let a = &self.a;
         let (one, half) = (T::one(), T::of_f64(0.5));
+        let rest = self.rest;
+        let (volume, lambda, mu) = (
+            &rest[tet_lane_row::VOLUME],
+            &rest[tet_lane_row::LAMBDA],
+            &rest[tet_lane_row::MU],
+        );
         for l in 0..LANES {
-            let (lambda, mu) = (self.lambda[l], self.mu[l]);
+            let (lambda, mu) = (lambda[l], mu[l]);
             let two_mu = mu + mu;
             let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = self.deformation(l);
             // E = ½(FᵀF − I), symmetric.
@@ -157,7 +142,7 @@ impl<T: Real> Block<T> {
             let e12 = (f01 * f02 + f11 * f12 + f21 * f22) * half;
             let trace = e00 + e11 + e22;
             // V S = V (λ tr(E) I + 2μ E).
-            let v = self.volume[l];
+            let v = volume[l];
             let diagonal = lambda * trace;
             let s00 = (diagonal + two_mu * e00) * v;
             let s11 = (diagonal + two_mu * e11) * v;
@@ -174,7 +159,7 @@ impl<T: Real> Block<T> {
             let p21 = f20 * s01 + f21 * s11 + f22 * s12;
             let p22 = f20 * s02 + f21 * s12 + f22 * s22;
             for (j, out) in gradients.iter_mut().enumerate() {
-                let (g0, g1, g2) = (a[j][0][l], a[j][1][l], a[j][2][l]);
+                let (g0, g1, g2) = (self.a(j, 0)[l], self.a(j, 1)[l], self.a(j, 2)[l]);
                 out[0][l] = p00 * g0 + p01 * g1 + p02 * g2;
                 out[1][l] = p10 * g0 + p11 * g1 + p12 * g2;
                 out[2][l] = p20 * g0 + p21 * g1 + p22 * g2;
@@ -198,7 +183,6 @@ impl<T: Real> Block<T> {
     fn penalty(&self, gamma_n: T) -> [[Lanes<T>; 3]; 4] {
         let z = [T::zero(); LANES];
         let mut forces = [[z; 3]; 4];
-        let a = &self.a;
         for l in 0..LANES {
             let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = self.deformation(l);
             let cof = [
@@ -220,9 +204,9 @@ impl<T: Real> Block<T> {
             ];
             let change = f00 * cof[0][0] + f01 * cof[0][1] + f02 * cof[0][2] - T::one();
             let magnitude = gamma_n * change * change.abs();
-            let a1: [T; 3] = core::array::from_fn(|c| a[0][c][l]);
-            let a2: [T; 3] = core::array::from_fn(|c| a[1][c][l]);
-            let a3: [T; 3] = core::array::from_fn(|c| a[2][c][l]);
+            let a1: [T; 3] = core::array::from_fn(|c| self.a(0, c)[l]);
+            let a2: [T; 3] = core::array::from_fn(|c| self.a(1, c)[l]);
+            let a3: [T; 3] = core::array::from_fn(|c| self.a(2, c)[l]);
             let a0: [T; 3] = core::array::from_fn(|c| -(a1[c] + a2[c] + a3[c]));
             for (out, aj) in forces.iter_mut().zip([a0, a1, a2, a3]) {
                 let n: [T; 3] = core::array::from_fn(|r| {
@@ -244,34 +228,33 @@ impl<T: Real> Block<T> {
 }
 
 impl<T: Real> TetPass<'_, '_, T> {
-    /// Calls `visit` on blocks of up to [`LANES`] live tets gathered from
-    /// `u` (m), in tet order. Bounded by the tet count; a tet whose
-    /// references fall outside `u` is skipped (validated at load).
+    /// Calls `visit` on each `tet-lanes` block with its live tets'
+    /// displacements gathered from `u` (m), in tet order. Bounded by the
+    /// table's block count; a tet whose references fall outside `u` is
+    /// left out like a dead one (validated at load).
     ///
     /// `visit` has one call site, so that inlining it (the passes ask for
     /// it, for [`crate::math::Dispatch`]) does not copy it. The tets are
-    /// walked by index rather than by a zip of four slices: inside a pass a
-    /// host compiles for more CPU features, the compiler left the zip's
-    /// `next` out of line, a call per tet.
+    /// read by index rather than by a zip of slices: inside a pass a host
+    /// compiles for more CPU features, the compiler left a zip's `next` out
+    /// of line, a call per tet.
     #[inline(always)]
-    fn for_each_block(&self, u: &[[T; 3]], mut visit: impl FnMut(&Block<T>)) {
-        let mut block = Block::empty();
-        let (tets, shapes) = (self.table.tets(), self.table.tet_shapes());
-        let materials = self.table.tet_materials();
-        let mut t = 0;
-        loop {
-            while block.used < LANES {
-                let (Some(&tet), Some(shape), Some(lame), Some(&alive)) = (
-                    tets.get(t),
-                    shapes.get(t),
-                    materials.get(t),
-                    self.tet_alive.get(t),
-                ) else {
-                    break;
+    fn for_each_block(&self, u: &[[T; 3]], mut visit: impl FnMut(&Block<'_, T>)) {
+        let tets = self.table.tets();
+        for (b, rest) in self.table.tet_lanes().iter().enumerate() {
+            let z = [T::zero(); LANES];
+            let mut block = Block {
+                corners: [[0; 4]; LANES],
+                live: [false; LANES],
+                du: [[z; 3]; 3],
+                rest,
+            };
+            for l in 0..LANES {
+                let t = b * LANES + l;
+                let (Some(&tet), Some(&true)) = (tets.get(t), self.tet_alive.get(t)) else {
+                    continue;
                 };
-                t += 1;
-                let (true, Some(u0), Some(u1), Some(u2), Some(u3)) = (
-                    alive,
+                let (Some(u0), Some(u1), Some(u2), Some(u3)) = (
                     u.get(tet[0] as usize),
                     u.get(tet[1] as usize),
                     u.get(tet[2] as usize),
@@ -279,19 +262,9 @@ impl<T: Real> TetPass<'_, '_, T> {
                 ) else {
                     continue;
                 };
-                block.push(tet, shape, lame, [u0, u1, u2, u3]);
-            }
-            if block.used == 0 {
-                return;
-            }
-            // Clear the stale lanes of the last block so they compute nothing.
-            for l in block.used..LANES {
-                if let Some(v) = block.volume.get_mut(l) {
-                    *v = T::zero();
-                }
+                block.gather(l, tet, [u0, u1, u2, u3]);
             }
             visit(&block);
-            block.used = 0;
         }
     }
 
@@ -306,7 +279,10 @@ impl<T: Real> TetPass<'_, '_, T> {
             #[inline(always)]
             |block| {
                 let ([r1, r2, r3], _) = block.elastic();
-                for (l, tet) in block.corners.iter().enumerate().take(block.used) {
+                for (l, tet) in block.corners.iter().enumerate() {
+                    if block.live.get(l) != Some(&true) {
+                        continue;
+                    }
                     let (g1, g2, g3) = (lane(&r1, l), lane(&r2, l), lane(&r3, l));
                     let g0 = [
                         -(g1[0] + g2[0] + g3[0]),
@@ -333,7 +309,10 @@ impl<T: Real> TetPass<'_, '_, T> {
             #[inline(always)]
             |block| {
                 let forces = block.penalty(gamma_n);
-                for (l, tet) in block.corners.iter().enumerate().take(block.used) {
+                for (l, tet) in block.corners.iter().enumerate() {
+                    if block.live.get(l) != Some(&true) {
+                        continue;
+                    }
                     for (&v, fj) in tet.iter().zip(&forces) {
                         if let Some(out) = f.get_mut(v as usize) {
                             let x = lane(fj, l);
@@ -350,9 +329,10 @@ impl<T: Real> TetPass<'_, '_, T> {
     pub(crate) fn stvk_energy_j(&self, u: &[[T; 3]]) -> T {
         let mut energy = T::zero();
         self.for_each_block(u, |block| {
+            // A lane without a live tet has `F = I`: zero energy.
             let (_, w) = block.elastic();
-            for x in w.iter().take(block.used) {
-                energy += *x;
+            for x in w {
+                energy += x;
             }
         });
         energy
