@@ -290,6 +290,16 @@ pub fn failures(study: &Study) -> Vec<String> {
                 r.load.name(),
                 100.0 * r.level
             ));
+        } else if r.inverted_tets > 0 {
+            lines.push(format!(
+                "the St Venant-Kirchhoff reference itself collapses under {} at {:.0} % (past the \
+                 buckling load its stable equilibrium): {} inverted tets, ΔV/V₀ {:+.1} %, tip {:.1} mm",
+                r.load.name(),
+                100.0 * r.level,
+                r.inverted_tets,
+                100.0 * r.volume_change,
+                1e3 * r.tip_m
+            ));
         }
     }
     for r in &study.runs {
