@@ -59,7 +59,7 @@ use crate::fem::newton::{NewtonOptions, StaticProblem, solve_stvk};
 use crate::fem::static_solve::solve_loaded;
 use crate::fix::{FixPredicate, fixed_vertices};
 use crate::hybrid::owned::with_hybrid;
-use crate::hybrid::{HybridOptions, build_hybrid};
+use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::generate::cylinder_mesh;
 use crate::mesh::{MeshReport, TetMesh};
 use crate::remap::fit::{FittedModel, fit_curves};
@@ -69,6 +69,7 @@ use crate::table::tensor_mass::{TensorMassArrays, static_study_table, write_tens
 use crate::tensor_mass::OwnedState;
 use crate::tensor_mass::run::{diagonal, volume_change};
 use crate::tensor_mass::stability::omega_max;
+use palpate_kernel::hybrid::HybridModel;
 
 /// Cylinder height, m.
 pub const HEIGHT_M: f64 = 0.1;
@@ -198,6 +199,21 @@ impl Model {
         )
     }
 
+    /// A stepped model: tensor-mass, or the hybrid.
+    pub fn is_dynamic(self) -> bool {
+        self.is_tensor_mass() || self == Model::Hybrid
+    }
+
+    /// The law and penalty (N) of the stepped tensor-mass model: the
+    /// model's own ([`Model::tensor_mass`]), the hybrid's region's
+    /// ([`HYBRID_LAW`]); `None` for the pre-computed models.
+    pub fn dynamic_law(self, body: &Body) -> Option<(ElasticLaw, Option<f64>)> {
+        match self {
+            Model::Hybrid => Some((HYBRID_LAW, None)),
+            _ => self.tensor_mass(body),
+        }
+    }
+
     /// Name used in the JSON, the charts and the report.
     pub fn name(self) -> &'static str {
         match self {
@@ -211,15 +227,11 @@ impl Model {
     }
 }
 
-/// How many of [`Model::ALL`] are tensor-mass models.
-fn tensor_mass_models() -> usize {
-    Model::ALL.iter().filter(|m| m.is_tensor_mass()).count()
-}
-
-/// How many of [`Model::ALL`] are relaxed to rest: the tensor-mass models
-/// and the hybrid (whose tensor-mass region has at most the mesh's tets).
+/// How many of [`Model::ALL`] are stepped (relaxed to rest, integrated
+/// in the trajectories): the tensor-mass models and the hybrid (whose
+/// tensor-mass region has at most the mesh's tets).
 fn relaxed_models() -> usize {
-    tensor_mass_models() + 1
+    Model::ALL.iter().filter(|m| m.is_dynamic()).count()
 }
 
 /// A user's mesh for the study (`palpate chart --mesh`): run at its own
@@ -400,7 +412,7 @@ impl Matrix {
     pub fn trajectories(&self) -> usize {
         self.mesh_count().min(self.trajectory.meshes)
             * self.loads.len()
-            * tensor_mass_models()
+            * relaxed_models()
             * Integrator::ALL.len()
             * self.trajectory.dt_factors.len()
     }
@@ -426,7 +438,10 @@ impl Matrix {
         let critical =
             crate::tensor_mass::stability::BISECTIONS * crate::tensor_mass::stability::TRIAL_STEPS;
         let trials = self.stability.trials() * stability::TRIAL_STEPS;
-        let maps = tets(coarsest) * evaluations * (critical + trials) as u64;
+        let maps = stability::MAP_MODELS.len() as u64
+            * tets(coarsest)
+            * evaluations
+            * (critical + trials) as u64;
         let mut trajectories = 0;
         for body in bodies.iter().take(self.trajectory.meshes) {
             let two_over_omega = trajectory::two_over_omega_s(body)?;
@@ -441,7 +456,7 @@ impl Matrix {
                 .sum();
             trajectories += tets(body)
                 * self.loads.len() as u64
-                * tensor_mass_models() as u64
+                * relaxed_models() as u64
                 * evaluations
                 * steps;
         }
@@ -1234,18 +1249,10 @@ fn dynamic(
 /// evaluation, so the residual is the whole body's); time per step of the
 /// coupled step in f64 at the equilibrium and in f32 from rest.
 fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<Outcome> {
-    let dynamic_tet = body.hybrid_dynamic_tets();
-    let options =
-        |precision| HybridOptions::new(body.material, DENSITY_KG_M3, body.fix.clone(), precision);
     let n = body.mesh.positions.len();
     // A mesh whose loaded end is all of it (or none) has no hybrid: a
     // fault of the run, not of the study.
-    let tables = match build_hybrid(
-        &body.mesh,
-        &body.report,
-        &dynamic_tet,
-        &options(Precision::F64),
-    ) {
+    let tables = match hybrid_tables(body, body.material, Precision::F64) {
         Ok(tables) => tables,
         Err(e) => {
             return Ok(Outcome {
@@ -1257,31 +1264,17 @@ fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<O
             });
         }
     };
-    let split = &tables.split;
-    let mut local = vec![[0.0; 3]; split.dynamic_vertex.len()];
-    for (v, f) in loads.iter().enumerate() {
-        if f.iter().any(|&x| x != 0.0) {
-            let l =
-                split.dynamic_index[v].context("a loaded vertex outside the tensor-mass region")?;
-            local[l as usize] = *f;
-        }
-    }
+    let local = region_loads(&tables, loads)?;
     let largest = loads
         .iter()
         .map(|f| Vector3::from(*f).norm())
         .fold(0.0, f64::max);
     let bound = 100.0 * diagonal(&body.mesh.positions);
-    let law = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
-    let params = DynamicParams::linear(0.0, bound).with_law(law);
+    let params = DynamicParams::linear(0.0, bound).with_law(HYBRID_LAW);
     let (u, fault, steps, step_s, dt_s) = with_hybrid(&tables, params, |h| {
         let dt_s = 0.5 / omega_max(h.dynamic_mut());
         h.reset();
-        for (l, f) in local.iter().enumerate() {
-            if f.iter().any(|&x| x != 0.0) {
-                h.dynamic_mut()
-                    .set_external_force(l as u32, Vector3::from(*f))?;
-            }
-        }
+        set_loads(h.dynamic_mut(), &local)?;
         let mut last = vec![[0.0; 3]; local.len()];
         let relaxed = relax(
             h.dynamic_mut(),
@@ -1292,11 +1285,10 @@ fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<O
             &mut last,
         );
         let (fault, steps) = relax_outcome(relaxed);
-        let mut u = vec![[0.0; 3]; n];
-        if fault.is_none() {
-            h.update_background(usize::MAX)?;
-            h.displacements::<1>(None, &mut u)?;
-        }
+        let u = match fault {
+            None => hybrid_field(h, n)?,
+            Some(_) => vec![[0.0; 3]; n],
+        };
         if h.dynamic().fault().is_some() {
             h.reset();
         }
@@ -1305,20 +1297,10 @@ fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<O
         });
         anyhow::Ok((u, fault, steps, step_s, dt_s))
     })??;
-    let tables32 = build_hybrid(
-        &body.mesh,
-        &body.report,
-        &dynamic_tet,
-        &options(Precision::F32),
-    )?;
-    let params32 = DynamicParams::linear(0.0f32, bound as f32).with_law(law);
+    let tables32 = hybrid_tables(body, body.material, Precision::F32)?;
+    let params32 = DynamicParams::linear(0.0f32, bound as f32).with_law(HYBRID_LAW);
     let step_f32_s = with_hybrid(&tables32, params32, |h| {
-        for (l, f) in local.iter().enumerate() {
-            if f.iter().any(|&x| x != 0.0) {
-                h.dynamic_mut()
-                    .set_external_force(l as u32, Vector3::from(f.map(|x| x as f32)))?;
-            }
-        }
+        set_loads(h.dynamic_mut(), &local)?;
         anyhow::Ok(median_s(|| {
             if h.dynamic().fault().is_some() {
                 h.reset();
@@ -1333,6 +1315,68 @@ fn hybrid(body: &Body, loads: &[[f64; 3]], max_steps: usize) -> anyhow::Result<O
         step_f32_s: Some(step_f32_s),
         steps,
     })
+}
+
+/// The hybrid's law on its tensor-mass region.
+pub const HYBRID_LAW: ElasticLaw = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
+
+/// The hybrid's tables of `body` with `material` in `precision`: its
+/// tensor-mass region [`Body::hybrid_dynamic_tets`], the rest pre-computed.
+pub(crate) fn hybrid_tables(
+    body: &Body,
+    material: Material,
+    precision: Precision,
+) -> anyhow::Result<HybridTables> {
+    let options = HybridOptions::new(material, DENSITY_KG_M3, body.fix.clone(), precision);
+    build_hybrid(
+        &body.mesh,
+        &body.report,
+        &body.hybrid_dynamic_tets(),
+        &options,
+    )
+}
+
+/// The nodal `loads` of the whole mesh on the hybrid's tensor-mass region
+/// (its vertex numbering); every loaded vertex must lie in it.
+pub(crate) fn region_loads(
+    tables: &HybridTables,
+    loads: &[[f64; 3]],
+) -> anyhow::Result<Vec<[f64; 3]>> {
+    let split = &tables.split;
+    let mut local = vec![[0.0; 3]; split.dynamic_vertex.len()];
+    for (v, f) in loads.iter().enumerate() {
+        if f.iter().any(|&x| x != 0.0) {
+            let l =
+                split.dynamic_index[v].context("a loaded vertex outside the tensor-mass region")?;
+            local[l as usize] = *f;
+        }
+    }
+    Ok(local)
+}
+
+/// Sets the nonzero nodal `loads` (N, f64, converted to `T`) on `model`.
+pub(crate) fn set_loads<T: palpate_kernel::Real>(
+    model: &mut TensorMassModel<'_, '_, T>,
+    loads: &[[f64; 3]],
+) -> anyhow::Result<()> {
+    for (v, f) in loads.iter().enumerate() {
+        if f.iter().any(|&x| x != 0.0) {
+            model.set_external_force(v as u32, Vector3::from(f.map(T::of_f64)))?;
+        }
+    }
+    Ok(())
+}
+
+/// The hybrid's displacement field over the whole mesh of `n` vertices, m:
+/// the pre-computed region's background brought up to date first.
+pub(crate) fn hybrid_field(
+    h: &mut HybridModel<'_, '_, f64>,
+    n: usize,
+) -> anyhow::Result<Vec<[f64; 3]>> {
+    let mut u = vec![[0.0; 3]; n];
+    h.update_background(usize::MAX)?;
+    h.displacements::<1>(None, &mut u)?;
+    Ok(u)
 }
 
 /// The fault (`None` when settled) and the steps of a relaxation.

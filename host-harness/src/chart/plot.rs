@@ -134,7 +134,10 @@ pub fn draw_all(
     ))?;
     names.push("cost-mesh".into());
     for map in &study.stability {
-        let name = format!("stability-{}", map.integrator);
+        let name = match map.model {
+            super::Model::Hybrid => format!("stability-hybrid-{}", map.integrator),
+            _ => format!("stability-{}", map.integrator),
+        };
         render!(dir, name, |root: &DrawingArea<_, Shift>| stability(
             root, map
         ))?;
@@ -463,8 +466,11 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!(
-                "{}: stability on cylinder {} (damping {} 1/s)",
-                map.integrator, map.mesh, map.damping_per_s
+                "{} {}: stability on cylinder {} (damping {} 1/s)",
+                map.model.name(),
+                map.integrator,
+                map.mesh,
+                map.damping_per_s
             ),
             ("sans-serif", 20),
         )

@@ -236,7 +236,7 @@ fn trajectories(out: &mut String, study: &Study, loads: &[Load]) {
     let _ = writeln!(
         out,
         "\n## Dynamic runs: trajectory error against Δt/{REFINEMENT}\n\n\
-         Each tensor-mass model and integrator, the load applied at rest, {} s simulated with \
+         Each tensor-mass model and the hybrid, each integrator, the load applied at rest, {} s simulated with \
          damping {} 1/s, against the same model and integrator at a step {REFINEMENT}× smaller: \
          error = max over the steps of ‖u − u_ref‖₂ / max ‖u_ref‖₂; cost = time per step / Δt \
          (compute seconds per simulated second, f64).\n",
@@ -352,7 +352,8 @@ pub fn failures(study: &Study) -> Vec<String> {
             })
             .collect();
         lines.push(format!(
-            "{}: measured critical step {:.3e} s, 2/ω_max {:.3e} s at E = {} Pa; {} of {} trials fail{}",
+            "{} {}: measured critical step {:.3e} s, 2/ω_max {:.3e} s at E = {} Pa; {} of {} trials fail{}",
+            map.model.name(),
             map.integrator,
             map.critical_dt_s,
             map.two_over_omega_s,

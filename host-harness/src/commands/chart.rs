@@ -119,7 +119,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         max_steps: matrix.max_relax_steps,
         ..volume_bend::Controls::default()
     };
-    let trials = 4 * matrix.stability.trials();
+    let trials = chart::stability::map_count() * matrix.stability.trials();
     // The tick counts need valgrind: without it, skipped (said in the report).
     let tick_runs = if matrix.tick_counts && ticks::valgrind_available() {
         ticks::TICK_RUNS
