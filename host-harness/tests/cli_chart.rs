@@ -6,7 +6,8 @@
 //! are 1.6 % off; the other runs within 1 % there, St Venant-Kirchhoff
 //! relaxed (4.6e-7: the reference's own law and mesh) and with the penalty
 //! (0.41 %), cost 25.5 and 69 µs per step); the SVGs carry their text as
-//! glyph outlines; the hybrid's run and `--mesh`.
+//! glyph outlines; the hybrid's run, maps and trajectories; the press
+//! past buckling; and `--mesh`.
 
 mod common;
 
@@ -52,7 +53,34 @@ fn quick_chart_writes_report_charts_and_json() {
         .map(|v| v.as_str().unwrap())
         .collect();
     assert!(front.contains(&"precomputed-quasi on 2x10"), "{front:?}");
-    assert_eq!(json["study"]["stability"].as_array().unwrap().len(), 4);
+    // One map per integrator for St Venant-Kirchhoff and for the hybrid,
+    // whose critical step is its tensor-mass region's: measured on 1x5
+    // (symplectic) 3.84e-3 s, within 1 % of 2/ω_max (3.86e-3 s).
+    let maps = json["study"]["stability"].as_array().unwrap();
+    assert_eq!(maps.len(), 8);
+    let hybrid_map = maps
+        .iter()
+        .find(|m| m["model"] == "hybrid" && m["integrator"] == "symplectic")
+        .unwrap();
+    let ratio = hybrid_map["critical_dt_s"].as_f64().unwrap()
+        / hybrid_map["two_over_omega_s"].as_f64().unwrap();
+    assert!((ratio - 1.0).abs() < 0.02, "{ratio}");
+    // The hybrid's trajectories: RK4 at 0.5 × 2/ω_max under the bend,
+    // measured 4.06e-5 against its Δt/16 run.
+    let rk4 = json["study"]["trajectories"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| {
+            t["model"] == "hybrid"
+                && t["integrator"] == "rk4"
+                && t["load"] == "bend"
+                && t["dt_factor"] == 0.5
+        })
+        .unwrap()["error"]
+        .as_f64()
+        .unwrap();
+    assert!(rk4 > 0.0 && rk4 < 1e-4, "{rk4}");
     // The hybrid (St Venant-Kirchhoff on the tets whose centroid is in the
     // top third: 320 of 960 tets on 2x10, the top three layers and the
     // upper tets of the seventh) lies between the linear and the St Venant-

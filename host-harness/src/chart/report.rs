@@ -81,22 +81,29 @@ fn tick_counts(out: &mut String, study: &Study) {
         TickCounts::Skipped { reason } => {
             let _ = writeln!(out, "Not measured: {reason}.");
         }
-        TickCounts::Measured { mesh, counts } => {
+        TickCounts::Measured { counts } => {
             let _ = writeln!(
                 out,
                 "Callgrind instructions (Ir) of one haptic tick (`palpate budget`'s measurement) on \
-                 the built-in block scene ({mesh}), its `{}` trajectory with 1 to 4 probes held \
-                 pressed (one contact each), f32; the quasi-non-linear tissue with the remap fitted \
-                 above.\n",
+                 each model's built-in scene, its `{}` trajectory with 1 to 4 probes held pressed \
+                 (one contact each), f32: the pre-computed models on the block (the \
+                 quasi-non-linear tissue with the remap fitted above), the tensor-mass models on \
+                 the same block, dynamic, with their law, the hybrid on the built-in organ. The \
+                 dynamic models' physics updates run outside the tick (every 10th), as in \
+                 `palpate budget`: the law costs the step above, not the tick.\n",
                 super::ticks::TICK_TRAJECTORY
             );
-            let _ = writeln!(out, "| model | contacts | ticks | mean Ir | max Ir |");
-            let _ = writeln!(out, "|---|---|---|---|---|");
+            let _ = writeln!(
+                out,
+                "| model | scene | contacts | ticks | mean Ir | max Ir |"
+            );
+            let _ = writeln!(out, "|---|---|---|---|---|---|");
             for c in counts {
                 let _ = writeln!(
                     out,
-                    "| {} | {} | {} | {:.0} | {} |",
+                    "| {} | {} | {} | {} | {:.0} | {} |",
                     c.model.name(),
+                    c.scene,
                     c.contacts,
                     c.ticks,
                     c.mean_ir,
