@@ -1,11 +1,13 @@
 //! `palpate chart --quick` (README "Speed against accuracy"): the files it
 //! writes and the JSON's keys; the quasi-non-linear pre-computed model on
 //! the reference mesh is the cheapest within 1 % under the small press and
-//! on its Pareto front (measured: tip error 4.9e-5 against the Newton St
-//! Venant-Kirchhoff reference at 13.6 µs per step, where the linear models
-//! are 1.6 % off; the other runs within 1 % there, St Venant-Kirchhoff
-//! relaxed (4.6e-7: the reference's own law and mesh) and with the penalty
-//! (0.41 %), cost 25.5 and 69 µs per step); the SVGs carry their text as
+//! on its Pareto front (measured, release build: tip error 3.2e-5 against
+//! the Newton St Venant-Kirchhoff reference at 11.3 µs per step, where the
+//! linear models are 1.6 % off; the other runs within 1 % there, St
+//! Venant-Kirchhoff relaxed (1.1e-6: the reference's own law and mesh) and
+//! with the penalty (0.41 %), cost 18.5 and 34 µs per step; the press's
+//! 1e-3 lateral imperfection moves the tip errors by at most 5e-5: quasi's
+//! was 4.9e-5 without it); the SVGs carry their text as
 //! glyph outlines; the hybrid's run, maps and trajectories; the press
 //! past buckling; and `--mesh`.
 
@@ -85,7 +87,7 @@ fn quick_chart_writes_report_charts_and_json() {
     // top third: 320 of 960 tets on 2x10, the top three layers and the
     // upper tets of the seventh) lies between the linear and the St Venant-
     // Kirchhoff model under the small press: measured tip errors 1.59 %
-    // (linear), 0.99 % (hybrid), 4.6e-7 (St Venant-Kirchhoff).
+    // (linear), 0.99 % (hybrid), 1.1e-6 (St Venant-Kirchhoff).
     let run = |model: &str, level: f64| {
         json["study"]["runs"]
             .as_array()
@@ -104,7 +106,8 @@ fn quick_chart_writes_report_charts_and_json() {
     // The press at 5 % is past the column's buckling load: the reference
     // exists (Newton following the stable equilibria, the imperfection
     // picking the bend), and it is St Venant-Kirchhoff's collapse (measured
-    // on 2x10: 144 tets inverted). St Venant-Kirchhoff relaxed reaches the
+    // on 2x10: 136 of 960 tets inverted, tip 184 mm, past the base; St
+    // Venant-Kirchhoff relaxed: 144 inverted). St Venant-Kirchhoff relaxed reaches the
     // same collapse: tip error 3.1 %, bound 5 %: both are equilibria of the
     // same law after a snap, reached along different paths (the relaxation
     // from rest under the whole load, Newton's energy descent in three

@@ -319,6 +319,7 @@ fn trajectory_chart<DB: DrawingBackend>(
                 let marker: DynElement<'static, DB, (i32, i32)> = match model {
                     Model::Stvk => TriangleMarker::new((0, 0), 7, style).into_dyn(),
                     Model::StvkPenalty => Rectangle::new([(-5, -5), (5, 5)], style).into_dyn(),
+                    Model::Hybrid => Cross::new((0, 0), 5, colour.stroke_width(2)).into_dyn(),
                     _ => Circle::new((0, 0), 5, style).into_dyn(),
                 };
                 EmptyElement::at(p) + marker + Text::new(mesh, (8, -6), ("sans-serif", 11))
@@ -347,6 +348,11 @@ fn trajectory_chart<DB: DrawingBackend>(
         .legend(move |(x, y)| {
             Rectangle::new([(x + 3, y - 5), (x + 13, y + 5)], grey.stroke_width(2))
         });
+    chart
+        .draw_series(none())
+        .map_err(err)?
+        .label(Model::Hybrid.name())
+        .legend(move |(x, y)| Cross::new((x + 8, y), 5, grey.stroke_width(2)));
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
