@@ -7,7 +7,9 @@
 //! The body: the generated cylinder ([`cylinder_mesh`], height
 //! [`HEIGHT_M`], radius `H/5`, E = 5 kPa, ν = 0.4), base fixed, loaded on its
 //! top face by dead loads (one force per top vertex):
-//! - **press**: equal shares of an axial force `−F ẑ`;
+//! - **press**: equal shares of an axial force `−F ẑ`, each with the
+//!   lateral imperfection [`PRESS_IMPERFECTION`] (so past the buckling
+//!   load every model bends the same way);
 //! - **bend**: equal shares of a lateral force `F x̂`;
 //! - **twist**: tangential forces `T (ẑ × r_v)/Σ|r_v|²` (a torque `T` about
 //!   the axis, `r_v` the vertex's distance vector from it).

@@ -1,7 +1,9 @@
-//! The stability maps: for each integrator, a grid of time step × Young's
+//! The stability maps: for St Venant-Kirchhoff and for the hybrid
+//! ([`MAP_MODELS`]) and each integrator, a grid of time step × Young's
 //! modulus on the coarsest body, each cell a loaded St Venant-Kirchhoff
-//! run from rest classified by its outcome, beside the measured critical
-//! step ([`critical_dt`], bisection on the linear model) and `2/ω_max`.
+//! run from rest (the hybrid's: on its tensor-mass region) classified by
+//! its outcome, beside the measured critical step ([`critical_dt`],
+//! bisection on the linear law; the hybrid's region's) and `2/ω_max`.
 //!
 //! A trial: the bend load at 5 % of the height (scaled with E, so the same
 //! strain at every E) applied at rest, [`TRIAL_STEPS`] steps with damping
