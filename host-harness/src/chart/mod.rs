@@ -1207,12 +1207,7 @@ fn dynamic(
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
     let dt_s = 0.5 / omega_max(&mut model);
     model.reset();
-    let loaded: Vec<u32> = (0..n as u32)
-        .filter(|&v| loads[v as usize].iter().any(|&x| x != 0.0))
-        .collect();
-    for &v in &loaded {
-        model.set_external_force(v, Vector3::from(loads[v as usize]))?;
-    }
+    set_loads(&mut model, loads)?;
     let largest = loads
         .iter()
         .map(|f| Vector3::from(*f).norm())
@@ -1426,11 +1421,7 @@ fn dynamic_f32_step(
         .with_law(law)
         .with_incompressibility(incompressibility_n.map(|g| g as f32));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
-    for (v, f) in loads.iter().enumerate() {
-        if f.iter().any(|&x| x != 0.0) {
-            model.set_external_force(v as u32, Vector3::from(f.map(|x| x as f32)))?;
-        }
-    }
+    set_loads(&mut model, loads)?;
     let dt = dt_s as f32;
     let dispatch = HostDispatch::detect();
     Ok(median_s(|| {
