@@ -254,3 +254,80 @@ fn newton_equals_the_dynamic_model_settled_at_rest() {
     assert!(relaxation.converged && reference.tolerance_met);
     assert!(difference <= 1e-6);
 }
+
+/// `NewtonOptions::descent` past the buckling load: the chart's 1×5
+/// cylinder (`chart::Body`) under the press at 20 % of its height (eight
+/// times the free-top column's Euler load, with the chart's lateral
+/// imperfection; at 5 % this coarse, stiffer mesh still passes by plain
+/// Newton).
+/// Plain load-stepped Newton fails there (the path loses stability); the
+/// descent returns a stable equilibrium, checked here independently of the
+/// solver: the element forces (this file's `forces`, summed per vertex)
+/// balance the loads on every free vertex to 1e-8 of the largest nodal load
+/// (the solver's tolerance is 1e-10 of it; 1e-8 leaves room for the
+/// rounding of the sums), and it is St Venant-Kirchhoff's collapse (tets
+/// inverted). Below the buckling load (1 %) the descent is Newton: the same
+/// equilibrium to 1e-9 (relative L2).
+#[test]
+fn descent_follows_the_stable_equilibrium_past_buckling() {
+    use palpate::chart::{Body, HEIGHT_M, Load, tip_m};
+    let body = Body::cylinder((1, 5));
+    let materials = TetMaterials::uniform(body.material, body.mesh.tets.len());
+    let unit = body.loads(Load::Press, 1.0);
+    let (u_unit, _) = solve_loaded(
+        &body.mesh.positions,
+        &body.mesh.tets,
+        &materials,
+        &body.fixed,
+        &[],
+        &unit,
+    )
+    .expect("linear solve");
+    let per_newton = tip_m(&unit, &u_unit);
+    let solve = |level: f64, descent: bool| {
+        let loads = body.loads(Load::Press, level * HEIGHT_M / per_newton);
+        let result = solve_stvk(
+            &StaticProblem {
+                positions: &body.mesh.positions,
+                tets: &body.mesh.tets,
+                materials: &materials,
+                fixed: &body.fixed,
+                prescribed: &[],
+                loads_n: &loads,
+            },
+            &NewtonOptions {
+                load_steps: 3,
+                max_iterations: 400,
+                tolerance: 1e-10,
+                descent,
+            },
+        );
+        (loads, result)
+    };
+    let (_, plain) = solve(0.2, false);
+    assert!(plain.is_err(), "plain Newton passed the buckling load");
+    let (loads, collapse) = solve(0.2, true);
+    let collapse = collapse.expect("descent");
+    let x: Vec<[f64; 3]> = body
+        .mesh
+        .positions
+        .iter()
+        .zip(&collapse.u)
+        .map(|(p, u)| [p[0] + u[0], p[1] + u[1], p[2] + u[2]])
+        .collect();
+    let f = forces(&body.mesh.positions, &body.mesh.tets, &body.material, &x);
+    let largest = loads
+        .iter()
+        .map(|l| Vector3::from(*l).amax())
+        .fold(0.0, f64::max);
+    for v in (0..x.len()).filter(|&v| !body.fixed[v]) {
+        let r = (f[v] + Vector3::from(loads[v])).amax();
+        assert!(r <= 1e-8 * largest, "vertex {v}: residual {r:e} N");
+    }
+    let inverted = palpate::experiment::volume_bend::inverted_tets(&body.mesh, &collapse.u);
+    assert!(inverted > 0, "no collapse");
+    let (_, a) = solve(0.01, false);
+    let (_, b) = solve(0.01, true);
+    let gap = relative(&a.expect("newton").u, &b.expect("descent").u);
+    assert!(gap < 1e-9, "{gap:e}");
+}

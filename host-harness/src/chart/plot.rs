@@ -134,7 +134,10 @@ pub fn draw_all(
     ))?;
     names.push("cost-mesh".into());
     for map in &study.stability {
-        let name = format!("stability-{}", map.integrator);
+        let name = match map.model {
+            super::Model::Hybrid => format!("stability-hybrid-{}", map.integrator),
+            _ => format!("stability-{}", map.integrator),
+        };
         render!(dir, name, |root: &DrawingArea<_, Shift>| stability(
             root, map
         ))?;
@@ -316,6 +319,7 @@ fn trajectory_chart<DB: DrawingBackend>(
                 let marker: DynElement<'static, DB, (i32, i32)> = match model {
                     Model::Stvk => TriangleMarker::new((0, 0), 7, style).into_dyn(),
                     Model::StvkPenalty => Rectangle::new([(-5, -5), (5, 5)], style).into_dyn(),
+                    Model::Hybrid => Cross::new((0, 0), 5, colour.stroke_width(2)).into_dyn(),
                     _ => Circle::new((0, 0), 5, style).into_dyn(),
                 };
                 EmptyElement::at(p) + marker + Text::new(mesh, (8, -6), ("sans-serif", 11))
@@ -344,6 +348,11 @@ fn trajectory_chart<DB: DrawingBackend>(
         .legend(move |(x, y)| {
             Rectangle::new([(x + 3, y - 5), (x + 13, y + 5)], grey.stroke_width(2))
         });
+    chart
+        .draw_series(none())
+        .map_err(err)?
+        .label(Model::Hybrid.name())
+        .legend(move |(x, y)| Cross::new((x + 8, y), 5, grey.stroke_width(2)));
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -463,8 +472,11 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!(
-                "{}: stability on cylinder {} (damping {} 1/s)",
-                map.integrator, map.mesh, map.damping_per_s
+                "{} {}: stability on cylinder {} (damping {} 1/s)",
+                map.model.name(),
+                map.integrator,
+                map.mesh,
+                map.damping_per_s
             ),
             ("sans-serif", 20),
         )

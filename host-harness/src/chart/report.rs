@@ -81,22 +81,29 @@ fn tick_counts(out: &mut String, study: &Study) {
         TickCounts::Skipped { reason } => {
             let _ = writeln!(out, "Not measured: {reason}.");
         }
-        TickCounts::Measured { mesh, counts } => {
+        TickCounts::Measured { counts } => {
             let _ = writeln!(
                 out,
                 "Callgrind instructions (Ir) of one haptic tick (`palpate budget`'s measurement) on \
-                 the built-in block scene ({mesh}), its `{}` trajectory with 1 to 4 probes held \
-                 pressed (one contact each), f32; the quasi-non-linear tissue with the remap fitted \
-                 above.\n",
+                 each model's built-in scene, its `{}` trajectory with 1 to 4 probes held pressed \
+                 (one contact each), f32: the pre-computed models on the block (the \
+                 quasi-non-linear tissue with the remap fitted above), the tensor-mass models on \
+                 the same block, dynamic, with their law, the hybrid on the built-in organ. The \
+                 dynamic models' physics updates run outside the tick (every 10th), as in \
+                 `palpate budget`: the law costs the step above, not the tick.\n",
                 super::ticks::TICK_TRAJECTORY
             );
-            let _ = writeln!(out, "| model | contacts | ticks | mean Ir | max Ir |");
-            let _ = writeln!(out, "|---|---|---|---|---|");
+            let _ = writeln!(
+                out,
+                "| model | scene | contacts | ticks | mean Ir | max Ir |"
+            );
+            let _ = writeln!(out, "|---|---|---|---|---|---|");
             for c in counts {
                 let _ = writeln!(
                     out,
-                    "| {} | {} | {} | {:.0} | {} |",
+                    "| {} | {} | {} | {} | {:.0} | {} |",
                     c.model.name(),
+                    c.scene,
                     c.contacts,
                     c.ticks,
                     c.mean_ir,
@@ -236,7 +243,7 @@ fn trajectories(out: &mut String, study: &Study, loads: &[Load]) {
     let _ = writeln!(
         out,
         "\n## Dynamic runs: trajectory error against Δt/{REFINEMENT}\n\n\
-         Each tensor-mass model and integrator, the load applied at rest, {} s simulated with \
+         Each tensor-mass model and the hybrid, each integrator, the load applied at rest, {} s simulated with \
          damping {} 1/s, against the same model and integrator at a step {REFINEMENT}× smaller: \
          error = max over the steps of ‖u − u_ref‖₂ / max ‖u_ref‖₂; cost = time per step / Δt \
          (compute seconds per simulated second, f64).\n",
@@ -290,6 +297,16 @@ pub fn failures(study: &Study) -> Vec<String> {
                 r.load.name(),
                 100.0 * r.level
             ));
+        } else if r.inverted_tets > 0 {
+            lines.push(format!(
+                "the St Venant-Kirchhoff reference itself collapses under {} at {:.0} % (past the \
+                 buckling load its stable equilibrium): {} inverted tets, ΔV/V₀ {:+.1} %, tip {:.1} mm",
+                r.load.name(),
+                100.0 * r.level,
+                r.inverted_tets,
+                100.0 * r.volume_change,
+                1e3 * r.tip_m
+            ));
         }
     }
     for r in &study.runs {
@@ -342,7 +359,8 @@ pub fn failures(study: &Study) -> Vec<String> {
             })
             .collect();
         lines.push(format!(
-            "{}: measured critical step {:.3e} s, 2/ω_max {:.3e} s at E = {} Pa; {} of {} trials fail{}",
+            "{} {}: measured critical step {:.3e} s, 2/ω_max {:.3e} s at E = {} Pa; {} of {} trials fail{}",
+            map.model.name(),
             map.integrator,
             map.critical_dt_s,
             map.two_over_omega_s,

@@ -1,7 +1,9 @@
-//! The stability maps: for each integrator, a grid of time step × Young's
+//! The stability maps: for St Venant-Kirchhoff and for the hybrid
+//! ([`MAP_MODELS`]) and each integrator, a grid of time step × Young's
 //! modulus on the coarsest body, each cell a loaded St Venant-Kirchhoff
-//! run from rest classified by its outcome, beside the measured critical
-//! step ([`critical_dt`], bisection on the linear model) and `2/ω_max`.
+//! run from rest (the hybrid's: on its tensor-mass region) classified by
+//! its outcome, beside the measured critical step ([`critical_dt`],
+//! bisection on the linear law; the hybrid's region's) and `2/ω_max`.
 //!
 //! A trial: the bend load at 5 % of the height (scaled with E, so the same
 //! strain at every E) applied at rest, [`TRIAL_STEPS`] steps with damping
@@ -19,13 +21,18 @@ use palpate_kernel::tensor_mass::{
 };
 use serde::Serialize;
 
-use super::{Body, Load, Progress};
+use super::{Body, Load, Model, Progress, hybrid_field, hybrid_tables, region_loads, set_loads};
+use crate::dispatch::HostDispatch;
 use crate::fem::material::{Material, TetMaterials};
 use crate::fem::static_solve::solve_loaded;
+use crate::hybrid::owned::with_hybrid;
+use crate::table::file::Precision;
 use crate::table::tensor_mass::static_study_table;
 use crate::tensor_mass::OwnedState;
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::stability::{critical_dt, omega_max};
+use palpate_kernel::hybrid::HybridModel;
+use palpate_kernel::tensor_mass::StepError;
 
 /// Steps of one trial.
 pub const TRIAL_STEPS: usize = 1000;
@@ -94,6 +101,8 @@ pub struct Cell {
 /// One integrator's map.
 #[derive(Clone, Debug, Serialize)]
 pub struct Map {
+    /// The model: St Venant-Kirchhoff or the hybrid.
+    pub model: Model,
     /// Integrator name.
     pub integrator: &'static str,
     /// The mesh, `"RxH"`.
@@ -113,7 +122,18 @@ pub struct Map {
     pub cells: Vec<Cell>,
 }
 
-/// Every integrator's map on `body`.
+/// The models mapped: St Venant-Kirchhoff on the whole mesh, and the
+/// hybrid (St Venant-Kirchhoff on its region, [`Model::Hybrid`]).
+pub const MAP_MODELS: [Model; 2] = [Model::Stvk, Model::Hybrid];
+
+/// Maps of one body: one per model of [`MAP_MODELS`] and integrator.
+pub fn map_count() -> usize {
+    MAP_MODELS.len() * Integrator::ALL.len()
+}
+
+/// Every model's and integrator's map on `body`. The hybrid's critical
+/// step and `ω_max` are its tensor-mass region's (the only stepped part;
+/// the condensed region's force is in each of its force evaluations).
 pub fn maps(
     body: &Body,
     extent: &MapExtent,
@@ -121,59 +141,55 @@ pub fn maps(
 ) -> anyhow::Result<Vec<Map>> {
     let reference = body.material;
     let mut maps = Vec::new();
-    for integrator in Integrator::ALL {
-        // The measured critical step on the linear model at the tissue's E.
-        let (omega, critical) = with_model(body, reference, ElasticLaw::Linear, |model| {
-            let amplitude = 1e-3 * diagonal(&body.mesh.positions);
-            let c = critical_dt(model, integrator, amplitude);
-            Ok((omega_max(model), c.critical_dt))
-        })?;
-        let two_over_omega = 2.0 / omega;
-        let mut cells = Vec::new();
-        for &young_pa in &extent.young_pa {
-            let material = Material {
-                young_pa,
-                ..reference
-            };
-            for &factor in &extent.dt_factors {
-                let dt_s = factor * two_over_omega;
-                let outcome = trial(body, material, integrator, dt_s)?;
-                progress.tick(&format!(
-                    "stability {} E = {young_pa} Pa, dt = {dt_s:.2e} s: {outcome:?}",
-                    integrator.name()
-                ));
-                cells.push(Cell {
+    for model in MAP_MODELS {
+        for integrator in Integrator::ALL {
+            // The measured critical step on the linear law at the tissue's E.
+            let params =
+                DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions))
+                    .with_law(ElasticLaw::Linear);
+            let (omega, critical) =
+                with_system(body, model, reference, params, &[], |system, _| {
+                    let region = system.region();
+                    let amplitude = 1e-3 * diagonal(&body.mesh.positions);
+                    let c = critical_dt(region, integrator, amplitude);
+                    Ok((omega_max(region), c.critical_dt))
+                })?;
+            let two_over_omega = 2.0 / omega;
+            let mut cells = Vec::new();
+            for &young_pa in &extent.young_pa {
+                let material = Material {
                     young_pa,
-                    dt_s,
-                    outcome,
-                });
+                    ..reference
+                };
+                for &factor in &extent.dt_factors {
+                    let dt_s = factor * two_over_omega;
+                    let outcome = trial(body, model, material, integrator, dt_s)?;
+                    progress.tick(&format!(
+                        "stability {} {} E = {young_pa} Pa, dt = {dt_s:.2e} s: {outcome:?}",
+                        model.name(),
+                        integrator.name()
+                    ));
+                    cells.push(Cell {
+                        young_pa,
+                        dt_s,
+                        outcome,
+                    });
+                }
             }
+            maps.push(Map {
+                model,
+                integrator: integrator.name(),
+                mesh: body.label.clone(),
+                damping_per_s: DAMPING_PER_S,
+                reference_young_pa: reference.young_pa,
+                omega_max: omega,
+                critical_dt_s: critical,
+                two_over_omega_s: two_over_omega,
+                cells,
+            });
         }
-        maps.push(Map {
-            integrator: integrator.name(),
-            mesh: body.label.clone(),
-            damping_per_s: DAMPING_PER_S,
-            reference_young_pa: reference.young_pa,
-            omega_max: omega,
-            critical_dt_s: critical,
-            two_over_omega_s: two_over_omega,
-            cells,
-        });
     }
     Ok(maps)
-}
-
-/// Builds the f64 model of `body` with `material` and `law`, damping
-/// [`DAMPING_PER_S`], and runs `f`.
-fn with_model<R>(
-    body: &Body,
-    material: Material,
-    law: ElasticLaw,
-    f: impl FnOnce(&mut TensorMassModel<'_, '_, f64>) -> anyhow::Result<R>,
-) -> anyhow::Result<R> {
-    let params =
-        DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions)).with_law(law);
-    with_params(body, material, params, f)
 }
 
 /// Builds the f64 model of `body` with `material` and `params` and runs `f`.
@@ -191,9 +207,110 @@ pub(super) fn with_params<R>(
     f(&mut model)
 }
 
-/// One trial (module documentation).
+/// A stepped model of the maps and trajectories: a tensor-mass model, or
+/// the hybrid (its tensor-mass region stepped, the condensed region's
+/// force in every force evaluation).
+pub(crate) trait System<'a, 's> {
+    /// One step of `integrator` at `dt_s`.
+    fn advance(&mut self, integrator: Integrator, dt_s: f64) -> Result<(), StepError>;
+    /// The same with the host's CPU-feature dispatch where the model has
+    /// one (the tensor-mass step; the hybrid's step has none), to be timed.
+    fn advance_dispatched(
+        &mut self,
+        dispatch: HostDispatch,
+        integrator: Integrator,
+        dt_s: f64,
+    ) -> Result<(), StepError>;
+    /// Back to rest (both regions of the hybrid).
+    fn reset(&mut self);
+    /// The stepped tensor-mass model (the hybrid's region).
+    fn region(&mut self) -> &mut TensorMassModel<'a, 's, f64>;
+    /// The displacement field of the whole mesh (`n` vertices), m.
+    fn field(&mut self, n: usize) -> anyhow::Result<Vec<[f64; 3]>>;
+}
+
+impl<'a, 's> System<'a, 's> for TensorMassModel<'a, 's, f64> {
+    fn advance(&mut self, integrator: Integrator, dt_s: f64) -> Result<(), StepError> {
+        self.step(integrator, dt_s).map(|_| ())
+    }
+    fn advance_dispatched(
+        &mut self,
+        dispatch: HostDispatch,
+        integrator: Integrator,
+        dt_s: f64,
+    ) -> Result<(), StepError> {
+        self.step_with(dispatch, integrator, dt_s).map(|_| ())
+    }
+    fn reset(&mut self) {
+        TensorMassModel::reset(self);
+    }
+    fn region(&mut self) -> &mut TensorMassModel<'a, 's, f64> {
+        self
+    }
+    fn field(&mut self, _: usize) -> anyhow::Result<Vec<[f64; 3]>> {
+        Ok(self
+            .displacements_m()
+            .map_err(|e| anyhow::anyhow!("no displacements: {e}"))?
+            .to_vec())
+    }
+}
+
+impl<'a, 's> System<'a, 's> for HybridModel<'a, 's, f64> {
+    fn advance(&mut self, integrator: Integrator, dt_s: f64) -> Result<(), StepError> {
+        self.step(integrator, dt_s).map(|_| ())
+    }
+    fn advance_dispatched(
+        &mut self,
+        _: HostDispatch,
+        integrator: Integrator,
+        dt_s: f64,
+    ) -> Result<(), StepError> {
+        self.advance(integrator, dt_s)
+    }
+    fn reset(&mut self) {
+        HybridModel::reset(self);
+    }
+    fn region(&mut self) -> &mut TensorMassModel<'a, 's, f64> {
+        self.dynamic_mut()
+    }
+    fn field(&mut self, n: usize) -> anyhow::Result<Vec<[f64; 3]>> {
+        hybrid_field(self, n)
+    }
+}
+
+/// Builds `model` of `body` (a tensor-mass model, or [`Model::Hybrid`]:
+/// its tables with `material`, [`super::hybrid_tables`]) with `material`
+/// and `params`, sets the nodal `loads` (on the hybrid's region, in its
+/// numbering), and runs `f` on it with the loads as set.
+pub(crate) fn with_system<R>(
+    body: &Body,
+    model: Model,
+    material: Material,
+    params: DynamicParams<f64>,
+    loads: &[[f64; 3]],
+    f: impl FnOnce(&mut dyn System<'_, '_>, &[[f64; 3]]) -> anyhow::Result<R>,
+) -> anyhow::Result<R> {
+    if model == Model::Hybrid {
+        let tables = hybrid_tables(body, material, Precision::F64)?;
+        let local = region_loads(&tables, loads)?;
+        with_hybrid(&tables, params, |h| {
+            set_loads(h.dynamic_mut(), &local)?;
+            f(h, &local)
+        })?
+    } else {
+        with_params(body, material, params, |m| {
+            set_loads(m, loads)?;
+            f(m, loads)
+        })
+    }
+}
+
+/// One trial of `model` (module documentation). The hybrid's energy is
+/// its tensor-mass region's (kinetic, elastic, the load's work): the
+/// condensed region's linear strain energy, never negative, is left out.
 fn trial(
     body: &Body,
+    model: Model,
     material: Material,
     integrator: Integrator,
     dt_s: f64,
@@ -216,26 +333,23 @@ fn trial(
         .map(|(f, u)| scale * Vector3::from(*f).dot(&Vector3::from(*u)))
         .sum();
     let law = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
-    with_model(body, material, law, |model| {
-        for (v, f) in loads.iter().enumerate() {
-            if f.iter().any(|&x| x != 0.0) {
-                model.set_external_force(v as u32, Vector3::from(*f))?;
-            }
-        }
-        let n = loads.len();
-        let mut scratch = vec![[0.0; 3]; n];
+    let params =
+        DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions)).with_law(law);
+    with_system(body, model, material, params, &loads, |system, loads| {
+        let mut scratch = vec![[0.0; 3]; loads.len()];
         let mut grew = false;
         for step in 0..TRIAL_STEPS {
-            if model.step(integrator, dt_s).is_err() {
+            if system.advance(integrator, dt_s).is_err() {
                 return Ok(Outcome::Diverged);
             }
             if step % 10 == 9 && !grew {
-                let (Ok(u), Ok(v)) = (model.displacements_m(), model.velocities_m_s()) else {
+                let region = system.region();
+                let (Ok(u), Ok(v)) = (region.displacements_m(), region.velocities_m_s()) else {
                     return Ok(Outcome::Diverged);
                 };
                 let kinetic: f64 = v
                     .iter()
-                    .zip(model.masses_kg())
+                    .zip(region.masses_kg())
                     .map(|(v, m)| 0.5 * m * Vector3::from(*v).norm_squared())
                     .sum();
                 let external: f64 = loads
@@ -243,15 +357,15 @@ fn trial(
                     .zip(u)
                     .map(|(f, u)| Vector3::from(*f).dot(&Vector3::from(*u)))
                     .sum();
-                let energy = kinetic + model.elastic_energy_of(u, &mut scratch) - external;
+                let energy = kinetic + region.elastic_energy_of(u, &mut scratch) - external;
                 grew = energy.is_nan() || energy > ENERGY_GROWTH * work;
             }
         }
-        let Ok(u) = model.displacements_m() else {
+        let Ok(u) = system.field(body.mesh.positions.len()) else {
             return Ok(Outcome::Diverged);
         };
         Ok(
-            if crate::experiment::volume_bend::inverted_tets(&body.mesh, u) > 0 {
+            if crate::experiment::volume_bend::inverted_tets(&body.mesh, &u) > 0 {
                 Outcome::Inverted
             } else if grew {
                 Outcome::EnergyGrowth

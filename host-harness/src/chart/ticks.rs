@@ -1,16 +1,30 @@
-//! Per-tick instruction counts of the pre-computed models' haptic tick
-//! (`palpate chart`'s cost in instructions, as `palpate budget` measures
-//! them: [`crate::budget::measure`], callgrind collecting inside
+//! Per-tick instruction counts of every model's haptic tick (`palpate
+//! chart`'s cost in instructions, as `palpate budget` measures them:
+//! [`crate::budget::measure`], callgrind collecting inside
 //! [`crate::budget::budget_tick`] only).
 //!
-//! The haptic tick needs a scene (a surface, a tool, a trajectory): the
-//! built-in block scene `palpate budget built-in` measures, with 1 to
+//! The haptic tick needs a scene (a surface, a tool, a trajectory), the
+//! one `palpate budget` measures for the model ([`tick_scene`]), with 1 to
 //! [`MAX_TOOL_POINTS`] probes held pressed on their own sites (the
 //! generated `press-hold` trajectory, so `P` probes make `P` simultaneous
-//! contacts), with the linear pre-computed tissue and the same tissue made
-//! quasi-non-linear by the chart's fitted remap (its coefficients change no
-//! instruction count: one polynomial of fixed degree per contact and per
-//! displaced vertex). The counts are deterministic for one binary.
+//! contacts):
+//! - the pre-computed models on the built-in block scene (`built-in`): the
+//!   linear tissue and the same tissue made quasi-non-linear by the chart's
+//!   fitted remap (its coefficients change no instruction count: one
+//!   polynomial of fixed degree per contact and per displaced vertex);
+//! - the tensor-mass models on the same block, dynamic
+//!   (`built-in-dynamic`), with the model's law: linear, St
+//!   Venant-Kirchhoff, St Venant-Kirchhoff + the penalty
+//!   ([`crate::experiment::scenes::penalty_n`] of the block);
+//! - the hybrid on the built-in hybrid organ (`built-in-hybrid`, probes in
+//!   place of its grasper and cutter), its tensor-mass region St
+//!   Venant-Kirchhoff as the chart's ([`super::HYBRID_LAW`]).
+//!
+//! The dynamic scenes' physics updates (the law's force evaluations) run
+//! every 10th tick outside the measured function, as in `palpate budget`:
+//! a tick's count is the contact work (detection on the deformed surface,
+//! solve), the step's cost is the chart's step time. The counts are
+//! deterministic for one binary.
 
 use std::path::Path;
 use std::process::Command;
@@ -19,22 +33,55 @@ use anyhow::Context;
 use palpate_kernel::precomputed::{QuasiNonLinear, REMAP_DEGREE, Remap};
 use serde::Serialize;
 
-use super::{Model, Progress};
+use super::{HYBRID_LAW, Model, Progress};
 use crate::budget::{HOST_IR, budget_table, chosen_trajectories, measure, probe_remapped};
+use crate::experiment::scenes::penalty_n;
+use crate::fem::material::Material;
 use crate::session::model::{SceneModel, SceneTables};
+use crate::session::scene::ModelSpec;
 use crate::session::scene::{MAX_TOOL_POINTS, ToolSpec};
 use crate::session::{Scene, Trajectory};
+use palpate_kernel::tensor_mass::ElasticLaw;
 
-/// The scene of the counts (`palpate budget`'s).
-pub const TICK_SCENE: &str = "built-in";
-/// Its trajectory: every probe pressed and held.
+/// The trajectory of the counts: every probe pressed and held.
 pub const TICK_TRAJECTORY: &str = "press-hold";
+
+/// The scene `palpate budget` measures for `model`, with `points` probes
+/// and the model's law (module documentation).
+pub fn tick_scene(model: Model, points: usize) -> anyhow::Result<Scene> {
+    let name = match model {
+        Model::PrecomputedLinear | Model::PrecomputedQuasi => "built-in",
+        Model::Hybrid => "built-in-hybrid",
+        Model::TensorMassLinear | Model::Stvk | Model::StvkPenalty => "built-in-dynamic",
+    };
+    let mut scene = Scene::named(name)?;
+    scene.tool = ToolSpec::probes(points, scene.tool.radius_m);
+    let (law, penalty) = match model {
+        Model::TensorMassLinear => (ElasticLaw::Linear, None),
+        Model::StvkPenalty => {
+            let (mesh, _) = scene.load_mesh()?;
+            let material = Material {
+                young_pa: scene.material.young_pa,
+                poisson: scene.material.poisson,
+            };
+            (HYBRID_LAW, Some(penalty_n(&mesh, &material)))
+        }
+        _ => (HYBRID_LAW, None),
+    };
+    if let ModelSpec::Dynamic(spec) = &mut scene.model {
+        spec.law = law;
+        spec.incompressibility_n = penalty;
+    }
+    Ok(scene)
+}
 
 /// One model's tick with `contacts` probes.
 #[derive(Clone, Debug, Serialize)]
 pub struct TickCount {
-    /// The model (pre-computed linear or quasi-non-linear).
+    /// The model.
     pub model: Model,
+    /// Its scene: name, vertices and tets.
+    pub scene: String,
     /// Probes, each making one contact while held.
     pub contacts: usize,
     /// Ticks measured.
@@ -51,8 +98,6 @@ pub struct TickCount {
 pub enum TickCounts {
     /// Measured.
     Measured {
-        /// The scene's mesh, "V vertices, T tets".
-        mesh: String,
         /// One per model and contact count.
         counts: Vec<TickCount>,
     },
@@ -63,8 +108,8 @@ pub enum TickCounts {
     },
 }
 
-/// Runs of [`measure_ticks`]: two models × 1..=[`MAX_TOOL_POINTS`] probes.
-pub const TICK_RUNS: usize = 2 * MAX_TOOL_POINTS;
+/// Runs of [`measure_ticks`]: every model × 1..=[`MAX_TOOL_POINTS`] probes.
+pub const TICK_RUNS: usize = Model::ALL.len() * MAX_TOOL_POINTS;
 
 /// Whether `valgrind --version` runs here.
 pub fn valgrind_available() -> bool {
@@ -72,13 +117,6 @@ pub fn valgrind_available() -> bool {
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success())
-}
-
-/// The built-in scene with `points` probes.
-fn scene_with(points: usize) -> anyhow::Result<Scene> {
-    let mut scene = Scene::named(TICK_SCENE)?;
-    scene.tool = ToolSpec::probes(points, scene.tool.radius_m);
-    Ok(scene)
 }
 
 /// `remap` as the command-line word of [`probe_child`]: `φ`'s then `ψ`'s
@@ -124,15 +162,21 @@ fn parse_remap(word: &str) -> anyhow::Result<Option<QuasiNonLinear<f32>>> {
 }
 
 /// The child process callgrind runs: the ticks of the trajectory file
-/// `trajectory` on the table `table` of the built-in scene with `points`
-/// probes, the tissue remapped by `remap` ([`remap_word`]).
+/// `trajectory` on the tables `table` of `model`'s scene ([`tick_scene`])
+/// with `points` probes, the pre-computed tissue remapped by `remap`
+/// ([`remap_word`]).
 pub fn probe_child(
+    model: &str,
     table: &Path,
     trajectory: &Path,
     points: usize,
     remap: &str,
 ) -> anyhow::Result<()> {
-    let scene = scene_with(points)?;
+    let model = Model::ALL
+        .into_iter()
+        .find(|m| m.name() == model)
+        .with_context(|| format!("no model {model}"))?;
+    let scene = tick_scene(model, points)?;
     let (mesh, report) = scene.load_mesh()?;
     let tables = SceneTables::read(SceneModel::of(&scene, &mesh, &report)?, table)?;
     let trajectory = Trajectory::read(trajectory, points)?;
@@ -140,14 +184,28 @@ pub fn probe_child(
     Ok(())
 }
 
-/// Measures the per-tick instructions of both pre-computed models with 1
-/// to [`MAX_TOOL_POINTS`] probes under callgrind: `exe` (this binary) runs
-/// [`probe_child`] through `child_args(table, trajectory, points, remap)`,
-/// its files under `work_dir`. Skipped, with the reason, when valgrind is
-/// not installed.
+/// The arguments of [`probe_child`] for one run: model name, table,
+/// trajectory, probes, remap word.
+pub struct ChildArgs<'a> {
+    /// The model.
+    pub model: Model,
+    /// Its tables (base path, [`SceneTables::write`]).
+    pub table: &'a Path,
+    /// The trajectory file.
+    pub trajectory: &'a Path,
+    /// Probes.
+    pub points: usize,
+    /// [`remap_word`].
+    pub remap: &'a str,
+}
+
+/// Measures the per-tick instructions of every model with 1 to
+/// [`MAX_TOOL_POINTS`] probes under callgrind: `exe` (this binary) runs
+/// [`probe_child`] through `child_args`, its files under `work_dir`.
+/// Skipped, with the reason, when valgrind is not installed.
 pub fn measure_ticks(
     exe: &Path,
-    child_args: impl Fn(&Path, &Path, usize, &str) -> Vec<String>,
+    child_args: impl Fn(&ChildArgs<'_>) -> Vec<String>,
     work_dir: &Path,
     remap: &QuasiNonLinear<f64>,
     progress: &mut dyn Progress,
@@ -158,36 +216,45 @@ pub fn measure_ticks(
         });
     }
     std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
-    // One table for every probe count (the tool changes only the bound).
-    let scene = scene_with(1)?;
-    let (mesh, report) = scene.load_mesh()?;
-    let mesh_size = format!(
-        "{} vertices, {} tets",
-        mesh.positions.len(),
-        mesh.tets.len()
-    );
-    let (tables, _) = budget_table(&scene, &mesh, &report, &HOST_IR, None)?;
-    let table = work_dir.join("table.bin");
-    tables.write(&table)?;
     let mut counts = Vec::new();
-    for points in 1..=MAX_TOOL_POINTS {
-        let scene = scene_with(points)?;
-        let (_, trajectory) = chosen_trajectories(&scene, &[TICK_TRAJECTORY.into()])?
-            .into_iter()
-            .next()
-            .context("no press-hold trajectory")?;
-        let csv = work_dir.join(format!("{TICK_TRAJECTORY}-{points}.csv"));
-        trajectory.write_csv_file(&csv)?;
-        for (model, word) in [
-            (Model::PrecomputedLinear, remap_word(None)),
-            (Model::PrecomputedQuasi, remap_word(Some(remap))),
-        ] {
-            let args = child_args(&table, &csv, points, &word);
+    for model in Model::ALL {
+        // One table for every probe count (the tool changes only the bound).
+        let scene = tick_scene(model, 1)?;
+        let (mesh, report) = scene.load_mesh()?;
+        let scene_name = format!(
+            "{} ({} vertices, {} tets)",
+            scene.source,
+            mesh.positions.len(),
+            mesh.tets.len()
+        );
+        let (tables, _) = budget_table(&scene, &mesh, &report, &HOST_IR, None)?;
+        let table = work_dir.join(format!("table-{}", model.name()));
+        tables.write(&table)?;
+        let word = match model {
+            Model::PrecomputedQuasi => remap_word(Some(remap)),
+            _ => remap_word(None),
+        };
+        for points in 1..=MAX_TOOL_POINTS {
+            let scene = tick_scene(model, points)?;
+            let (_, trajectory) = chosen_trajectories(&scene, &[TICK_TRAJECTORY.into()])?
+                .into_iter()
+                .next()
+                .context("no press-hold trajectory")?;
+            let csv = work_dir.join(format!("{TICK_TRAJECTORY}-{}-{points}.csv", model.name()));
+            trajectory.write_csv_file(&csv)?;
+            let args = child_args(&ChildArgs {
+                model,
+                table: &table,
+                trajectory: &csv,
+                points,
+                remap: &word,
+            });
             let dumps = work_dir.join(format!("cg-{}-{points}", model.name()));
             let irs = measure(exe, &args, &dumps)?;
             anyhow::ensure!(!irs.is_empty(), "callgrind counted no tick");
             counts.push(TickCount {
                 model,
+                scene: scene_name.clone(),
                 contacts: points,
                 ticks: irs.len(),
                 mean_ir: irs.iter().sum::<u64>() as f64 / irs.len() as f64,
@@ -200,10 +267,7 @@ pub fn measure_ticks(
             ));
         }
     }
-    Ok(TickCounts::Measured {
-        mesh: mesh_size,
-        counts,
-    })
+    Ok(TickCounts::Measured { counts })
 }
 
 #[cfg(test)]

@@ -1,4 +1,6 @@
-//! The dynamic runs' trajectory error: each tensor-mass model under a load
+//! The dynamic runs' trajectory error: each tensor-mass model and the
+//! hybrid (its tensor-mass region stepped, the field over the whole mesh)
+//! under a load
 //! applied at rest, integrated for [`DURATION_S`] with each integrator at a
 //! time step `Δt`, against the same model and integrator at `Δt/16` (the
 //! issue's reference; the scheme's own converged motion, so the error is
@@ -15,10 +17,10 @@
 use std::collections::HashMap;
 
 use nalgebra::Vector3;
-use palpate_kernel::tensor_mass::{DynamicParams, Integrator, TensorMassModel};
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator};
 use serde::Serialize;
 
-use super::stability::{DAMPING_PER_S, with_params};
+use super::stability::{DAMPING_PER_S, with_params, with_system};
 use super::{Body, Load, Model, Progress, median_s};
 use crate::dispatch::HostDispatch;
 use crate::tensor_mass::run::diagonal;
@@ -70,7 +72,7 @@ pub struct Trajectory {
     pub load: Load,
     /// The level.
     pub level: f64,
-    /// The model (a tensor-mass one).
+    /// The model (a tensor-mass one or the hybrid).
     pub model: Model,
     /// Integrator name.
     pub integrator: &'static str,
@@ -128,7 +130,7 @@ pub fn trajectories(
         for &(load, magnitude) in loads {
             let nodal = body.loads(load, magnitude);
             for model in Model::ALL {
-                let Some((law, penalty)) = model.tensor_mass(body) else {
+                let Some((law, penalty)) = model.dynamic_law(body) else {
                     continue;
                 };
                 let params =
@@ -140,6 +142,7 @@ pub fn trajectories(
                         let dt_s = factor * two_over_omega;
                         let reference = run(
                             body,
+                            model,
                             params,
                             &nodal,
                             integrator,
@@ -147,12 +150,21 @@ pub fn trajectories(
                             REFINEMENT,
                             steps(dt_s),
                         )?;
-                        let coarse = run(body, params, &nodal, integrator, dt_s, 1, steps(dt_s))?;
+                        let coarse = run(
+                            body,
+                            model,
+                            params,
+                            &nodal,
+                            integrator,
+                            dt_s,
+                            1,
+                            steps(dt_s),
+                        )?;
                         let key = (model.name(), integrator.name());
                         let step_s = match step_times.get(&key) {
                             Some(&t) => t,
                             None => {
-                                let t = step_time(body, params, &nodal, integrator, dt_s)?;
+                                let t = step_time(body, model, params, &nodal, integrator, dt_s)?;
                                 step_times.insert(key, t);
                                 t
                             }
@@ -197,9 +209,12 @@ pub fn trajectories(
 }
 
 /// The displacements after every `every` steps of `dt_s` (`samples` of
-/// them) from rest under the nodal `loads`, or the fault that ended the run.
+/// them) of `model` from rest under the nodal `loads`, or the fault that
+/// ended the run.
+#[allow(clippy::too_many_arguments)]
 fn run(
     body: &Body,
+    model: Model,
     params: DynamicParams<f64>,
     loads: &[[f64; 3]],
     integrator: Integrator,
@@ -207,54 +222,45 @@ fn run(
     every: usize,
     samples: usize,
 ) -> anyhow::Result<Result<Vec<Vec<[f64; 3]>>, String>> {
-    with_params(body, body.material, params, |model| {
-        apply(model, loads)?;
+    let n = body.mesh.positions.len();
+    with_system(body, model, body.material, params, loads, |system, _| {
         let mut out = Vec::with_capacity(samples);
         for k in 0..samples * every {
-            if let Err(e) = model.step(integrator, dt_s) {
+            if let Err(e) = system.advance(integrator, dt_s) {
                 return Ok(Err(format!(
                     "diverged at t = {:.3e} s: {e}",
                     k as f64 * dt_s
                 )));
             }
             if (k + 1) % every == 0 {
-                let Ok(u) = model.displacements_m() else {
-                    return Ok(Err("no displacements".into()));
-                };
-                out.push(u.to_vec());
+                match system.field(n) {
+                    Ok(u) => out.push(u),
+                    Err(e) => return Ok(Err(format!("{e:#}"))),
+                }
             }
         }
         Ok(Ok(out))
     })
 }
 
-/// Sets the nodal `loads` on `model`.
-fn apply(model: &mut TensorMassModel<'_, '_, f64>, loads: &[[f64; 3]]) -> anyhow::Result<()> {
-    for (v, f) in loads.iter().enumerate() {
-        if f.iter().any(|&x| x != 0.0) {
-            model.set_external_force(v as u32, Vector3::from(*f))?;
-        }
-    }
-    Ok(())
-}
-
-/// Median time of one step of `integrator` at `dt_s` under `loads`, timed
-/// on the motion from rest (from rest again after a fault), s.
+/// Median time of one step of `integrator` at `dt_s` of `model` under
+/// `loads`, timed on the motion from rest (from rest again after a
+/// fault), s.
 fn step_time(
     body: &Body,
+    model: Model,
     params: DynamicParams<f64>,
     loads: &[[f64; 3]],
     integrator: Integrator,
     dt_s: f64,
 ) -> anyhow::Result<f64> {
-    with_params(body, body.material, params, |model| {
-        apply(model, loads)?;
+    with_system(body, model, body.material, params, loads, |system, _| {
         let dispatch = HostDispatch::detect();
         Ok(median_s(|| {
-            if model.fault().is_some() {
-                model.reset();
+            if system.region().fault().is_some() {
+                system.reset();
             }
-            let _ = core::hint::black_box(model.step_with(dispatch, integrator, dt_s));
+            let _ = core::hint::black_box(system.advance_dispatched(dispatch, integrator, dt_s));
         }))
     })
 }

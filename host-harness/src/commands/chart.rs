@@ -3,7 +3,7 @@
 //! `index.html` and `study.json` into `--out`, prints the summary (or the
 //! JSON).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
@@ -54,9 +54,10 @@ pub struct ChartArgs {
     #[arg(long = "load-on", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
     load_on: Vec<FixPredicate>,
     /// Internal: run the haptic ticks of this trajectory on this table of
-    /// the built-in scene with POINTS probes, REMAP the quasi-non-linear
-    /// remap or `linear` (the process callgrind measures).
-    #[arg(long, hide = true, num_args = 4, value_names = ["TABLE", "TRAJECTORY", "POINTS", "REMAP"])]
+    /// MODEL's scene (`chart::ticks::tick_scene`) with POINTS probes, REMAP
+    /// the quasi-non-linear remap or `linear` (the process callgrind
+    /// measures).
+    #[arg(long, hide = true, num_args = 5, value_names = ["MODEL", "TABLE", "TRAJECTORY", "POINTS", "REMAP"])]
     tick_probe: Option<Vec<String>>,
 }
 
@@ -88,9 +89,9 @@ impl ChartArgs {
 
 /// Runs `palpate chart`.
 pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
-    if let Some([table, trajectory, points, remap]) = args.tick_probe.as_deref() {
+    if let Some([model, table, trajectory, points, remap]) = args.tick_probe.as_deref() {
         let points: usize = points.parse().context("--tick-probe POINTS")?;
-        return ticks::probe_child(table.as_ref(), trajectory.as_ref(), points, remap);
+        return ticks::probe_child(model, table.as_ref(), trajectory.as_ref(), points, remap);
     }
     let matrix = if args.quick {
         Matrix::quick()
@@ -119,7 +120,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         max_steps: matrix.max_relax_steps,
         ..volume_bend::Controls::default()
     };
-    let trials = 4 * matrix.stability.trials();
+    let trials = chart::stability::map_count() * matrix.stability.trials();
     // The tick counts need valgrind: without it, skipped (said in the report).
     let tick_runs = if matrix.tick_counts && ticks::valgrind_available() {
         ticks::TICK_RUNS
@@ -189,18 +190,22 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     let mut study = chart::run(&matrix, &mut tick)?;
     study.ticks = if !matrix.tick_counts {
         ticks::TickCounts::Skipped {
-            reason: "--quick (eight callgrind runs; `--tick-counts` measures them)".into(),
+            reason: format!(
+                "--quick ({} callgrind runs; `--tick-counts` measures them)",
+                ticks::TICK_RUNS
+            ),
         }
     } else {
         let exe = std::env::current_exe()?;
-        let child = |table: &Path, trajectory: &Path, points: usize, remap: &str| {
+        let child = |a: &ticks::ChildArgs<'_>| {
             vec![
                 "chart".into(),
                 "--tick-probe".into(),
-                table.display().to_string(),
-                trajectory.display().to_string(),
-                points.to_string(),
-                remap.into(),
+                a.model.name().into(),
+                a.table.display().to_string(),
+                a.trajectory.display().to_string(),
+                a.points.to_string(),
+                a.remap.into(),
             ]
         };
         let quasi = study.remap.kernel::<f64>()?;

@@ -18,6 +18,7 @@
 
 use anyhow::{Context, bail, ensure};
 use faer::Mat;
+use faer::sparse::SparseColMat;
 use nalgebra::Vector3;
 
 use super::assembly::assemble_restricted_with;
@@ -34,6 +35,22 @@ pub struct NewtonOptions {
     pub max_iterations: usize,
     /// Convergence: largest residual force over the load scale.
     pub tolerance: f64,
+    /// Follow the stable equilibria past a limit point or a bifurcation
+    /// (buckling) instead of failing there: each increment minimizes the
+    /// total potential energy `Π(u) = Σ W_e(u) − s f·u` from the previous
+    /// equilibrium by Newton steps on the tangent shifted by `μ d̄ I` (`d̄`
+    /// the mean absolute diagonal; `μ` raised ×10 from [`MIN_SHIFT`] until
+    /// the factorization succeeds or a step fails to lower `Π`, lowered
+    /// ÷10 after each full step, dropped below [`MIN_SHIFT`]): a
+    /// Levenberg-Marquardt (trust-region) descent, which cannot stop at a
+    /// saddle of `Π`, with the plain Newton step (quadratic convergence)
+    /// wherever the tangent is positive definite. The line search accepts
+    /// a step that lowers `Π`, or one that lowers the residual while `Π`
+    /// changes by less than its rounding ([`ENERGY_ROUNDING`]). The end
+    /// state's unshifted tangent must factorize: the equilibrium returned
+    /// is stable. `false`: plain Newton, failing where the tangent is not
+    /// positive definite.
+    pub descent: bool,
 }
 
 impl Default for NewtonOptions {
@@ -42,6 +59,7 @@ impl Default for NewtonOptions {
             load_steps: 1,
             max_iterations: 40,
             tolerance: 1e-10,
+            descent: false,
         }
     }
 }
@@ -82,6 +100,14 @@ pub struct Equilibrium {
 
 /// Halvings of the Newton step at most in the line search.
 const MAX_HALVINGS: usize = 12;
+/// The smallest tangent shift of [`NewtonOptions::descent`], over the mean
+/// absolute diagonal.
+pub const MIN_SHIFT: f64 = 1e-6;
+/// Raises of the shift (×10 each) at most within one iteration: up to
+/// `1e14` times [`MIN_SHIFT`], a gradient step.
+const MAX_SHIFTS: usize = 20;
+/// Energy changes below this fraction of `Σ|W_e| + |f·u|` are rounding.
+pub const ENERGY_ROUNDING: f64 = 1e-12;
 
 /// A residual below this fraction of the load scale that no step decreases
 /// is rounding (the element forces that cancel at a vertex are each of the
@@ -167,6 +193,26 @@ pub fn solve_stvk(
             .map(|v| Vector3::from(load(v)).amax() * s)
             .fold(largest(&r), f64::max);
         let tolerance_n = options.tolerance * scale;
+        // Π(u) and the scale of its rounding, Σ|W_e| + |s f·u|, J.
+        let energy = |u: &[[f64; 3]]| -> (f64, f64) {
+            let elastic: f64 = problem
+                .tets
+                .iter()
+                .zip(&elements)
+                .map(|(t, e)| {
+                    e.energy_j(&t.map(|v| {
+                        let (p, d) = (problem.positions[v as usize], u[v as usize]);
+                        [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+                    }))
+                })
+                .sum();
+            let work: f64 = unknown
+                .iter()
+                .map(|&v| s * Vector3::from(load(v)).dot(&Vector3::from(u[v])))
+                .sum();
+            (elastic - work, elastic.abs() + work.abs())
+        };
+        let mut shift = 0.0;
         let mut converged = largest(&r) <= tolerance_n;
         let mut k = 0;
         while !converged {
@@ -185,7 +231,12 @@ pub fn solve_stvk(
                 });
                 elements[t].tangent(&x)
             });
-            let llt = SparseLlt::new(tangent.as_ref()).with_context(|| {
+            let factorized = if options.descent {
+                factor_shifted(&tangent, &mut shift)
+            } else {
+                SparseLlt::new(tangent.as_ref())
+            };
+            let llt = factorized.with_context(|| {
                 format!(
                     "load step {step}/{}: the tangent stiffness is not positive definite \
                      (the equilibrium lost stability: buckling or collapse)",
@@ -200,6 +251,11 @@ pub fn solve_stvk(
             }
             llt.solve_in_place(delta.as_mut());
             let before = norm(&r);
+            let (energy_before, energy_scale) = if options.descent {
+                energy(&u)
+            } else {
+                (0.0, 0.0)
+            };
             let mut alpha = 1.0;
             let mut accepted = false;
             for _ in 0..=MAX_HALVINGS {
@@ -210,12 +266,33 @@ pub fn solve_stvk(
                     }
                 }
                 let r_trial = residual(&trial);
-                if norm(&r_trial) < before || largest(&r_trial) <= tolerance_n {
+                let lower = norm(&r_trial) < before || largest(&r_trial) <= tolerance_n;
+                let take = if options.descent {
+                    let (e, _) = energy(&trial);
+                    e < energy_before
+                        || (lower && e <= energy_before + ENERGY_ROUNDING * energy_scale)
+                } else {
+                    lower
+                };
+                if take {
                     (u, r) = (trial, r_trial);
                     accepted = true;
                     break;
                 }
                 alpha *= 0.5;
+            }
+            if options.descent {
+                if accepted && alpha == 1.0 {
+                    shift = if shift / 10.0 < MIN_SHIFT {
+                        0.0
+                    } else {
+                        shift / 10.0
+                    };
+                } else if !accepted && largest(&r) > STAGNATION * scale {
+                    // Trust the tangent less: a shorter, steeper step.
+                    shift = (10.0 * shift).max(MIN_SHIFT);
+                    continue;
+                }
             }
             if !accepted && largest(&r) <= STAGNATION * scale {
                 // At rounding level: no step can decrease the residual.
@@ -234,6 +311,18 @@ pub fn solve_stvk(
         iterations += k;
         residual_n = largest(&r);
     }
+    if options.descent {
+        let tangent = assemble_restricted_with(n, problem.tets, &slot, unknown.len(), |t| {
+            let x = problem.tets[t].map(|v| {
+                let (p, d) = (problem.positions[v as usize], u[v as usize]);
+                [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+            });
+            elements[t].tangent(&x)
+        });
+        SparseLlt::new(tangent.as_ref()).context(
+            "the equilibrium reached is not stable (its tangent is not positive definite)",
+        )?;
+    }
     let f = internal(&u);
     let reactions_n = problem
         .prescribed
@@ -246,5 +335,38 @@ pub fn solve_stvk(
         residual_n,
         tolerance_met,
         reactions_n,
+    })
+}
+
+/// Factorizes `k + shift d̄ I` (`d̄` the mean absolute diagonal of `k`),
+/// raising `shift` ×10 from [`MIN_SHIFT`] (when 0 and `k` fails) until the
+/// factorization succeeds, at most [`MAX_SHIFTS`] times.
+fn factor_shifted(k: &SparseColMat<usize, f64>, shift: &mut f64) -> anyhow::Result<SparseLlt> {
+    let symbolic = k.symbolic();
+    let diagonal: Vec<usize> = (0..k.ncols())
+        .filter_map(|j| symbolic.col_range(j).find(|&i| symbolic.row_idx()[i] == j))
+        .collect();
+    let mean =
+        diagonal.iter().map(|&i| k.val()[i].abs()).sum::<f64>() / diagonal.len().max(1) as f64;
+    let mut last = None;
+    for _ in 0..=MAX_SHIFTS {
+        let attempt = if *shift == 0.0 {
+            SparseLlt::new(k.as_ref())
+        } else {
+            let mut shifted = k.clone();
+            let values = shifted.val_mut();
+            for &i in &diagonal {
+                values[i] += *shift * mean;
+            }
+            SparseLlt::new(shifted.as_ref())
+        };
+        match attempt {
+            Ok(llt) => return Ok(llt),
+            Err(e) => last = Some(e),
+        }
+        *shift = (10.0 * *shift).max(MIN_SHIFT);
+    }
+    Err(last.unwrap_or_else(|| anyhow::anyhow!("no factorization tried"))).with_context(|| {
+        format!("not positive definite with a shift of {shift:e} of its mean diagonal")
     })
 }
