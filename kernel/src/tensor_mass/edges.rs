@@ -20,8 +20,6 @@
 //! cylinder of issue 15, 8160 edges take 2051 groups (8204 lanes, 1.005×;
 //! every edge in its lower row would take 10 048 lanes, 1.23×).
 
-use core::ops::{Add, Mul, Sub};
-
 use super::force::{mul, mul_transposed};
 use crate::Real;
 use crate::table::{TensorMassTable, span};
@@ -251,58 +249,6 @@ pub(crate) fn subtract_block<T: Real>(
     }
 }
 
-/// One value per lane of an [`EdgeGroup`], with lane-wise arithmetic (what
-/// the compiler turns into one vector instruction per operation).
-#[derive(Clone, Copy)]
-struct Lanes<T>([T; EDGE_LANES]);
-
-impl<T: Real> Lanes<T> {
-    #[inline(always)]
-    fn splat(x: T) -> Self {
-        Self([x; EDGE_LANES])
-    }
-
-    /// `(x₀ + x₁) + (x₂ + x₃)`.
-    #[inline(always)]
-    fn sum(self) -> T {
-        let [a, b, c, d] = self.0;
-        (a + b) + (c + d)
-    }
-
-    #[inline(always)]
-    fn zip(self, other: Self, op: impl Fn(T, T) -> T) -> Self {
-        let mut out = self.0;
-        for (o, &x) in out.iter_mut().zip(&other.0) {
-            *o = op(*o, x);
-        }
-        Self(out)
-    }
-}
-
-impl<T: Real> Add for Lanes<T> {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, other: Self) -> Self {
-        self.zip(other, |a, b| a + b)
-    }
-}
-
-impl<T: Real> Sub for Lanes<T> {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, other: Self) -> Self {
-        self.zip(other, |a, b| a - b)
-    }
-}
-
-impl<T: Real> Mul for Lanes<T> {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, other: Self) -> Self {
-        self.zip(other, |a, b| a * b)
-    }
-}
-
 /// `f_i −= Σ_j K_ij u_j` and `f_j −= K_ijᵀ u_i` over every stored edge
 /// (MODELS.md §1), `u` in m, `f` in N. Per group: the 3 components of the 4
 /// `u_j` gathered into lanes, `K u_j` subtracted from 3 lane accumulators of
@@ -317,36 +263,47 @@ pub(crate) fn add_edge_forces<T: Real>(
     u: &[[T; 3]],
     f: &mut [[T; 3]],
 ) {
-    let zero = [T::zero(); 3];
-    for (i, pair) in edges.starts.windows(2).enumerate() {
-        let (Some(&[start, end]), Some(ui)) = (pair.first_chunk::<2>(), u.get(i)) else {
-            continue;
-        };
-        let Some(groups) = edges.groups.get(span(start, end)) else {
+    // Every column is `< N` (`lay_out` places table edges only) and `u`,
+    // `f` hold `N` entries; clamping the columns to the common length lets
+    // the compiler drop every bounds check without a panic path.
+    let n = u.len().min(f.len());
+    let (Some(u), Some(f), Some(last)) = (u.get(..n), f.get_mut(..n), n.checked_sub(1)) else {
+        return;
+    };
+    let at = |j: u32| (j as usize).min(last);
+    for ((i, pair), ui) in edges.starts.windows(2).enumerate().zip(u) {
+        let Some(groups) = pair
+            .first_chunk::<2>()
+            .and_then(|&[start, end]| edges.groups.get(span(start, end)))
+        else {
             continue;
         };
         // A copy: `f`'s writes below cannot change it.
-        let ui = ui.map(Lanes::splat);
-        let mut sum = [Lanes::splat(T::zero()); 3];
+        let ui = ui.map(|x| T::lanes([x; EDGE_LANES]));
+        let mut sum = [T::lanes([T::zero(); EDGE_LANES]); 3];
         for g in groups {
-            let k = g.tensors.map(Lanes);
-            let [u0, u1, u2, u3] = g.columns.map(|j| u.get(j as usize).copied().unwrap_or(zero));
+            let k = g.tensors.map(T::lanes);
+            let columns = g.columns.map(at);
+            let [u0, u1, u2, u3] = columns.map(|j| u.get(j).copied().unwrap_or_default());
             let uj = [
-                Lanes([u0[0], u1[0], u2[0], u3[0]]),
-                Lanes([u0[1], u1[1], u2[1], u3[1]]),
-                Lanes([u0[2], u1[2], u2[2], u3[2]]),
+                T::lanes([u0[0], u1[0], u2[0], u3[0]]),
+                T::lanes([u0[1], u1[1], u2[1], u3[1]]),
+                T::lanes([u0[2], u1[2], u2[2], u3[2]]),
             ];
             let a = mul(&k, &uj);
             sum = [sum[0] - a[0], sum[1] - a[1], sum[2] - a[2]];
-            let [b0, b1, b2] = mul_transposed(&k, &ui).map(|b| b.0);
-            for (((&j, x), y), z) in g.columns.iter().zip(b0).zip(b1).zip(b2) {
-                if let Some(fj) = f.get_mut(j as usize) {
+            let [b0, b1, b2] = mul_transposed(&k, &ui).map(T::lane_values);
+            for (((j, x), y), z) in columns.into_iter().zip(b0).zip(b1).zip(b2) {
+                if let Some(fj) = f.get_mut(j) {
                     *fj = [fj[0] - x, fj[1] - y, fj[2] - z];
                 }
             }
         }
         if let Some(fi) = f.get_mut(i) {
-            let [x, y, z] = sum.map(Lanes::sum);
+            let [x, y, z] = sum.map(|s| {
+                let [a, b, c, d] = T::lane_values(s);
+                (a + b) + (c + d)
+            });
             *fi = [fi[0] + x, fi[1] + y, fi[2] + z];
         }
     }
