@@ -530,9 +530,11 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         forces.forces(dispatch, u, f);
         let c = self.params.damping_per_s;
         let limits = &self.params.limits;
+        // `move`: the scalars and `loads` live in the pass's registers, not
+        // reloaded through the closure at every vertex.
         dispatch.run(
             #[inline(always)]
-            || {
+            move || {
                 let mut watch = Watch::new(limits);
                 let rows = u
                     .iter_mut()
