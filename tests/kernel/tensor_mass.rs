@@ -680,7 +680,8 @@ fn edge_layout_stores_each_edge_once_in_groups_of_4() {
     let (cube, _) = cube();
     for (mesh, groups_used) in [(cylinder, Some(2051)), (cube, None)] {
         let opts = options(&["z<1e-6"], 5000.0, 0.4);
-        let file = TableFile::from_bytes(&build(&mesh, &MeshReport::default(), &opts).unwrap().bytes);
+        let file =
+            TableFile::from_bytes(&build(&mesh, &MeshReport::default(), &opts).unwrap().bytes);
         let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
         let capacity = StateBuffers::edge_group_count(&table);
         let mut state = OwnedState::for_table(&table);
@@ -689,7 +690,10 @@ fn edge_layout_stores_each_edge_once_in_groups_of_4() {
         let n = table.vertex_count();
         assert_eq!((starts.len(), groups.len()), (n + 1, capacity));
         let used = starts[n] as usize;
-        println!("{n} vertices, {} edges: {used} groups of {capacity}", table.edge_count());
+        println!(
+            "{n} vertices, {} edges: {used} groups of {capacity}",
+            table.edge_count()
+        );
         assert!(used <= capacity);
         if let Some(expected) = groups_used {
             assert_eq!(used, expected);

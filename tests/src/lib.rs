@@ -417,7 +417,9 @@ pub fn tensor_difference(
             let want = row
                 .binary_search(&j)
                 .map_or([0.0; 9], |k| rebuilt.edge_tensors[start + k]);
-            let ours = model.edge_tensor(i as u32, j).expect("every edge is stored");
+            let ours = model
+                .edge_tensor(i as u32, j)
+                .expect("every edge is stored");
             for (a, b) in ours.iter().zip(&want) {
                 worst = worst.max((a - b).abs());
             }

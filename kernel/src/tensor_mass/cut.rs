@@ -159,9 +159,8 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
                 continue;
             };
             let block = stiffness_block(aj, al, volume, lambda, mu);
-            let block: [T; 9] = core::array::from_fn(|e| {
-                block.get((e / 3, e % 3)).copied().unwrap_or(T::zero())
-            });
+            let block: [T; 9] =
+                core::array::from_fn(|e| block.get((e / 3, e % 3)).copied().unwrap_or(T::zero()));
             subtract_edge_block(
                 s.edge_group_starts,
                 s.edge_groups,

@@ -83,7 +83,11 @@ pub(crate) fn lay_out<T: Real>(
         let incoming = starts.get(i + 1).copied().unwrap_or(0);
         let out = moved(incoming, own);
         let first_moved = end.saturating_sub(out);
-        for &j in table.edge_columns().get(span(first_moved, end)).unwrap_or(&[]) {
+        for &j in table
+            .edge_columns()
+            .get(span(first_moved, end))
+            .unwrap_or(&[])
+        {
             if let Some(count) = starts.get_mut(j as usize + 1) {
                 *count += 1;
             }
@@ -118,10 +122,9 @@ pub(crate) fn lay_out<T: Real>(
         let incoming = row_groups(starts, groups, row).map_or(0, |r| r.iter().map(placed).sum());
         let first_moved = end.saturating_sub(moved(incoming as u32, own));
         let range = span(start, end);
-        let (Some(columns), Some(blocks)) = (
-            table.edge_columns().get(range.clone()),
-            tensors.get(range),
-        ) else {
+        let (Some(columns), Some(blocks)) =
+            (table.edge_columns().get(range.clone()), tensors.get(range))
+        else {
             continue;
         };
         for ((e, &j), k) in (start..end).zip(columns).zip(blocks) {
@@ -146,13 +149,7 @@ fn row_groups<'g, T>(
 
 /// Writes block `k` and column `column` into the first free lane (column
 /// `row`) of row `row`; nothing if the row is full.
-fn place<T: Real>(
-    starts: &[u32],
-    groups: &mut [EdgeGroup<T>],
-    row: u32,
-    column: u32,
-    k: &[T; 9],
-) {
+fn place<T: Real>(starts: &[u32], groups: &mut [EdgeGroup<T>], row: u32, column: u32, k: &[T; 9]) {
     let r = row as usize;
     let (Some(&start), Some(&end)) = (starts.get(r), starts.get(r.wrapping_add(1))) else {
         return;
@@ -186,7 +183,12 @@ fn transposed<T: Real>(k: &[T; 9]) -> [T; 9] {
 /// `row`: its group index and lane; `None` if it is stored in the other
 /// row, or for `row == column` (padding is no edge). Cost: one scan of the
 /// row's lanes.
-fn slot<T>(starts: &[u32], groups: &[EdgeGroup<T>], row: u32, column: u32) -> Option<(usize, usize)> {
+fn slot<T>(
+    starts: &[u32],
+    groups: &[EdgeGroup<T>],
+    row: u32,
+    column: u32,
+) -> Option<(usize, usize)> {
     if row == column {
         return None;
     }
@@ -202,7 +204,12 @@ fn slot<T>(starts: &[u32], groups: &[EdgeGroup<T>], row: u32, column: u32) -> Op
 
 /// The edge between `i` and `j` as stored: `(group, lane, transposed)`,
 /// `transposed` when the stored block is `K_ji`. `None` for no edge.
-fn find<T>(starts: &[u32], groups: &[EdgeGroup<T>], i: u32, j: u32) -> Option<(usize, usize, bool)> {
+fn find<T>(
+    starts: &[u32],
+    groups: &[EdgeGroup<T>],
+    i: u32,
+    j: u32,
+) -> Option<(usize, usize, bool)> {
     slot(starts, groups, i, j)
         .map(|(g, l)| (g, l, false))
         .or_else(|| slot(starts, groups, j, i).map(|(g, l)| (g, l, true)))
@@ -258,11 +265,7 @@ pub(crate) fn subtract_block<T: Real>(
 /// out-of-range index is skipped, never a panic). Always inlined, so that a
 /// [`crate::math::Dispatch`] compiles it where it runs.
 #[inline(always)]
-pub(crate) fn add_edge_forces<T: Real>(
-    edges: &EdgeTensors<'_, T>,
-    u: &[[T; 3]],
-    f: &mut [[T; 3]],
-) {
+pub(crate) fn add_edge_forces<T: Real>(edges: &EdgeTensors<'_, T>, u: &[[T; 3]], f: &mut [[T; 3]]) {
     // Every column is `< N` (`lay_out` places table edges only) and `u`,
     // `f` hold `N` entries; clamping the columns to the common length lets
     // the compiler drop every bounds check without a panic path.
