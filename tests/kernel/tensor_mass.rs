@@ -725,7 +725,7 @@ fn edge_layout_stores_each_edge_once_in_groups_of_4() {
             for e in rows[i] as usize..rows[i + 1] as usize {
                 let j = table.edge_columns()[e] as usize;
                 let k = table.edge_tensors()[e];
-                let kt: [f64; 9] = std::array::from_fn(|x| k[(x % 3) * 3 + x / 3]);
+                let kt: [f64; 9] = core::array::from_fn(|x| k[(x % 3) * 3 + x / 3]);
                 let (row, ours) = stored[&(i, j)];
                 assert_eq!(ours, if row == i { k } else { kt }, "edge {i}-{j}");
                 assert_eq!(model.edge_tensor(i as u32, j as u32), Some(k));
