@@ -10,7 +10,8 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, EdgeGroup, ElasticLaw, StateBuffers, StvkForm, SurfaceBuffers, TensorMassModel, VertexMode,
+    DynamicParams, EdgeGroup, ElasticLaw, StateBuffers, StvkForm, SurfaceBuffers, TensorMassModel,
+    VertexMode,
 };
 
 use crate::arena::Arena;
