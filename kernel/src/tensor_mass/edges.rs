@@ -1,9 +1,9 @@
 //! The model's own copy of the edge tensors `K_ij` (MODELS.md §1), laid out
 //! for the force pass: groups of [`EDGE_LANES`] edges of one row as
 //! structure of arrays, so that the pass multiplies 4 blocks at once in
-//! vector lanes instead of one 3×3 block in scalars (about 22 instructions
-//! per edge instead of 50 on x86-64 with AVX2, README "Timing your own
-//! mesh").
+//! vector lanes instead of one 3×3 block in scalars (31 instructions per
+//! edge instead of 50 on x86-64 with AVX2, f32, measured with callgrind:
+//! README "Timing your own mesh").
 //!
 //! Layout (rebuilt from the table by [`lay_out`] at construction and reset;
 //! the table's format is unchanged): row `i` owns the groups
