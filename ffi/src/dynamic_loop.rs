@@ -17,7 +17,7 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicTissue, StateBuffers, SurfaceBuffers, TensorMassModel, VertexMode,
+    DynamicTissue, EdgeGroup, StateBuffers, SurfaceBuffers, TensorMassModel, VertexMode,
 };
 
 use crate::P;
@@ -85,7 +85,8 @@ impl DynamicParts {
         let zero = [0.0f32; 3];
         let state = StateBuffers {
             vertex_tensors: arena.take(n, [0.0; 9])?,
-            edge_tensors: arena.take(e, [0.0; 9])?,
+            edge_groups: arena.take(StateBuffers::edge_group_count(table), EdgeGroup::default())?,
+            edge_group_starts: arena.take(n + 1, 0)?,
             masses_kg: arena.take(n, 0.0)?,
             tet_alive: arena.take(t, false)?,
             live_tets: arena.take(n, 0)?,

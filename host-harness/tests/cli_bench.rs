@@ -10,7 +10,9 @@ use palpate::mesh::read_mesh;
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
+use palpate::tensor_mass::OwnedState;
 use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::tensor_mass::{DynamicParams, TensorMassModel};
 
 /// `palpate bench` on the reference cube (216 vertices, 750 tets, base
 /// fixed) with `extra`, sampled briefly (2 samples of 0.2 ms, no warm-up)
@@ -57,13 +59,13 @@ fn lines(out: &std::process::Output) -> Vec<serde_json::Value> {
 
 /// The bytes one linear symplectic step reads in f32, counted by hand from
 /// the arrays of `kernel/src/tensor_mass` (independently of
-/// `StepCounts::step_bytes`): vertex tensors 36 N, edge tensors 36 E, CSR
-/// columns 4 E and row starts 4 (N + 1), `u` and `f` 12 N each in the force
-/// pass; `u`, `v`, `f`, external forces 12 N each, masses 4 N and modes
-/// 1 N in the vertex pass.
-fn linear_symplectic_f32_bytes(vertices: u64, edges: u64) -> u64 {
+/// `StepCounts::step_bytes`): vertex tensors 36 N, the model's edge groups
+/// 160 G (4 blocks of 9 f32 and 4 columns of 4 bytes) and their row starts
+/// 4 (N + 1), `u` and `f` 12 N each in the force pass; `u`, `v`, `f`,
+/// external forces 12 N each, masses 4 N and modes 1 N in the vertex pass.
+fn linear_symplectic_f32_bytes(vertices: u64, groups: u64) -> u64 {
     let n = vertices;
-    36 * n + 36 * edges + 4 * edges + 4 * (n + 1) + 24 * n + 48 * n + 4 * n + n
+    36 * n + 160 * groups + 4 * (n + 1) + 24 * n + 48 * n + 4 * n + n
 }
 
 #[test]
@@ -85,7 +87,7 @@ fn bench_prints_one_json_object_per_measurement() {
     assert_eq!(records.len(), 12 + 4, "{stderr}");
     // The estimate, printed before the run, names the same count.
     assert!(stderr.contains("16 measurements, estimated"), "{stderr}");
-    let edges = {
+    let edge_groups = {
         let (mesh, report) =
             read_mesh(std::path::Path::new(&reference("meshes/cube.msh"))).unwrap();
         let options = BuildOptions::tensor_mass(
@@ -95,9 +97,11 @@ fn bench_prints_one_json_object_per_measurement() {
             Precision::F32,
         );
         let file = TableFile::from_bytes(&build(&mesh, &report, &options).unwrap().bytes);
-        TensorMassTable::<f32>::load(file.bytes())
-            .unwrap()
-            .edge_count() as u64
+        let table = TensorMassTable::<f32>::load(file.bytes()).unwrap();
+        let mut state = OwnedState::for_table(&table);
+        let params = DynamicParams::linear(0.0, 1.0);
+        let model = TensorMassModel::new(table, state.buffers(), params).unwrap();
+        u64::from(model.edge_groups().0[table.vertex_count()])
     };
     let mut groups = std::collections::BTreeMap::new();
     for r in &records {
@@ -127,7 +131,7 @@ fn bench_prints_one_json_object_per_measurement() {
                 let integrator = r["integrator"].as_str().unwrap();
                 assert!(["symplectic", "rk4"].contains(&integrator), "{r}");
                 if r["model"] == "linear" && integrator == "symplectic" {
-                    let want = linear_symplectic_f32_bytes(216, edges);
+                    let want = linear_symplectic_f32_bytes(216, edge_groups);
                     assert_eq!(r["bytes_read"].as_u64(), Some(want), "{r}");
                 }
             }

@@ -661,3 +661,77 @@ fn tearing_removes_overstretched_tets_only() {
         assert_eq!(model.tet_alive()[t], !in_top, "tet {t}");
     }
 }
+
+/// The model's edge layout (`kernel/src/tensor_mass/edges.rs`) on issue 15's
+/// cylinder (`cylinder_mesh(0.1, 4, 16)`: 1377 vertices, 6144 tets, 8160
+/// edges) and the reference cube: every table edge is stored exactly once,
+/// as `K_ij` in row `i` or as `K_ij`ᵀ in row `j`, bit for bit (the layout
+/// copies and transposes, it computes nothing); every other lane is padding
+/// (zero block, column = its row); a row that had 3 or more table edges of
+/// its own holds a multiple of 4 (what bounds `edge_group_count`), and the
+/// groups used fit in `edge_group_count`. The cylinder's count, 2051 groups
+/// (8204 lanes, 1.005× the edges) in 2083, is what a Python port of the
+/// placement rule gives on the mesh `tools/reference/step_baselines.py`
+/// writes; every edge in its lower row would take 2512.
+#[test]
+fn edge_layout_stores_each_edge_once_in_groups_of_4() {
+    use palpate_kernel::tensor_mass::{EDGE_LANES, StateBuffers};
+    let cylinder = palpate::mesh::generate::cylinder_mesh(0.1, 4, 16);
+    let (cube, _) = cube();
+    for (mesh, groups_used) in [(cylinder, Some(2051)), (cube, None)] {
+        let opts = options(&["z<1e-6"], 5000.0, 0.4);
+        let file =
+            TableFile::from_bytes(&build(&mesh, &MeshReport::default(), &opts).unwrap().bytes);
+        let table = TensorMassTable::<f64>::load(file.bytes()).unwrap();
+        let capacity = StateBuffers::edge_group_count(&table);
+        let mut state = OwnedState::for_table(&table);
+        let model = TensorMassModel::new(table, state.buffers(), params(0.0)).unwrap();
+        let (starts, groups) = model.edge_groups();
+        let n = table.vertex_count();
+        assert_eq!((starts.len(), groups.len()), (n + 1, capacity));
+        let used = starts[n] as usize;
+        println!(
+            "{n} vertices, {} edges: {used} groups of {capacity}",
+            table.edge_count()
+        );
+        assert!(used <= capacity);
+        if let Some(expected) = groups_used {
+            assert_eq!(used, expected);
+        }
+        let mut stored = std::collections::HashMap::new();
+        for i in 0..n {
+            let mut lanes = 0;
+            for g in &groups[starts[i] as usize..starts[i + 1] as usize] {
+                for l in 0..EDGE_LANES {
+                    let (j, k) = (g.columns[l], g.tensors.map(|e| e[l]));
+                    if j as usize == i {
+                        assert_eq!(k, [0.0; 9], "padding of row {i}");
+                    } else {
+                        lanes += 1;
+                        let key = (i.min(j as usize), i.max(j as usize));
+                        assert!(stored.insert(key, (i, k)).is_none(), "{key:?} twice");
+                    }
+                }
+            }
+            let own = (table.edge_row_starts()[i + 1] - table.edge_row_starts()[i]) as usize;
+            if own >= 3 {
+                assert_eq!(lanes % EDGE_LANES, 0, "row {i}: {lanes} edges");
+            }
+        }
+        assert!(groups[used..].iter().all(|g| g.tensors == [[0.0; 4]; 9]));
+        assert_eq!(stored.len(), table.edge_count());
+        let rows = table.edge_row_starts();
+        for i in 0..n {
+            for e in rows[i] as usize..rows[i + 1] as usize {
+                let j = table.edge_columns()[e] as usize;
+                let k = table.edge_tensors()[e];
+                let kt: [f64; 9] = core::array::from_fn(|x| k[(x % 3) * 3 + x / 3]);
+                let (row, ours) = stored[&(i, j)];
+                assert_eq!(ours, if row == i { k } else { kt }, "edge {i}-{j}");
+                assert_eq!(model.edge_tensor(i as u32, j as u32), Some(k));
+                assert_eq!(model.edge_tensor(j as u32, i as u32), Some(kt));
+            }
+        }
+        assert_eq!(model.edge_tensor(0, 0), None);
+    }
+}

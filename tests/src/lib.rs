@@ -417,7 +417,10 @@ pub fn tensor_difference(
             let want = row
                 .binary_search(&j)
                 .map_or([0.0; 9], |k| rebuilt.edge_tensors[start + k]);
-            for (a, b) in model.edge_tensors()[e].iter().zip(&want) {
+            let ours = model
+                .edge_tensor(i as u32, j)
+                .expect("every edge is stored");
+            for (a, b) in ours.iter().zip(&want) {
                 worst = worst.max((a - b).abs());
             }
         }

@@ -83,6 +83,9 @@ pub struct StepCounts {
     pub vertices: u64,
     /// Edges `E` (each once).
     pub edges: u64,
+    /// Groups of 4 edges the linear pass reads (the model's edge layout,
+    /// `kernel/src/tensor_mass/edges.rs`: about `E / 4`, rows padded).
+    pub edge_groups: u64,
     /// Tets `T`.
     pub tets: u64,
     /// Mesh triangles (every face once; the split terms' triangles).
@@ -90,11 +93,17 @@ pub struct StepCounts {
 }
 
 impl StepCounts {
-    /// The counts of a loaded table.
+    /// The counts of a loaded table (the edge groups of a model built on
+    /// it).
     pub fn of<T: Real>(table: &TensorMassTable<'_, T>) -> Self {
+        let mut state = OwnedState::for_table(table).without_split_terms();
+        let params = DynamicParams::linear(T::zero(), T::one());
+        let edge_groups = TensorMassModel::new(*table, state.buffers(), params)
+            .map_or(0, |model| model.edge_groups().0.last().map_or(0, |&g| g));
         Self {
             vertices: table.vertex_count() as u64,
             edges: table.edge_count() as u64,
+            edge_groups: u64::from(edge_groups),
             tets: table.tet_count() as u64,
             triangles: table.mesh_triangles().len() as u64,
         }
@@ -104,13 +113,15 @@ impl StepCounts {
     /// scalars: each array counted once per pass over it
     /// (`kernel/src/tensor_mass/{force,stvk,stvk_terms,model,integrator}.rs`).
     ///
-    /// - linear force pass: vertex and edge tensors (9 scalars each), the
-    ///   CSR columns and row starts (4 bytes each), `u` and `f` (3 each);
+    /// - linear force pass: vertex tensors (9 scalars each), the edge
+    ///   groups (36 scalars and 4 columns of 4 bytes each) and their row
+    ///   starts (4 bytes each), `u` and `f` (3 each);
     /// - per-tet St Venant-Kirchhoff pass, and the penalty's pass: the tets
     ///   (16 bytes), rest shapes (13 scalars), Lamé pairs (2), alive flags
     ///   (1 byte), `u` and `f`;
     /// - split terms: the linear pass, then the terms' pass over vertices
-    ///   (4 scalars), edges (16, and the CSR again), triangles (12 bytes,
+    ///   (4 scalars), edges (16, and the CSR: 4 bytes per edge and per
+    ///   row start), triangles (12 bytes,
     ///   15 scalars), tets (16 bytes, 3 scalars, alive), `u` and `f`;
     /// - the integrator's vertex pass: `u`, `v`, `f`, external forces,
     ///   masses and modes, plus the previous displacements for the central
@@ -120,11 +131,12 @@ impl StepCounts {
     ///   2 sums, masses and modes last.
     pub fn step_bytes(&self, config: &StepConfig, scalar_bytes: u64) -> u64 {
         let (n, e, t, tri) = (self.vertices, self.edges, self.tets, self.triangles);
+        let groups = self.edge_groups;
         let s = scalar_bytes;
         let vector = 3 * s * n;
         let modes = size_of::<VertexMode>() as u64 * n;
         let csr = 4 * e + 4 * (n + 1);
-        let linear = 9 * s * n + 9 * s * e + csr + 2 * vector;
+        let linear = 9 * s * n + (36 * s + 16) * groups + 4 * (n + 1) + 2 * vector;
         let tet_pass = 16 * t + (TET_SHAPE_LEN + TET_MATERIAL_LEN) as u64 * s * t + t + 2 * vector;
         let terms = VERTEX_TERMS_LEN as u64 * s * n
             + EDGE_TERMS_LEN as u64 * s * e

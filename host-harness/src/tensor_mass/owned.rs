@@ -8,13 +8,14 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::SurfaceBuffers;
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
-use palpate_kernel::tensor_mass::{StateBuffers, TensorMassModel, VertexMode};
+use palpate_kernel::tensor_mass::{EdgeGroup, StateBuffers, TensorMassModel, VertexMode};
 
 /// The mutable state of a tensor-mass model in vectors: what firmware keeps
 /// in static arrays.
 pub struct OwnedState<T> {
     vertex_tensors: Vec<[T; 9]>,
-    edge_tensors: Vec<[T; 9]>,
+    edge_groups: Vec<EdgeGroup<T>>,
+    edge_group_starts: Vec<u32>,
     masses_kg: Vec<T>,
     tet_alive: Vec<bool>,
     live_tets: Vec<u32>,
@@ -35,7 +36,8 @@ impl<T: Real> OwnedState<T> {
         let zero = [T::zero(); 3];
         Self {
             vertex_tensors: vec![[T::zero(); 9]; n],
-            edge_tensors: vec![[T::zero(); 9]; table.edge_count()],
+            edge_groups: vec![EdgeGroup::default(); StateBuffers::edge_group_count(table)],
+            edge_group_starts: vec![0; n + 1],
             masses_kg: vec![T::zero(); n],
             tet_alive: vec![true; table.tet_count()],
             live_tets: vec![0; n],
@@ -64,7 +66,8 @@ impl<T: Real> OwnedState<T> {
         let [u, v, previous, external, force] = &mut self.vectors;
         StateBuffers {
             vertex_tensors: &mut self.vertex_tensors,
-            edge_tensors: &mut self.edge_tensors,
+            edge_groups: &mut self.edge_groups,
+            edge_group_starts: &mut self.edge_group_starts,
             masses_kg: &mut self.masses_kg,
             tet_alive: &mut self.tet_alive,
             live_tets: &mut self.live_tets,

@@ -1,5 +1,7 @@
 //! The scalar the kernel computes in: `f32` on firmware, `f64` for verification.
 
+use core::ops::{Add, Mul, Sub};
+
 use nalgebra::RealField;
 
 /// A floating-point scalar usable both as table storage and for computation.
@@ -43,10 +45,23 @@ pub trait Real:
     fn larger(self, other: Self) -> Self {
         if self > other { self } else { other }
     }
+    /// Four values in one SIMD vector where the target has one (`wide`:
+    /// `f32x4` in SSE, `f64x4` in AVX or two SSE2 halves on x86-64; four
+    /// scalars on the Cortex-M4F), with lane-wise IEEE-754 `+ − ×`: the
+    /// same results as the scalar operations, lane by lane.
+    type Lanes: Copy
+        + Add<Output = Self::Lanes>
+        + Sub<Output = Self::Lanes>
+        + Mul<Output = Self::Lanes>;
+    /// `[x₀, x₁, x₂, x₃]` as lanes.
+    fn lanes(x: [Self; 4]) -> Self::Lanes;
+    /// The lanes' values.
+    fn lane_values(v: Self::Lanes) -> [Self; 4];
 }
 
 impl Real for f32 {
     const BYTES: u32 = 4;
+    type Lanes = wide::f32x4;
     const MIN_PIVOT_RATIO: Self = 3.5e-4;
     const WEIGHT_TOLERANCE: Self = 1e-5;
     fn of_f64(x: f64) -> Self {
@@ -67,10 +82,19 @@ impl Real for f32 {
     fn trunc_u32(self) -> u32 {
         self as u32
     }
+    #[inline(always)]
+    fn lanes(x: [Self; 4]) -> Self::Lanes {
+        Self::Lanes::new(x)
+    }
+    #[inline(always)]
+    fn lane_values(v: Self::Lanes) -> [Self; 4] {
+        v.to_array()
+    }
 }
 
 impl Real for f64 {
     const BYTES: u32 = 8;
+    type Lanes = wide::f64x4;
     const MIN_PIVOT_RATIO: Self = 1.5e-8;
     const WEIGHT_TOLERANCE: Self = 1e-12;
     fn of_f64(x: f64) -> Self {
@@ -90,5 +114,13 @@ impl Real for f64 {
     }
     fn trunc_u32(self) -> u32 {
         self as u32
+    }
+    #[inline(always)]
+    fn lanes(x: [Self; 4]) -> Self::Lanes {
+        Self::Lanes::new(x)
+    }
+    #[inline(always)]
+    fn lane_values(v: Self::Lanes) -> [Self; 4] {
+        v.to_array()
     }
 }

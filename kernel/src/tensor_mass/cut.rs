@@ -9,6 +9,7 @@ use core::fmt;
 
 use nalgebra::Vector3;
 
+use super::edges::subtract_block as subtract_edge_block;
 use super::model::TensorMassModel;
 use super::stvk_terms::{TetPlace, tet_terms};
 use crate::Real;
@@ -149,17 +150,24 @@ impl<T: Real> TensorMassModel<'_, '_, T> {
                 *m -= share;
             }
         }
-        for ([j, l], &e) in TET_EDGE_PAIRS.into_iter().zip(&edges) {
-            // The stored edge tensor couples its lower vertex (row) to its higher.
-            let (Some(&vj), Some(&vl)) = (tet.get(j), tet.get(l)) else {
+        for [j, l] in TET_EDGE_PAIRS {
+            // `K_jl −= B(a_j, a_l)`, in whichever row the layout stores the
+            // edge (as `K_lj` it takes `B(a_j, a_l)ᵀ = B(a_l, a_j)`).
+            let (Some(vj), Some(vl), Some(aj), Some(al)) =
+                (tet.get(j), tet.get(l), a.get(j), a.get(l))
+            else {
                 continue;
             };
-            let (row, col) = if vj < vl { (j, l) } else { (l, j) };
-            if let (Some(ar), Some(ac), Some(k)) =
-                (a.get(row), a.get(col), s.edge_tensors.get_mut(e.get()))
-            {
-                subtract_block(k, &stiffness_block(ar, ac, volume, lambda, mu));
-            }
+            let block = stiffness_block(aj, al, volume, lambda, mu);
+            let block: [T; 9] =
+                core::array::from_fn(|e| block.get((e / 3, e % 3)).copied().unwrap_or(T::zero()));
+            subtract_edge_block(
+                s.edge_group_starts,
+                s.edge_groups,
+                vj.as_u32(),
+                vl.as_u32(),
+                &block,
+            );
         }
         let triangles = self.table.tet_triangles().get(t.get());
         if let (true, Some(&triangles)) = (s.has_stvk_terms(), triangles) {

@@ -1,16 +1,19 @@
 //! The elastic force of the tensor-mass model (MODELS.md §1):
 //! `f_i = −(K_ii u_i + Σ_j K_ij u_j)`, one pass over the vertices and one over
-//! the edges (each edge stored once, `K_ji = K_ijᵀ`).
+//! the edges (each edge stored once, `K_ji = K_ijᵀ`, in the groups of
+//! [`super::edges`]).
+
+use core::ops::{Add, Mul};
 
 use nalgebra::Vector3;
 
 use super::coupling::CouplingForces;
+use super::edges::{EdgeTensors, add_edge_forces};
 use super::law::{ElasticLaw, StvkForm};
 use super::stvk::TetPass;
 use super::stvk_terms::NonLinearTerms;
 use crate::Real;
 use crate::math::Dispatch;
-use crate::table::span;
 
 /// Everything the internal-force pass of a step reads, for the configured
 /// [`ElasticLaw`] and optional incompressibility penalty.
@@ -94,12 +97,10 @@ impl<T: Real> InternalForces<'_, '_, T> {
     }
 }
 
-/// The stiffness the force pass reads: current tensors and the CSR edge list.
+/// The stiffness the force pass reads: the current vertex and edge tensors.
 pub(crate) struct Stiffness<'t, T> {
     pub(crate) vertex_tensors: &'t [[T; 9]],
-    pub(crate) edge_tensors: &'t [[T; 9]],
-    pub(crate) row_start: &'t [u32],
-    pub(crate) column: &'t [u32],
+    pub(crate) edges: EdgeTensors<'t, T>,
 }
 
 /// `[T; 3]` as a vector.
@@ -107,9 +108,10 @@ pub(crate) fn vec3<T: Real>(v: &[T; 3]) -> Vector3<T> {
     Vector3::new(v[0], v[1], v[2])
 }
 
-/// `K x` for a row-major 3×3 `K`.
+/// `K x` for a row-major 3×3 `K`, of scalars or of lanes
+/// ([`super::edges`]).
 #[inline(always)]
-fn mul<T: Real>(k: &[T; 9], x: &[T; 3]) -> [T; 3] {
+pub(crate) fn mul<S: Copy + Add<Output = S> + Mul<Output = S>>(k: &[S; 9], x: &[S; 3]) -> [S; 3] {
     [
         k[0] * x[0] + k[1] * x[1] + k[2] * x[2],
         k[3] * x[0] + k[4] * x[1] + k[5] * x[2],
@@ -117,9 +119,12 @@ fn mul<T: Real>(k: &[T; 9], x: &[T; 3]) -> [T; 3] {
     ]
 }
 
-/// `Kᵀ x` for a row-major 3×3 `K`.
+/// `Kᵀ x` for a row-major 3×3 `K`, of scalars or of lanes.
 #[inline(always)]
-fn mul_transposed<T: Real>(k: &[T; 9], x: &[T; 3]) -> [T; 3] {
+pub(crate) fn mul_transposed<S: Copy + Add<Output = S> + Mul<Output = S>>(
+    k: &[S; 9],
+    x: &[S; 3],
+) -> [S; 3] {
     [
         k[0] * x[0] + k[3] * x[1] + k[6] * x[2],
         k[1] * x[0] + k[4] * x[1] + k[7] * x[2],
@@ -129,8 +134,9 @@ fn mul_transposed<T: Real>(k: &[T; 9], x: &[T; 3]) -> [T; 3] {
 
 impl<T: Real> Stiffness<'_, T> {
     /// Overwrites `f` with the elastic forces (N) of displacements `u` (m).
-    /// Loops: `N` vertices, then `E` edges (lengths validated at load and at
-    /// state construction; an out-of-range access is skipped, never a panic).
+    /// Loops: `N` vertices, then the edge groups ([`add_edge_forces`];
+    /// lengths validated at load and at state construction; an out-of-range
+    /// access is skipped, never a panic).
     /// Always inlined, so that a [`Dispatch`] compiles it where it runs.
     #[inline(always)]
     pub(crate) fn elastic_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
@@ -138,32 +144,6 @@ impl<T: Real> Stiffness<'_, T> {
             let ku = mul(k, ui);
             *fi = [-ku[0], -ku[1], -ku[2]];
         }
-        for (i, pair) in self.row_start.windows(2).enumerate() {
-            let (Some(&[start, end]), Some(ui)) = (pair.first_chunk::<2>(), u.get(i)) else {
-                continue;
-            };
-            let range = span(start, end);
-            let (Some(columns), Some(tensors)) =
-                (self.column.get(range.clone()), self.edge_tensors.get(range))
-            else {
-                continue;
-            };
-            // A copy: `f`'s writes below cannot change it (without the copy,
-            // the compiler reloads `u_i` at every edge).
-            let ui = *ui;
-            let mut fi = [T::zero(); 3];
-            for (&j, k) in columns.iter().zip(tensors) {
-                let (Some(uj), Some(fj)) = (u.get(j as usize), f.get_mut(j as usize)) else {
-                    continue;
-                };
-                let a = mul(k, uj);
-                let b = mul_transposed(k, &ui);
-                fi = [fi[0] - a[0], fi[1] - a[1], fi[2] - a[2]];
-                *fj = [fj[0] - b[0], fj[1] - b[1], fj[2] - b[2]];
-            }
-            if let Some(f) = f.get_mut(i) {
-                *f = [f[0] + fi[0], f[1] + fi[1], f[2] + fi[2]];
-            }
-        }
+        add_edge_forces(&self.edges, u, f);
     }
 }

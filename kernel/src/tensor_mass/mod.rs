@@ -19,6 +19,7 @@
 
 mod coupling;
 mod cut;
+mod edges;
 mod force;
 mod integrator;
 mod law;
@@ -31,6 +32,7 @@ mod surface;
 mod tissue;
 
 pub use cut::{CutReport, RemoveError, TearThresholds};
+pub use edges::{EDGE_LANES, EdgeGroup};
 pub use integrator::Integrator;
 pub use law::{ElasticLaw, StvkForm};
 pub use limits::Limits;

@@ -5,6 +5,7 @@ use core::fmt;
 use nalgebra::Vector3;
 
 use super::coupling::Coupling;
+use super::edges::{EdgeGroup, EdgeTensors, lay_out};
 use super::force::{InternalForces, Stiffness, vec3};
 use super::integrator::{Integrator, Loads};
 use super::law::{ElasticLaw, StvkForm};
@@ -226,8 +227,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         let s = &mut self.state;
         s.vertex_tensors
             .copy_from_slice_checked(self.table.vertex_tensors());
-        s.edge_tensors
-            .copy_from_slice_checked(self.table.edge_tensors());
+        lay_out(&self.table, s.edge_group_starts, s.edge_groups);
         s.masses_kg.copy_from_slice_checked(self.table.masses_kg());
         let terms = &mut s.stvk_terms;
         terms
@@ -311,9 +311,27 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         self.state.vertex_tensors
     }
 
-    /// Current edge tensors `K_ij`, `i < j` (row-major, N/m).
-    pub fn edge_tensors(&self) -> &[[T; 9]] {
-        self.state.edge_tensors
+    /// The current edge tensor `K_ij` (row `i`, column `j`, row-major, N/m;
+    /// `K_ji = K_ijᵀ`) of the edge between vertices `i` and `j`, `None` if
+    /// there is none. Cost: a scan of the two rows' edge groups.
+    pub fn edge_tensor(&self, i: u32, j: u32) -> Option<[T; 9]> {
+        self.edge_tensors().block(i, j)
+    }
+
+    /// The current edge tensors as the force pass reads them: groups of 4
+    /// edges of one row (`EdgeGroup`: the entries by lane, the other ends,
+    /// padding lanes with a zero block and the row itself), row `i`'s
+    /// groups `starts[i]..starts[i+1]`; returned as `(starts, groups)`. The
+    /// groups past `starts[N]` are unused (zero).
+    pub fn edge_groups(&self) -> (&[u32], &[EdgeGroup<T>]) {
+        (self.state.edge_group_starts, self.state.edge_groups)
+    }
+
+    fn edge_tensors(&self) -> EdgeTensors<'_, T> {
+        EdgeTensors {
+            starts: self.state.edge_group_starts,
+            groups: self.state.edge_groups,
+        }
     }
 
     fn vertex_index(&self, vertex: u32) -> Result<usize, InputError> {
@@ -444,7 +462,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         internal_forces(
             &self.table,
             s.vertex_tensors,
-            s.edge_tensors,
+            self.edge_tensors(),
             s.tet_alive,
             &s.stvk_terms,
             &self.params,
@@ -512,9 +530,11 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         forces.forces(dispatch, u, f);
         let c = self.params.damping_per_s;
         let limits = &self.params.limits;
+        // `move`: the scalars and `loads` live in the pass's registers, not
+        // reloaded through the closure at every vertex.
         dispatch.run(
             #[inline(always)]
-            || {
+            move || {
                 let mut watch = Watch::new(limits);
                 let rows = u
                     .iter_mut()
@@ -689,7 +709,10 @@ fn split<'b, 'a, T: Real>(
     let forces = internal_forces(
         table,
         state.vertex_tensors,
-        state.edge_tensors,
+        EdgeTensors {
+            starts: state.edge_group_starts,
+            groups: state.edge_groups,
+        },
         state.tet_alive,
         &state.stvk_terms,
         params,
@@ -715,7 +738,7 @@ fn split<'b, 'a, T: Real>(
 fn internal_forces<'b, 'a, T: Real>(
     table: &'b TensorMassTable<'a, T>,
     vertex_tensors: &'b [[T; 9]],
-    edge_tensors: &'b [[T; 9]],
+    edges: EdgeTensors<'b, T>,
     tet_alive: &'b [bool],
     terms: &'b TermArraysMut<'_, T>,
     params: &DynamicParams<T>,
@@ -735,9 +758,7 @@ fn internal_forces<'b, 'a, T: Real>(
     InternalForces {
         stiffness: Stiffness {
             vertex_tensors,
-            edge_tensors,
-            row_start: table.edge_row_starts(),
-            column: table.edge_columns(),
+            edges,
         },
         tets: TetPass { table, tet_alive },
         terms,

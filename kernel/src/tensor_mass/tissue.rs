@@ -445,7 +445,6 @@ impl<'a, 's, T: Real, const P: usize, D: Dispatch> DynamicTissue<'a, 's, T, P, D
     /// over `vertices` (module docs); `n · K_c n` is the normal stiffness.
     /// Cost: 9 tensor reads and 6 edge look-ups.
     fn contact_stiffness(&self, vertices: &[VertexIndex; 3], shares: &[T; 3]) -> Matrix3<T> {
-        let table = self.model.table();
         let mut k = Matrix3::zeros();
         for (&i, &si) in vertices.iter().zip(shares) {
             for (&j, &sj) in vertices.iter().zip(shares) {
@@ -458,14 +457,9 @@ impl<'a, 's, T: Real, const P: usize, D: Dispatch> DynamicTissue<'a, 's, T, P, D
                         .get(i.get())
                         .map(|kij| Matrix3::from_row_slice(kij))
                 } else {
-                    // The stored edge tensor is K_{lo,hi}; K_{hi,lo} is its transpose.
-                    table
-                        .edge_between(i, j)
-                        .and_then(|e| self.model.edge_tensors().get(e.get()))
-                        .map(|kij| {
-                            let m = Matrix3::from_row_slice(kij);
-                            if i > j { m.transpose() } else { m }
-                        })
+                    self.model
+                        .edge_tensor(i.as_u32(), j.as_u32())
+                        .map(|kij| Matrix3::from_row_slice(&kij))
                 };
                 if let Some(kij) = kij {
                     k += kij * (si * sj);

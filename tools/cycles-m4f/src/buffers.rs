@@ -10,7 +10,8 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, StateBuffers, StvkForm, SurfaceBuffers, TensorMassModel, VertexMode,
+    DynamicParams, EdgeGroup, ElasticLaw, StateBuffers, StvkForm, SurfaceBuffers, TensorMassModel,
+    VertexMode,
 };
 
 use crate::arena::Arena;
@@ -38,7 +39,10 @@ pub fn model_parts<'a>(
     let split = |len: usize| if terms { len } else { 0 };
     let state = StateBuffers {
         vertex_tensors: arena.slice(n, [0.0; 9]).ok_or(full)?,
-        edge_tensors: arena.slice(e, [0.0; 9]).ok_or(full)?,
+        edge_groups: arena
+            .slice(StateBuffers::edge_group_count(&table), EdgeGroup::default())
+            .ok_or(full)?,
+        edge_group_starts: arena.slice(n + 1, 0).ok_or(full)?,
         masses_kg: arena.slice(n, 0.0).ok_or(full)?,
         tet_alive: arena.slice(table.tet_count(), true).ok_or(full)?,
         live_tets: arena.slice(n, 0).ok_or(full)?,

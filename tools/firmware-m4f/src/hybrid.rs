@@ -21,7 +21,9 @@ use cortex_m_semihosting::hio;
 use palpate_kernel::hybrid::{HybridBuffers, HybridModel};
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
-use palpate_kernel::tensor_mass::{StateBuffers, TensorMassModel, VertexMode};
+use palpate_kernel::tensor_mass::{
+    EDGE_LANES, EdgeGroup, StateBuffers, TensorMassModel, VertexMode,
+};
 use palpate_kernel::{PrecomputedTable, include_table};
 
 /// The pre-computed region's table (connection nodes fixed), from
@@ -38,8 +40,9 @@ static SEQUENCE: &str = include_str!("../hybrid-sequence.txt");
 const VERTICES: usize = 64;
 /// Capacity for the tensor-mass region's vertices: the corner cell's 8.
 const DYNAMIC_VERTICES: usize = 8;
-/// Capacity for its edges: the cell's 12, 6 face diagonals, 1 body diagonal.
-const DYNAMIC_EDGES: usize = 19;
+/// Capacity for its edge groups (`StateBuffers::edge_group_count`): the
+/// cell's 12 edges, 6 face diagonals and 1 body diagonal take 8 groups of 4.
+const DYNAMIC_EDGE_GROUPS: usize = 8;
 /// Capacity for its tets: the cell's 6 (Kuhn split).
 const DYNAMIC_TETS: usize = 6;
 /// Capacity for the connection nodes: the corner cell's vertices but the
@@ -51,7 +54,8 @@ const FREE: usize = 40;
 /// The static state: fixed-capacity arrays (see the module docs).
 struct State {
     vertex_tensors: [[f32; 9]; DYNAMIC_VERTICES],
-    edge_tensors: [[f32; 9]; DYNAMIC_EDGES],
+    edge_groups: [EdgeGroup<f32>; DYNAMIC_EDGE_GROUPS],
+    edge_group_starts: [u32; DYNAMIC_VERTICES + 1],
     masses_kg: [f32; DYNAMIC_VERTICES],
     tet_alive: [bool; DYNAMIC_TETS],
     live_tets: [u32; DYNAMIC_VERTICES],
@@ -70,7 +74,11 @@ struct State {
 impl State {
     const ZERO: Self = Self {
         vertex_tensors: [[0.0; 9]; DYNAMIC_VERTICES],
-        edge_tensors: [[0.0; 9]; DYNAMIC_EDGES],
+        edge_groups: [EdgeGroup {
+            tensors: [[0.0; EDGE_LANES]; 9],
+            columns: [0; EDGE_LANES],
+        }; DYNAMIC_EDGE_GROUPS],
+        edge_group_starts: [0; DYNAMIC_VERTICES + 1],
         masses_kg: [0.0; DYNAMIC_VERTICES],
         tet_alive: [false; DYNAMIC_TETS],
         live_tets: [0; DYNAMIC_VERTICES],
@@ -113,15 +121,15 @@ pub fn run() -> Result<(), ()> {
         refused("state", &"already taken");
         return Err(());
     };
-    let (n, e, t) = (
-        dynamic.vertex_count(),
-        dynamic.edge_count(),
-        dynamic.tet_count(),
-    );
+    let (n, t) = (dynamic.vertex_count(), dynamic.tet_count());
     let [u, v, previous, external, force] = &mut state.vectors;
     let buffers = StateBuffers {
         vertex_tensors: prefix(&mut state.vertex_tensors, n),
-        edge_tensors: prefix(&mut state.edge_tensors, e),
+        edge_groups: prefix(
+            &mut state.edge_groups,
+            StateBuffers::edge_group_count(&dynamic),
+        ),
+        edge_group_starts: prefix(&mut state.edge_group_starts, n + 1),
         masses_kg: prefix(&mut state.masses_kg, n),
         tet_alive: prefix(&mut state.tet_alive, t),
         live_tets: prefix(&mut state.live_tets, n),

@@ -71,7 +71,8 @@ static mut HYBRID_INPUTS: HybridInputs = HybridInputs {
     table_lens: [usize::MAX; 3],
     lengths: BufferLengths {
         vertex_tensors: 8,
-        edge_tensors: 19,
+        edge_groups: 8,
+        edge_group_starts: 9,
         masses_kg: 8,
         tet_alive: 6,
         live_tets: 8,

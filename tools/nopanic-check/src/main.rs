@@ -132,7 +132,7 @@ use palpate_kernel::table::format::{
 };
 use palpate_kernel::tensor_mass::stvk_terms::TermArraysMut;
 use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, ElasticLaw, Extrapolation, Fault, Integrator,
+    DynamicParams, DynamicTissue, EdgeGroup, ElasticLaw, Extrapolation, Fault, Integrator,
     MAX_REMOVED_PER_UPDATE, PhysicsConfig, StateBuffers, StvkForm, SurfaceBuffers, TearThresholds,
     Tearing, TensorMassModel, VertexMode,
 };
@@ -775,10 +775,14 @@ fn publish(displacements: &[[f32; 3]; VERTICES]) {
 static TENSOR_TABLE: &[u8] =
     palpate_kernel::include_table!(concat!(env!("OUT_DIR"), "/tensor_table.bin"));
 
-/// Capacity of the edge buffer: the checked table has 279 edges; one more
-/// than that, so that a too-long `edge_tensors` is reachable as well as a
-/// too-short one.
+/// Capacity of the edge-term buffer: the checked table has 279 edges; one
+/// more than that, so that a too-long `edge_terms` is reachable as well as
+/// a too-short one.
 const EDGES: usize = 280;
+
+/// Capacity of the edge-group buffer: the checked table needs 78 groups of
+/// 4 edges (`StateBuffers::edge_group_count`); one more, as for `EDGES`.
+const EDGE_GROUPS: usize = 79;
 
 /// Capacity of the per-tet buffer: the checked table has 162 tets.
 const TETS: usize = 162;
@@ -799,7 +803,8 @@ const SURFACE: usize = 4 * TETS;
 #[derive(Clone, Copy)]
 struct BufferLengths {
     vertex_tensors: usize,
-    edge_tensors: usize,
+    edge_groups: usize,
+    edge_group_starts: usize,
     masses_kg: usize,
     tet_alive: usize,
     live_tets: usize,
@@ -883,7 +888,8 @@ static mut TENSOR_INPUTS: TensorInputs = TensorInputs {
     table_len: usize::MAX,
     lengths: BufferLengths {
         vertex_tensors: VERTICES,
-        edge_tensors: EDGES - 1,
+        edge_groups: EDGE_GROUPS - 1,
+        edge_group_starts: VERTICES + 1,
         masses_kg: VERTICES,
         tet_alive: TETS,
         live_tets: VERTICES,
@@ -970,7 +976,8 @@ static mut TENSOR_OUTPUTS: TensorOutputs = TensorOutputs {
 /// stack), sliced to the volatile lengths each tick.
 struct TensorState {
     vertex_tensors: [[f32; 9]; VERTICES],
-    edge_tensors: [[f32; 9]; EDGES],
+    edge_groups: [EdgeGroup<f32>; EDGE_GROUPS],
+    edge_group_starts: [u32; VERTICES + 2],
     masses_kg: [f32; VERTICES],
     tet_alive: [bool; TETS],
     live_tets: [u32; VERTICES],
@@ -991,7 +998,8 @@ impl TensorState {
     fn new() -> Self {
         Self {
             vertex_tensors: [[0.0; 9]; VERTICES],
-            edge_tensors: [[0.0; 9]; EDGES],
+            edge_groups: [EdgeGroup::default(); EDGE_GROUPS],
+            edge_group_starts: [0; VERTICES + 2],
             masses_kg: [0.0; VERTICES],
             tet_alive: [false; TETS],
             live_tets: [0; VERTICES],
@@ -1013,7 +1021,8 @@ impl TensorState {
     fn buffers(&mut self, n: &BufferLengths) -> StateBuffers<'_, f32> {
         StateBuffers {
             vertex_tensors: prefix(&mut self.vertex_tensors, n.vertex_tensors),
-            edge_tensors: prefix(&mut self.edge_tensors, n.edge_tensors),
+            edge_groups: prefix(&mut self.edge_groups, n.edge_groups),
+            edge_group_starts: prefix(&mut self.edge_group_starts, n.edge_group_starts),
             masses_kg: prefix(&mut self.masses_kg, n.masses_kg),
             tet_alive: prefix(&mut self.tet_alive, n.tet_alive),
             live_tets: prefix(&mut self.live_tets, n.live_tets),
