@@ -54,7 +54,12 @@ fn quick_chart_writes_report_charts_and_json() {
         .iter()
         .map(|v| v.as_str().unwrap())
         .collect();
-    assert!(front.contains(&"precomputed-quasi on 2x10"), "{front:?}");
+    // The cheapest within 1 % is on the front by definition (a run that
+    // dominated it would be cheaper and within 1 %), whichever of the quasi
+    // and the hybrid timing made it; the most accurate run, St
+    // Venant-Kirchhoff on the reference mesh, is on it whatever the timing.
+    assert!(front.contains(&cheapest), "{front:?}");
+    assert!(front.contains(&"stvk on 2x10"), "{front:?}");
     // One map per integrator for St Venant-Kirchhoff and for the hybrid,
     // whose critical step is its tensor-mass region's: measured on 1x5
     // (symplectic) 3.84e-3 s, within 1 % of 2/ω_max (3.86e-3 s).
