@@ -270,31 +270,14 @@ fn newton_equals_the_dynamic_model_settled_at_rest() {
 /// equilibrium to 1e-9 (relative L2).
 #[test]
 fn descent_follows_the_stable_equilibrium_past_buckling() {
-    use palpate::chart::{Body, HEIGHT_M, Load, tip_m};
+    use palpate::chart::{Body, HEIGHT_M, Load};
     let body = Body::cylinder((1, 5));
-    let materials = TetMaterials::uniform(body.material, body.mesh.tets.len());
-    let unit = body.loads(Load::Press, 1.0);
-    let (u_unit, _) = solve_loaded(
-        &body.mesh.positions,
-        &body.mesh.tets,
-        &materials,
-        &body.fixed,
-        &[],
-        &unit,
-    )
-    .expect("linear solve");
-    let per_newton = tip_m(&unit, &u_unit);
+    let materials = body.materials();
+    let per_newton = body.tip_per_newton_m(Load::Press).expect("linear solve");
     let solve = |level: f64, descent: bool| {
         let loads = body.loads(Load::Press, level * HEIGHT_M / per_newton);
         let result = solve_stvk(
-            &StaticProblem {
-                positions: &body.mesh.positions,
-                tets: &body.mesh.tets,
-                materials: &materials,
-                fixed: &body.fixed,
-                prescribed: &[],
-                loads_n: &loads,
-            },
+            &body.static_problem(&materials, &loads),
             &NewtonOptions {
                 load_steps: 3,
                 max_iterations: 400,

@@ -730,8 +730,40 @@ impl Body {
             .collect()
     }
 
-    fn materials(&self) -> TetMaterials {
+    /// Every tet's material (the body is homogeneous).
+    pub fn materials(&self) -> TetMaterials {
         TetMaterials::uniform(self.material, self.mesh.tets.len())
+    }
+
+    /// The linear FEM tip displacement ([`tip_m`]) per newton of `load`,
+    /// m/N: what scales a load level to its magnitude.
+    pub fn tip_per_newton_m(&self, load: Load) -> anyhow::Result<f64> {
+        let unit = self.loads(load, 1.0);
+        let (u_unit, _) = solve_loaded(
+            &self.mesh.positions,
+            &self.mesh.tets,
+            &self.materials(),
+            &self.fixed,
+            &[],
+            &unit,
+        )?;
+        Ok(tip_m(&unit, &u_unit))
+    }
+
+    /// The static problem of the body under `loads_n` (N per vertex).
+    pub fn static_problem<'b>(
+        &'b self,
+        materials: &'b TetMaterials,
+        loads_n: &'b [[f64; 3]],
+    ) -> StaticProblem<'b> {
+        StaticProblem {
+            positions: &self.mesh.positions,
+            tets: &self.mesh.tets,
+            materials,
+            fixed: &self.fixed,
+            prescribed: &[],
+            loads_n,
+        }
     }
 }
 
@@ -804,16 +836,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
     let mut trajectory_loads = Vec::new();
     for &load in &matrix.loads {
         // Unit-load linear response on the finest mesh: scales the levels.
-        let unit = finest.loads(load, 1.0);
-        let (u_unit, _) = solve_loaded(
-            &finest.mesh.positions,
-            &finest.mesh.tets,
-            &finest.materials(),
-            &finest.fixed,
-            &[],
-            &unit,
-        )?;
-        let tip_per_unit = tip_m(&unit, &u_unit);
+        let tip_per_unit = finest.tip_per_newton_m(load)?;
         trajectory_loads.push((load, matrix.trajectory.level * height_m / tip_per_unit));
         for &level in &matrix.levels {
             let magnitude = level * height_m / tip_per_unit;
@@ -916,14 +939,7 @@ fn reference(
 ) -> (Reference, Option<Vec<[f64; 3]>>) {
     let loads = body.loads(load, magnitude);
     let materials = body.materials();
-    let problem = StaticProblem {
-        positions: &body.mesh.positions,
-        tets: &body.mesh.tets,
-        materials: &materials,
-        fixed: &body.fixed,
-        prescribed: &[],
-        loads_n: &loads,
-    };
+    let problem = body.static_problem(&materials, &loads);
     let options = NewtonOptions {
         load_steps: ((100.0 * level * NEWTON_STEPS_PER_PERCENT).ceil() as usize).max(1),
         max_iterations: 400,
