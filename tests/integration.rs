@@ -45,6 +45,7 @@ mod host {
 }
 
 mod kernel {
+    mod candidates;
     mod haptic;
     mod haptic_dynamic;
     mod haptic_tools;

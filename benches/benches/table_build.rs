@@ -12,7 +12,7 @@
 use core::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palpate::table::build::{TableKindOptions, build};
+use palpate::table::build::{DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build};
 use palpate::table::compliance::Solver;
 use palpate_benches::tissue_cube;
 
@@ -31,6 +31,7 @@ fn table_build(c: &mut Criterion) {
             options.kind = TableKindOptions::Precomputed {
                 solver,
                 compression: None,
+                tool_radius_m: DEFAULT_LIST_TOOL_RADIUS_M,
             };
             let name = format!("{solver:?}").to_lowercase();
             let id = BenchmarkId::new(name, format!("{}v", mesh.positions.len()));

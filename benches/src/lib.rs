@@ -8,7 +8,9 @@ use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
 use palpate::session::Scene;
 use palpate::session::run::precomputed_options;
-use palpate::table::build::{BuildOptions, BuiltTable, TableKindOptions, build};
+use palpate::table::build::{
+    BuildOptions, BuiltTable, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build,
+};
 use palpate::table::compliance::Solver;
 use palpate::table::compress::Compression;
 use palpate::table::file::Precision;
@@ -46,6 +48,7 @@ pub fn scene_table(scene: &Scene, compression: Option<Compression>) -> BuiltTabl
         kind: TableKindOptions::Precomputed {
             solver: Solver::Cholesky,
             compression,
+            tool_radius_m: DEFAULT_LIST_TOOL_RADIUS_M,
         },
         ..options
     };

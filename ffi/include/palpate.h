@@ -79,14 +79,14 @@
  `palpate_abi_version()` with it at start-up to catch a header and a
  library of different versions.
  */
-#define PALPATE_ABI_VERSION 1
+#define PALPATE_ABI_VERSION 2
 
 /*
  The table format version this library reads (`palpate tables build`
  writes it; any other version is refused with
  `PALPATE_STATUS_TABLE_UNSUPPORTED_VERSION`).
  */
-#define PALPATE_TABLE_FORMAT_VERSION 4
+#define PALPATE_TABLE_FORMAT_VERSION 5
 
 /*
  Tool points of a haptic loop, at most (a probe tip, a grasper's two
@@ -115,14 +115,14 @@
 /*
  Words of a `palpate_table` on 64-bit targets (the host).
  */
-#define PALPATE_TABLE_WORDS 72
+#define PALPATE_TABLE_WORDS 73
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_table` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_TABLE_WORDS 48
+#define PALPATE_TABLE_WORDS 51
 #endif
 
 /*
@@ -366,6 +366,11 @@ enum palpate_status
    (`LoadError::BadTetLanes`).
    */
   PALPATE_STATUS_TABLE_BAD_TET_LANES = 136,
+  /*
+   A grid cell's candidate triangle list is not the triangles the grid
+   files there (`LoadError::BadCellTriangles`).
+   */
+  PALPATE_STATUS_TABLE_BAD_CELL_TRIANGLES = 137,
   /*
    More contacts than `PALPATE_MAX_CONTACTS`.
    */
@@ -1226,11 +1231,11 @@ palpate_status palpate_precomputed_loop_displacements(const struct palpate_preco
 /*
  Writes to `bytes` the size of the memory block a dynamic loop over
  tensor-mass table `table` with `physics` needs (aligned to
- `PALPATE_MEMORY_ALIGN`): `141 N + 36 E + 48 F + T` bytes and a few of
+ `PALPATE_MEMORY_ALIGN`): `141 N + 36 E + 72 F + T` bytes and a few of
  alignment for `N` vertices, `E` edges, `F` mesh triangles (every tet
  face once) and `T` tets; RK4 adds `48 N`, the split St Venant-Kirchhoff
  form `16 N + 64 E + 60 F + 12 T`. The firmware box (64 vertices, 279
- edges, 378 faces, 162 tets): 37 384 bytes.
+ edges, 378 faces, 162 tets): 46 456 bytes.
 
  # Safety
 

@@ -10,6 +10,7 @@
 //! form need more); the collision grid has room for one cell per vertex.
 
 use core::ffi::c_void;
+use palpate_kernel::table::format::PLANE_LEN;
 
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::table::format::{
@@ -111,7 +112,7 @@ impl DynamicParts {
             triangles: arena.take(l.triangles, [0; 3])?,
             face_slot: arena.take(l.triangles, 0)?,
             slot_tet: arena.take(l.triangles, 0)?,
-            planes: arena.take(l.triangles, [0.0; 4])?,
+            planes: arena.take(l.triangles, [0.0; PLANE_LEN])?,
             vertex_triangle_start: arena.take(l.vertex_triangle_start, 0)?,
             vertex_triangle: arena.take(l.vertex_triangle, 0)?,
             cell_start: arena.take(l.cell_start, 0)?,
@@ -151,11 +152,11 @@ pub(crate) struct Region {
 
 /// Writes to `bytes` the size of the memory block a dynamic loop over
 /// tensor-mass table `table` with `physics` needs (aligned to
-/// `PALPATE_MEMORY_ALIGN`): `141 N + 36 E + 48 F + T` bytes and a few of
+/// `PALPATE_MEMORY_ALIGN`): `141 N + 36 E + 72 F + T` bytes and a few of
 /// alignment for `N` vertices, `E` edges, `F` mesh triangles (every tet
 /// face once) and `T` tets; RK4 adds `48 N`, the split St Venant-Kirchhoff
 /// form `16 N + 64 E + 60 F + 12 T`. The firmware box (64 vertices, 279
-/// edges, 378 faces, 162 tets): 37 384 bytes.
+/// edges, 378 faces, 162 tets): 46 456 bytes.
 ///
 /// # Safety
 ///

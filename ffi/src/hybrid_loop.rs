@@ -11,6 +11,7 @@
 //! surface's collision grid has room for one cell per mesh vertex.
 
 use core::ffi::c_void;
+use palpate_kernel::table::format::PLANE_LEN;
 
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::hybrid::{HybridBuffers, HybridSurfaceBuffers, HybridTissue};
@@ -105,7 +106,7 @@ fn hybrid_parts(
     let surface = HybridSurfaceBuffers {
         positions_m: arena.take(l.vertices, zero)?,
         triangles: arena.take(l.triangles, [0; 3])?,
-        planes: arena.take(l.triangles, [0.0; 4])?,
+        planes: arena.take(l.triangles, [0.0; PLANE_LEN])?,
         vertex_triangle_start: arena.take(l.vertices.saturating_add(1), 0)?,
         vertex_triangle: arena.take(l.triangles.saturating_mul(3), 0)?,
         cell_start: arena.take(l.cell_start, 0)?,

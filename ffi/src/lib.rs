@@ -70,12 +70,12 @@ use palpate_kernel::table::format::FORMAT_VERSION;
 /// handle's size or a code's meaning changes. Compare
 /// `palpate_abi_version()` with it at start-up to catch a header and a
 /// library of different versions.
-pub const PALPATE_ABI_VERSION: u32 = 1;
+pub const PALPATE_ABI_VERSION: u32 = 2;
 
 /// The table format version this library reads (`palpate tables build`
 /// writes it; any other version is refused with
 /// `PALPATE_STATUS_TABLE_UNSUPPORTED_VERSION`).
-pub const PALPATE_TABLE_FORMAT_VERSION: u32 = 4;
+pub const PALPATE_TABLE_FORMAT_VERSION: u32 = 5;
 const _: () = assert!(PALPATE_TABLE_FORMAT_VERSION == FORMAT_VERSION);
 
 /// Tool points of a haptic loop, at most (a probe tip, a grasper's two

@@ -122,6 +122,9 @@ pub enum Status {
     /// A tet's `tet-lanes` entry differs from its rest shape and material
     /// (`LoadError::BadTetLanes`).
     TableBadTetLanes = 136,
+    /// A grid cell's candidate triangle list is not the triangles the grid
+    /// files there (`LoadError::BadCellTriangles`).
+    TableBadCellTriangles = 137,
 
     // Contacts (`palpate_precomputed_solve`, `..._displacements`): the
     // kernel's `ContactError` and `DisplacementError`.
@@ -250,6 +253,9 @@ impl Status {
             Self::TableBadTetLanes => {
                 c"table tet-lanes entry differs from the tet's shape or material"
             }
+            Self::TableBadCellTriangles => {
+                c"table grid cell's candidate triangle list is not the triangles filed there"
+            }
             Self::ContactTooMany => c"more contacts than PALPATE_MAX_CONTACTS",
             Self::ContactVertexOutOfRange => c"contact vertex out of range",
             Self::ContactFixedVertex => c"contact on a fixed vertex",
@@ -323,6 +329,7 @@ impl From<LoadError> for Status {
             LoadError::BadKeptBlocks { .. } => Self::TableBadKeptBlocks,
             LoadError::DroppedDiagonal { .. } => Self::TableDroppedDiagonal,
             LoadError::BadTetLanes { .. } => Self::TableBadTetLanes,
+            LoadError::BadCellTriangles { .. } => Self::TableBadCellTriangles,
         }
     }
 }
@@ -448,7 +455,7 @@ impl From<FieldError> for Status {
 /// raw number, and the tests).
 ///
 /// cbindgen:ignore
-pub const ALL: [Status; 73] = [
+pub const ALL: [Status; 74] = [
     Status::Ok,
     Status::NullPointer,
     Status::Misaligned,
@@ -493,6 +500,7 @@ pub const ALL: [Status; 73] = [
     Status::TableBadKeptBlocks,
     Status::TableDroppedDiagonal,
     Status::TableBadTetLanes,
+    Status::TableBadCellTriangles,
     Status::ContactTooMany,
     Status::ContactVertexOutOfRange,
     Status::ContactFixedVertex,

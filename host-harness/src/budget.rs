@@ -8,11 +8,14 @@
 //! (`Ir`, deterministic: the same binary and input give the same count).
 //!
 //! Bound (instructions): `BASE + P · (TRIANGLE · D + WALK · MAX_WALK_STEPS +
-//! TRACK) + (P + 1) · SOLVE · M³`, with `D = 3 · max_query_triangles` the
-//! worst-case triangle tests of one detection (two point queries, the
-//! sweep's and the penetration test's sharing the one at the tool, and the
-//! penetration test's second pass at the tool; the
-//! table-declared maximum over all grid cells, computed at load), `P` tool
+//! TRACK) + (P + 1) · SOLVE · M³`, with `D` the worst-case triangle tests
+//! of one detection (`SurfaceIndex::max_detection_tests`: with the table's
+//! per-cell candidate lists, which serve the scene's tool radius, 9 times
+//! the longest list, the tool's cell for the test and the penetration
+//! test's second pass and up to 7 more cells along the sweep; without, `3
+//! · max_query_triangles`, two point queries, the sweep's and the
+//! penetration test's sharing the one at the tool, and the second pass;
+//! both table-declared maxima over all grid cells, computed at load), `P` tool
 //! points, `M` the contact capacity and `P + 1` the most solves a tick can
 //! do. The unit costs are the largest per-unit costs callgrind measured on
 //! this build (x86-64, `cargo build`, the workspace's opt-level 2 for our
@@ -125,14 +128,16 @@ pub const M4F_CYCLES: UnitCosts = UnitCosts {
 };
 
 /// The static per-tick bound (in the unit of `costs`) for `points` tool
-/// points and capacity `capacity` over `table`.
+/// points of radius `radius_m` (m) and capacity `capacity` over `table`.
 pub fn tick_bound(
     costs: &UnitCosts,
     table: &PrecomputedTable<'_, f32>,
+    radius_m: f64,
     points: u64,
     capacity: u64,
 ) -> u64 {
-    let detection = 3 * u64::from(table.surface_index().max_query_triangles());
+    let radius_m = radius_m as f32;
+    let detection = u64::from(table.surface_index().max_detection_tests(radius_m));
     costs.base
         + points
             * (costs.triangle * detection + costs.walk * u64::from(MAX_WALK_STEPS) + costs.track)
@@ -202,7 +207,7 @@ pub fn budget_table(
     let bound = match &tables {
         SceneTables::Precomputed(file) => {
             let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
-            tick_bound(costs, &table, points, points)
+            tick_bound(costs, &table, scene.tool.radius_m, points, points)
         }
         SceneTables::Dynamic(file, _) => {
             let table = TensorMassTable::<f32>::load(file.bytes()).map_err(load)?;

@@ -21,7 +21,9 @@ use palpate_kernel::haptic::{
     DynamicLoop as KernelLoop, LoopConfig as KernelConfig, SafetyLimits, ToolAction as Action,
     ToolInput,
 };
+use palpate_kernel::table::Plane;
 use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::table::format::PLANE_LEN;
 use palpate_kernel::tensor_mass::{
     DynamicParams, DynamicTissue, Integrator as KernelIntegrator, PhysicsConfig as KernelPhysics,
     SurfaceBuffers, TensorMassModel,
@@ -71,7 +73,7 @@ pub struct Surface {
     triangles: Vec<[u32; 3]>,
     face_slot: Vec<u32>,
     slot_tet: Vec<u32>,
-    planes: Vec<[f32; 4]>,
+    planes: Vec<Plane<f32>>,
     vertex_triangle_start: Vec<u32>,
     vertex_triangle: Vec<u32>,
     cell_start: Vec<u32>,
@@ -87,7 +89,7 @@ impl Surface {
             triangles: vec![[0; 3]; l.triangles],
             face_slot: vec![0; l.triangles],
             slot_tet: vec![0; l.triangles],
-            planes: vec![[0.0; 4]; l.triangles],
+            planes: vec![[0.0; PLANE_LEN]; l.triangles],
             vertex_triangle_start: vec![0; l.vertex_triangle_start],
             vertex_triangle: vec![0; l.vertex_triangle],
             cell_start: vec![0; l.cell_start],

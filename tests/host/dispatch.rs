@@ -20,7 +20,7 @@ use palpate::dispatch::HostDispatch;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::{box_mesh, cylinder_mesh};
 use palpate::mesh::{MeshReport, TetMesh};
-use palpate::table::build::{BuildOptions, TableKindOptions, build};
+use palpate::table::build::{BuildOptions, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build};
 use palpate::table::compliance::Solver;
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::file::Precision;
@@ -173,6 +173,7 @@ fn update_tables(mesh: &TetMesh, precision: Precision) -> Vec<(String, TableFile
                 kind: TableKindOptions::Precomputed {
                     solver: Solver::Cholesky,
                     compression: Some(compression),
+                    tool_radius_m: DEFAULT_LIST_TOOL_RADIUS_M,
                 },
                 ..dense.clone()
             };

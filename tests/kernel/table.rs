@@ -138,6 +138,28 @@ fn structural_errors_behind_a_valid_checksum() {
         })
     );
 
+    // The plane record's barycentric frame (format 5): each gradient must
+    // weigh the corners 1 and 0 and lie in the plane. Triangle [1, 2, 3]
+    // spans e₁ = (−1, 1, 0), e₂ = (−1, 0, 1): g₁ = (−1, 2, −1)/3.
+    let t = TinyTable::new();
+    let g1 = t.bytes_with_index(|c| {
+        let g1 = c.planes[0][4..7].to_vec();
+        assert!((g1[0] + 1.0 / 3.0).abs() < 1e-12, "{g1:?}");
+        assert!((g1[1] - 2.0 / 3.0).abs() < 1e-12, "{g1:?}");
+        assert!((g1[2] + 1.0 / 3.0).abs() < 1e-12, "{g1:?}");
+    });
+    assert_eq!(load32(&g1), Ok(()));
+    for (at, by) in [(4, 1e-3), (8, -1e-3)] {
+        // g₁ₓ off by 1e-3 (g₁ weighs e₁ 1.001), or g₂ᵧ (g₂ weighs e₁
+        // −0.001): beyond the loader's 1e-4.
+        let bad = t.bytes_with_index(|c| c.planes[0][at] += by);
+        assert_eq!(
+            load32(&bad),
+            Err(LoadError::BadSurfacePlane { triangle: 0 }),
+            "scalar {at}"
+        );
+    }
+
     let mut t = TinyTable::new();
     t.young_pa = -1.0;
     assert_eq!(load32(&t.bytes()), Err(LoadError::BadMaterial));
@@ -172,4 +194,54 @@ fn info_reports_counts_and_checksum() {
     bytes[last] ^= 0x10;
     let info = TableFile::from_bytes(&bytes).info("bad.tbl").unwrap_err();
     assert!(info.contains("checksum: MISMATCH"), "{info}");
+}
+
+/// The barycentric weights from the stored frame (format 5) equal the
+/// ratios of sub-triangle areas (cross products over the corners, the
+/// formula the frame replaced), on every surface triangle of the reference
+/// cube (f64), at its corners, its centroid, a point outside it and
+/// points off its plane (the frame weighs the projection): to 1e-9, the
+/// f64 rounding of a few products of unit-sized numbers with margin.
+#[test]
+fn frame_weights_are_the_area_ratios() {
+    use nalgebra::Vector3;
+    use palpate_kernel::table::TriangleIndex;
+    let file = reference_cube_table(Precision::F64);
+    let table = PrecomputedTable::<f64>::load(file.bytes()).unwrap();
+    let index = table.surface_index();
+    let positions = table.rest_positions();
+    let corner = |v: u32| Vector3::from(positions[v as usize]);
+    let triangles = table.surface_triangles();
+    assert!(triangles.len() > 100);
+    for (t, tri) in triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(corner);
+        let m = (b - a).cross(&(c - a));
+        let n = m.normalize();
+        let area = |p: &Vector3<f64>, q: &Vector3<f64>, x: &Vector3<f64>| {
+            (p - x).cross(&(q - x)).dot(&n) / m.norm()
+        };
+        let centroid = (a + b + c) / 3.0;
+        let outside = a * 1.5 - centroid * 0.5;
+        let points = [
+            a,
+            b,
+            c,
+            centroid,
+            outside,
+            centroid + n * 0.01,
+            outside - n * 0.3,
+        ];
+        let id = TriangleIndex::new(t as u32, triangles.len()).unwrap();
+        for x in points {
+            let on = x - n * n.dot(&(x - a));
+            let want = [area(&b, &c, &on), area(&c, &a, &on), area(&a, &b, &on)];
+            let got = index.weights(id, positions, &x).unwrap();
+            for (g, w) in got.iter().zip(want) {
+                assert!(
+                    (g - w).abs() < 1e-9,
+                    "triangle {t} at {x:?}: {got:?} vs {want:?}"
+                );
+            }
+        }
+    }
 }

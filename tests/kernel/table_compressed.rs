@@ -12,8 +12,7 @@ use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate_kernel::table::ComplianceBlocks;
 use palpate_kernel::table::format::{
-    BlockEncoding, CRC_LEN, CRC32, HEADER_LEN, SECTION_ENTRY_LEN, SectionKind, f16_to_f32, is_kept,
-    kept_position, kept_rank, surface_block_index,
+    BlockEncoding, SectionKind, f16_to_f32, is_kept, kept_position, kept_rank, surface_block_index,
 };
 use palpate_kernel::{LoadError, PrecomputedTable};
 use palpate_tests::TinyTable;
@@ -330,6 +329,7 @@ fn a_wrong_rank_past_the_first_word_is_refused() {
             drop_below: 0.2,
             contact: ContactBlocks::Dropped,
         }),
+        tool_radius_m: palpate::table::build::DEFAULT_LIST_TOOL_RADIUS_M,
     };
     let bytes = palpate::table::build::build(&mesh, &report, &options)
         .expect("build")
@@ -337,7 +337,7 @@ fn a_wrong_rank_past_the_first_word_is_refused() {
     assert_eq!(load32(&bytes), Ok(()));
     for kind in [SectionKind::SurfaceKept, SectionKind::InteriorKept] {
         // Word 3's rank (bytes 4..8 of its 8), one too many.
-        let patched = patch(&bytes, kind, |words| {
+        let patched = palpate_tests::patch_section(&bytes, kind, |words| {
             let rank = u32::from_le_bytes(words[28..32].try_into().unwrap());
             words[28..32].copy_from_slice(&(rank + 1).to_le_bytes());
         });
@@ -347,29 +347,6 @@ fn a_wrong_rank_past_the_first_word_is_refused() {
             "{kind:?}"
         );
     }
-}
-
-/// `bytes` with `f` applied to the payload of section `kind` and the CRC-32 trailer repaired.
-fn patch(bytes: &[u8], kind: SectionKind, f: impl FnOnce(&mut [u8])) -> Vec<u8> {
-    let mut out = bytes.to_vec();
-    let u32_at = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
-    let u64_at = |b: &[u8], at: usize| u64::from_le_bytes(b[at..at + 8].try_into().unwrap());
-    // RawHeader: section_count at byte 20; SectionEntry: kind, elem_bytes, offset, count.
-    let sections = u32_at(&out, 20) as usize;
-    let entry = (0..sections)
-        .map(|i| HEADER_LEN + i * SECTION_ENTRY_LEN)
-        .find(|&at| u32_at(&out, at) == kind as u32)
-        .expect("section present");
-    let elem = u32_at(&out, entry + 4) as usize;
-    let (offset, count) = (
-        u64_at(&out, entry + 8) as usize,
-        u64_at(&out, entry + 16) as usize,
-    );
-    f(&mut out[offset..offset + elem * count]);
-    let body = out.len() - CRC_LEN;
-    let crc = crc::Crc::<u32>::new(&CRC32).checksum(&out[..body]);
-    out[body..].copy_from_slice(&crc.to_le_bytes());
-    out
 }
 
 #[test]

@@ -566,8 +566,24 @@ impl TinyTable {
 
     /// The table file (f32), compressed as [`TinyTable::compressed`] says.
     pub fn bytes(&self) -> Vec<u8> {
+        self.bytes_with_index(|_| {})
+    }
+
+    /// [`Self::bytes`] with the collision index as `edit` leaves it (a
+    /// corrupted section behind a valid checksum).
+    pub fn bytes_with_index(
+        &self,
+        edit: impl FnOnce(&mut palpate::table::collision::CollisionIndex),
+    ) -> Vec<u8> {
         use palpate::table::collision::collision_index;
         use palpate::table::file::{Precision, TableContents, write_table};
+        let mut collision = collision_index(
+            &self.positions,
+            &self.triangles,
+            palpate::table::build::DEFAULT_LIST_TOOL_RADIUS_M,
+            Precision::F32,
+        );
+        edit(&mut collision);
         write_table(
             &TableContents {
                 tet_lame: &[[1.0, 1.0]; 2],
@@ -582,7 +598,7 @@ impl TinyTable {
                 surface: &self.surface,
                 interior: &self.interior,
                 compressed: self.compressed.as_ref(),
-                collision: &collision_index(&self.positions, &self.triangles),
+                collision: &collision,
             },
             Precision::F32,
         )
@@ -593,4 +609,43 @@ impl Default for TinyTable {
     fn default() -> Self {
         Self::new()
     }
+}
+
+/// Where section `kind`'s payload lies in table `bytes`: byte offset,
+/// element size and count, from its directory entry.
+pub fn section_span(
+    bytes: &[u8],
+    kind: palpate_kernel::table::format::SectionKind,
+) -> (usize, usize, usize) {
+    use palpate_kernel::table::format::{HEADER_LEN, SECTION_ENTRY_LEN};
+    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+    let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+    // RawHeader: section_count at byte 20; SectionEntry: kind, elem_bytes, offset, count.
+    let sections = u32_at(20) as usize;
+    let entry = (0..sections)
+        .map(|i| HEADER_LEN + i * SECTION_ENTRY_LEN)
+        .find(|&at| u32_at(at) == kind as u32)
+        .expect("section present");
+    (
+        u64_at(entry + 8) as usize,
+        u32_at(entry + 4) as usize,
+        u64_at(entry + 16) as usize,
+    )
+}
+
+/// `bytes` with `f` applied to the payload of section `kind` and the CRC-32
+/// trailer repaired (a corrupted section behind a valid checksum).
+pub fn patch_section(
+    bytes: &[u8],
+    kind: palpate_kernel::table::format::SectionKind,
+    f: impl FnOnce(&mut [u8]),
+) -> Vec<u8> {
+    use palpate_kernel::table::format::{CRC_LEN, CRC32};
+    let mut out = bytes.to_vec();
+    let (offset, elem, count) = section_span(&out, kind);
+    f(&mut out[offset..offset + elem * count]);
+    let body = out.len() - CRC_LEN;
+    let crc = crc::Crc::<u32>::new(&CRC32).checksum(&out[..body]);
+    out[body..].copy_from_slice(&crc.to_le_bytes());
+    out
 }

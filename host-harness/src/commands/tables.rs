@@ -9,7 +9,9 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Subcommand};
 use palpate::mesh::read_mesh;
 use palpate::output::atomic::{self, AtomicFile};
-use palpate::table::build::{BuildOptions, TableKindOptions, build_with_limits};
+use palpate::table::build::{
+    BuildOptions, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build_with_limits,
+};
 use palpate::table::compliance::Solver;
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::estimate::SizeLimits;
@@ -65,6 +67,12 @@ pub enum TablesCommand {
         /// Mass density, kg/m3 (required with, and only with, --kind tensor-mass).
         #[arg(long)]
         density: Option<f64>,
+        /// The largest tool-sphere radius, m, the pre-computed table's
+        /// per-cell contact candidate lists serve (a larger tool still
+        /// works, by the slower walk over 27 grid cells); at most the grid
+        /// cell over 2.25 (the longest surface edge over 2.25, or more).
+        #[arg(long, value_name = "M", default_value_t = DEFAULT_LIST_TOOL_RADIUS_M)]
+        tool_radius: f64,
         /// Refuse, before building, a table estimated above this many bytes
         /// (the estimate is printed; 4294967296, MAX_TABLE_FILE_BYTES, and the
         /// memory available apply in any case).
@@ -131,6 +139,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             output,
             kind,
             density,
+            tool_radius,
             max_table_bytes,
         } => {
             let solver_given = matches
@@ -170,6 +179,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                         drop_below: drop_below.unwrap_or(0.0),
                         contact: contact_blocks.unwrap_or_default(),
                     }),
+                    tool_radius_m: tool_radius,
                 },
             };
             // The output: never one of the inputs, and written whole or not at

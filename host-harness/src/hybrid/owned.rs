@@ -3,6 +3,8 @@
 
 use anyhow::{Context, anyhow};
 use palpate_kernel::hybrid::{HybridBuffers, HybridModel, HybridSurfaceBuffers, HybridTissue};
+use palpate_kernel::table::Plane;
+use palpate_kernel::table::format::PLANE_LEN;
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 use palpate_kernel::tensor_mass::{DynamicParams, PhysicsConfig, TensorMassModel};
 use palpate_kernel::{PrecomputedTable, Real};
@@ -98,7 +100,7 @@ pub struct OwnedHybridBuffers<T> {
     background_m: Vec<[T; 3]>,
     positions_m: Vec<[T; 3]>,
     triangles: Vec<[u32; 3]>,
-    planes: Vec<[T; 4]>,
+    planes: Vec<Plane<T>>,
     vertex_triangle_start: Vec<u32>,
     vertex_triangle: Vec<u32>,
     cell_start: Vec<u32>,
@@ -122,7 +124,7 @@ impl<T: Real> OwnedHybridBuffers<T> {
             background_m: vec![zero; interface.free_count()],
             positions_m: vec![zero; n.vertices],
             triangles: vec![[0; 3]; n.triangles],
-            planes: vec![[T::zero(); 4]; n.triangles],
+            planes: vec![[T::zero(); PLANE_LEN]; n.triangles],
             vertex_triangle_start: vec![0; n.vertices + 1],
             vertex_triangle: vec![0; 3 * n.triangles],
             cell_start: vec![0; n.cell_start],

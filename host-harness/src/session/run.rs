@@ -90,7 +90,8 @@ pub fn precomputed_options(
         scene.fix.clone(),
         Solver::Cholesky,
         Precision::F32,
-    );
+    )
+    .with_tool_radius(scene.tool.radius_m);
     Ok(options.with_tet_materials(materials))
 }
 

@@ -27,6 +27,10 @@ use crate::fem::material::{Material, TetMaterials};
 use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, Surface, TetMesh, boundary_surface};
 
+/// The tool radius (m) a pre-computed table's candidate lists serve unless
+/// told otherwise: the default tool's.
+pub const DEFAULT_LIST_TOOL_RADIUS_M: f64 = crate::session::scene::DEFAULT_TOOL_RADIUS_M;
+
 /// Everything a table build needs besides the mesh.
 #[derive(Clone, Debug)]
 pub struct BuildOptions {
@@ -60,6 +64,10 @@ pub enum TableKindOptions {
         /// Store the compliance compressed ([`super::compress`]; `f32`
         /// tables only), `None` for all of it in the table scalar.
         compression: Option<Compression>,
+        /// The largest tool radius (m) the collision index's per-cell
+        /// candidate lists serve (a detection by a larger tool walks the
+        /// grid instead; `palpate_kernel::table::SurfaceIndex::candidates`).
+        tool_radius_m: f64,
     },
     /// The dynamic tensor-mass table (RR-3510 §5). Any predicates, none
     /// included (a free body).
@@ -82,6 +90,7 @@ impl BuildOptions {
             kind: TableKindOptions::Precomputed {
                 solver,
                 compression: None,
+                tool_radius_m: DEFAULT_LIST_TOOL_RADIUS_M,
             },
             material,
             tet_materials: None,
@@ -96,10 +105,35 @@ impl BuildOptions {
     /// tensor-mass table or `None`.
     pub fn with_compression(self, compression: Option<Compression>) -> Self {
         match self.kind {
-            TableKindOptions::Precomputed { solver, .. } => Self {
+            TableKindOptions::Precomputed {
+                solver,
+                tool_radius_m,
+                ..
+            } => Self {
                 kind: TableKindOptions::Precomputed {
                     solver,
                     compression,
+                    tool_radius_m,
+                },
+                ..self
+            },
+            TableKindOptions::TensorMass { .. } => self,
+        }
+    }
+
+    /// The same options with candidate lists for tools of radius up to
+    /// `tool_radius_m` (m); nothing changes for a tensor-mass table.
+    pub fn with_tool_radius(self, tool_radius_m: f64) -> Self {
+        match self.kind {
+            TableKindOptions::Precomputed {
+                solver,
+                compression,
+                ..
+            } => Self {
+                kind: TableKindOptions::Precomputed {
+                    solver,
+                    compression,
+                    tool_radius_m,
                 },
                 ..self
             },
@@ -401,7 +435,16 @@ pub(crate) fn precomputed(
     )
     .with_context(|| format!("{}: computing the compliance table", report.source))?;
     let arrays_time = start.elapsed();
-    let collision = collision_index(&mesh.positions, &surface.triangles);
+    let tool_radius_m = match options.kind {
+        TableKindOptions::Precomputed { tool_radius_m, .. } => tool_radius_m,
+        TableKindOptions::TensorMass { .. } => DEFAULT_LIST_TOOL_RADIUS_M,
+    };
+    let collision = collision_index(
+        &mesh.positions,
+        &surface.triangles,
+        tool_radius_m,
+        options.precision,
+    );
     let (tet_lame, vertex_slot) = (materials.lame(), ordering.slot_entries());
     let contents = TableContents {
         tet_lame: &tet_lame,

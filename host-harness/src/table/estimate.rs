@@ -6,10 +6,11 @@
 //! 40³-cell box with its base fixed (68 921 vertices, 7 921 touchable) has 5.0·10⁸ blocks, an
 //! 18 GB f32 table whose build once aborted the process on a 33.8 GB allocation. [`TableEstimate::table_bytes`] is the
 //! file's layout (the format's own section counts, [`SectionKind::expected_count`]) from these
-//! counts, so it is exact but for the collision grid, whose cell count is known only once it
-//! is built: the estimate takes its bound ([`CELLS_PER_SURFACE_VERTEX`] cells per surface
-//! vertex) and is above the real size by less than `32·Vs + 16` bytes (`Vs` surface vertices),
-//! never below. A tensor-mass table is linear in the mesh; its edge and mesh-triangle counts
+//! counts, so it is exact but for the collision grid, whose cell count and per-cell candidate
+//! lists are known only once it is built: the estimate takes their bounds
+//! ([`CELLS_PER_SURFACE_VERTEX`] cells per surface vertex, 64 list entries per surface
+//! triangle: the format's `cell-triangle`) and is above the real size by less than
+//! `64·Vs + 256·Ts + 16` bytes (`Vs` surface vertices, `Ts` surface triangles; both CSR starts over the cells count), never below. A tensor-mass table is linear in the mesh; its edge and mesh-triangle counts
 //! come from Euler's formula for a solid without holes (`E = V + F_all − T − 1`,
 //! `F_all = (4T + F_boundary)/2`), exact for such a mesh, off by a few edges otherwise.
 //!

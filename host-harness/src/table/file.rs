@@ -133,6 +133,8 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         ),
         Section::ints(SectionKind::VertexTriangle, &index.vertex_triangle),
         Section::floats(SectionKind::SurfacePlane, &index.planes, precision),
+        Section::ints(SectionKind::CellTriangleStart, &index.cell_triangle_start),
+        Section::ints(SectionKind::CellTriangle, &index.cell_triangle),
         Section::floats(SectionKind::TetMaterial, c.tet_lame, precision),
     ]);
     write_container(header, precision, &sections)

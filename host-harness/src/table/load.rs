@@ -290,6 +290,11 @@ impl TableFile {
         {
             let _ = writeln!(out, "compression: {}", describe_compression(record));
         }
+        if kind == Some(TableKind::Precomputed)
+            && let Ok(model) = self.model()
+        {
+            let _ = writeln!(out, "{}", describe_candidates(&model));
+        }
         let checksum_ok = bytes.len() >= HEADER_LEN + CRC_LEN && {
             let (body, trailer) = bytes.split_at(bytes.len() - CRC_LEN);
             let stored = u32::from_le_bytes(trailer.try_into().unwrap_or_default());
@@ -311,6 +316,37 @@ impl TableFile {
             }
         }
     }
+}
+
+/// The contact candidate lists of a pre-computed table's collision index:
+/// the tool radius they serve and their longest list, next to the walk over
+/// 27 cells a larger tool does.
+fn describe_candidates(model: &AnyModel<'_>) -> String {
+    let (radius_m, longest, walk) = match model {
+        AnyModel::F32(m) => {
+            let index = m.table().surface_index();
+            let radius = index.candidate_radius_m().map(f64::from);
+            (
+                radius,
+                index.max_cell_triangles(),
+                index.max_query_triangles(),
+            )
+        }
+        AnyModel::F64(m) => {
+            let index = m.table().surface_index();
+            let radius = index.candidate_radius_m();
+            (
+                radius,
+                index.max_cell_triangles(),
+                index.max_query_triangles(),
+            )
+        }
+    };
+    format!(
+        "contact candidates: per-cell lists for tools of radius up to {:.3} mm, at most \
+         {longest} triangles per cell (a larger tool walks 27 cells: at most {walk})",
+        1e3 * radius_m.unwrap_or(0.0)
+    )
 }
 
 /// One `section NAME: COUNT x ELEM bytes = SIZE bytes` line.

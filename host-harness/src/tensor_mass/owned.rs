@@ -2,7 +2,9 @@
 //! table.
 
 use palpate_kernel::Real;
+use palpate_kernel::table::Plane;
 use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::table::format::PLANE_LEN;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
 };
@@ -95,7 +97,7 @@ pub struct OwnedSurface<T> {
     triangles: Vec<[u32; 3]>,
     face_slot: Vec<u32>,
     slot_tet: Vec<u32>,
-    planes: Vec<[T; 4]>,
+    planes: Vec<Plane<T>>,
     vertex_triangle_start: Vec<u32>,
     vertex_triangle: Vec<u32>,
     cell_start: Vec<u32>,
@@ -120,7 +122,7 @@ impl<T: Real> OwnedSurface<T> {
             triangles: vec![[0; 3]; n.triangles],
             face_slot: vec![0; n.triangles],
             slot_tet: vec![0; n.triangles],
-            planes: vec![[T::zero(); 4]; n.triangles],
+            planes: vec![[T::zero(); PLANE_LEN]; n.triangles],
             vertex_triangle_start: vec![0; n.vertex_triangle_start],
             vertex_triangle: vec![0; n.vertex_triangle],
             cell_start: vec![0; n.cell_start],

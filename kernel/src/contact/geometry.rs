@@ -25,8 +25,8 @@ use nalgebra::Vector3;
 use super::Contact;
 use crate::Real;
 use crate::table::{
-    InterfaceTable, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex,
-    within,
+    CandidateList, InterfaceTable, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex,
+    VertexIndex, within,
 };
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
@@ -39,6 +39,10 @@ pub const MAX_WALK_STEPS: u32 = 8;
 /// into it) is found, and a tool hovering clear of the surface costs one
 /// dot product per candidate triangle.
 pub const PENETRATION_DEPTH_RADII: f64 = 2.0;
+
+// A table's candidate lists file each triangle wide enough for the
+// penetration test's depth.
+const _: () = assert!(crate::table::CANDIDATE_MARGIN_RADII > PENETRATION_DEPTH_RADII);
 
 /// Work done by detection and tracking (per-stage counters for the timing
 /// budget).
@@ -95,12 +99,6 @@ pub struct SurfaceGeometry<'a, T: Real> {
     positions: &'a [[T; 3]],
     index: SurfaceIndex<'a, T>,
     supports: Supports<'a, T>,
-}
-
-/// Vertices and corners of a triangle.
-struct Corners<T: Real> {
-    vertices: [VertexIndex; 3],
-    corners: [Vector3<T>; 3],
 }
 
 /// Corners and unit outward normal of a triangle.
@@ -207,6 +205,10 @@ impl<T: Real> Unreached<T> {
     }
 }
 
+/// Candidate triangles the 27-cell walk hands to the tests at once
+/// ([`SurfaceGeometry::visit`]).
+const WALK_CHUNK: usize = 32;
+
 /// Distinct triangles one detection remembers having tested: the 27-cell
 /// visit meets a triangle once per corner in those cells, and tests it
 /// once. A power of two; a detection on the built-in block tests at most
@@ -268,18 +270,6 @@ impl Visited {
         }
         true
     }
-}
-
-/// Barycentric weights of `x`'s projection onto the plane of `c`.
-fn barycentric<T: Real>(c: &[Vector3<T>; 3], normal: &Vector3<T>, x: &Vector3<T>) -> [T; 3] {
-    let [a, b, cc] = c;
-    let area2 = (b - a).cross(&(cc - a)).dot(normal);
-    if area2 <= T::zero() {
-        return [T::zero(); 3];
-    }
-    let w0 = (b - x).cross(&(cc - x)).dot(normal) / area2;
-    let w1 = (cc - x).cross(&(a - x)).dot(normal) / area2;
-    [w0, w1, T::one() - w0 - w1]
 }
 
 /// Weights clamped to `[0, 1]` and renormalized.
@@ -356,19 +346,29 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         &self.index
     }
 
-    /// Vertices and rest corners of a surface triangle.
-    fn corners(&self, triangle: TriangleIndex) -> Option<Corners<T>> {
+    /// The barycentric weights of the point of triangle `t`'s plane under
+    /// `x_m` (m), from its stored frame ([`SurfaceIndex::weights`]).
+    #[inline(always)]
+    fn weights(&self, t: TriangleIndex, x_m: &Vector3<T>) -> Option<[T; 3]> {
+        self.index.weights(t, self.positions, x_m)
+    }
+
+    /// [`Self::weights`], all zero for a triangle that has left the
+    /// surface: tracking's form, one copy in the firmware's flash for its
+    /// two calls (the candidate tests keep theirs inline).
+    #[inline(never)]
+    fn tracked_weights(&self, t: TriangleIndex, x_m: &Vector3<T>) -> [T; 3] {
+        self.weights(t, x_m).unwrap_or([T::zero(); 3])
+    }
+
+    /// Vertices, corners (m) and unit outward normal of a surface triangle.
+    fn face(&self, triangle: TriangleIndex) -> Option<Face<T>> {
         let vertices = self.index.triangle(triangle)?;
         let mut corners = [Vector3::zeros(); 3];
         for (c, &v) in corners.iter_mut().zip(&vertices) {
             let p = self.positions.get(v.get())?;
             *c = Vector3::new(p[0], p[1], p[2]);
         }
-        Some(Corners { vertices, corners })
-    }
-
-    fn face(&self, triangle: TriangleIndex) -> Option<Face<T>> {
-        let Corners { vertices, corners } = self.corners(triangle)?;
         let (normal, _) = self.index.plane(triangle)?;
         Some(Face {
             vertices,
@@ -476,12 +476,31 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             order: 0,
             covered: false,
         };
-        let mut visited = Visited::new();
-        if to_in {
-            self.visit(to_m, &mut visited, work, Pass::Tool, &mut scan);
-        }
-        if let Some((_, _, Some(from_m))) = &sweep {
-            self.visit(from_m, &mut visited, work, Pass::Start, &mut scan);
+        // The table's per-cell lists when they serve this radius, else the
+        // walk over the 27 cells around each point.
+        let lists = self.index.candidates(to_m, radius_m);
+        match lists {
+            Some(list) => {
+                if to_in {
+                    self.visit_list(list, work, Pass::Tool, &mut scan);
+                }
+                if let Some((_, end_m, Some(from_m))) = &sweep {
+                    // The lists serve this radius (`lists`).
+                    self.index
+                        .for_each_candidate_list_between(from_m, end_m, to_in, |list| {
+                            self.visit_list(list, work, Pass::Start, &mut scan)
+                        });
+                }
+            }
+            None => {
+                let mut visited = Visited::new();
+                if to_in {
+                    self.visit(to_m, &mut visited, work, Pass::Tool, &mut scan);
+                }
+                if let Some((_, _, Some(from_m))) = &sweep {
+                    self.visit(from_m, &mut visited, work, Pass::Start, &mut scan);
+                }
+            }
         }
         if let Some((_, triangle, weights)) = scan.hit {
             let face = self.face(triangle)?;
@@ -498,16 +517,17 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             let covered = if scan.unreached.overflowed {
                 // The second pass, over the same candidates in the same order.
                 scan.order = 0;
-                let mut visited = Visited::new();
                 let pass = Pass::Covered { bound_m, order };
-                self.visit(to_m, &mut visited, work, pass, &mut scan);
+                match lists {
+                    Some(list) => self.visit_list(list, work, pass, &mut scan),
+                    None => self.visit(to_m, &mut Visited::new(), work, pass, &mut scan),
+                }
                 scan.covered
             } else {
                 scan.unreached.planes.iter().any(|&(t, k)| {
                     self.index.plane(t).is_some_and(|(normal, offset)| {
                         let distance = normal.dot(to_m) - offset;
-                        Unreached::nearer(distance, k, bound_m, order)
-                            && self.over(t, &normal, distance, to_m)
+                        Unreached::nearer(distance, k, bound_m, order) && self.over(t, to_m)
                     })
                 })
             };
@@ -526,12 +546,23 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         })
     }
 
+    /// Runs `pass` of `scan` once for each triangle of a cell's candidate
+    /// `list`, in its order.
+    fn visit_list(
+        &self,
+        list: CandidateList<'_>,
+        work: &mut ContactWork,
+        pass: Pass<T>,
+        scan: &mut Scan<T>,
+    ) {
+        self.visit_triangles(list.as_slice(), work, pass, scan);
+    }
+
     /// Runs `pass` of `scan` once for each surface triangle around the
     /// surface vertices in the 27 grid cells around `around` (m) that
-    /// `visited` has not met, with its stored plane; a triangle is around
-    /// up to three of the vertices, and is tested at the first. Counts the
-    /// tests in `work`. One function for the three passes (one copy of the
-    /// visit in the firmware's flash).
+    /// `visited` has not met; a triangle is around up to three of the
+    /// vertices, and is tested at the first. The walk hands them to the
+    /// tests [`WALK_CHUNK`] at a time, in its order.
     fn visit(
         &self,
         around: &Vector3<T>,
@@ -540,18 +571,45 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         pass: Pass<T>,
         scan: &mut Scan<T>,
     ) {
+        let mut chunk = heapless::Vec::<u32, WALK_CHUNK>::new();
         self.index.for_each_vertex_near(around, |v| {
             for t in self.index.triangles_of(v) {
                 if !visited.first_visit(t) {
                     continue;
                 }
-                let Some((normal, offset)) = self.index.plane(t) else {
-                    continue;
-                };
-                work.triangles_tested = work.triangles_tested.saturating_add(1);
-                self.test(pass, scan, t, normal, offset);
+                if chunk.push(t.as_u32()).is_err() {
+                    self.visit_triangles(&chunk, work, pass, scan);
+                    chunk.clear();
+                    // Room: just cleared.
+                    let _ = chunk.push(t.as_u32());
+                }
             }
         });
+        self.visit_triangles(&chunk, work, pass, scan);
+    }
+
+    /// Runs `pass` of `scan` once for each of `triangles` (surface
+    /// triangle indices: a cell's list or a chunk of the walk), in order,
+    /// with its stored plane, and counts the tests in `work`. The one copy
+    /// of the tests in the firmware's flash (not inlined into its two
+    /// callers).
+    #[inline(never)]
+    fn visit_triangles(
+        &self,
+        triangles: &[u32],
+        work: &mut ContactWork,
+        pass: Pass<T>,
+        scan: &mut Scan<T>,
+    ) {
+        for &t in triangles {
+            let t = TriangleIndex::checked(t);
+            let Some((normal, offset)) = self.index.plane(t) else {
+                continue;
+            };
+            // At most `max_detection_tests` per detection: no wrap.
+            work.triangles_tested = work.triangles_tested.wrapping_add(1);
+            self.test(pass, scan, t, normal, offset);
+        }
     }
 
     /// One candidate `t` (plane `normal`, `offset`) of `pass`.
@@ -590,14 +648,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 }
                 if distance.abs() <= depth_m && normal != Vector3::zeros() {
                     if distance < radius_m {
-                        self.nearest_test(
-                            t,
-                            normal,
-                            distance,
-                            &to_m,
-                            scan.order,
-                            &mut scan.reached,
-                        );
+                        self.nearest_test(t, distance, &to_m, scan.order, &mut scan.reached);
                     } else {
                         scan.unreached.note(t, distance, scan.order);
                     }
@@ -609,7 +660,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 let nearer = Unreached::nearer(distance, scan.order, bound_m, order);
                 scan.order = scan.order.wrapping_add(1);
                 if !scan.covered && distance >= radius_m && distance <= depth_m && nearer {
-                    scan.covered = self.over(t, &normal, distance, &to_m);
+                    scan.covered = self.over(t, &to_m);
                 }
             }
         }
@@ -636,7 +687,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let s0 = normal.dot(start_m) - offset - radius_m;
         let s1 = end_distance_m - radius_m;
         if s0 >= -slack_m && s1 < T::zero() {
-            self.sweep_hit(t, normal, [s0, s1], segment, radius_m, best);
+            self.sweep_hit(t, [s0, s1], segment, best);
         }
     }
 
@@ -646,10 +697,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     fn sweep_hit(
         &self,
         t: TriangleIndex,
-        normal: Vector3<T>,
         s: [T; 2],
         segment: &[Vector3<T>; 2],
-        radius_m: T,
         best: &mut Option<(T, TriangleIndex, [T; 3])>,
     ) {
         let tolerance = T::WEIGHT_TOLERANCE;
@@ -660,25 +709,29 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         if best.as_ref().is_some_and(|(b, _, _)| *b <= along) {
             return;
         }
-        let Some(f) = self.corners(t) else { return };
-        if f.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
+        // The frame's gradients lie in the plane: the centre's point of the
+        // segment weighs as its contact point, a radius below it.
+        let x = start_m + (end_m - start_m) * along;
+        let Some(w) = self.weights(t, &x) else { return };
+        if !w.iter().all(|&wi| wi >= -tolerance) {
             return;
         }
-        let x = start_m + (end_m - start_m) * along - normal * radius_m;
-        let w = barycentric(&f.corners, &normal, &x);
-        if w.iter().all(|&wi| wi >= -tolerance) {
-            *best = Some((along, t, clamp_weights(w)));
+        let Some(vertices) = self.index.triangle(t) else {
+            return;
+        };
+        if vertices.iter().all(|&v| self.supports.is_fixed(v)) {
+            return;
         }
+        *best = Some((along, t, clamp_weights(w)));
     }
 
-    /// The penetration test of triangle `t` (unit `normal`), whose plane
-    /// lies `distance_m` from the centre `tip_m`, the `order`-th tested:
+    /// The penetration test of triangle `t`, whose plane lies `distance_m`
+    /// from the centre `tip_m`, the `order`-th tested:
     /// keeps in `nearest` the triangle with the nearest plane under the
     /// centre (the first tested of equals).
     fn nearest_test(
         &self,
         t: TriangleIndex,
-        normal: Vector3<T>,
         distance_m: T,
         tip_m: &Vector3<T>,
         order: u32,
@@ -690,8 +743,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         {
             return;
         }
-        let Some(f) = self.corners(t) else { return };
-        let w = barycentric(&f.corners, &normal, &(tip_m - normal * distance_m));
+        let Some(w) = self.weights(t, tip_m) else {
+            return;
+        };
         if w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE) {
             *nearest = Some(Nearest {
                 distance_m,
@@ -702,19 +756,12 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         }
     }
 
-    /// Whether the centre `tip_m` projects into triangle `t` (unit
-    /// `normal`, its plane `distance_m` from the centre).
-    fn over(
-        &self,
-        t: TriangleIndex,
-        normal: &Vector3<T>,
-        distance_m: T,
-        tip_m: &Vector3<T>,
-    ) -> bool {
-        self.corners(t).is_some_and(|f| {
-            let w = barycentric(&f.corners, normal, &(tip_m - normal * distance_m));
-            w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE)
-        })
+    /// Whether the centre `tip_m` projects into triangle `t` (the rare
+    /// check of the planes the sphere does not reach: out of line).
+    #[inline(never)]
+    fn over(&self, t: TriangleIndex, tip_m: &Vector3<T>) -> bool {
+        self.weights(t, tip_m)
+            .is_some_and(|w| w.iter().all(|&wi| wi >= -T::WEIGHT_TOLERANCE))
     }
 
     /// Moves `contact` with a sphere now at `tip_m` (m): the projection of
@@ -751,12 +798,10 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             });
         }
         let mut came_from = None;
+        // The weights on the current triangle (each step moves to the next
+        // and weighs again).
+        let mut w = self.tracked_weights(triangle, tip_m);
         for _ in 0..MAX_WALK_STEPS {
-            let w = barycentric(
-                &face.corners,
-                &face.normal,
-                &(tip_m - face.normal * radius_m),
-            );
             let Some(out) = (0..3).find(|&i| w.get(i).is_some_and(|&x| x < -tolerance)) else {
                 break;
             };
@@ -779,9 +824,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             work.walk_steps = work.walk_steps.saturating_add(1);
             came_from = Some(triangle);
             (triangle, face) = next;
+            w = self.tracked_weights(triangle, tip_m);
         }
-        let x_plane = tip_m - face.normal * radius_m;
-        let weights = clamp_weights(barycentric(&face.corners, &face.normal, &x_plane));
+        let weights = clamp_weights(w);
         Some(Contact {
             entry_gap_m: contact.entry_gap_m,
             ..self.contact(contact.tool, triangle, &face, weights, tip_m, radius_m)

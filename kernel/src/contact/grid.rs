@@ -25,7 +25,11 @@
 use nalgebra::Vector3;
 
 use crate::Real;
-use crate::table::{BuiltLists, DEAD_TRIANGLE, Grid, SurfaceIndex, max_row};
+use crate::table::format::PLANE_LEN;
+use crate::table::{
+    BuiltLists, DEAD_TRIANGLE, Grid, Plane, SurfaceIndex, for_each_candidate_filing, max_row,
+    plane_record,
+};
 
 /// Factor by which the cell edge grows until the grid fits its capacity.
 pub const CELL_GROWTH: f64 = 1.25;
@@ -39,9 +43,10 @@ pub const MIN_CELL_M: f64 = 1e-6;
 
 /// The buffers [`bin`] fills.
 pub struct BinBuffers<'b, T> {
-    /// Plane of every surface triangle (unit outward normal, offset `n·p`
-    /// in m; zero for a collapsed triangle, which is never touched): `T`.
-    pub planes: &'b mut [[T; 4]],
+    /// Plane and barycentric frame of every surface triangle
+    /// ([`crate::table::format::SectionKind::SurfacePlane`]; zero for a
+    /// collapsed triangle, which is never touched): `T`.
+    pub planes: &'b mut [Plane<T>],
     /// Start of each cell's vertex list: capacity in cells plus one, at
     /// least 2; the grid uses the first `cells + 1`.
     pub cell_start: &'b mut [u32],
@@ -86,7 +91,7 @@ pub(crate) struct SurfaceLists<'b, T> {
     pub(crate) triangles: &'b [[u32; 3]],
     pub(crate) vertex_triangle_start: &'b mut [u32],
     pub(crate) vertex_triangle: &'b mut [u32],
-    pub(crate) planes: &'b mut [[T; 4]],
+    pub(crate) planes: &'b mut [Plane<T>],
     pub(crate) cell_start: &'b mut [u32],
     pub(crate) grid_vertex: &'b mut [u32],
 }
@@ -143,7 +148,7 @@ impl<T: Real> Rebinned<T> {
         triangles: &'b [[u32; 3]],
         vertex_triangle_start: &'b [u32],
         vertex_triangle: &'b [u32],
-        planes: &'b [[T; 4]],
+        planes: &'b [Plane<T>],
         cell_start: &'b [u32],
         grid_vertex: &'b [u32],
     ) -> SurfaceIndex<'b, T> {
@@ -225,6 +230,49 @@ pub fn bin<T: Real>(
     }
 }
 
+/// Each cell's candidate triangles as a CSR list, ascending within a cell
+/// (a counting sort over the triangles in order): triangle `t` in every
+/// cell of its [`candidate_cells`] for a tool of radius up to `radius_m`
+/// (m). `start` has the grid's cells plus one entries; `list` room for
+/// every filing ([`candidate_count`]; a shorter one drops the rest).
+/// [`DEAD_TRIANGLE`] slots and triangles with a corner beyond
+/// `positions_m` are not filed. Returns the longest list.
+pub fn cell_triangles<T: Real>(
+    grid: &Grid<T>,
+    positions_m: &[[T; 3]],
+    triangles: &[[u32; 3]],
+    radius_m: T,
+    start: &mut [u32],
+    list: &mut [u32],
+) -> u32 {
+    start.fill(0);
+    for_each_candidate_filing(grid, positions_m, triangles, radius_m, |cell, _| {
+        if let Some(s) = start.get_mut(cell + 1) {
+            *s += 1;
+        }
+    });
+    prefix_sum(start);
+    for_each_candidate_filing(grid, positions_m, triangles, radius_m, |cell, t| {
+        if let Some(cursor) = start.get_mut(cell) {
+            place(list, cursor, t);
+        }
+    });
+    shift_back(start);
+    max_row(start)
+}
+
+/// The entries [`cell_triangles`] files.
+pub fn candidate_count<T: Real>(
+    grid: &Grid<T>,
+    positions_m: &[[T; 3]],
+    triangles: &[[u32; 3]],
+    radius_m: T,
+) -> usize {
+    let mut count = 0usize;
+    for_each_candidate_filing(grid, positions_m, triangles, radius_m, |_, _| count += 1);
+    count
+}
+
 /// Surface vertices (with at least one triangle) of a CSR vertex list.
 pub fn surface_vertex_count(vertex_triangle_start: &[u32]) -> usize {
     (0..vertex_triangle_start.len().saturating_sub(1))
@@ -232,8 +280,13 @@ pub fn surface_vertex_count(vertex_triangle_start: &[u32]) -> usize {
         .count()
 }
 
-/// Recomputes every triangle's plane; returns the longest edge, m.
-fn planes<T: Real>(positions_m: &[[T; 3]], triangles: &[[u32; 3]], planes: &mut [[T; 4]]) -> T {
+/// Recomputes every triangle's plane and barycentric frame
+/// ([`crate::table::format::SectionKind::SurfacePlane`]): with
+/// `e₁ = b − a`, `e₂ = c − a` and `m = e₁ × e₂`, the unit normal `m/|m|`,
+/// the offset `n·a`, and the gradients `g₁ = (e₂ × m)/|m|²`,
+/// `g₂ = (m × e₁)/|m|²` (so `gᵢ·eⱼ = δᵢⱼ` and `gᵢ·m = 0`). Returns the
+/// longest edge, m.
+fn planes<T: Real>(positions_m: &[[T; 3]], triangles: &[[u32; 3]], planes: &mut [Plane<T>]) -> T {
     let at = |v: u32| {
         positions_m
             .get(v as usize)
@@ -242,21 +295,22 @@ fn planes<T: Real>(positions_m: &[[T; 3]], triangles: &[[u32; 3]], planes: &mut 
     let mut longest2 = T::zero();
     for (plane, tri) in planes.iter_mut().zip(triangles) {
         if *tri == DEAD_TRIANGLE {
-            *plane = [T::zero(); 4];
+            *plane = [T::zero(); PLANE_LEN];
             continue;
         }
         let [a, b, c] = tri.map(at);
         for e in [b - a, c - b, a - c] {
             longest2 = longest2.max(e.norm_squared());
         }
-        let n = (b - a).cross(&(c - a));
-        let length = n.norm();
+        let (e1, e2) = (b - a, c - a);
+        let m = e1.cross(&e2);
+        let area2 = m.norm_squared();
         // A collapsed triangle gets a zero normal: never touched.
-        *plane = if length > T::zero() {
-            let n = n / length;
-            [n.x, n.y, n.z, n.dot(&a)]
+        *plane = if area2 > T::zero() {
+            let n = m / area2.sqrt();
+            plane_record(&n, n.dot(&a), &[e2.cross(&m) / area2, m.cross(&e1) / area2])
         } else {
-            [T::zero(); 4]
+            [T::zero(); PLANE_LEN]
         };
     }
     longest2.sqrt()

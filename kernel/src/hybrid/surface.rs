@@ -23,7 +23,7 @@ use super::region::CondensedRegion;
 use crate::Real;
 use crate::contact::grid::{Rebinned, SurfaceLists};
 use crate::contact::{Supports, SurfaceGeometry};
-use crate::table::{DEAD_TRIANGLE, PrecomputedTable, TensorMassTable, TriangleIndex};
+use crate::table::{DEAD_TRIANGLE, Plane, PrecomputedTable, TensorMassTable, TriangleIndex};
 use crate::tensor_mass::{NonFinitePosition, SurfaceBufferError, TensorMassModel, check_lengths};
 
 /// The caller's buffers of a hybrid surface (static arrays on firmware);
@@ -34,7 +34,7 @@ pub struct HybridSurfaceBuffers<'s, T> {
     /// The triangle in each slot (module docs): `B + F`.
     pub triangles: &'s mut [[u32; 3]],
     /// Plane of every slot's triangle: `B + F`.
-    pub planes: &'s mut [[T; 4]],
+    pub planes: &'s mut [Plane<T>],
     /// Start of each vertex's triangle list: `N + 1`.
     pub vertex_triangle_start: &'s mut [u32],
     /// The triangles around each vertex: `3 (B + F)`.

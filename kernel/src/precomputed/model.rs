@@ -217,28 +217,47 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     }
 
     /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N): each stored
-    /// block read once, accumulated in place; for `p = q` (`same`) the
-    /// pair `a ≠ b` is one read of the stored block for both its terms,
-    /// so at most six reads instead of nine.
+    /// block read once and added, or its transpose, to one row-major sum
+    /// (nine scalars the firmware target keeps in registers); for `p = q`
+    /// (`same`) the pair `a ≠ b` is one read of the stored block for both
+    /// its terms, `β_a β_b (C_ab + C_abᵀ)`, so at most six reads instead of
+    /// nine.
     fn point_compliance(
         &self,
         p: &ResolvedPoint<T>,
         q: &ResolvedPoint<T>,
         same: bool,
     ) -> Matrix3<T> {
-        let mut sum = [[T::zero(); 9]; 2];
+        let mut sum = [T::zero(); 9];
         for (i, (a, beta_a)) in p.terms().enumerate() {
             for (j, (b, beta_b)) in q.terms().enumerate() {
                 if same && j < i {
                     continue;
                 }
+                let Some((block, transposed)) = self.table.stored_touchable_block(a, b) else {
+                    continue;
+                };
                 let both = same && j > i;
-                self.table
-                    .add_touchable_block(a, b, beta_a * beta_b, both, &mut sum);
+                // `C_ab`, its transpose, or both added (one code path: the
+                // firmware's flash holds one copy of the sum).
+                let mut b = block;
+                if transposed || both {
+                    b.swap(1, 3);
+                    b.swap(2, 6);
+                    b.swap(5, 7);
+                }
+                if both {
+                    for (x, y) in b.iter_mut().zip(&block) {
+                        *x += *y;
+                    }
+                }
+                let w = beta_a * beta_b;
+                for (s, x) in sum.iter_mut().zip(&b) {
+                    *s += w * *x;
+                }
             }
         }
-        let [upper, lower] = sum;
-        Matrix3::from_row_slice(&upper) + Matrix3::from_row_slice(&lower).transpose()
+        Matrix3::from_row_slice(&sum)
     }
 
     /// The displacement of every free vertex for a solved contact set, m, by

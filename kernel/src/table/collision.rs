@@ -12,6 +12,7 @@
 use nalgebra::Vector3;
 
 use super::LoadError;
+use super::format::{GRID_LEN, PLANE_LEN};
 use super::index::{TriangleIndex, VertexIndex, csr_row, span};
 use crate::Real;
 
@@ -31,21 +32,30 @@ pub struct SurfaceIndex<'a, T> {
     grid_vertex: &'a [u32],
     vertex_triangle_start: &'a [u32],
     vertex_triangle: &'a [u32],
-    planes: &'a [[T; 4]],
+    planes: &'a [Plane<T>],
+    /// Each cell's candidate triangles (CSR; empty for an index the kernel
+    /// assembled) and the largest tool radius they serve, m (`None`: no
+    /// lists, every query walks the cells).
+    cell_triangle_start: &'a [u32],
+    cell_triangle: &'a [u32],
+    candidate_radius_m: Option<T>,
     max_bucket: u32,
     max_valence: u32,
     max_query_triangles: u32,
+    max_cell_triangles: u32,
 }
 
 /// The raw sections of a collision index, before validation.
 pub(crate) struct SurfaceSections<'a, T> {
-    pub(crate) grid: &'a [[T; 4]],
+    pub(crate) grid: &'a [[T; GRID_LEN]],
     pub(crate) dims: &'a [[u32; 3]],
     pub(crate) cell_start: &'a [u32],
     pub(crate) grid_vertex: &'a [u32],
     pub(crate) vertex_triangle_start: &'a [u32],
     pub(crate) vertex_triangle: &'a [u32],
-    pub(crate) planes: &'a [[T; 4]],
+    pub(crate) planes: &'a [Plane<T>],
+    pub(crate) cell_triangle_start: &'a [u32],
+    pub(crate) cell_triangle: &'a [u32],
 }
 
 /// A regular grid over a box: origin (its lowest corner), cell edge and
@@ -135,10 +145,44 @@ pub(crate) struct BuiltLists<'a, T> {
     pub(crate) grid_vertex: &'a [u32],
     pub(crate) vertex_triangle_start: &'a [u32],
     pub(crate) vertex_triangle: &'a [u32],
-    pub(crate) planes: &'a [[T; 4]],
+    pub(crate) planes: &'a [Plane<T>],
     /// The largest row of `cell_start` and of `vertex_triangle_start`.
     pub(crate) max_bucket: u32,
     pub(crate) max_valence: u32,
+}
+
+/// Most cells per axis a sweep's candidate lists span
+/// ([`SurfaceIndex::for_each_candidate_list_between`]): a segment between
+/// neighbouring cells; a longer one reads its start's cell and those next
+/// to it towards its end.
+pub const MAX_SWEEP_CELLS_PER_AXIS: u32 = 2;
+
+/// One cell's candidate triangles, ascending
+/// ([`SurfaceIndex::candidates`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CandidateList<'a>(&'a [u32]);
+
+impl<'a> CandidateList<'a> {
+    /// The triangles (in range by the loader's check).
+    #[inline(always)]
+    pub fn iter(&self) -> impl Iterator<Item = TriangleIndex> + '_ {
+        self.0.iter().map(|&t| TriangleIndex::checked(t))
+    }
+
+    /// The triangle indices (each below the surface's triangle count).
+    pub(crate) fn as_slice(&self) -> &'a [u32] {
+        self.0
+    }
+
+    /// How many.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// `true` for an empty list.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
 }
 
 /// A triangle slot that holds no triangle (a face of the deforming
@@ -147,6 +191,10 @@ pub(crate) struct BuiltLists<'a, T> {
 /// `contact::grid`'s builders; never a valid triangle (its corners are
 /// out of every vertex range).
 pub const DEAD_TRIANGLE: [u32; 3] = [u32::MAX; 3];
+
+/// A surface triangle's stored plane and barycentric frame (layout:
+/// [`super::format::SectionKind::SurfacePlane`]).
+pub type Plane<T> = [T; PLANE_LEN];
 
 /// `true` if `starts` begins at 0, never decreases and ends at `total`.
 fn csr_ok(starts: &[u32], total: usize) -> bool {
@@ -176,7 +224,8 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         triangles: &'a [[u32; 3]],
     ) -> Result<Self, LoadError> {
         let grid_error = |index: u32| LoadError::BadSurfaceGrid { index };
-        let (Some(&[x, y, z, cell_m]), Some(&dims)) = (s.grid.first(), s.dims.first()) else {
+        let (Some(&[x, y, z, cell_m, radius_m]), Some(&dims)) = (s.grid.first(), s.dims.first())
+        else {
             return Err(grid_error(0));
         };
         let grid = Grid {
@@ -184,7 +233,10 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             cell_m,
             dims,
         };
-        let geometry_ok = [x, y, z, cell_m].iter().all(|v| v.finite()) && cell_m > T::zero();
+        let geometry_ok = [x, y, z, cell_m, radius_m].iter().all(|v| v.finite())
+            && cell_m > T::zero()
+            && radius_m >= T::zero()
+            && candidate_margin_m(radius_m) <= cell_m;
         if !geometry_ok
             || dims.contains(&0)
             || grid.cell_count().and_then(|c| c.checked_add(1)) != Some(s.cell_start.len())
@@ -200,9 +252,13 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             vertex_triangle_start: s.vertex_triangle_start,
             vertex_triangle: s.vertex_triangle,
             planes: s.planes,
+            cell_triangle_start: s.cell_triangle_start,
+            cell_triangle: s.cell_triangle,
+            candidate_radius_m: Some(radius_m),
             max_bucket: max_row(s.cell_start),
             max_valence: max_row(s.vertex_triangle_start),
             max_query_triangles: 0,
+            max_cell_triangles: max_row(s.cell_triangle_start),
         };
         // Every filed vertex exists and lies within one cell of its own.
         for (cell, bucket) in s.cell_start.windows(2).enumerate() {
@@ -243,12 +299,13 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             }
         }
         // Each plane: finite, unit normal, through the triangle's corners,
-        // pointing along the corners' right-hand normal.
+        // pointing along the corners' right-hand normal; its frame: the
+        // gradients weigh the corners 1 and 0 (within the tolerance, in
+        // units of the weights) and lie in the plane.
         let tolerance = T::of_f64(1e-4);
         for (t, (plane, tri)) in s.planes.iter().zip(triangles).enumerate() {
             let bad = LoadError::BadSurfacePlane { triangle: t as u32 };
-            let [nx, ny, nz, d] = *plane;
-            let n = Vector3::new(nx, ny, nz);
+            let (n, d, [g1, g2]) = parts_of(plane);
             let mut corners = [Vector3::zeros(); 3];
             for (c, &v) in corners.iter_mut().zip(tri) {
                 let p = VertexIndex::new(v, positions.len())
@@ -261,10 +318,19 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                 .iter()
                 .all(|p| (n.dot(p) - d).abs() <= tolerance * cell_m);
             let unit = (n.norm_squared() - T::one()).abs() <= tolerance;
+            let (e1, e2) = (b - a, c - a);
+            let near = |x: T, want: T| (x - want).abs() <= tolerance;
+            let frame = near(g1.dot(&e1), T::one())
+                && near(g1.dot(&e2), T::zero())
+                && near(g2.dot(&e1), T::zero())
+                && near(g2.dot(&e2), T::one())
+                && near(g1.dot(&n) * e1.norm(), T::zero())
+                && near(g2.dot(&n) * e2.norm(), T::zero());
             if !(plane.iter().all(|x| x.finite())
                 && unit
                 && through
-                && n.dot(&(b - a).cross(&(c - a))) > T::zero())
+                && frame
+                && n.dot(&e1.cross(&e2)) > T::zero())
             {
                 return Err(bad);
             }
@@ -272,6 +338,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         if s.planes.len() != triangles.len() {
             return Err(LoadError::BadSurfacePlane { triangle: 0 });
         }
+        index.check_cell_triangles(positions)?;
         // The most triangles one query can visit: over every cell, the
         // triangles around the vertices of its 27-cell neighbourhood.
         let mut index = index;
@@ -314,9 +381,156 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             vertex_triangle_start: lists.vertex_triangle_start,
             vertex_triangle: lists.vertex_triangle,
             planes: lists.planes,
+            cell_triangle_start: &[],
+            cell_triangle: &[],
+            candidate_radius_m: None,
             max_bucket,
             max_valence,
             max_query_triangles,
+            max_cell_triangles: 0,
+        }
+    }
+
+    /// Checks the per-cell candidate lists: CSR over the grid's cells, each
+    /// list strictly ascending, and exactly the filings of
+    /// [`crate::contact::grid::candidate_cells`] for the declared radius
+    /// (every triangle in each of its cells' lists, and nothing else: the
+    /// lists hold as many entries as there are filings). Cost: the filings
+    /// times a binary search in a list.
+    fn check_cell_triangles(&self, positions: &[[T; 3]]) -> Result<(), LoadError> {
+        let bad = |cell: usize| LoadError::BadCellTriangles { cell: cell as u32 };
+        let cells = self.grid.cell_count().unwrap_or(0);
+        if self.cell_triangle_start.len() != cells + 1
+            || !csr_ok(self.cell_triangle_start, self.cell_triangle.len())
+        {
+            return Err(bad(0));
+        }
+        for cell in 0..cells {
+            let list = self.cell_triangles_at(cell);
+            let in_range = list.iter().all(|&t| (t as usize) < self.triangles.len());
+            if !in_range || !list.windows(2).all(|w| w.first() < w.get(1)) {
+                return Err(bad(cell));
+            }
+        }
+        let radius_m = self.candidate_radius_m.unwrap_or(T::zero());
+        let margin_m = candidate_margin_m(radius_m);
+        // Nothing else: each listed triangle is filed in its cell.
+        for cell in 0..cells {
+            let c = self.grid.coordinates(cell);
+            for &t in self.cell_triangles_at(cell) {
+                let corners = self
+                    .triangles
+                    .get(t as usize)
+                    .and_then(|tri| corners_of(positions, tri))
+                    .ok_or(bad(cell))?;
+                let [lo, hi] = candidate_cells(&self.grid, &corners, margin_m);
+                let filed = c
+                    .iter()
+                    .zip(lo.iter().zip(&hi))
+                    .all(|(x, (l, h))| l <= x && x <= h);
+                if !filed {
+                    return Err(bad(cell));
+                }
+            }
+        }
+        // Everything: each filing is listed.
+        let mut missing = None;
+        for_each_candidate_filing(
+            &self.grid,
+            positions,
+            self.triangles,
+            radius_m,
+            |cell, t| {
+                if missing.is_none() && self.cell_triangles_at(cell).binary_search(&t).is_err() {
+                    missing = Some(cell);
+                }
+            },
+        );
+        missing.map_or(Ok(()), |cell| Err(bad(cell)))
+    }
+
+    /// The candidate list of cell `cell` (linear index; empty out of range).
+    fn cell_triangles_at(&self, cell: usize) -> &'a [u32] {
+        csr_row(self.cell_triangle_start, cell)
+            .and_then(|row| self.cell_triangle.get(row))
+            .unwrap_or(&[])
+    }
+
+    /// The candidate triangles of the cell of `p` (m) for a tool of radius
+    /// `radius_m` (m): every triangle a sphere of that radius centred in
+    /// the cell can touch or lie under
+    /// ([`super::format::SectionKind::CellTriangle`]), ascending; `None`
+    /// when the index has no lists or they serve a smaller radius (then a
+    /// query walks the 27 cells around `p`). Bounded by
+    /// [`Self::max_cell_triangles`].
+    #[inline]
+    pub fn candidates(&self, p: &Vector3<T>, radius_m: T) -> Option<CandidateList<'a>> {
+        let served = self.candidate_radius_m.is_some_and(|r| radius_m <= r);
+        served.then(|| CandidateList(self.cell_triangles_at(self.grid.linear(self.cell_of(p)))))
+    }
+
+    /// The candidate lists, for a tool of radius `radius_m`, of a sweep
+    /// from `a` to `b` (m): each cell of the box of cells from the cell of
+    /// `a` towards the cell of `b`, at most [`MAX_SWEEP_CELLS_PER_AXIS`]
+    /// per axis (for a segment between neighbouring cells, the box between
+    /// their cells: every point of the segment has its cell in it; a
+    /// longer one reads the cells next to `a` towards `b`), but the cell of
+    /// `b` when `skip_b` (its list read already). `f` gets each list. For
+    /// a tool the lists serve: the caller has [`Self::candidates`]' list.
+    pub(crate) fn for_each_candidate_list_between(
+        &self,
+        a: &Vector3<T>,
+        b: &Vector3<T>,
+        skip_b: bool,
+        mut f: impl FnMut(CandidateList<'a>),
+    ) {
+        let ([ax, ay, az], [bx, by, bz]) = (self.cell_of(a), self.cell_of(b));
+        let reach = MAX_SWEEP_CELLS_PER_AXIS - 1;
+        let span = |p: u32, q: u32| {
+            let q = q.min(p.saturating_add(reach)).max(p.saturating_sub(reach));
+            (p.min(q), p.max(q))
+        };
+        let ((x0, x1), (y0, y1), (z0, z1)) = (span(ax, bx), span(ay, by), span(az, bz));
+        for k in z0..=z1 {
+            for j in y0..=y1 {
+                for i in x0..=x1 {
+                    // Corner by corner: an array comparison is a `memcmp`
+                    // call on the firmware target.
+                    let at_b = i == bx && j == by && k == bz;
+                    if !(skip_b && at_b) {
+                        f(CandidateList(
+                            self.cell_triangles_at(self.grid.linear([i, j, k])),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The longest per-cell candidate list (0 without lists): a
+    /// table-declared bound.
+    pub fn max_cell_triangles(&self) -> u32 {
+        self.max_cell_triangles
+    }
+
+    /// The largest tool radius (m) the per-cell candidate lists serve,
+    /// `None` without lists.
+    pub fn candidate_radius_m(&self) -> Option<T> {
+        self.candidate_radius_m
+    }
+
+    /// The most triangle tests one detection by a tool of radius
+    /// `radius_m` does (`SurfaceGeometry::detect`): with the lists, the
+    /// tool's cell twice (the test, and the penetration test's second
+    /// pass) and up to `2³ − 1` more cells along the sweep; without,
+    /// `3 × max_query_triangles`.
+    pub fn max_detection_tests(&self, radius_m: T) -> u32 {
+        let lists_serve = self.candidate_radius_m.is_some_and(|r| radius_m <= r);
+        if lists_serve {
+            let cells = MAX_SWEEP_CELLS_PER_AXIS.pow(3) + 1;
+            self.max_cell_triangles.saturating_mul(cells)
+        } else {
+            self.max_query_triangles.saturating_mul(3)
         }
     }
 
@@ -429,9 +643,37 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
 
     /// The stored plane of surface triangle `t`: unit outward normal and
     /// offset `n·p` (m).
+    #[inline(always)]
     pub fn plane(&self, t: TriangleIndex) -> Option<(Vector3<T>, T)> {
-        let [x, y, z, d] = *self.planes.get(t.get())?;
-        Some((Vector3::new(x, y, z), d))
+        self.planes.get(t.get()).map(|p| {
+            let (normal, offset, _) = parts_of(p);
+            (normal, offset)
+        })
+    }
+
+    /// The barycentric weights of `x_m` (m) on surface triangle `t`, of the
+    /// point of its plane under `x_m` (the frame's gradients lie in the
+    /// plane): `w₁ = g₁·(x − p₀)`, `w₂ = g₂·(x − p₀)`, `w₀ = 1 − w₁ − w₂`
+    /// ([`super::format::SectionKind::SurfacePlane`]). All zero for a
+    /// collapsed triangle (zero normal), which no test accepts; `None` for an
+    /// index beyond this surface's triangles or an empty slot.
+    #[inline(always)]
+    pub fn weights(
+        &self,
+        t: TriangleIndex,
+        positions_m: &[[T; 3]],
+        x_m: &Vector3<T>,
+    ) -> Option<[T; 3]> {
+        let plane = self.planes.get(t.get())?;
+        let &[a, ..] = self.triangles.get(t.get())?;
+        let p = positions_m.get(a as usize)?;
+        let d = x_m - Vector3::new(p[0], p[1], p[2]);
+        let (normal, _, [g1, g2]) = parts_of(plane);
+        if normal == Vector3::zeros() {
+            return Some([T::zero(); 3]);
+        }
+        let (w1, w2) = (g1.dot(&d), g2.dot(&d));
+        Some([T::one() - w1 - w2, w1, w2])
     }
 
     /// The surface triangles around `vertex`, ascending. Bounded by
@@ -483,5 +725,118 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         csr_row(self.vertex_triangle_start, vertex.get())
             .and_then(|row| self.vertex_triangle.get(row))
             .unwrap_or(&[])
+    }
+}
+
+/// The unit normal, offset (m) and barycentric gradients `g₁`, `g₂` (1/m)
+/// of a stored plane (layout: [`super::format::SectionKind::SurfacePlane`]).
+#[inline(always)]
+fn parts_of<T: Real>(plane: &Plane<T>) -> (Vector3<T>, T, [Vector3<T>; 2]) {
+    let [nx, ny, nz, d, g1x, g1y, g1z, g2x, g2y, g2z] = *plane;
+    (
+        Vector3::new(nx, ny, nz),
+        d,
+        [Vector3::new(g1x, g1y, g1z), Vector3::new(g2x, g2y, g2z)],
+    )
+}
+
+/// A stored plane of unit normal `normal`, offset `offset_m` (m) and
+/// barycentric gradients `g` (1/m): the inverse of [`parts_of`].
+pub(crate) fn plane_record<T: Real>(
+    normal: &Vector3<T>,
+    offset_m: T,
+    g: &[Vector3<T>; 2],
+) -> Plane<T> {
+    let [g1, g2] = g;
+    [
+        normal.x, normal.y, normal.z, offset_m, g1.x, g1.y, g1.z, g2.x, g2.y, g2.z,
+    ]
+}
+
+/// The corners (m) of triangle `tri` over `positions`, `None` for a corner
+/// beyond them.
+pub(crate) fn corners_of<T: Real>(positions: &[[T; 3]], tri: &[u32; 3]) -> Option<[Vector3<T>; 3]> {
+    let at = |v: u32| {
+        positions
+            .get(v as usize)
+            .map(|p| Vector3::new(p[0], p[1], p[2]))
+    };
+    let [a, b, c] = tri.map(at);
+    Some([a?, b?, c?])
+}
+
+/// How far beyond a triangle's bounding box, in tool radii, the per-cell
+/// candidate lists file it ([`candidate_margin_m`]): the contact test's
+/// penetration depth (`contact::PENETRATION_DEPTH_RADII`, 2: a plane that
+/// far from the centre, with the centre over its triangle; the contact
+/// layer asserts it fits) plus a quarter radius for the weight tolerance's
+/// reach past a triangle's edges.
+pub const CANDIDATE_MARGIN_RADII: f64 = 2.25;
+
+/// The margin (m) by which the candidate lists widen each triangle's
+/// bounding box for a tool of radius up to `radius_m`.
+pub fn candidate_margin_m<T: Real>(radius_m: T) -> T {
+    radius_m * T::of_f64(CANDIDATE_MARGIN_RADII)
+}
+
+/// The tool radius (m) a table's candidate lists serve when asked for
+/// `tool_radius_m`: at most the cell edge over [`CANDIDATE_MARGIN_RADII`],
+/// so that a triangle's widened box spans at most 4 cells per axis (its
+/// box is at most an edge, at most a cell, wide): at most 64 lists per
+/// triangle. Negative or non-finite asks give 0.
+pub fn candidate_radius_m<T: Real>(grid: &Grid<T>, tool_radius_m: T) -> T {
+    let most = grid.cell_m / T::of_f64(CANDIDATE_MARGIN_RADII);
+    if tool_radius_m > T::zero() {
+        if tool_radius_m < most {
+            tool_radius_m
+        } else {
+            most
+        }
+    } else {
+        T::zero()
+    }
+}
+
+/// The cells (lowest and highest, per axis, clamped to the grid as a query
+/// point is) whose candidate lists hold the triangle of `corners_m` (m),
+/// its bounding box widened by `margin_m` (m): the one rule of the lists'
+/// builder (`contact::grid::cell_triangles`) and of the loader's check. A sphere centred
+/// within `margin_m` of the triangle lies in the box, and clamping is
+/// monotone, so its cell is in the range.
+pub fn candidate_cells<T: Real>(
+    grid: &Grid<T>,
+    corners_m: &[Vector3<T>; 3],
+    margin_m: T,
+) -> [[u32; 3]; 2] {
+    let [a, b, c] = corners_m;
+    let margin = Vector3::repeat(margin_m);
+    let lo = a.inf(b).inf(c) - margin;
+    let hi = a.sup(b).sup(c) + margin;
+    [grid.cell_of(&lo), grid.cell_of(&hi)]
+}
+
+/// `f(cell, t)` for every cell of every triangle `t`'s
+/// [`candidate_cells`], triangles in order, cells `x` fastest (a triangle
+/// with a corner beyond `positions_m`, a dead slot, is not filed).
+pub(crate) fn for_each_candidate_filing<T: Real>(
+    grid: &Grid<T>,
+    positions_m: &[[T; 3]],
+    triangles: &[[u32; 3]],
+    radius_m: T,
+    mut f: impl FnMut(usize, u32),
+) {
+    let margin_m = candidate_margin_m(radius_m);
+    for (t, tri) in triangles.iter().enumerate() {
+        let Some(corners) = corners_of(positions_m, tri) else {
+            continue;
+        };
+        let [[x0, y0, z0], [x1, y1, z1]] = candidate_cells(grid, &corners, margin_m);
+        for k in z0..=z1 {
+            for j in y0..=y1 {
+                for i in x0..=x1 {
+                    f(grid.linear([i, j, k]), t as u32);
+                }
+            }
+        }
     }
 }

@@ -137,7 +137,8 @@ pub enum LoadError {
         index: u32,
     },
     /// A surface triangle's stored plane is not finite, not a unit normal,
-    /// or not the plane of its corners.
+    /// or not the plane of its corners, or its barycentric frame does not
+    /// weigh its corners.
     BadSurfacePlane {
         /// Surface triangle index.
         triangle: u32,
@@ -168,6 +169,13 @@ pub enum LoadError {
     BadTetMaterial {
         /// Tet index.
         tet: u32,
+    },
+    /// A grid cell's candidate triangle list is not the triangles the grid
+    /// files there for the declared tool radius (out of range, not
+    /// ascending, one missing or one too many).
+    BadCellTriangles {
+        /// Grid cell, linear index.
+        cell: u32,
     },
     /// A tet's lane of the `tet-lanes` section differs from its
     /// `tet-shape` and `tet-material` entries, or a lane past the last tet
@@ -311,7 +319,7 @@ impl fmt::Display for LoadError {
             }
             LoadError::BadSurfacePlane { triangle } => write!(
                 f,
-                "surface triangle {triangle}: stored plane is not the unit outward plane of its corners"
+                "surface triangle {triangle}: stored plane or barycentric frame is not that of its corners"
             ),
             LoadError::BadVertexTriangles { vertex } => write!(
                 f,
@@ -328,6 +336,10 @@ impl fmt::Display for LoadError {
             LoadError::BadTetMaterial { tet } => write!(
                 f,
                 "tet {tet}: Lame coefficients out of range (need mu > 0 and lambda > -2 mu / 3)"
+            ),
+            LoadError::BadCellTriangles { cell } => write!(
+                f,
+                "grid cell {cell}: candidate triangle list is not the triangles the grid files there"
             ),
             LoadError::BadTetLanes { tet } => write!(
                 f,

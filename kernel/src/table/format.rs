@@ -41,7 +41,16 @@
 //! tensor-mass tables: the rest shapes and Lamé coefficients again, by
 //! blocks of [`TET_LANES`] tets in structure-of-arrays form, which the
 //! St Venant-Kirchhoff pass reads with vector loads instead of gathering
-//! them tet by tet. A table of an earlier version is refused
+//! them tet by tet. 5 widens [`SectionKind::SurfacePlane`] from 4 to
+//! [`PLANE_LEN`] scalars: after the plane, the in-plane gradients of the
+//! triangle's second and third barycentric weights, so that a contact test
+//! weighs a point with two dot products instead of two cross products and
+//! two divisions over the corners; it also adds to pre-computed tables
+//! the collision index's per-cell candidate lists
+//! ([`SectionKind::CellTriangleStart`], [`SectionKind::CellTriangle`]: the
+//! triangles a detection in a cell tests, filed against the tool radius the
+//! table declares in [`SectionKind::SurfaceGrid`], read as one list instead
+//! of a walk over 27 cells). A table of an earlier version is refused
 //! ([`super::LoadError::UnsupportedVersion`]), never misread.
 //!
 //! ## Compressed compliance (version 3, additive)
@@ -80,7 +89,7 @@ use bytemuck::{Pod, Zeroable};
 /// First 8 bytes of every table.
 pub const MAGIC: [u8; 8] = *b"PALPTBL\0";
 /// The format version this kernel reads and the host writes.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 /// Every section starts at a multiple of this many bytes from the file start.
 pub const SECTION_ALIGN: usize = 16;
 /// Size of the CRC-32 trailer.
@@ -204,6 +213,8 @@ impl TableKind {
                 SectionKind::VertexTriangleStart,
                 SectionKind::VertexTriangle,
                 SectionKind::SurfacePlane,
+                SectionKind::CellTriangleStart,
+                SectionKind::CellTriangle,
                 SectionKind::TetMaterial,
             ],
             TableKind::TensorMass => &[
@@ -276,8 +287,10 @@ pub enum SectionKind {
     ComplianceSurface = 5,
     /// `[scalar; 9]` × (F−S)·S: compliance of interior rows, m/N.
     ComplianceInterior = 6,
-    /// `[scalar; 4]` × 1: the surface-vertex grid (Cotin 1999 collision
-    /// buckets): origin `x, y, z` and cell edge, m.
+    /// `[scalar; 5]` × 1: the surface-vertex grid (Cotin 1999 collision
+    /// buckets): origin `x, y, z` and cell edge, m; then the largest tool
+    /// radius (m, ≥ 0) the per-cell candidate lists
+    /// ([`SectionKind::CellTriangle`]) serve.
     SurfaceGrid = 7,
     /// `[u32; 3]` × 1: grid cells per axis; their product is the header's
     /// `grid_cell_count`. Cell `(i, j, k)` has index `i + nx (j + ny k)`.
@@ -292,10 +305,31 @@ pub enum SectionKind {
     /// `u32` × 3·triangle_count: the surface triangles around each vertex,
     /// ascending within a vertex.
     VertexTriangle = 12,
-    /// `[scalar; 4]` × triangle_count: each surface triangle's plane, the
-    /// unit outward normal `n` and the offset `n·p₀` (m), so a contact test
-    /// is two dot products.
+    /// `[scalar; PLANE_LEN]` × triangle_count: each surface triangle's
+    /// plane, the unit outward normal `n` and the offset `n·p₀` (m), so a
+    /// contact test is two dot products; then its barycentric frame, the
+    /// in-plane gradients `g₁ = (e₂ × n)/|n|²` and `g₂ = (n × e₁)/|n|²`
+    /// (1/m; `e₁ = p₁ − p₀`, `e₂ = p₂ − p₀`, `n` the unnormalized normal
+    /// here), so that a point `x` of the plane has the weights
+    /// `w₁ = g₁·(x − p₀)`, `w₂ = g₂·(x − p₀)`, `w₀ = 1 − w₁ − w₂`. Layout:
+    /// `[n_x, n_y, n_z, n·p₀, g₁ (3), g₂ (3)]`. All zero for a collapsed
+    /// triangle.
     SurfacePlane = 13,
+    /// `u32` × (grid_cell_count + 1): CSR starts of each cell's candidate
+    /// triangles (version 5).
+    CellTriangleStart = 14,
+    /// `u32` × (the directory declares the count): each cell's candidate
+    /// triangles, ascending: triangle `t` is in the list of every cell
+    /// between the cells of the lowest and the highest corner of its
+    /// corners' bounding box widened by the candidate margin (the kernel's
+    /// `contact::grid::candidate_margin_m` of the grid record's tool
+    /// radius: the penetration test's depth plus slack), each clamped to
+    /// the grid as a query point is. So a sphere of at most that radius
+    /// centred in a cell finds in its list every triangle it can touch or
+    /// lie under. Checked at load by filing every triangle again. The
+    /// radius is at most the cell edge over the margin's radii, so a
+    /// triangle (at most a cell wide) is in at most 4 × 4 × 4 lists.
+    CellTriangle = 15,
     /// `scalar` × N: lumped vertex masses `m_i = ρ Σ_{tets ∋ i} V/4`, kg.
     LumpedMass = 16,
     /// `[scalar; 9]` × N: vertex tensors `K_ii`, row-major, N/m.
@@ -593,6 +627,12 @@ pub const TET_SHAPE_LEN: usize = 13;
 pub const VERTEX_TERMS_LEN: usize = 4;
 /// Scalars per [`SectionKind::EdgeTerms`] element.
 pub const EDGE_TERMS_LEN: usize = 16;
+/// Scalars per [`SectionKind::SurfaceGrid`] element: origin, cell edge and
+/// the candidate lists' tool radius.
+pub const GRID_LEN: usize = 5;
+/// Scalars per [`SectionKind::SurfacePlane`] element: the unit normal, the
+/// offset, and the barycentric gradients `g₁`, `g₂`.
+pub const PLANE_LEN: usize = 10;
 /// Scalars per [`SectionKind::TriangleTerms`] element.
 pub const TRIANGLE_TERMS_LEN: usize = 15;
 /// Scalars per [`SectionKind::TetTerms`] element.
@@ -617,7 +657,7 @@ pub mod tet_lane_row {
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 44] = [
+    pub const ALL: [SectionKind; 46] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -631,6 +671,8 @@ impl SectionKind {
         SectionKind::VertexTriangleStart,
         SectionKind::VertexTriangle,
         SectionKind::SurfacePlane,
+        SectionKind::CellTriangleStart,
+        SectionKind::CellTriangle,
         SectionKind::LumpedMass,
         SectionKind::VertexTensor,
         SectionKind::EdgeRowStart,
@@ -665,10 +707,14 @@ impl SectionKind {
     ];
 
     /// `true` for the sections whose element count the directory declares
-    /// (the blocks a compressed part kept): the header's counts give only
+    /// (the blocks a compressed part kept, the cells' candidate triangles):
+    /// the header's counts give only
     /// the most they may hold ([`Self::expected_count`]).
     pub const fn count_is_declared(self) -> bool {
-        matches!(self, SectionKind::SurfaceCodes | SectionKind::InteriorCodes)
+        matches!(
+            self,
+            SectionKind::SurfaceCodes | SectionKind::InteriorCodes | SectionKind::CellTriangle
+        )
     }
 
     /// `true` for the compliance sections a [`CompressionRecord`] may
@@ -697,12 +743,14 @@ impl SectionKind {
             | SectionKind::LoadForce => 3 * scalar_bytes,
             SectionKind::RestPositions => 3 * scalar_bytes,
             SectionKind::SurfaceTriangles | SectionKind::MeshTriangle | SectionKind::GridDims => 12,
-            SectionKind::SurfaceGrid => 4 * scalar_bytes,
+            SectionKind::SurfaceGrid => GRID_LEN as u32 * scalar_bytes,
             SectionKind::GridCellStart
             | SectionKind::GridVertex
             | SectionKind::VertexTriangleStart
-            | SectionKind::VertexTriangle => 4,
-            SectionKind::SurfacePlane => 4 * scalar_bytes,
+            | SectionKind::VertexTriangle
+            | SectionKind::CellTriangleStart
+            | SectionKind::CellTriangle => 4,
+            SectionKind::SurfacePlane => PLANE_LEN as u32 * scalar_bytes,
             SectionKind::ComplianceSurface
             | SectionKind::ComplianceInterior
             | SectionKind::VertexTensor
@@ -761,7 +809,10 @@ impl SectionKind {
             SectionKind::MeshTriangle | SectionKind::TriangleTerms => Some(h.mesh_triangle_count),
             SectionKind::FreeVertex => Some(f),
             SectionKind::SurfaceGrid | SectionKind::GridDims => Some(1),
-            SectionKind::GridCellStart => u64::from(h.grid_cell_count).checked_add(1),
+            SectionKind::GridCellStart | SectionKind::CellTriangleStart => {
+                u64::from(h.grid_cell_count).checked_add(1)
+            }
+            SectionKind::CellTriangle => u64::from(h.triangle_count).checked_mul(64),
             SectionKind::GridVertex => Some(u64::from(h.surface_vertex_count)),
             SectionKind::VertexTriangleStart => n.checked_add(1),
             SectionKind::VertexTriangle => u64::from(h.triangle_count).checked_mul(3),
@@ -800,6 +851,8 @@ impl SectionKind {
             SectionKind::VertexTriangleStart => "vertex-triangle-start",
             SectionKind::VertexTriangle => "vertex-triangle",
             SectionKind::SurfacePlane => "surface-plane",
+            SectionKind::CellTriangleStart => "cell-triangle-start",
+            SectionKind::CellTriangle => "cell-triangle",
             SectionKind::LumpedMass => "lumped-mass",
             SectionKind::VertexTensor => "vertex-tensor",
             SectionKind::EdgeRowStart => "edge-row-start",

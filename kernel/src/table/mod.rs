@@ -22,7 +22,11 @@ mod precomputed;
 mod tensor_mass;
 
 pub(crate) use collision::BuiltLists;
-pub use collision::{DEAD_TRIANGLE, Grid, SurfaceIndex, max_row, within};
+pub use collision::{
+    CANDIDATE_MARGIN_RADII, CandidateList, DEAD_TRIANGLE, Grid, MAX_SWEEP_CELLS_PER_AXIS, Plane,
+    SurfaceIndex, candidate_cells, candidate_margin_m, candidate_radius_m, max_row, within,
+};
+pub(crate) use collision::{for_each_candidate_filing, plane_record};
 pub use compressed::{CodedBlocks, ComplianceBlocks};
 pub use error::LoadError;
 pub(crate) use index::span;

@@ -65,6 +65,8 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             vertex_triangle_start: c.section(SectionKind::VertexTriangleStart)?,
             vertex_triangle: c.section(SectionKind::VertexTriangle)?,
             planes: c.section(SectionKind::SurfacePlane)?,
+            cell_triangle_start: c.section(SectionKind::CellTriangleStart)?,
+            cell_triangle: c.section(SectionKind::CellTriangle)?,
         };
         let parts = load_parts(&c)?;
         let table = Self {
@@ -235,53 +237,24 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         Some(if n <= k { block } else { block.transpose() })
     }
 
-    /// Accumulates `w · C_nk` for two touchable free indices `n`, `k`
-    /// (either order) into `sum` = `upper + lowerᵀ` (each row-major, m/N):
-    /// the stored block `C_lo,hi` is added to `upper` for `n ≤ k`, to
-    /// `lower` for `n > k`, and with `both` to both (`w · (C_nk + C_kn)`,
-    /// the two off-diagonal terms of a symmetric sum from one read). Nothing
-    /// if either is not touchable. The haptic path's form of
-    /// [`Self::touchable_block_of`]: one stored block read straight from
-    /// the table, its transpose left to the end of the sum.
+    /// The stored block `C_lo,hi` of two touchable free indices `n`, `k`
+    /// (either order), row-major, m/N, and whether `C_nk` is its transpose
+    /// (`n > k`). `None` if either is not touchable. The haptic path's
+    /// form of [`Self::touchable_block_of`]: one block read straight from
+    /// the table (decoded if coded), returned by value so that a caller's
+    /// sum stays in registers.
     #[inline(always)]
-    pub fn add_touchable_block(
-        &self,
-        n: FreeIndex,
-        k: FreeIndex,
-        w: T,
-        both: bool,
-        sum: &mut [[T; 9]; 2],
-    ) {
+    pub fn stored_touchable_block(&self, n: FreeIndex, k: FreeIndex) -> Option<([T; 9], bool)> {
         let (lo, hi) = if n <= k { (n, k) } else { (k, n) };
         if hi.get() >= self.touchable_count() {
-            return;
+            return None;
         }
         let j = format::surface_block_index(lo.get(), hi.get());
-        let decoded;
         let block = match self.surface {
-            ComplianceBlocks::Dense(blocks) => match blocks.get(j) {
-                Some(block) => block,
-                None => return,
-            },
-            coded => match coded.block(j, hi.get()) {
-                Some(block) => {
-                    decoded = block;
-                    &decoded
-                }
-                None => return,
-            },
+            ComplianceBlocks::Dense(blocks) => *blocks.get(j)?,
+            coded => coded.block(j, hi.get())?,
         };
-        let [upper, lower] = sum;
-        if both || n <= k {
-            for (x, &y) in upper.iter_mut().zip(block) {
-                *x += w * y;
-            }
-        }
-        if both || n > k {
-            for (x, &y) in lower.iter_mut().zip(block) {
-                *x += w * y;
-            }
-        }
+        Some((block, n > k))
     }
 
     fn check_vertex_maps(&self) -> Result<(), LoadError> {

@@ -32,7 +32,7 @@ use crate::Real;
 use crate::contact::grid::{Rebinned, SurfaceLists};
 use crate::contact::{Supports, SurfaceGeometry};
 use crate::table::format::{NO_NEIGHBOUR, tet_face_vertices};
-use crate::table::{DEAD_TRIANGLE, SurfaceIndex, TensorMassTable, TetIndex, TriangleIndex};
+use crate::table::{DEAD_TRIANGLE, Plane, SurfaceIndex, TensorMassTable, TetIndex, TriangleIndex};
 
 /// The caller's buffers of a deforming surface (static arrays on
 /// firmware). Lengths for a table of `N` vertices and `F` mesh triangles
@@ -48,9 +48,9 @@ pub struct SurfaceBuffers<'s, T> {
     pub face_slot: &'s mut [u32],
     /// The live tet whose face each surface slot holds: `F`.
     pub slot_tet: &'s mut [u32],
-    /// Plane of every slot's triangle (unit outward normal, offset `n·p`
-    /// in m; zero for an empty slot): `F`.
-    pub planes: &'s mut [[T; 4]],
+    /// Plane and barycentric frame of every slot's triangle
+    /// ([`crate::table::Plane`]; zero for an empty slot): `F`.
+    pub planes: &'s mut [Plane<T>],
     /// Start of each vertex's triangle list: `N + 1`.
     pub vertex_triangle_start: &'s mut [u32],
     /// The triangles around each vertex, ascending: `3 F`.

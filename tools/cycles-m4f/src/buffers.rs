@@ -5,6 +5,7 @@
 //! deforming surface with one grid cell per surface vertex.
 
 use palpate_kernel::table::TensorMassTable;
+use palpate_kernel::table::format::PLANE_LEN;
 use palpate_kernel::table::format::{
     EDGE_TERMS_LEN, TET_TERMS_LEN, TRIANGLE_TERMS_LEN, VERTEX_TERMS_LEN,
 };
@@ -82,7 +83,7 @@ pub fn model_parts<'a>(
         triangles: arena.slice(l.triangles, [0; 3]).ok_or(full)?,
         face_slot: arena.slice(l.triangles, 0).ok_or(full)?,
         slot_tet: arena.slice(l.triangles, 0).ok_or(full)?,
-        planes: arena.slice(l.triangles, [0.0; 4]).ok_or(full)?,
+        planes: arena.slice(l.triangles, [0.0; PLANE_LEN]).ok_or(full)?,
         vertex_triangle_start: arena.slice(l.vertex_triangle_start, 0).ok_or(full)?,
         vertex_triangle: arena.slice(l.vertex_triangle, 0).ok_or(full)?,
         cell_start: arena.slice(l.cell_start, 0).ok_or(full)?,

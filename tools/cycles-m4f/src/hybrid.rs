@@ -5,6 +5,7 @@
 //! per run; the tick between physics updates is measured.
 
 use core::fmt::Write;
+use palpate_kernel::table::format::PLANE_LEN;
 
 use cortex_m_semihosting::hio::HostStream;
 use palpate_kernel::haptic::HybridLoop;
@@ -92,7 +93,7 @@ impl Model {
         let buffers = HybridSurfaceBuffers {
             positions_m: arena.slice(l.vertices, zero).ok_or(full)?,
             triangles: arena.slice(l.triangles, [0; 3]).ok_or(full)?,
-            planes: arena.slice(l.triangles, [0.0; 4]).ok_or(full)?,
+            planes: arena.slice(l.triangles, [0.0; PLANE_LEN]).ok_or(full)?,
             vertex_triangle_start: arena.slice(l.vertices + 1, 0).ok_or(full)?,
             vertex_triangle: arena.slice(3 * l.triangles, 0).ok_or(full)?,
             cell_start: arena.slice(l.cell_start, 0).ok_or(full)?,

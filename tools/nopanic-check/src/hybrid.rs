@@ -9,6 +9,8 @@
 //! volatile.
 
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
+use palpate_kernel::table::Plane;
+use palpate_kernel::table::format::PLANE_LEN;
 
 use palpate_kernel::haptic::HybridLoop;
 use palpate_kernel::hybrid::{HybridBuffers, HybridModel, HybridSurfaceBuffers, HybridTissue};
@@ -133,7 +135,7 @@ pub(super) struct HybridState {
     background_m: [[f32; 3]; VERTICES],
     positions_m: [[f32; 3]; VERTICES],
     triangles: [[u32; 3]; TRIANGLES],
-    planes: [[f32; 4]; TRIANGLES],
+    planes: [Plane<f32>; TRIANGLES],
     vertex_triangle_start: [u32; VERTICES + 1],
     vertex_triangle: [u32; 3 * TRIANGLES],
     cell_start: [u32; CELLS + 1],
@@ -148,7 +150,7 @@ impl HybridState {
             background_m: [[0.0; 3]; VERTICES],
             positions_m: [[0.0; 3]; VERTICES],
             triangles: [[0; 3]; TRIANGLES],
-            planes: [[0.0; 4]; TRIANGLES],
+            planes: [[0.0; PLANE_LEN]; TRIANGLES],
             vertex_triangle_start: [0; VERTICES + 1],
             vertex_triangle: [0; 3 * TRIANGLES],
             cell_start: [0; CELLS + 1],

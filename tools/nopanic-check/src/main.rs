@@ -118,6 +118,8 @@
 mod hybrid;
 
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
+use palpate_kernel::table::Plane;
+use palpate_kernel::table::format::PLANE_LEN;
 
 use cortex_m_rt::entry;
 use nalgebra::Vector3;
@@ -541,7 +543,7 @@ struct SurfaceState {
     triangles: [[u32; 3]; TRIANGLES],
     face_slot: [u32; TRIANGLES],
     slot_tet: [u32; TRIANGLES],
-    planes: [[f32; 4]; TRIANGLES],
+    planes: [Plane<f32>; TRIANGLES],
     vertex_triangle_start: [u32; VERTICES + 1],
     vertex_triangle: [u32; 3 * TRIANGLES],
     cell_start: [u32; CELLS + 1],
@@ -556,7 +558,7 @@ impl SurfaceState {
             triangles: [[0; 3]; TRIANGLES],
             face_slot: [0; TRIANGLES],
             slot_tet: [0; TRIANGLES],
-            planes: [[0.0; 4]; TRIANGLES],
+            planes: [[0.0; PLANE_LEN]; TRIANGLES],
             vertex_triangle_start: [0; VERTICES + 1],
             vertex_triangle: [0; 3 * TRIANGLES],
             cell_start: [0; CELLS + 1],
