@@ -13,6 +13,7 @@ use palpate::table::load::TableFile;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::contact::{ContactWork, SurfaceGeometry};
 use palpate_kernel::table::{CANDIDATE_MARGIN_RADII, TriangleIndex};
+use palpate_tests::Lcg;
 
 /// A tool a quarter of the surface's edge (0.2 m): its lists span a few
 /// cells' triangles, not all.
@@ -34,21 +35,9 @@ fn cube_table(tool_radius_m: f64) -> TableFile {
     TableFile::from_bytes(&build(&mesh, &report, &options).expect("build").bytes)
 }
 
-/// Deterministic uniform numbers in `[0, 1)` (a 64-bit LCG's top bits).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn vector(&mut self, half_m: f64) -> Vector3<f64> {
-        Vector3::new(self.next(), self.next(), self.next()).map(|u| (2.0 * u - 1.0) * half_m)
-    }
+/// A vector of uniform components in `[−half_m, half_m)`, m.
+fn vector(rng: &mut Lcg, half_m: f64) -> Vector3<f64> {
+    Vector3::new(rng.signed(), rng.signed(), rng.signed()) * half_m
 }
 
 /// The distance (m) from `p` to the triangle `[a, b, c]`: to its plane
@@ -74,16 +63,16 @@ fn distance_to_triangle(p: &Vector3<f64>, [a, b, c]: &[Vector3<f64>; 3]) -> f64 
 /// over a random point of a random surface triangle.
 fn near_surface(rng: &mut Lcg, table: &PrecomputedTable<'_, f64>, at_m: f64) -> Vector3<f64> {
     let triangles = table.surface_triangles();
-    let t = ((rng.next() * triangles.len() as f64) as usize).min(triangles.len() - 1);
+    let t = ((rng.unit() * triangles.len() as f64) as usize).min(triangles.len() - 1);
     let [a, b, c] = triangles[t].map(|v| Vector3::from(table.rest_positions()[v as usize]));
-    let (u, v) = (rng.next(), rng.next());
+    let (u, v) = (rng.unit(), rng.unit());
     let (u, v) = if u + v > 1.0 {
         (1.0 - u, 1.0 - v)
     } else {
         (u, v)
     };
     let n = (b - a).cross(&(c - a)).normalize();
-    a + (b - a) * u + (c - a) * v + n * ((2.0 * rng.next() - 1.0) * at_m)
+    a + (b - a) * u + (c - a) * v + n * ((2.0 * rng.unit() - 1.0) * at_m)
 }
 
 /// Every triangle within the candidate margin (2.25 radii: the penetration
@@ -164,7 +153,7 @@ fn detection_with_lists_finds_what_the_walk_finds() {
     let (mut contacts, mut tests_listed, mut tests_walked) = (0, 0u64, 0u64);
     for _ in 0..3000 {
         let to = near_surface(&mut rng, &listed, 3.0 * RADIUS_M);
-        let from = to + rng.vector(0.9 * RADIUS_M);
+        let from = to + vector(&mut rng, 0.9 * RADIUS_M);
         let (mut w1, mut w2) = (ContactWork::default(), ContactWork::default());
         let a = with_lists.detect(0, Some(&from), &to, RADIUS_M, &mut w1);
         let b = with_walk.detect(0, Some(&from), &to, RADIUS_M, &mut w2);

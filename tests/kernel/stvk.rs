@@ -10,7 +10,7 @@ use palpate::fem::material::Material;
 use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::tensor_mass::evaluate::forces_and_energy;
 use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
-use palpate_tests::{json_rows, read_reference_json, reference_dir};
+use palpate_tests::{Lcg, json_rows, read_reference_json, reference_dir};
 
 /// Both St Venant-Kirchhoff implementations.
 const FORMS: [StvkForm; 2] = [StvkForm::PerTet, StvkForm::Tensors];
@@ -43,27 +43,13 @@ fn max_diff(a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
     (diff, scale)
 }
 
-/// A deterministic pseudo-random number in [−1, 1) (64-bit LCG; no test
-/// dependency on a random crate's stream).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-}
-
 /// The cube (cells of 0.2 m) with every vertex moved by up to `amplitude_m`
 /// per axis: nodal noise of 0.04 m gives Green strains of 10–30 %.
 fn jiggled(mesh: &TetMesh, amplitude_m: f64, seed: u64) -> Vec<[f64; 3]> {
     let mut rng = Lcg(seed);
     mesh.positions
         .iter()
-        .map(|p| p.map(|c| c + amplitude_m * rng.next()))
+        .map(|p| p.map(|c| c + amplitude_m * rng.signed()))
         .collect()
 }
 

@@ -649,3 +649,23 @@ pub fn patch_section(
     out[body..].copy_from_slice(&crc.to_le_bytes());
     out
 }
+
+/// A deterministic pseudo-random stream (a 64-bit LCG with Knuth's MMIX
+/// constants): no test depends on a random crate's stream.
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next number, uniform in `[0, 1)` (the state's top 53 bits).
+    pub fn unit(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The next number, uniform in `[−1, 1)`.
+    pub fn signed(&mut self) -> f64 {
+        2.0 * self.unit() - 1.0
+    }
+}
