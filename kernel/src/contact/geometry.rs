@@ -411,15 +411,24 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// penetrates where it stands; triangles with all three vertices fixed
     /// (a rigid support, no compliance) are not touchable.
     ///
-    /// Candidates: the triangles around the surface vertices in the 27 grid
-    /// cells around `to_m` and, for the sweep, around `from_m` (once when
-    /// both are in the same cell; none for a point more than a cell plus
-    /// the radius outside the grid), each tested once however many of its
-    /// corners the cells hold. Bounded by `3 × max_query_triangles`
-    /// triangle tests (the cells around `to_m` and `from_m`, and the
+    /// Candidates, when the table's per-cell lists serve `radius_m`
+    /// ([`SurfaceIndex::candidates`]): the list of `to_m`'s cell (every
+    /// triangle such a sphere there can touch or lie under) and, for the
+    /// sweep, the lists of the cells from `from_m`'s towards `to_m`'s
+    /// (`SurfaceIndex::for_each_candidate_list_between`; a triangle in
+    /// two of them is tested twice, which changes nothing: each test keeps
+    /// the first of equals). Otherwise (a deforming surface, or a tool
+    /// larger than the lists serve): the triangles around the surface
+    /// vertices in the 27 grid cells around `to_m` and, for the sweep,
+    /// around `from_m`, each tested once however many of its corners the
+    /// cells hold. In both, none around `from_m` when both points are in
+    /// the same cell, and none for a point more than a cell plus the radius
+    /// outside the grid. Bounded by
+    /// [`SurfaceIndex::max_detection_tests`] triangle tests (with the
     /// penetration test's second pass), most rejected by two dot products
     /// with the stored plane; the sweep and the penetration test share the
-    /// visit of the cells around `to_m`.
+    /// visit at `to_m`. A candidate's barycentric weights are two more dot
+    /// products, with its stored frame ([`SurfaceIndex::weights`]).
     ///
     /// Sweep: an end outside that reach is first moved along the segment to
     /// where the segment leaves it ([`clip_towards`], computed from the end

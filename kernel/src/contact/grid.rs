@@ -232,7 +232,7 @@ pub fn bin<T: Real>(
 
 /// Each cell's candidate triangles as a CSR list, ascending within a cell
 /// (a counting sort over the triangles in order): triangle `t` in every
-/// cell of its [`candidate_cells`] for a tool of radius up to `radius_m`
+/// cell of its [`crate::table::candidate_cells`] for a tool of radius up to `radius_m`
 /// (m). `start` has the grid's cells plus one entries; `list` room for
 /// every filing ([`candidate_count`]; a shorter one drops the rest).
 /// [`DEAD_TRIANGLE`] slots and triangles with a corner beyond

@@ -7,7 +7,11 @@
 //! assembled from lists the kernel built itself. Both are then
 //! queried in bounded time: a query visits the 27 cells around a point,
 //! each holding at most [`SurfaceIndex::max_bucket`] vertices, each with at
-//! most [`SurfaceIndex::max_valence`] triangles.
+//! most [`SurfaceIndex::max_valence`] triangles; or, in a table (format 5),
+//! reads the candidate list of the point's cell, filed for a declared tool
+//! radius ([`SurfaceIndex::candidates`], at most
+//! [`SurfaceIndex::max_cell_triangles`] triangles). Each triangle's plane
+//! carries its barycentric frame ([`SurfaceIndex::weights`]).
 
 use nalgebra::Vector3;
 
@@ -152,7 +156,7 @@ pub(crate) struct BuiltLists<'a, T> {
 }
 
 /// Most cells per axis a sweep's candidate lists span
-/// ([`SurfaceIndex::for_each_candidate_list_between`]): a segment between
+/// (`SurfaceIndex::for_each_candidate_list_between`): a segment between
 /// neighbouring cells; a longer one reads its start's cell and those next
 /// to it towards its end.
 pub const MAX_SWEEP_CELLS_PER_AXIS: u32 = 2;
