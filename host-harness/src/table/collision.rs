@@ -47,7 +47,8 @@ pub const CELLS_PER_SURFACE_VERTEX: usize = 8;
 /// at most [`CELLS_PER_SURFACE_VERTEX`] cells per surface vertex, and its
 /// per-cell candidate lists for tools of radius up to `tool_radius_m` (m;
 /// at most the grid's cell edge over the margin's radii,
-/// `grid::candidate_radius_m`, so that a triangle is in at most 64 lists),
+/// `palpate_kernel::table::candidate_radius_m`, so that a triangle is in
+/// at most 64 lists),
 /// filed in `precision` (the loader files every triangle again in the
 /// table's scalar, from the stored positions and grid, and must find the
 /// same cells). A triangle corner outside `positions` (a corrupted input)

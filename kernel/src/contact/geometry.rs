@@ -472,31 +472,39 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 (true, false) => (*from_m, clip_towards(from_m, to_m, &reach)),
                 _ => (*from_m, *to_m),
             };
-            (start_m, end_m, (!same_cell && from_in).then_some(*from_m))
+            // A motion between neighbouring cells within the reach: the
+            // lists of the cells between its ends hold every triangle the
+            // walk would meet (a longer one walks).
+            let near = a.abs_diff(x) <= 1 && b.abs_diff(y) <= 1 && c.abs_diff(z) <= 1;
+            let short = from_in && to_in && near;
+            let from_m = (!same_cell && from_in).then_some(*from_m);
+            (start_m, end_m, from_m, short)
         });
         let mut scan = Scan {
             to_m: *to_m,
             radius_m,
             depth_m: radius_m * T::of_f64(PENETRATION_DEPTH_RADII),
-            segment: sweep.map(|(start_m, end_m, _)| [start_m, end_m]),
+            segment: sweep.map(|(start_m, end_m, ..)| [start_m, end_m]),
             hit: None,
             reached: None,
             unreached: Unreached::new(),
             order: 0,
             covered: false,
         };
-        // The table's per-cell lists when they serve this radius, else the
-        // walk over the 27 cells around each point.
-        let lists = self.index.candidates(to_m, radius_m);
+        // The table's per-cell lists when they serve this radius and the
+        // motion is short, else the walk over the 27 cells around each
+        // point.
+        let short = sweep.is_none_or(|(.., short)| short);
+        let lists = self.index.candidates(to_m, radius_m).filter(|_| short);
         match lists {
             Some(list) => {
                 if to_in {
                     self.visit_list(list, work, Pass::Tool, &mut scan);
                 }
-                if let Some((_, end_m, Some(from_m))) = &sweep {
-                    // The lists serve this radius (`lists`).
+                if let Some((_, end_m, Some(from_m), _)) = &sweep {
+                    // The lists serve this radius and the motion is short.
                     self.index
-                        .for_each_candidate_list_between(from_m, end_m, to_in, |list| {
+                        .for_each_candidate_list_between(from_m, end_m, |list| {
                             self.visit_list(list, work, Pass::Start, &mut scan)
                         });
                 }
@@ -506,7 +514,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 if to_in {
                     self.visit(to_m, &mut visited, work, Pass::Tool, &mut scan);
                 }
-                if let Some((_, _, Some(from_m))) = &sweep {
+                if let Some((_, _, Some(from_m), _)) = &sweep {
                     self.visit(from_m, &mut visited, work, Pass::Start, &mut scan);
                 }
             }
@@ -615,7 +623,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             let Some((normal, offset)) = self.index.plane(t) else {
                 continue;
             };
-            // At most `max_detection_tests` per detection: no wrap.
+            // At most `max_detection_tests` per detection, P per tick: no
+            // wrap.
             work.triangles_tested = work.triangles_tested.wrapping_add(1);
             self.test(pass, scan, t, normal, offset);
         }

@@ -155,12 +155,6 @@ pub(crate) struct BuiltLists<'a, T> {
     pub(crate) max_valence: u32,
 }
 
-/// Most cells per axis a sweep's candidate lists span
-/// (`SurfaceIndex::for_each_candidate_list_between`): a segment between
-/// neighbouring cells; a longer one reads its start's cell and those next
-/// to it towards its end.
-pub const MAX_SWEEP_CELLS_PER_AXIS: u32 = 2;
-
 /// One cell's candidate triangles, ascending
 /// ([`SurfaceIndex::candidates`]).
 #[derive(Clone, Copy, Debug)]
@@ -240,7 +234,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         let geometry_ok = [x, y, z, cell_m, radius_m].iter().all(|v| v.finite())
             && cell_m > T::zero()
             && radius_m >= T::zero()
-            && candidate_margin_m(radius_m) <= cell_m;
+            && candidate_margin_m(&grid, radius_m) <= cell_m;
         if !geometry_ok
             || dims.contains(&0)
             || grid.cell_count().and_then(|c| c.checked_add(1)) != Some(s.cell_start.len())
@@ -397,10 +391,10 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
 
     /// Checks the per-cell candidate lists: CSR over the grid's cells, each
     /// list strictly ascending, and exactly the filings of
-    /// [`crate::contact::grid::candidate_cells`] for the declared radius
-    /// (every triangle in each of its cells' lists, and nothing else: the
-    /// lists hold as many entries as there are filings). Cost: the filings
-    /// times a binary search in a list.
+    /// [`candidate_cells`] for the declared radius (each listed triangle
+    /// filed in its cell, and as many entries as filings: every triangle in
+    /// each of its cells' lists). Cost: linear in the entries and the
+    /// triangles.
     fn check_cell_triangles(&self, positions: &[[T; 3]]) -> Result<(), LoadError> {
         let bad = |cell: usize| LoadError::BadCellTriangles { cell: cell as u32 };
         let cells = self.grid.cell_count().unwrap_or(0);
@@ -417,7 +411,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             }
         }
         let radius_m = self.candidate_radius_m.unwrap_or(T::zero());
-        let margin_m = candidate_margin_m(radius_m);
+        let margin_m = candidate_margin_m(&self.grid, radius_m);
         // Nothing else: each listed triangle is filed in its cell.
         for cell in 0..cells {
             let c = self.grid.coordinates(cell);
@@ -437,20 +431,33 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                 }
             }
         }
-        // Everything: each filing is listed.
-        let mut missing = None;
-        for_each_candidate_filing(
-            &self.grid,
-            positions,
-            self.triangles,
-            radius_m,
-            |cell, t| {
-                if missing.is_none() && self.cell_triangles_at(cell).binary_search(&t).is_err() {
-                    missing = Some(cell);
-                }
-            },
-        );
-        missing.map_or(Ok(()), |cell| Err(bad(cell)))
+        // Everything: the lists hold as many entries as there are filings
+        // (with the above, listed ⊆ filed and no entry twice in a list:
+        // the same sets). Each triangle's count is the product of its
+        // spans, so this is linear in the triangles whatever their size; a
+        // total past the lists' names the first cell of the triangle that
+        // passed it.
+        let listed = self.cell_triangle.len() as u64;
+        let mut filings = 0u64;
+        for tri in self.triangles {
+            let Some(corners) = corners_of(positions, tri) else {
+                continue;
+            };
+            let [lo, hi] = candidate_cells(&self.grid, &corners, margin_m);
+            let span = |axis: usize| {
+                let (l, h) = (lo.get(axis).copied(), hi.get(axis).copied());
+                u64::from(h.unwrap_or(0).saturating_sub(l.unwrap_or(0))) + 1
+            };
+            filings = filings.saturating_add(span(0) * span(1) * span(2));
+            if filings > listed {
+                return Err(bad(self.grid.linear(lo)));
+            }
+        }
+        if filings == listed {
+            Ok(())
+        } else {
+            Err(bad(0))
+        }
     }
 
     /// The candidate list of cell `cell` (linear index; empty out of range).
@@ -473,27 +480,21 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         served.then(|| CandidateList(self.cell_triangles_at(self.grid.linear(self.cell_of(p)))))
     }
 
-    /// The candidate lists, for a tool of radius `radius_m`, of a sweep
-    /// from `a` to `b` (m): each cell of the box of cells from the cell of
-    /// `a` towards the cell of `b`, at most [`MAX_SWEEP_CELLS_PER_AXIS`]
-    /// per axis (for a segment between neighbouring cells, the box between
-    /// their cells: every point of the segment has its cell in it; a
-    /// longer one reads the cells next to `a` towards `b`), but the cell of
-    /// `b` when `skip_b` (its list read already). `f` gets each list. For
-    /// a tool the lists serve: the caller has [`Self::candidates`]' list.
+    /// The candidate lists of a sweep from `a` to `b` (m) in neighbouring
+    /// cells (at most one apart on each axis): each cell of the box of
+    /// cells between the two points' cells (at most 8; every point of the
+    /// segment has its cell in it) but the cell of `b` (its list read
+    /// already, at the tool). `f` gets each list. For a tool the lists
+    /// serve (the caller has [`Self::candidates`]' list) and a short motion
+    /// (`SurfaceGeometry::detect` walks the cells for a longer one).
     pub(crate) fn for_each_candidate_list_between(
         &self,
         a: &Vector3<T>,
         b: &Vector3<T>,
-        skip_b: bool,
         mut f: impl FnMut(CandidateList<'a>),
     ) {
         let ([ax, ay, az], [bx, by, bz]) = (self.cell_of(a), self.cell_of(b));
-        let reach = MAX_SWEEP_CELLS_PER_AXIS - 1;
-        let span = |p: u32, q: u32| {
-            let q = q.min(p.saturating_add(reach)).max(p.saturating_sub(reach));
-            (p.min(q), p.max(q))
-        };
+        let span = |p: u32, q: u32| (p.min(q), p.max(q));
         let ((x0, x1), (y0, y1), (z0, z1)) = (span(ax, bx), span(ay, by), span(az, bz));
         for k in z0..=z1 {
             for j in y0..=y1 {
@@ -501,7 +502,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                     // Corner by corner: an array comparison is a `memcmp`
                     // call on the firmware target.
                     let at_b = i == bx && j == by && k == bz;
-                    if !(skip_b && at_b) {
+                    if !at_b {
                         f(CandidateList(
                             self.cell_triangles_at(self.grid.linear([i, j, k])),
                         ));
@@ -524,17 +525,17 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     }
 
     /// The most triangle tests one detection by a tool of radius
-    /// `radius_m` does (`SurfaceGeometry::detect`): with the lists, the
-    /// tool's cell twice (the test, and the penetration test's second
-    /// pass) and up to `2³ − 1` more cells along the sweep; without,
-    /// `3 × max_query_triangles`.
+    /// `radius_m` does (`SurfaceGeometry::detect`): with the lists, for a
+    /// short motion, the tool's cell twice (the test, and the penetration
+    /// test's second pass) and up to `2³ − 1` more cells along the sweep;
+    /// a longer motion, or a tool the lists do not serve, walks: `3 ×
+    /// max_query_triangles`. The larger of the two when the lists serve.
     pub fn max_detection_tests(&self, radius_m: T) -> u32 {
-        let lists_serve = self.candidate_radius_m.is_some_and(|r| radius_m <= r);
-        if lists_serve {
-            let cells = MAX_SWEEP_CELLS_PER_AXIS.pow(3) + 1;
-            self.max_cell_triangles.saturating_mul(cells)
+        let walk = self.max_query_triangles.saturating_mul(3);
+        if self.candidate_radius_m.is_some_and(|r| radius_m <= r) {
+            walk.max(self.max_cell_triangles.saturating_mul(9))
         } else {
-            self.max_query_triangles.saturating_mul(3)
+            walk
         }
     }
 
@@ -773,14 +774,22 @@ pub(crate) fn corners_of<T: Real>(positions: &[[T; 3]], tri: &[u32; 3]) -> Optio
 /// candidate lists file it ([`candidate_margin_m`]): the contact test's
 /// penetration depth (`contact::PENETRATION_DEPTH_RADII`, 2: a plane that
 /// far from the centre, with the centre over its triangle; the contact
-/// layer asserts it fits) plus a quarter radius for the weight tolerance's
-/// reach past a triangle's edges.
+/// layer asserts it fits) plus a quarter radius of slack (the weight
+/// tolerance's reach past an edge is [`CANDIDATE_MARGIN_CELLS`]).
 pub const CANDIDATE_MARGIN_RADII: f64 = 2.25;
 
-/// The margin (m) by which the candidate lists widen each triangle's
-/// bounding box for a tool of radius up to `radius_m`.
-pub fn candidate_margin_m<T: Real>(radius_m: T) -> T {
-    radius_m * T::of_f64(CANDIDATE_MARGIN_RADII)
+/// The part of a cell edge the candidate lists add to every margin
+/// ([`candidate_margin_m`]): the weight tolerance's reach past a triangle's
+/// edges (`WEIGHT_TOLERANCE` of an edge, a cell at most, on both weights
+/// of an edge: 2e-5 in f32) with a margin, whatever the radius.
+pub const CANDIDATE_MARGIN_CELLS: f64 = 1e-4;
+
+/// The margin (m) by which the candidate lists of `grid` widen each
+/// triangle's bounding box for a tool of radius up to `radius_m`:
+/// [`CANDIDATE_MARGIN_RADII`] radii and [`CANDIDATE_MARGIN_CELLS`] of a
+/// cell.
+pub fn candidate_margin_m<T: Real>(grid: &Grid<T>, radius_m: T) -> T {
+    radius_m * T::of_f64(CANDIDATE_MARGIN_RADII) + grid.cell_m * T::of_f64(CANDIDATE_MARGIN_CELLS)
 }
 
 /// The tool radius (m) a table's candidate lists serve when asked for
@@ -789,7 +798,7 @@ pub fn candidate_margin_m<T: Real>(radius_m: T) -> T {
 /// box is at most an edge, at most a cell, wide): at most 64 lists per
 /// triangle. Negative or non-finite asks give 0.
 pub fn candidate_radius_m<T: Real>(grid: &Grid<T>, tool_radius_m: T) -> T {
-    let most = grid.cell_m / T::of_f64(CANDIDATE_MARGIN_RADII);
+    let most = grid.cell_m * T::of_f64((1.0 - CANDIDATE_MARGIN_CELLS) / CANDIDATE_MARGIN_RADII);
     if tool_radius_m > T::zero() {
         if tool_radius_m < most {
             tool_radius_m
@@ -829,7 +838,7 @@ pub(crate) fn for_each_candidate_filing<T: Real>(
     radius_m: T,
     mut f: impl FnMut(usize, u32),
 ) {
-    let margin_m = candidate_margin_m(radius_m);
+    let margin_m = candidate_margin_m(grid, radius_m);
     for (t, tri) in triangles.iter().enumerate() {
         let Some(corners) = corners_of(positions_m, tri) else {
             continue;

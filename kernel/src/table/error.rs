@@ -129,9 +129,10 @@ pub enum LoadError {
         tet: u32,
     },
     /// The surface-vertex grid is malformed (non-finite or non-positive
-    /// geometry, dimensions not matching the cell count, cell starts not
-    /// ascending, or a vertex filed more than one cell away from its
-    /// position).
+    /// geometry, a candidate-list tool radius negative, not finite or
+    /// widening by more than a cell, dimensions not matching the cell
+    /// count, cell starts not ascending, or a vertex filed more than one
+    /// cell away from its position).
     BadSurfaceGrid {
         /// Grid cell (or vertex, for a misfiled vertex) where it was found.
         index: u32,

@@ -321,14 +321,15 @@ pub enum SectionKind {
     /// `u32` × (the directory declares the count): each cell's candidate
     /// triangles, ascending: triangle `t` is in the list of every cell
     /// between the cells of the lowest and the highest corner of its
-    /// corners' bounding box widened by the candidate margin (the kernel's
-    /// `contact::grid::candidate_margin_m` of the grid record's tool
-    /// radius: the penetration test's depth plus slack), each clamped to
-    /// the grid as a query point is. So a sphere of at most that radius
-    /// centred in a cell finds in its list every triangle it can touch or
-    /// lie under. Checked at load by filing every triangle again. The
-    /// radius is at most the cell edge over the margin's radii, so a
-    /// triangle (at most a cell wide) is in at most 4 × 4 × 4 lists.
+    /// corners' bounding box widened by the candidate margin
+    /// (`table::candidate_margin_m` of the grid record's tool radius:
+    /// 2.25 radii, the penetration test's depth and slack, and 1e-4 of a
+    /// cell for the weight tolerance), each clamped to the grid as a query
+    /// point is. So a sphere of at most that radius centred in a cell finds
+    /// in its list every triangle it can touch or lie under. Checked at
+    /// load (each listed triangle filed in its cell, as many entries as
+    /// filings). The margin is at most a cell, so a triangle built from a
+    /// mesh (at most a cell wide) is in at most 4 × 4 × 4 lists.
     CellTriangle = 15,
     /// `scalar` × N: lumped vertex masses `m_i = ρ Σ_{tets ∋ i} V/4`, kg.
     LumpedMass = 16,

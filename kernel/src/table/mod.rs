@@ -23,7 +23,7 @@ mod tensor_mass;
 
 pub(crate) use collision::BuiltLists;
 pub use collision::{
-    CANDIDATE_MARGIN_RADII, CandidateList, DEAD_TRIANGLE, Grid, MAX_SWEEP_CELLS_PER_AXIS, Plane,
+    CANDIDATE_MARGIN_CELLS, CANDIDATE_MARGIN_RADII, CandidateList, DEAD_TRIANGLE, Grid, Plane,
     SurfaceIndex, candidate_cells, candidate_margin_m, candidate_radius_m, max_row, within,
 };
 pub(crate) use collision::{for_each_candidate_filing, plane_record};
