@@ -59,6 +59,27 @@ pub trait Real:
     fn lane_values(v: Self::Lanes) -> [Self; 4];
 }
 
+/// The methods whose text is the same for `f32` and `f64` (each type's
+/// own `is_finite`, cast and `wide` vector).
+macro_rules! same_in_both {
+    () => {
+        fn finite(self) -> bool {
+            self.is_finite()
+        }
+        fn trunc_u32(self) -> u32 {
+            self as u32
+        }
+        #[inline(always)]
+        fn lanes(x: [Self; 4]) -> Self::Lanes {
+            Self::Lanes::new(x)
+        }
+        #[inline(always)]
+        fn lane_values(v: Self::Lanes) -> [Self; 4] {
+            v.to_array()
+        }
+    };
+}
+
 impl Real for f32 {
     const BYTES: u32 = 4;
     type Lanes = wide::f32x4;
@@ -73,23 +94,10 @@ impl Real for f32 {
     fn of_f32(x: f32) -> Self {
         x
     }
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
     fn of_u32(x: u32) -> Self {
         x as f32
     }
-    fn trunc_u32(self) -> u32 {
-        self as u32
-    }
-    #[inline(always)]
-    fn lanes(x: [Self; 4]) -> Self::Lanes {
-        Self::Lanes::new(x)
-    }
-    #[inline(always)]
-    fn lane_values(v: Self::Lanes) -> [Self; 4] {
-        v.to_array()
-    }
+    same_in_both!();
 }
 
 impl Real for f64 {
@@ -106,21 +114,8 @@ impl Real for f64 {
     fn of_f32(x: f32) -> Self {
         f64::from(x)
     }
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
     fn of_u32(x: u32) -> Self {
         f64::from(x)
     }
-    fn trunc_u32(self) -> u32 {
-        self as u32
-    }
-    #[inline(always)]
-    fn lanes(x: [Self; 4]) -> Self::Lanes {
-        Self::Lanes::new(x)
-    }
-    #[inline(always)]
-    fn lane_values(v: Self::Lanes) -> [Self; 4] {
-        v.to_array()
-    }
+    same_in_both!();
 }

@@ -171,16 +171,6 @@ impl<'a> CandidateList<'a> {
     pub(crate) fn as_slice(&self) -> &'a [u32] {
         self.0
     }
-
-    /// How many.
-    pub fn len(&self) -> usize {
-        self.0.len()
-    }
-
-    /// `true` for an empty list.
-    pub fn is_empty(&self) -> bool {
-        self.0.is_empty()
-    }
 }
 
 /// A triangle slot that holds no triangle (a face of the deforming
