@@ -2,11 +2,11 @@
 
 use core::fmt;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint, resolve};
 use super::remap::QuasiNonLinear;
-use crate::math::cholesky::solve_blocks;
+use crate::math::ldlt::ContactMatrix;
 use crate::math::{Dispatch, Portable};
 use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
@@ -125,14 +125,35 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
 
     /// Contact forces for `contacts` (MODELS.md §2): builds the point
     /// compliances `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` and solves
-    /// `Σ_q C_pq g_q = d_p` by block Cholesky on the stack. The haptic path.
+    /// `Σ_q C_pq g_q = d_p` by a dense LDLᵀ on the stack. The haptic path.
     ///
-    /// Bounded: at most `M` contacts × 3 vertices each, `O(M³)` 3×3 products.
-    /// An empty set gives zero force. Errors: see [`ContactError`]; no force
-    /// is returned unless every check passed and every force is finite.
+    /// Bounded: at most `M` contacts × 3 vertices each, `(3M)³/6`
+    /// multiply-adds. An empty set gives zero force. Errors: see
+    /// [`ContactError`]; no force is returned unless every check passed and
+    /// every force is finite.
     pub fn contact_forces<const M: usize>(
         &self,
         contacts: &[impl AsConstraint<T>],
+    ) -> Result<ContactSolution<T, M>, ContactError> {
+        self.solve_contacts(contacts, None)
+    }
+
+    /// [`Self::contact_forces`], taking the point compliances of points
+    /// `memo` holds from it instead of the table, and leaving this set's in
+    /// it: a re-solve after a release in the same tick, or a tool at rest,
+    /// reads no compliance block again. The same result.
+    pub(crate) fn contact_forces_memo<const M: usize>(
+        &self,
+        contacts: &[impl AsConstraint<T>],
+        memo: &mut ComplianceMemo<T, M>,
+    ) -> Result<ContactSolution<T, M>, ContactError> {
+        self.solve_contacts(contacts, Some(memo))
+    }
+
+    fn solve_contacts<const M: usize>(
+        &self,
+        contacts: &[impl AsConstraint<T>],
+        memo: Option<&mut ComplianceMemo<T, M>>,
     ) -> Result<ContactSolution<T, M>, ContactError> {
         const {
             assert!(
@@ -168,27 +189,42 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             return Ok(solution);
         }
 
-        // Lower blocks of the point-compliance matrix, and its scale.
-        let mut blocks = [[Matrix3::<T>::zeros(); M]; M];
+        // The lower blocks of the point-compliance matrix, and its scale.
+        let remembered = memo
+            .as_deref()
+            .map(|memo| solution.points.map(|point| memo.position(&point)));
+        let mut matrix = ContactMatrix::zeros();
         let mut scale = T::zero();
-        for (q, (row, pq)) in blocks.iter_mut().zip(solution.points.iter()).enumerate() {
-            for (p, (block, pp)) in row
-                .iter_mut()
-                .zip(solution.points.iter())
-                .enumerate()
-                .take(q + 1)
-            {
-                *block = self.point_compliance(pq, pp, p == q);
+        for (q, pq) in solution.points.iter().enumerate().take(m) {
+            for (p, pp) in solution.points.iter().enumerate().take(q + 1) {
+                let cached = remembered.and_then(|at| match (at.get(q), at.get(p)) {
+                    (Some(&Some(i)), Some(&Some(j))) if i >= j => Some((i, j)),
+                    _ => None,
+                });
+                let block = cached
+                    .and_then(|(i, j)| memo.as_deref()?.matrix.block(i, j))
+                    .unwrap_or_else(|| self.point_compliance(pq, pp, p == q));
+                matrix.set_block(q, p, &block);
                 if p == q {
-                    scale = block.diagonal().iter().fold(scale, |s, &c| s.larger(c));
+                    scale = block
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(i, row)| row.get(i))
+                        .fold(scale, |s, &c| s.larger(c));
                 }
             }
+        }
+        if let Some(memo) = memo {
+            memo.points = solution.points;
+            memo.len = m;
+            memo.matrix = matrix;
         }
         let min_pivot = T::MIN_PIVOT_RATIO * scale;
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
         }
-        solve_blocks(&mut blocks, &mut solution.linear_forces_n, m, min_pivot)
+        matrix
+            .solve(&mut solution.linear_forces_n, m, min_pivot)
             .map_err(|contact| ContactError::IllConditioned { contact })?;
         solution.forces_n = solution.linear_forces_n;
         if let Some(remap) = &self.remap {
@@ -216,48 +252,39 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         Ok(solution)
     }
 
-    /// `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` (3×3, m/N): each stored
-    /// block read once and added, or its transpose, to one row-major sum
-    /// (nine scalars the firmware target keeps in registers); for `p = q`
-    /// (`same`) the pair `a ≠ b` is one read of the stored block for both
-    /// its terms, `β_a β_b (C_ab + C_abᵀ)`, so at most six reads instead of
-    /// nine.
+    /// `C_qp = Σ_a Σ_b β^q_a β^p_b C_{v^q_a v^p_b}` (3×3 row-major, m/N):
+    /// each stored block (`C_lo,hi`) read once and added, or its transpose,
+    /// to one sum (nine scalars the firmware target keeps in registers);
+    /// for `q = p` (`same`) the pair `a ≠ b` is one read of the stored block
+    /// for both its terms, `β_a β_b (C_ab + C_abᵀ)`, so at most six reads
+    /// instead of nine.
     fn point_compliance(
         &self,
-        p: &ResolvedPoint<T>,
         q: &ResolvedPoint<T>,
+        p: &ResolvedPoint<T>,
         same: bool,
-    ) -> Matrix3<T> {
-        let mut sum = [T::zero(); 9];
-        for (i, (a, beta_a)) in p.terms().enumerate() {
-            for (j, (b, beta_b)) in q.terms().enumerate() {
-                if same && j < i {
+    ) -> [[T; 3]; 3] {
+        let mut sum = [[T::zero(); 3]; 3];
+        for (i, (&a, &beta_a)) in q.touchable.iter().zip(&q.weights).enumerate().take(q.len) {
+            let first = if same { i } else { 0 };
+            for (j, (&b, &beta_b)) in p.touchable.iter().zip(&p.weights).enumerate().take(p.len) {
+                if j < first {
                     continue;
                 }
                 let Some((block, transposed)) = self.table.stored_touchable_block(a, b) else {
                     continue;
                 };
                 let both = same && j > i;
-                // `C_ab`, its transpose, or both added (one code path: the
-                // firmware's flash holds one copy of the sum).
-                let mut b = block;
-                if transposed || both {
-                    b.swap(1, 3);
-                    b.swap(2, 6);
-                    b.swap(5, 7);
-                }
-                if both {
-                    for (x, y) in b.iter_mut().zip(&block) {
-                        *x += *y;
-                    }
-                }
                 let w = beta_a * beta_b;
-                for (s, x) in sum.iter_mut().zip(&b) {
-                    *s += w * *x;
+                if !transposed || both {
+                    add_scaled(&mut sum, w, &block, false);
+                }
+                if transposed || both {
+                    add_scaled(&mut sum, w, &block, true);
                 }
             }
         }
-        Matrix3::from_row_slice(&sum)
+        sum
     }
 
     /// The displacement of every free vertex for a solved contact set, m, by
@@ -415,6 +442,50 @@ fn check_length<E>(expected: usize, out: &[E]) -> Result<(), DisplacementError> 
             expected,
             found: out.len(),
         })
+    }
+}
+
+/// `sum += w B` for the row-major 3×3 `block` `B`, or `w Bᵀ`.
+#[inline(always)]
+fn add_scaled<T: Real>(sum: &mut [[T; 3]; 3], w: T, block: &[T; 9], transposed: bool) {
+    for (r, row) in sum.iter_mut().enumerate() {
+        for (c, s) in row.iter_mut().enumerate() {
+            let k = if transposed { 3 * c + r } else { 3 * r + c };
+            if let Some(&x) = block.get(k) {
+                *s += w * x;
+            }
+        }
+    }
+}
+
+/// The point compliances of the last contact set a tissue solved, before
+/// factorization, with its points (see
+/// [`PrecomputedModel::contact_forces_memo`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ComplianceMemo<T: Real, const M: usize> {
+    points: [ResolvedPoint<T>; M],
+    len: usize,
+    matrix: ContactMatrix<T, M>,
+}
+
+impl<T: Real, const M: usize> ComplianceMemo<T, M> {
+    /// Remembers nothing.
+    pub(crate) fn new() -> Self {
+        Self {
+            points: [ResolvedPoint::empty(); M],
+            len: 0,
+            matrix: ContactMatrix::zeros(),
+        }
+    }
+
+    /// Forgets every point.
+    pub(crate) fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// Where `point` is among the remembered points.
+    fn position(&self, point: &ResolvedPoint<T>) -> Option<usize> {
+        self.points.iter().take(self.len).position(|p| p == point)
     }
 }
 

@@ -5,17 +5,20 @@
 
 use nalgebra::Vector3;
 
+use super::model::ComplianceMemo;
 use super::{ContactSolution, PrecomputedModel, QuasiNonLinear};
 use crate::contact::{ContactSet, Refusal, SurfaceGeometry, Tissue};
 use crate::table::PrecomputedTable;
 use crate::{MAX_CONTACTS, Real};
 
 /// The pre-computed model as a tissue, with the last contact solution (for
-/// the deformation field at the physics rate).
+/// the deformation field at the physics rate) and its point compliances (a
+/// re-solve after a release reads no table block again).
 pub struct PrecomputedTissue<'a, T: Real, const M: usize> {
     model: PrecomputedModel<'a, T>,
     table: &'a PrecomputedTable<'a, T>,
     solution: Option<ContactSolution<T, M>>,
+    memo: ComplianceMemo<T, M>,
 }
 
 impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
@@ -26,6 +29,7 @@ impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
             model: PrecomputedModel::new(*table),
             table,
             solution: None,
+            memo: ComplianceMemo::new(),
         }
     }
 
@@ -63,7 +67,7 @@ impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
     fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal> {
         let solution = self
             .model
-            .contact_forces::<M>(set.as_slice())
+            .contact_forces_memo(set.as_slice(), &mut self.memo)
             .map_err(|e| e.contact().map_or(Refusal::Fault, Refusal::Contact))?;
         for (c, g) in set.iter_mut().zip(solution.contact_forces_n()) {
             c.force_n = *g;
@@ -75,9 +79,10 @@ impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
 
     fn forget(&mut self) {
         self.solution = None;
+        self.memo.clear();
     }
 
     fn reset(&mut self) {
-        self.solution = None;
+        self.forget();
     }
 }

@@ -1,6 +1,6 @@
 //! The validated, zero-copy view of a pre-computed table.
 
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 use super::LoadError;
 use super::collision::{SurfaceIndex, SurfaceSections};
@@ -11,7 +11,7 @@ use super::format::{
 };
 use super::index::{FreeIndex, VertexIndex, VertexSlot};
 use crate::Real;
-use crate::math::cholesky::cholesky3;
+use crate::math::ldlt::ContactMatrix;
 
 /// A pre-computed table that passed every load-time check; the step path
 /// takes only this type.
@@ -287,7 +287,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
 
     /// Every `C_kk` must be stored, symmetric (to 1e-4 relative, well above
     /// f32 rounding and the 16-bit codes' rounding, which the writer applies
-    /// to a symmetrized block) and positive definite (a 3×3 Cholesky with
+    /// to a symmetrized block) and positive definite (an LDLᵀ with
     /// positive pivots): a compliance of an elastic body with fixed vertices
     /// is SPD.
     fn check_diagonal_blocks(&self) -> Result<(), LoadError> {
@@ -301,7 +301,11 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             let scale = c.abs().max();
             let sym_tol = T::of_f64(1e-4) * scale;
             let asym = (c - c.transpose()).abs().max();
-            if asym > sym_tol || !asym.finite() || cholesky3(&c, T::zero()).is_none() {
+            let mut matrix = ContactMatrix::<T, 1>::zeros();
+            // The rows of `c`: the columns of its (column-major) transpose.
+            matrix.set_block(0, 0, &c.transpose().data.0);
+            let factorizes = matrix.solve(&mut [Vector3::zeros()], 1, T::zero()).is_ok();
+            if asym > sym_tol || !asym.finite() || !factorizes {
                 return Err(bad);
             }
         }

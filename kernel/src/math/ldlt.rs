@@ -1,0 +1,220 @@
+//! The contact system's dense LDLᵀ factorization, on the stack.
+//!
+//! The contact system of MODELS.md §2 is symmetric positive definite with
+//! `3m × 3m` scalars for `m ≤ M` contacts. Stable Rust cannot size an array
+//! `3·M`, so [`ContactMatrix`] holds it as `M` block rows of three scalar
+//! rows of `M` blocks of three scalars: the same bytes as a row-major
+//! `3M × 3M` array. It is factorized by 3×3 blocks as `A = L D Lᵀ` (`L`
+//! unit lower-triangular, `D` diagonal; Golub & Van Loan, *Matrix
+//! Computations*, 4th ed., §4.1.2 and §4.2.9): no square root, one division
+//! per row, and `D_jj` is exactly the square of the Cholesky factor's
+//! diagonal, so the pivot test is the textbook Cholesky one.
+
+use nalgebra::Vector3;
+
+use crate::Real;
+
+/// The lower triangle of a symmetric `3m × 3m` matrix of at most `M`
+/// contacts: scalar `(3q + r, 3p + c)` is `rows[q][r][p][c]`. Only entries
+/// on or below the diagonal are read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ContactMatrix<T, const M: usize> {
+    rows: [[[[T; 3]; M]; 3]; M],
+}
+
+impl<T: Real, const M: usize> ContactMatrix<T, M> {
+    /// All zero.
+    pub(crate) fn zeros() -> Self {
+        Self {
+            rows: [[[[T::zero(); 3]; M]; 3]; M],
+        }
+    }
+
+    /// Block `(q, p)` (row `r` of it is `[3q + r][3p .. 3p + 3]`), `None`
+    /// beyond `M`.
+    pub(crate) fn block(&self, q: usize, p: usize) -> Option<[[T; 3]; 3]> {
+        let rows = self.rows.get(q)?;
+        let mut block = [[T::zero(); 3]; 3];
+        for (out, row) in block.iter_mut().zip(rows) {
+            *out = *row.get(p)?;
+        }
+        Some(block)
+    }
+
+    /// Sets block `(q, p)`; nothing beyond `M`.
+    pub(crate) fn set_block(&mut self, q: usize, p: usize, block: &[[T; 3]; 3]) {
+        if let Some(rows) = self.rows.get_mut(q) {
+            for (row, values) in rows.iter_mut().zip(block) {
+                if let Some(out) = row.get_mut(p) {
+                    *out = *values;
+                }
+            }
+        }
+    }
+
+    /// Block `(q, p)`, zero beyond `M`.
+    #[inline(always)]
+    fn at(&self, q: usize, p: usize) -> Block<T> {
+        let mut block = [[T::zero(); 3]; 3];
+        if let Some(rows) = self.rows.get(q) {
+            for (out, row) in block.iter_mut().zip(rows) {
+                if let Some(values) = row.get(p) {
+                    *out = *values;
+                }
+            }
+        }
+        block
+    }
+
+    /// Factorizes the leading `3m × 3m` part in place as `A = L D Lᵀ` by
+    /// 3×3 blocks (`L_qp` below the diagonal, the unit lower `L_pp` on it)
+    /// and solves `A g = d` in place of `d` (`m` is clamped to `M`):
+    /// `L y = d`, `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two
+    /// 3×3 blocks loads 18 scalars for 27 multiply-adds.
+    ///
+    /// Returns `Err(p)` with the contact (block row) of the first pivot
+    /// `D_jj` that is not finite or not greater than `min_pivot` (a
+    /// singular or ill-conditioned contact set). Work: about `(3m)³/6`
+    /// multiply-adds and `3m` divisions.
+    pub(crate) fn solve(
+        &mut self,
+        d: &mut [Vector3<T>; M],
+        m: usize,
+        min_pivot: T,
+    ) -> Result<(), usize> {
+        let m = m.min(M);
+        let inverse_pivots = self.factor(m, min_pivot)?;
+        // L y = d, block row by block row.
+        for p in 0..m {
+            let mut y = d.get(p).map_or([T::zero(); 3], |v| [v.x, v.y, v.z]);
+            for (r, x) in d.iter().enumerate().take(p) {
+                subtract_product(&mut y, &self.at(p, r), &[x.x, x.y, x.z]);
+            }
+            let l = self.at(p, p);
+            y[1] -= l[1][0] * y[0];
+            y[2] -= l[2][0] * y[0] + l[2][1] * y[1];
+            if let Some(out) = d.get_mut(p) {
+                *out = Vector3::new(y[0], y[1], y[2]);
+            }
+        }
+        // Lᵀ g = z with z = D⁻¹ y, from the last block row.
+        for (p, inv) in inverse_pivots.iter().enumerate().take(m).rev() {
+            let y = d.get(p).map_or([T::zero(); 3], |v| [v.x, v.y, v.z]);
+            let mut x = [y[0] * inv[0], y[1] * inv[1], y[2] * inv[2]];
+            for (q, g) in d.iter().enumerate().take(m).skip(p + 1) {
+                subtract_transposed_product(&mut x, &self.at(q, p), &[g.x, g.y, g.z]);
+            }
+            let l = self.at(p, p);
+            x[1] -= l[2][1] * x[2];
+            x[0] -= l[1][0] * x[1] + l[2][0] * x[2];
+            if let Some(out) = d.get_mut(p) {
+                *out = Vector3::new(x[0], x[1], x[2]);
+            }
+        }
+        Ok(())
+    }
+
+    /// `A = L D Lᵀ` of the leading `m × m` blocks, `L` in place; returns
+    /// `D⁻¹` by block row (see [`Self::solve`] for the error).
+    fn factor(&mut self, m: usize, min_pivot: T) -> Result<[[T; 3]; M], usize> {
+        let mut pivots = [[T::zero(); 3]; M];
+        let mut inverse_pivots = [[T::zero(); 3]; M];
+        for p in 0..m {
+            // S = A_pp − Σ_r L_pr D_r L_prᵀ.
+            let mut s = self.at(p, p);
+            for (r, pivot) in pivots.iter().enumerate().take(p) {
+                let l = self.at(p, r);
+                subtract_block_product(&mut s, &l, &scale_columns(&l, pivot));
+            }
+            let (unit, pivot, inverse) = ldlt3(&s, min_pivot).ok_or(p)?;
+            self.set_block(p, p, &unit);
+            if let (Some(d), Some(inv)) = (pivots.get_mut(p), inverse_pivots.get_mut(p)) {
+                *d = pivot;
+                *inv = inverse;
+            }
+            for q in p + 1..m {
+                // X = A_qp − Σ_r L_qr D_r L_prᵀ, then L_qp = X L_ppᵀ⁻¹ D_p⁻¹:
+                // each row x of X solves L_pp y = x, over D_p.
+                let mut x = self.at(q, p);
+                for (r, pivot) in pivots.iter().enumerate().take(p) {
+                    let w = scale_columns(&self.at(p, r), pivot);
+                    subtract_block_product(&mut x, &self.at(q, r), &w);
+                }
+                let l_qp = x.map(|mut y| {
+                    y[1] -= unit[1][0] * y[0];
+                    y[2] -= unit[2][0] * y[0] + unit[2][1] * y[1];
+                    [y[0] * inverse[0], y[1] * inverse[1], y[2] * inverse[2]]
+                });
+                self.set_block(q, p, &l_qp);
+            }
+        }
+        Ok(inverse_pivots)
+    }
+}
+
+/// A 3×3 block, row-major.
+type Block<T> = [[T; 3]; 3];
+
+/// `S = L D Lᵀ` of the symmetric 3×3 `s` (its lower triangle read):
+/// the unit lower `L`, `D` and `D⁻¹`; `None` if a pivot is not finite or
+/// not greater than `min_pivot`.
+fn ldlt3<T: Real>(s: &Block<T>, min_pivot: T) -> Option<(Block<T>, [T; 3], [T; 3])> {
+    let pivot_ok = |d: T| d.finite() && d > min_pivot;
+    let d0 = s[0][0];
+    if !pivot_ok(d0) {
+        return None;
+    }
+    let i0 = T::one() / d0;
+    let l10 = s[1][0] * i0;
+    let l20 = s[2][0] * i0;
+    let d1 = s[1][1] - l10 * s[1][0];
+    if !pivot_ok(d1) {
+        return None;
+    }
+    let i1 = T::one() / d1;
+    let l21 = (s[2][1] - l20 * s[1][0]) * i1;
+    let d2 = s[2][2] - l20 * s[2][0] - l21 * l21 * d1;
+    if !pivot_ok(d2) {
+        return None;
+    }
+    let (z, o) = (T::zero(), T::one());
+    Some((
+        [[o, z, z], [l10, o, z], [l20, l21, o]],
+        [d0, d1, d2],
+        [i0, i1, T::one() / d2],
+    ))
+}
+
+/// `L D`: column `k` of `l` times `d_k`.
+#[inline(always)]
+fn scale_columns<T: Real>(l: &Block<T>, d: &[T; 3]) -> Block<T> {
+    l.map(|row| [row[0] * d[0], row[1] * d[1], row[2] * d[2]])
+}
+
+/// `x −= a bᵀ`.
+#[inline(always)]
+fn subtract_block_product<T: Real>(x: &mut Block<T>, a: &Block<T>, b: &Block<T>) {
+    for (x_row, a_row) in x.iter_mut().zip(a) {
+        for (x_ij, b_row) in x_row.iter_mut().zip(b) {
+            *x_ij -= a_row[0] * b_row[0] + a_row[1] * b_row[1] + a_row[2] * b_row[2];
+        }
+    }
+}
+
+/// `y −= a v`.
+#[inline(always)]
+fn subtract_product<T: Real>(y: &mut [T; 3], a: &Block<T>, v: &[T; 3]) {
+    for (y_i, a_row) in y.iter_mut().zip(a) {
+        *y_i -= a_row[0] * v[0] + a_row[1] * v[1] + a_row[2] * v[2];
+    }
+}
+
+/// `y −= aᵀ v`.
+#[inline(always)]
+fn subtract_transposed_product<T: Real>(y: &mut [T; 3], a: &Block<T>, v: &[T; 3]) {
+    for (a_row, &v_i) in a.iter().zip(v) {
+        for (y_j, &a_ij) in y.iter_mut().zip(a_row) {
+            *y_j -= a_ij * v_i;
+        }
+    }
+}
