@@ -86,7 +86,7 @@
  writes it; any other version is refused with
  `PALPATE_STATUS_TABLE_UNSUPPORTED_VERSION`).
  */
-#define PALPATE_TABLE_FORMAT_VERSION 5
+#define PALPATE_TABLE_FORMAT_VERSION 6
 
 /*
  Tool points of a haptic loop, at most (a probe tip, a grasper's two
@@ -115,14 +115,14 @@
 /*
  Words of a `palpate_table` on 64-bit targets (the host).
  */
-#define PALPATE_TABLE_WORDS 73
+#define PALPATE_TABLE_WORDS 77
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_table` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_TABLE_WORDS 51
+#define PALPATE_TABLE_WORDS 55
 #endif
 
 /*
@@ -134,14 +134,14 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 280
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 288
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 250
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 258
 #endif
 
 #if defined(PALPATE_POINTER_64)

@@ -75,7 +75,7 @@ pub const PALPATE_ABI_VERSION: u32 = 3;
 /// The table format version this library reads (`palpate tables build`
 /// writes it; any other version is refused with
 /// `PALPATE_STATUS_TABLE_UNSUPPORTED_VERSION`).
-pub const PALPATE_TABLE_FORMAT_VERSION: u32 = 5;
+pub const PALPATE_TABLE_FORMAT_VERSION: u32 = 6;
 const _: () = assert!(PALPATE_TABLE_FORMAT_VERSION == FORMAT_VERSION);
 
 /// Tool points of a haptic loop, at most (a probe tip, a grasper's two

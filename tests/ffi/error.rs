@@ -82,7 +82,7 @@ fn details_display_as_the_kernel() {
         ),
         (
             Detail::Load(LoadError::UnsupportedVersion { found: 2 }),
-            "table format version 2 is not read by this kernel (version 5)",
+            "table format version 2 is not read by this kernel (version 6)",
         ),
         (
             Detail::Abi(Status::NullPointer),

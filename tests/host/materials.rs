@@ -393,7 +393,7 @@ fn version_2_tables_and_bad_tet_materials_are_refused() {
     println!("{message}");
     assert!(
         message.contains(
-            "table format version 2 is not read by this kernel (version 5): rebuild the table with `palpate tables build`"
+            "table format version 2 is not read by this kernel (version 6): rebuild the table with `palpate tables build`"
         ),
         "{message}"
     );

@@ -1,7 +1,7 @@
-//! The collision index's per-cell candidate lists (table format 5;
+//! The collision index's per-cell candidate lists (table format 6;
 //! `palpate_kernel::table::SurfaceIndex::candidates`, used by
-//! `SurfaceGeometry::detect`): checked against an exact point-triangle
-//! distance (every triangle a tool can reach is in its cell's list) and
+//! `SurfaceGeometry::detect`): checked against an exact projection on each
+//! triangle (every triangle a tool can be found on is in its cell's list) and
 //! against the walk over 27 cells they replace (the same contacts), on the
 //! reference cube (1 m, 0.2 m cells of 6 tets).
 
@@ -40,23 +40,18 @@ fn vector(rng: &mut Lcg, half_m: f64) -> Vector3<f64> {
     Vector3::new(rng.signed(), rng.signed(), rng.signed()) * half_m
 }
 
-/// The distance (m) from `p` to the triangle `[a, b, c]`: to its plane
-/// when `p` projects inside, else to the nearest edge (Ericson, Real-Time
-/// Collision Detection §5.1.5, by regions).
-fn distance_to_triangle(p: &Vector3<f64>, [a, b, c]: &[Vector3<f64>; 3]) -> f64 {
+/// The signed distance (m) of `p` from the plane of triangle `[a, b, c]`
+/// (along its right-hand unit normal), and whether `p` projects into the
+/// triangle (edges included): by cross products, independent of the
+/// table's stored frames.
+fn over_triangle(p: &Vector3<f64>, [a, b, c]: &[Vector3<f64>; 3]) -> (f64, bool) {
     let n = (b - a).cross(&(c - a)).normalize();
-    let q = p - n * n.dot(&(p - a));
+    let distance = n.dot(&(p - a));
+    let q = p - n * distance;
     let inside = [(a, b), (b, c), (c, a)]
         .iter()
         .all(|(u, v)| (*v - *u).cross(&(q - *u)).dot(&n) >= 0.0);
-    if inside {
-        return n.dot(&(p - a)).abs();
-    }
-    let segment = |u: &Vector3<f64>, v: &Vector3<f64>| {
-        let t = ((p - u).dot(&(v - u)) / (v - u).norm_squared()).clamp(0.0, 1.0);
-        (p - (u + (v - u) * t)).norm()
-    };
-    segment(a, b).min(segment(b, c)).min(segment(c, a))
+    (distance, inside)
 }
 
 /// A point `at_m` metres off the surface (along the normal, either side)
@@ -75,19 +70,21 @@ fn near_surface(rng: &mut Lcg, table: &PrecomputedTable<'_, f64>, at_m: f64) -> 
     a + (b - a) * u + (c - a) * v + n * ((2.0 * rng.unit() - 1.0) * at_m)
 }
 
-/// Every triangle within the candidate margin (2.25 radii: the penetration
-/// test's depth of 2 radii, and slack) of a point is in the list of the
-/// point's cell, for 4000 points within 3 radii of the surface and beyond
-/// the grid's box; and the lists are short: the longest holds at most a
-/// third of the triangles the walk over 27 cells visits (measured: 32 of
-/// the 300 surface triangles, against 366 triangle visits).
+/// Every triangle a tool can be found on from a point (the point projects
+/// into it and lies within 2.25 radii of its plane: the penetration test's
+/// depth of 2 radii, and slack) is in the list of the point's cell, for
+/// 4000 points within 3 radii of the surface and beyond the grid's box;
+/// and the lists are short: the longest holds at most a sixth of the
+/// triangles the walk over 27 cells visits (measured: 24 of the 300
+/// surface triangles, against 366 triangle visits; 32 when the lists
+/// filed every triangle within 2.25 radii of a cell, whatever its normal).
 #[test]
 fn every_triangle_within_reach_is_in_the_cell_list() {
     let file = cube_table(RADIUS_M);
     let table = PrecomputedTable::<f64>::load(file.bytes()).unwrap();
     let index = table.surface_index();
     assert_eq!(index.candidate_radius_m(), Some(RADIUS_M));
-    let margin_m = RADIUS_M * CANDIDATE_MARGIN_RADII;
+    let depth_m = RADIUS_M * CANDIDATE_MARGIN_RADII;
     let corners: Vec<[Vector3<f64>; 3]> = table
         .surface_triangles()
         .iter()
@@ -107,21 +104,22 @@ fn every_triangle_within_reach_is_in_the_cell_list() {
             .expect("lists serve the radius");
         let listed: Vec<TriangleIndex> = list.iter().collect();
         for (t, c) in corners.iter().enumerate() {
-            if distance_to_triangle(&p, c) <= margin_m {
+            let (distance_m, inside) = over_triangle(&p, c);
+            if inside && distance_m.abs() <= depth_m {
                 checked += 1;
                 let id = TriangleIndex::new(t as u32, corners.len()).unwrap();
                 assert!(listed.contains(&id), "triangle {t} not listed at {p:?}");
             }
         }
     }
-    assert!(checked > 4000, "{checked}");
+    assert!(checked > 3000, "{checked}");
     let longest = index.max_cell_triangles();
     println!(
         "longest list {longest} of {} triangles; walk {}",
         corners.len(),
         index.max_query_triangles()
     );
-    assert!(3 * longest <= index.max_query_triangles(), "{longest}");
+    assert!(6 * longest <= index.max_query_triangles(), "{longest}");
     // A larger tool than the lists serve walks the grid.
     assert!(
         index
@@ -135,8 +133,9 @@ fn every_triangle_within_reach_is_in_the_cell_list() {
 /// 1.5 radii per tick, from up to 3 radii off it) both find the same
 /// contact (point, normal and gap to 1e-12 m: the same triangle but where
 /// the point lies on an edge between coplanar ones) or none, while the
-/// lists test at most half the triangles (measured: 1386 contacts, 90 218
-/// triangle tests against 260 477).
+/// lists test at most a quarter of the triangles (measured: 1386 contacts,
+/// 49 528 triangle tests against 260 477; 90 218 when the lists filed
+/// every triangle within 2.25 radii of a cell, whatever its normal).
 #[test]
 fn detection_with_lists_finds_what_the_walk_finds() {
     let (listed_file, walked_file) = (cube_table(RADIUS_M), cube_table(0.0));
@@ -177,7 +176,7 @@ fn detection_with_lists_finds_what_the_walk_finds() {
     println!("{contacts} contacts; triangles tested: lists {tests_listed}, walk {tests_walked}");
     assert!(contacts > 500, "{contacts}");
     assert!(
-        2 * tests_listed <= tests_walked,
+        4 * tests_listed <= tests_walked,
         "{tests_listed} vs {tests_walked}"
     );
 }

@@ -7,7 +7,7 @@
 
 use palpate_kernel::Real;
 use palpate_kernel::contact::grid::{self, BinBuffers, Binned};
-use palpate_kernel::table::{Grid, candidate_radius_m};
+use palpate_kernel::table::{Grid, candidate_radius_m, list_subdivision};
 
 use super::file::Precision;
 use palpate_kernel::table::Plane;
@@ -21,6 +21,9 @@ pub struct CollisionIndex {
     pub grid: [f64; GRID_LEN],
     /// Cells per axis.
     pub dims: [u32; 3],
+    /// Cells per axis of the candidate lists' grid (the grid's box in
+    /// cells `palpate_kernel::table::list_subdivision` times finer).
+    pub list_dims: [u32; 3],
     /// CSR starts of each cell's vertices (cells + 1).
     pub cell_start: Vec<u32>,
     /// Surface vertices by cell, each once.
@@ -47,8 +50,8 @@ pub const CELLS_PER_SURFACE_VERTEX: usize = 8;
 /// at most [`CELLS_PER_SURFACE_VERTEX`] cells per surface vertex, and its
 /// per-cell candidate lists for tools of radius up to `tool_radius_m` (m;
 /// at most the grid's cell edge over the margin's radii,
-/// `palpate_kernel::table::candidate_radius_m`, so that a triangle is in
-/// at most 64 lists),
+/// `palpate_kernel::table::candidate_radius_m`) over the lists' grid
+/// (`palpate_kernel::table::list_subdivision` times finer),
 /// filed in `precision` (the loader files every triangle again in the
 /// table's scalar, from the stored positions and grid, and must find the
 /// same cells). A triangle corner outside `positions` (a corrupted input)
@@ -86,14 +89,16 @@ pub fn collision_index(
     // still widens a box by at most a cell.
     let most_m = candidate_radius_m(&grid, f64::INFINITY) * (1.0 - 1e-6);
     let radius_m = candidate_radius_m(&grid, tool_radius_m).min(most_m);
+    let k = list_subdivision(&grid, radius_m);
     let (cell_triangle_start, cell_triangle) = match precision {
-        Precision::F32 => candidate_lists::<f32>(&grid, positions, triangles, radius_m),
-        Precision::F64 => candidate_lists::<f64>(&grid, positions, triangles, radius_m),
+        Precision::F32 => candidate_lists::<f32>(&grid, k, positions, triangles, radius_m),
+        Precision::F64 => candidate_lists::<f64>(&grid, k, positions, triangles, radius_m),
     };
     let o = grid.origin_m;
     CollisionIndex {
         grid: [o.x, o.y, o.z, grid.cell_m, radius_m],
         dims: grid.dims,
+        list_dims: grid.dims.map(|d| d * k),
         cell_start,
         grid_vertex,
         vertex_triangle_start,
@@ -105,11 +110,12 @@ pub fn collision_index(
 }
 
 /// The per-cell candidate lists (CSR starts, entries) of the surface
-/// `triangles` over `positions` for tools of radius up to `radius_m`, filed
-/// in the scalar `T` with the grid, positions and radius rounded to it, as
-/// the loader files them.
+/// `triangles` over `positions` for tools of radius up to `radius_m`, over
+/// `grid` subdivided `k` times, filed in the scalar `T` with the grid,
+/// positions and radius rounded to it, as the loader files them.
 fn candidate_lists<T: Real>(
     grid: &Grid<f64>,
+    k: u32,
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     radius_m: f64,
@@ -119,6 +125,9 @@ fn candidate_lists<T: Real>(
         cell_m: T::of_f64(grid.cell_m),
         dims: grid.dims,
     };
+    // `k` is at most `MAX_LIST_SUBDIVISION` and the grid's cells fit the
+    // table's `u32` count: no overflow.
+    let grid = grid.subdivided(k).unwrap_or(grid);
     let positions: Vec<[T; 3]> = positions.iter().map(|p| p.map(T::of_f64)).collect();
     let radius_m = T::of_f64(radius_m);
     let cells = grid.dims.iter().map(|&d| d as usize).product::<usize>();

@@ -8,9 +8,10 @@
 //! file's layout (the format's own section counts, [`SectionKind::expected_count`]) from these
 //! counts, so it is exact but for the collision grid, whose cell count and per-cell candidate
 //! lists are known only once it is built: the estimate takes their bounds
-//! ([`CELLS_PER_SURFACE_VERTEX`] cells per surface vertex, 64 list entries per surface
-//! triangle: the format's `cell-triangle`) and is above the real size by less than
-//! `64·Vs + 256·Ts + 16` bytes (`Vs` surface vertices, `Ts` surface triangles; both CSR starts over the cells count), never below. A tensor-mass table is linear in the mesh; its edge and mesh-triangle counts
+//! ([`CELLS_PER_SURFACE_VERTEX`] cells per surface vertex, up to 4³ list cells per cell and
+//! 343 list entries per surface triangle: the format's `cell-triangle-start` and
+//! `cell-triangle`) and is above the real size by less than `2080·Vs + 1372·Ts + 32` bytes
+//! (`Vs` surface vertices, `Ts` surface triangles), never below. A tensor-mass table is linear in the mesh; its edge and mesh-triangle counts
 //! come from Euler's formula for a solid without holes (`E = V + F_all − T − 1`,
 //! `F_all = (4T + F_boundary)/2`), exact for such a mesh, off by a few edges otherwise.
 //!

@@ -124,7 +124,7 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
     });
     sections.extend([
         Section::floats(SectionKind::SurfaceGrid, &[index.grid], precision),
-        Section::ints(SectionKind::GridDims, &[index.dims]),
+        Section::ints(SectionKind::GridDims, &[index.dims, index.list_dims]),
         Section::ints(SectionKind::GridCellStart, &index.cell_start),
         Section::ints(SectionKind::GridVertex, &index.grid_vertex),
         Section::ints(

@@ -319,34 +319,30 @@ impl TableFile {
 }
 
 /// The contact candidate lists of a pre-computed table's collision index:
-/// the tool radius they serve and their longest list, next to the walk over
-/// 27 cells a larger tool does.
+/// the tool radius they serve, their cells and their longest list, next to
+/// the walk over 27 cells a larger tool does.
 fn describe_candidates(model: &AnyModel<'_>) -> String {
-    let (radius_m, longest, walk) = match model {
-        AnyModel::F32(m) => {
-            let index = m.table().surface_index();
-            let radius = index.candidate_radius_m().map(f64::from);
-            (
-                radius,
-                index.max_cell_triangles(),
-                index.max_query_triangles(),
-            )
-        }
-        AnyModel::F64(m) => {
-            let index = m.table().surface_index();
-            let radius = index.candidate_radius_m();
-            (
-                radius,
-                index.max_cell_triangles(),
-                index.max_query_triangles(),
-            )
-        }
-    };
-    format!(
-        "contact candidates: per-cell lists for tools of radius up to {:.3} mm, at most \
-         {longest} triangles per cell (a larger tool walks 27 cells: at most {walk})",
-        1e3 * radius_m.unwrap_or(0.0)
-    )
+    fn describe<T: palpate_kernel::Real + Into<f64>>(
+        index: &palpate_kernel::table::SurfaceIndex<'_, T>,
+    ) -> String {
+        let lists = index.list_grid();
+        format!(
+            "contact candidates: per-cell lists for tools of radius up to {:.3} mm over {} x {} x \
+             {} cells of {:.3} mm, at most {} triangles per cell (a larger tool walks 27 cells: \
+             at most {})",
+            1e3 * index.candidate_radius_m().map_or(0.0, Into::into),
+            lists.dims[0],
+            lists.dims[1],
+            lists.dims[2],
+            1e3 * lists.cell_m.into(),
+            index.max_cell_triangles(),
+            index.max_query_triangles()
+        )
+    }
+    match model {
+        AnyModel::F32(m) => describe(m.table().surface_index()),
+        AnyModel::F64(m) => describe(m.table().surface_index()),
+    }
 }
 
 /// One `section NAME: COUNT x ELEM bytes = SIZE bytes` line.

@@ -459,9 +459,17 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     ) -> Option<Contact<T>> {
         let reach = self.index.reach(radius_m);
         let to_in = within(to_m, &reach);
+        // The table's per-cell lists when they serve this radius (and the
+        // motion is short, below), else the walk over the 27 cells around
+        // each point; cells of the lists' grid or of the grid.
+        let served = self.index.candidates(to_m, radius_m);
+        let cell_of = |p: &Vector3<T>| match served {
+            Some(_) => self.index.list_cell_of(p),
+            None => self.index.cell_of(p),
+        };
         let sweep = from_m.map(|from_m| {
             let from_in = within(from_m, &reach);
-            let ([a, b, c], [x, y, z]) = (self.index.cell_of(from_m), self.index.cell_of(to_m));
+            let ([a, b, c], [x, y, z]) = (cell_of(from_m), cell_of(to_m));
             // Corner by corner: an array comparison is a `memcmp` call on
             // the firmware target.
             let same_cell = a == x && b == y && c == z;
@@ -491,11 +499,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             order: 0,
             covered: false,
         };
-        // The table's per-cell lists when they serve this radius and the
-        // motion is short, else the walk over the 27 cells around each
-        // point.
         let short = sweep.is_none_or(|(.., short)| short);
-        let lists = self.index.candidates(to_m, radius_m).filter(|_| short);
+        let lists = served.filter(|_| short);
         match lists {
             Some(list) => {
                 if to_in {
@@ -705,13 +710,23 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let s0 = normal.dot(start_m) - offset - radius_m;
         let s1 = end_distance_m - radius_m;
         if s0 >= -slack_m && s1 < T::zero() {
+            // The crossing lies `along = s0 / (s0 − s1)` of the way: no
+            // earlier than the earliest hit so far (the first of equals
+            // kept), compared without the division (`s0 − s1 > 0`), is no
+            // hit. Over a flat face every candidate crosses at the same
+            // `along`: after the hit, each costs this comparison.
+            let s0 = s0.larger(T::zero());
+            if best.as_ref().is_some_and(|(b, ..)| *b * (s0 - s1) <= s0) {
+                return;
+            }
             self.sweep_hit(t, [s0, s1], segment, best);
         }
     }
 
     /// The rest of [`Self::sweep_test`] for a segment that crosses the
     /// plane (signed distances `s` of its ends from the plane, less the
-    /// radius): the crossing point's barycentric weights.
+    /// radius, the first not below zero), earlier than the earliest hit so
+    /// far: the crossing point's barycentric weights.
     fn sweep_hit(
         &self,
         t: TriangleIndex,
@@ -722,11 +737,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let tolerance = T::WEIGHT_TOLERANCE;
         let [start_m, end_m] = segment;
         let [s0, s1] = s;
-        let s0 = s0.larger(T::zero());
         let along = s0 / (s0 - s1);
-        if best.as_ref().is_some_and(|(b, _, _)| *b <= along) {
-            return;
-        }
         // The frame's gradients lie in the plane: the centre's point of the
         // segment weighs as its contact point, a radius below it.
         let x = start_m + (end_m - start_m) * along;

@@ -6,10 +6,10 @@
 //! host runs the step's hot loops compiled for its CPU ([`dispatch`]).
 //! Depends on nothing else in the crate.
 
-pub(crate) mod ldlt;
 pub mod dense;
 pub mod dispatch;
 pub mod element;
+pub(crate) mod ldlt;
 mod scalar;
 
 pub use dispatch::{Dispatch, Portable};

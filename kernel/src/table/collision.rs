@@ -16,7 +16,7 @@
 use nalgebra::Vector3;
 
 use super::LoadError;
-use super::format::{GRID_LEN, PLANE_LEN};
+use super::format::{GRID_LEN, MAX_LIST_SUBDIVISION, PLANE_LEN};
 use super::index::{TriangleIndex, VertexIndex, csr_row, span};
 use crate::Real;
 
@@ -37,9 +37,12 @@ pub struct SurfaceIndex<'a, T> {
     vertex_triangle_start: &'a [u32],
     vertex_triangle: &'a [u32],
     planes: &'a [Plane<T>],
-    /// Each cell's candidate triangles (CSR; empty for an index the kernel
-    /// assembled) and the largest tool radius they serve, m (`None`: no
-    /// lists, every query walks the cells).
+    /// The candidate lists' grid: the grid's box in cells `k` times finer
+    /// (the grid itself for an index the kernel assembled).
+    lists: Grid<T>,
+    /// Each list cell's candidate triangles (CSR; empty for an index the
+    /// kernel assembled) and the largest tool radius they serve, m
+    /// (`None`: no lists, every query walks the cells).
     cell_triangle_start: &'a [u32],
     cell_triangle: &'a [u32],
     candidate_radius_m: Option<T>,
@@ -116,6 +119,18 @@ impl<T> Grid<T> {
 }
 
 impl<T: Real> Grid<T> {
+    /// The same box in cells `k` times finer on every axis (edge
+    /// `cell_m / k`), `None` for `k = 0` or cell counts past `u32`.
+    pub fn subdivided(&self, k: u32) -> Option<Self> {
+        let [x, y, z] = self.dims;
+        let dims = [x.checked_mul(k)?, y.checked_mul(k)?, z.checked_mul(k)?];
+        (k > 0).then(|| Self {
+            origin_m: self.origin_m,
+            cell_m: self.cell_m / T::of_u32(k),
+            dims,
+        })
+    }
+
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
     pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
@@ -212,7 +227,8 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         triangles: &'a [[u32; 3]],
     ) -> Result<Self, LoadError> {
         let grid_error = |index: u32| LoadError::BadSurfaceGrid { index };
-        let (Some(&[x, y, z, cell_m, radius_m]), Some(&dims)) = (s.grid.first(), s.dims.first())
+        let (Some(&[x, y, z, cell_m, radius_m]), Some(&dims), Some(&list_dims)) =
+            (s.grid.first(), s.dims.first(), s.dims.get(1))
         else {
             return Err(grid_error(0));
         };
@@ -221,6 +237,12 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             cell_m,
             dims,
         };
+        // The lists' grid: `k` list cells per grid cell on every axis.
+        let k = list_dims[0].checked_div(dims[0]).unwrap_or(0);
+        let lists = grid
+            .subdivided(k)
+            .filter(|l| l.dims == list_dims && k <= MAX_LIST_SUBDIVISION)
+            .ok_or(grid_error(0))?;
         let geometry_ok = [x, y, z, cell_m, radius_m].iter().all(|v| v.finite())
             && cell_m > T::zero()
             && radius_m >= T::zero()
@@ -234,6 +256,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         }
         let index = Self {
             grid,
+            lists,
             triangles,
             cell_start: s.cell_start,
             grid_vertex: s.grid_vertex,
@@ -363,6 +386,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             .min(lists.vertex_triangle.len() as u32);
         Self {
             grid,
+            lists: grid,
             triangles: lists.triangles,
             cell_start: lists.cell_start,
             grid_vertex: lists.grid_vertex,
@@ -379,7 +403,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         }
     }
 
-    /// Checks the per-cell candidate lists: CSR over the grid's cells, each
+    /// Checks the per-cell candidate lists: CSR over the lists' grid's cells, each
     /// list strictly ascending, and exactly the filings of
     /// [`candidate_cells`] for the declared radius (each listed triangle
     /// filed in its cell, and as many entries as filings: every triangle in
@@ -387,7 +411,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// triangles.
     fn check_cell_triangles(&self, positions: &[[T; 3]]) -> Result<(), LoadError> {
         let bad = |cell: usize| LoadError::BadCellTriangles { cell: cell as u32 };
-        let cells = self.grid.cell_count().unwrap_or(0);
+        let cells = self.lists.cell_count().unwrap_or(0);
         if self.cell_triangle_start.len() != cells + 1
             || !csr_ok(self.cell_triangle_start, self.cell_triangle.len())
         {
@@ -401,17 +425,16 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             }
         }
         let radius_m = self.candidate_radius_m.unwrap_or(T::zero());
-        let margin_m = candidate_margin_m(&self.grid, radius_m);
         // Nothing else: each listed triangle is filed in its cell.
         for cell in 0..cells {
-            let c = self.grid.coordinates(cell);
+            let c = self.lists.coordinates(cell);
             for &t in self.cell_triangles_at(cell) {
                 let corners = self
                     .triangles
                     .get(t as usize)
                     .and_then(|tri| corners_of(positions, tri))
                     .ok_or(bad(cell))?;
-                let [lo, hi] = candidate_cells(&self.grid, &corners, margin_m);
+                let [lo, hi] = candidate_cells(&self.lists, &corners, radius_m);
                 let filed = c
                     .iter()
                     .zip(lo.iter().zip(&hi))
@@ -433,14 +456,14 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             let Some(corners) = corners_of(positions, tri) else {
                 continue;
             };
-            let [lo, hi] = candidate_cells(&self.grid, &corners, margin_m);
+            let [lo, hi] = candidate_cells(&self.lists, &corners, radius_m);
             let span = |axis: usize| {
                 let (l, h) = (lo.get(axis).copied(), hi.get(axis).copied());
                 u64::from(h.unwrap_or(0).saturating_sub(l.unwrap_or(0))) + 1
             };
             filings = filings.saturating_add(span(0) * span(1) * span(2));
             if filings > listed {
-                return Err(bad(self.grid.linear(lo)));
+                return Err(bad(self.lists.linear(lo)));
             }
         }
         if filings == listed {
@@ -467,7 +490,8 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     #[inline]
     pub fn candidates(&self, p: &Vector3<T>, radius_m: T) -> Option<CandidateList<'a>> {
         let served = self.candidate_radius_m.is_some_and(|r| radius_m <= r);
-        served.then(|| CandidateList(self.cell_triangles_at(self.grid.linear(self.cell_of(p)))))
+        served
+            .then(|| CandidateList(self.cell_triangles_at(self.lists.linear(self.list_cell_of(p)))))
     }
 
     /// The candidate lists of a sweep from `a` to `b` (m) in neighbouring
@@ -483,7 +507,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         b: &Vector3<T>,
         mut f: impl FnMut(CandidateList<'a>),
     ) {
-        let ([ax, ay, az], [bx, by, bz]) = (self.cell_of(a), self.cell_of(b));
+        let ([ax, ay, az], [bx, by, bz]) = (self.list_cell_of(a), self.list_cell_of(b));
         let span = |p: u32, q: u32| (p.min(q), p.max(q));
         let ((x0, x1), (y0, y1), (z0, z1)) = (span(ax, bx), span(ay, by), span(az, bz));
         for k in z0..=z1 {
@@ -494,7 +518,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                     let at_b = i == bx && j == by && k == bz;
                     if !at_b {
                         f(CandidateList(
-                            self.cell_triangles_at(self.grid.linear([i, j, k])),
+                            self.cell_triangles_at(self.lists.linear([i, j, k])),
                         ));
                     }
                 }
@@ -577,6 +601,19 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// maps to the nearest border cell; non-finite coordinates map to 0).
     pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
         self.grid.cell_of(p)
+    }
+
+    /// The candidate lists' cell containing `p` (m), clamped as
+    /// [`Self::cell_of`]: the cell of the grid itself for an index without
+    /// lists.
+    pub fn list_cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
+        self.lists.cell_of(p)
+    }
+
+    /// The candidate lists' grid: the grid's box in cells `k` times finer
+    /// ([`super::format::SectionKind::GridDims`]).
+    pub fn list_grid(&self) -> &Grid<T> {
+        &self.lists
     }
 
     /// The box within one cell edge plus `margin_m` (m) of the grid: its
@@ -760,24 +797,27 @@ pub(crate) fn corners_of<T: Real>(positions: &[[T; 3]], tri: &[u32; 3]) -> Optio
     Some([a?, b?, c?])
 }
 
-/// How far beyond a triangle's bounding box, in tool radii, the per-cell
-/// candidate lists file it ([`candidate_margin_m`]): the contact test's
-/// penetration depth (`contact::PENETRATION_DEPTH_RADII`, 2: a plane that
-/// far from the centre, with the centre over its triangle; the contact
-/// layer asserts it fits) plus a quarter radius of slack (the weight
-/// tolerance's reach past an edge is [`CANDIDATE_MARGIN_CELLS`]).
+/// How far from a triangle's plane, in tool radii, the per-cell candidate
+/// lists reach ([`candidate_cells`]): the contact test's penetration depth
+/// (`contact::PENETRATION_DEPTH_RADII`, 2: a plane that far from the
+/// centre, with the centre over its triangle; the contact layer asserts it
+/// fits) plus a quarter radius of slack, beyond the sweep's reach in front
+/// of the plane (one radius).
 pub const CANDIDATE_MARGIN_RADII: f64 = 2.25;
 
-/// The part of a cell edge the candidate lists add to every margin
-/// ([`candidate_margin_m`]): the weight tolerance's reach past a triangle's
-/// edges (`WEIGHT_TOLERANCE` of an edge, a cell at most, on both weights
-/// of an edge: 2e-5 in f32) with a margin, whatever the radius.
-pub const CANDIDATE_MARGIN_CELLS: f64 = 1e-4;
+/// The part of a list cell's edge the candidate lists add on every axis
+/// ([`candidate_cells`]): the weight tolerance's reach past a triangle's
+/// edges (`WEIGHT_TOLERANCE` of an edge, a grid cell at most, on both
+/// weights of an edge: 2e-5 of a grid cell in f32) and the normal's
+/// rounding, with a margin: at least 1e-4 of a grid cell, whose list cells
+/// are at most [`super::format::MAX_LIST_SUBDIVISION`] times finer.
+pub const CANDIDATE_MARGIN_CELLS: f64 = 4e-4;
 
-/// The margin (m) by which the candidate lists of `grid` widen each
-/// triangle's bounding box for a tool of radius up to `radius_m`:
-/// [`CANDIDATE_MARGIN_RADII`] radii and [`CANDIDATE_MARGIN_CELLS`] of a
-/// cell.
+/// The widest margin (m) by which candidate lists over `grid` (or a finer
+/// lists' grid of its box) widen a triangle's bounding box on an axis, for
+/// a tool of radius up to `radius_m`: [`CANDIDATE_MARGIN_RADII`] radii (on
+/// an axis along the triangle's normal) and [`CANDIDATE_MARGIN_CELLS`] of a
+/// cell of `grid`.
 pub fn candidate_margin_m<T: Real>(grid: &Grid<T>, radius_m: T) -> T {
     radius_m * T::of_f64(CANDIDATE_MARGIN_RADII) + grid.cell_m * T::of_f64(CANDIDATE_MARGIN_CELLS)
 }
@@ -785,8 +825,9 @@ pub fn candidate_margin_m<T: Real>(grid: &Grid<T>, radius_m: T) -> T {
 /// The tool radius (m) a table's candidate lists serve when asked for
 /// `tool_radius_m`: at most the cell edge over [`CANDIDATE_MARGIN_RADII`],
 /// so that a triangle's widened box spans at most 4 cells per axis (its
-/// box is at most an edge, at most a cell, wide): at most 64 lists per
-/// triangle. Negative or non-finite asks give 0.
+/// box is at most an edge, at most a cell, wide; [`candidate_margin_m`] at
+/// most a cell): at most 64 lists per triangle. Negative or non-finite
+/// asks give 0.
 pub fn candidate_radius_m<T: Real>(grid: &Grid<T>, tool_radius_m: T) -> T {
     let most = grid.cell_m * T::of_f64((1.0 - CANDIDATE_MARGIN_CELLS) / CANDIDATE_MARGIN_RADII);
     if tool_radius_m > T::zero() {
@@ -800,21 +841,58 @@ pub fn candidate_radius_m<T: Real>(grid: &Grid<T>, tool_radius_m: T) -> T {
     }
 }
 
+/// The subdivision `k` of the candidate lists' grid a builder chooses for
+/// `grid` and tools of radius up to `radius_m` (m): list cells no finer than
+/// the lists' depth, [`CANDIDATE_MARGIN_RADII`] radii (a face's prism spans
+/// at most three of them across), in `1..=`[`MAX_LIST_SUBDIVISION`]. Finer
+/// cells hold fewer triangles each, in more lists.
+pub fn list_subdivision<T: Real>(grid: &Grid<T>, radius_m: T) -> u32 {
+    let depth_m = radius_m * T::of_f64(CANDIDATE_MARGIN_RADII);
+    (1..MAX_LIST_SUBDIVISION)
+        .rev()
+        .map(|k| k + 1)
+        .find(|&k| T::of_u32(k) * depth_m <= grid.cell_m)
+        .unwrap_or(1)
+}
+
 /// The cells (lowest and highest, per axis, clamped to the grid as a query
-/// point is) whose candidate lists hold the triangle of `corners_m` (m),
-/// its bounding box widened by `margin_m` (m): the one rule of the lists'
-/// builder (`contact::grid::cell_triangles`) and of the loader's check. A sphere centred
-/// within `margin_m` of the triangle lies in the box, and clamping is
-/// monotone, so its cell is in the range.
+/// point is) whose candidate lists hold the triangle of `corners_m` (m)
+/// for a tool of radius up to `radius_m` (m): the one rule of the lists'
+/// builder (`contact::grid::cell_triangles`) and of the loader's check.
+///
+/// The contact tests accept a triangle only from a sphere centre whose
+/// projection on its plane falls in it (within the weight tolerance) and
+/// that lies at most [`CANDIDATE_MARGIN_RADII`] radii from the plane (the
+/// sweep's hit, one radius in front; the penetration test, two behind):
+/// the triangle's prism along its unit normal `n`. Its box is the
+/// triangle's, widened on axis `i` by `2.25 r |n_i|`, and by
+/// [`CANDIDATE_MARGIN_CELLS`] of a cell of `grid` (the lists' grid) on
+/// every axis. A face along the
+/// grid's axes is widened in its plane by that slack alone, so a cell's
+/// list holds the triangles over or under the cell, not all within reach
+/// around it. A collapsed triangle (no normal), which no test accepts, is
+/// widened by the whole margin on every axis. Clamping is monotone, so
+/// the cell of any centre in the prism is in the range.
 pub fn candidate_cells<T: Real>(
     grid: &Grid<T>,
     corners_m: &[Vector3<T>; 3],
-    margin_m: T,
+    radius_m: T,
 ) -> [[u32; 3]; 2] {
     let [a, b, c] = corners_m;
-    let margin = Vector3::repeat(margin_m);
-    let lo = a.inf(b).inf(c) - margin;
-    let hi = a.sup(b).sup(c) + margin;
+    let normal = (b - a).cross(&(c - a));
+    let length = normal.norm();
+    let depth_m = radius_m * T::of_f64(CANDIDATE_MARGIN_RADII);
+    let slack_m = grid.cell_m * T::of_f64(CANDIDATE_MARGIN_CELLS);
+    let reach = normal.map(|x| {
+        let along = if length > T::zero() {
+            (x / length).abs()
+        } else {
+            T::one()
+        };
+        along * depth_m + slack_m
+    });
+    let lo = a.inf(b).inf(c) - reach;
+    let hi = a.sup(b).sup(c) + reach;
     [grid.cell_of(&lo), grid.cell_of(&hi)]
 }
 
@@ -828,12 +906,11 @@ pub(crate) fn for_each_candidate_filing<T: Real>(
     radius_m: T,
     mut f: impl FnMut(usize, u32),
 ) {
-    let margin_m = candidate_margin_m(grid, radius_m);
     for (t, tri) in triangles.iter().enumerate() {
         let Some(corners) = corners_of(positions_m, tri) else {
             continue;
         };
-        let [[x0, y0, z0], [x1, y1, z1]] = candidate_cells(grid, &corners, margin_m);
+        let [[x0, y0, z0], [x1, y1, z1]] = candidate_cells(grid, &corners, radius_m);
         for k in z0..=z1 {
             for j in y0..=y1 {
                 for i in x0..=x1 {

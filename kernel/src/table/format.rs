@@ -89,9 +89,16 @@ use bytemuck::{Pod, Zeroable};
 /// First 8 bytes of every table.
 pub const MAGIC: [u8; 8] = *b"PALPTBL\0";
 /// The format version this kernel reads and the host writes.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 /// Every section starts at a multiple of this many bytes from the file start.
 pub const SECTION_ALIGN: usize = 16;
+/// The most list cells per grid cell and axis: the candidate lists' grid
+/// ([`SectionKind::GridDims`]) is the grid in cells 1 to this many times
+/// finer.
+pub const MAX_LIST_SUBDIVISION: u32 = 4;
+/// The most candidate lists one triangle is in: `(k + 3)³` for the
+/// largest subdivision `k` ([`SectionKind::CellTriangle`]).
+pub const MAX_LISTS_PER_TRIANGLE: u64 = (MAX_LIST_SUBDIVISION as u64 + 3).pow(3);
 /// Size of the CRC-32 trailer.
 pub const CRC_LEN: usize = 4;
 /// Marks a fixed vertex in [`SectionKind::VertexSlot`].
@@ -292,8 +299,11 @@ pub enum SectionKind {
     /// radius (m, ≥ 0) the per-cell candidate lists
     /// ([`SectionKind::CellTriangle`]) serve.
     SurfaceGrid = 7,
-    /// `[u32; 3]` × 1: grid cells per axis; their product is the header's
-    /// `grid_cell_count`. Cell `(i, j, k)` has index `i + nx (j + ny k)`.
+    /// `[u32; 3]` × 2: grid cells per axis, their product the header's
+    /// `grid_cell_count` (cell `(i, j, k)` has index `i + nx (j + ny k)`);
+    /// then (version 6) the cells per axis of the candidate lists' grid
+    /// ([`SectionKind::CellTriangleStart`]): the same box in cells `k`
+    /// times finer, `k` in `1..=`[`MAX_LIST_SUBDIVISION`] on every axis.
     GridDims = 8,
     /// `u32` × (grid_cell_count + 1): CSR starts of each cell's vertices.
     GridCellStart = 9,
@@ -315,21 +325,27 @@ pub enum SectionKind {
     /// `[n_x, n_y, n_z, n·p₀, g₁ (3), g₂ (3)]`. All zero for a collapsed
     /// triangle.
     SurfacePlane = 13,
-    /// `u32` × (grid_cell_count + 1): CSR starts of each cell's candidate
-    /// triangles (version 5).
+    /// `u32` × (list cells + 1; the directory declares the count, at most
+    /// `grid_cell_count · MAX_LIST_SUBDIVISION³ + 1`): CSR starts of each
+    /// cell's candidate triangles (version 5), over the candidate lists'
+    /// grid (version 6, [`SectionKind::GridDims`]).
     CellTriangleStart = 14,
-    /// `u32` × (the directory declares the count): each cell's candidate
-    /// triangles, ascending: triangle `t` is in the list of every cell
-    /// between the cells of the lowest and the highest corner of its
-    /// corners' bounding box widened by the candidate margin
-    /// (`table::candidate_margin_m` of the grid record's tool radius:
-    /// 2.25 radii, the penetration test's depth and slack, and 1e-4 of a
-    /// cell for the weight tolerance), each clamped to the grid as a query
-    /// point is. So a sphere of at most that radius centred in a cell finds
-    /// in its list every triangle it can touch or lie under. Checked at
-    /// load (each listed triangle filed in its cell, as many entries as
-    /// filings). The margin is at most a cell, so a triangle built from a
-    /// mesh (at most a cell wide) is in at most 4 × 4 × 4 lists.
+    /// `u32` × (the directory declares the count): each list cell's
+    /// candidate triangles, ascending: triangle `t` is in the list of every
+    /// cell of the lists' grid between the cells of the lowest and the
+    /// highest corner of the box of its prism for the grid record's tool
+    /// radius `r` (`table::candidate_cells`, version 6): the corners'
+    /// bounding box widened on axis `i` by `2.25 r |n_i|` (`n` the unit
+    /// normal: the centres the contact tests accept it from lie over the
+    /// triangle, at most the penetration test's depth of 2 radii and slack
+    /// from its plane) and by 1e-4 of a cell on every axis (the weight
+    /// tolerance), each clamped to the grid as a query point is. So a
+    /// sphere of at most that radius centred in a list cell finds in its
+    /// list every triangle it can touch or lie under. Checked at load (each
+    /// listed triangle filed in its cell, as many entries as filings). The
+    /// widening is at most a grid cell and a triangle built from a mesh at
+    /// most a grid cell wide, so a triangle is in at most `(k + 3)³` lists
+    /// ([`MAX_LISTS_PER_TRIANGLE`] for the largest `k`).
     CellTriangle = 15,
     /// `scalar` × N: lumped vertex masses `m_i = ρ Σ_{tets ∋ i} V/4`, kg.
     LumpedMass = 16,
@@ -708,13 +724,16 @@ impl SectionKind {
     ];
 
     /// `true` for the sections whose element count the directory declares
-    /// (the blocks a compressed part kept, the cells' candidate triangles):
+    /// (the blocks a compressed part kept, the candidate lists' starts and entries):
     /// the header's counts give only
     /// the most they may hold ([`Self::expected_count`]).
     pub const fn count_is_declared(self) -> bool {
         matches!(
             self,
-            SectionKind::SurfaceCodes | SectionKind::InteriorCodes | SectionKind::CellTriangle
+            SectionKind::SurfaceCodes
+                | SectionKind::InteriorCodes
+                | SectionKind::CellTriangleStart
+                | SectionKind::CellTriangle
         )
     }
 
@@ -809,11 +828,15 @@ impl SectionKind {
             SectionKind::TetLanes => Some(tets.div_ceil(TET_LANES as u64)),
             SectionKind::MeshTriangle | SectionKind::TriangleTerms => Some(h.mesh_triangle_count),
             SectionKind::FreeVertex => Some(f),
-            SectionKind::SurfaceGrid | SectionKind::GridDims => Some(1),
-            SectionKind::GridCellStart | SectionKind::CellTriangleStart => {
-                u64::from(h.grid_cell_count).checked_add(1)
+            SectionKind::SurfaceGrid => Some(1),
+            SectionKind::GridDims => Some(2),
+            SectionKind::GridCellStart => u64::from(h.grid_cell_count).checked_add(1),
+            SectionKind::CellTriangleStart => u64::from(h.grid_cell_count)
+                .checked_mul(u64::from(MAX_LIST_SUBDIVISION).pow(3))?
+                .checked_add(1),
+            SectionKind::CellTriangle => {
+                u64::from(h.triangle_count).checked_mul(MAX_LISTS_PER_TRIANGLE)
             }
-            SectionKind::CellTriangle => u64::from(h.triangle_count).checked_mul(64),
             SectionKind::GridVertex => Some(u64::from(h.surface_vertex_count)),
             SectionKind::VertexTriangleStart => n.checked_add(1),
             SectionKind::VertexTriangle => u64::from(h.triangle_count).checked_mul(3),

@@ -24,7 +24,8 @@ mod tensor_mass;
 pub(crate) use collision::BuiltLists;
 pub use collision::{
     CANDIDATE_MARGIN_CELLS, CANDIDATE_MARGIN_RADII, CandidateList, DEAD_TRIANGLE, Grid, Plane,
-    SurfaceIndex, candidate_cells, candidate_margin_m, candidate_radius_m, max_row, within,
+    SurfaceIndex, candidate_cells, candidate_margin_m, candidate_radius_m, list_subdivision,
+    max_row, within,
 };
 pub(crate) use collision::{for_each_candidate_filing, plane_record};
 pub use compressed::{CodedBlocks, ComplianceBlocks};

@@ -355,9 +355,12 @@ fn table_size_estimate_matches_built_tables() {
             let options =
                 BuildOptions::precomputed(material(), fix.clone(), Solver::Cholesky, precision);
             let (estimate, real) = estimate_and_build(mesh, report, &options);
-            let slack = 64 * estimate.counts.surface_vertices
-                + 256 * estimate.counts.surface_triangles
-                + 16;
+            // The grid's bounds: 8 cells per surface vertex (starts of 4
+            // bytes), up to 4³ list cells per cell, 343 list entries per
+            // surface triangle; and alignment.
+            let slack = (8 * 4 + 8 * 64 * 4) * estimate.counts.surface_vertices
+                + 343 * 4 * estimate.counts.surface_triangles
+                + 32;
             println!(
                 "{name} {precision:?} pre-computed: estimate {} real {real} (slack {slack}); peak {}",
                 estimate.table_bytes, estimate.peak_bytes
