@@ -134,14 +134,14 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 288
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 360
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 258
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 330
 #endif
 
 #if defined(PALPATE_POINTER_64)

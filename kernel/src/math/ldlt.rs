@@ -66,31 +66,34 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         block
     }
 
-    /// Factorizes the leading `3m × 3m` part in place as `A = L D Lᵀ` by
-    /// 3×3 blocks (`L_qp` below the diagonal, the unit lower `L_pp` on it)
-    /// and solves `A g = d` in place of `d` (`m` is clamped to `M`):
-    /// `L y = d`, `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two
-    /// 3×3 blocks loads 18 scalars for 27 multiply-adds.
+    /// Factorizes the leading `3m × 3m` part, `A = L D Lᵀ`, by 3×3 blocks
+    /// into `factor` (`L_qp` below the diagonal, the unit lower `L_pp` on
+    /// it; `A` is only read, `factor`'s upper blocks are not touched) and
+    /// solves `A g = d` in place of `d` (`m` is clamped to `M`): `L y = d`,
+    /// `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two 3×3 blocks
+    /// loads 18 scalars for 27 multiply-adds.
     ///
     /// Returns `Err(p)` with the contact (block row) of the first pivot
     /// `D_jj` that is not finite or not greater than `min_pivot` (a
     /// singular or ill-conditioned contact set). Work: about `(3m)³/6`
     /// multiply-adds and `3m` divisions.
     pub(crate) fn solve(
-        &mut self,
+        &self,
+        factor: &mut Self,
         d: &mut [Vector3<T>; M],
         m: usize,
         min_pivot: T,
     ) -> Result<(), usize> {
         let m = m.min(M);
-        let inverse_pivots = self.factor(m, min_pivot)?;
+        let inverse_pivots = self.factor(factor, m, min_pivot)?;
+        let l = &*factor;
         // L y = d, block row by block row.
         for p in 0..m {
             let mut y = d.get(p).map_or([T::zero(); 3], |v| [v.x, v.y, v.z]);
             for (r, x) in d.iter().enumerate().take(p) {
-                subtract_product(&mut y, &self.at(p, r), &[x.x, x.y, x.z]);
+                subtract_product(&mut y, &l.at(p, r), &[x.x, x.y, x.z]);
             }
-            let l = self.at(p, p);
+            let l = l.at(p, p);
             y[1] -= l[1][0] * y[0];
             y[2] -= l[2][0] * y[0] + l[2][1] * y[1];
             if let Some(out) = d.get_mut(p) {
@@ -102,9 +105,9 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
             let y = d.get(p).map_or([T::zero(); 3], |v| [v.x, v.y, v.z]);
             let mut x = [y[0] * inv[0], y[1] * inv[1], y[2] * inv[2]];
             for (q, g) in d.iter().enumerate().take(m).skip(p + 1) {
-                subtract_transposed_product(&mut x, &self.at(q, p), &[g.x, g.y, g.z]);
+                subtract_transposed_product(&mut x, &l.at(q, p), &[g.x, g.y, g.z]);
             }
-            let l = self.at(p, p);
+            let l = l.at(p, p);
             x[1] -= l[2][1] * x[2];
             x[0] -= l[1][0] * x[1] + l[2][0] * x[2];
             if let Some(out) = d.get_mut(p) {
@@ -114,20 +117,20 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         Ok(())
     }
 
-    /// `A = L D Lᵀ` of the leading `m × m` blocks, `L` in place; returns
+    /// `A = L D Lᵀ` of the leading `m × m` blocks, `L` into `l`; returns
     /// `D⁻¹` by block row (see [`Self::solve`] for the error).
-    fn factor(&mut self, m: usize, min_pivot: T) -> Result<[[T; 3]; M], usize> {
+    fn factor(&self, l: &mut Self, m: usize, min_pivot: T) -> Result<[[T; 3]; M], usize> {
         let mut pivots = [[T::zero(); 3]; M];
         let mut inverse_pivots = [[T::zero(); 3]; M];
         for p in 0..m {
             // S = A_pp − Σ_r L_pr D_r L_prᵀ.
             let mut s = self.at(p, p);
             for (r, pivot) in pivots.iter().enumerate().take(p) {
-                let l = self.at(p, r);
-                subtract_block_product(&mut s, &l, &scale_columns(&l, pivot));
+                let l_pr = l.at(p, r);
+                subtract_block_product(&mut s, &l_pr, &scale_columns(&l_pr, pivot));
             }
             let (unit, pivot, inverse) = ldlt3(&s, min_pivot).ok_or(p)?;
-            self.set_block(p, p, &unit);
+            l.set_block(p, p, &unit);
             if let (Some(d), Some(inv)) = (pivots.get_mut(p), inverse_pivots.get_mut(p)) {
                 *d = pivot;
                 *inv = inverse;
@@ -137,15 +140,15 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
                 // each row x of X solves L_pp y = x, over D_p.
                 let mut x = self.at(q, p);
                 for (r, pivot) in pivots.iter().enumerate().take(p) {
-                    let w = scale_columns(&self.at(p, r), pivot);
-                    subtract_block_product(&mut x, &self.at(q, r), &w);
+                    let w = scale_columns(&l.at(p, r), pivot);
+                    subtract_block_product(&mut x, &l.at(q, r), &w);
                 }
                 let l_qp = x.map(|mut y| {
                     y[1] -= unit[1][0] * y[0];
                     y[2] -= unit[2][0] * y[0] + unit[2][1] * y[1];
                     [y[0] * inverse[0], y[1] * inverse[1], y[2] * inverse[2]]
                 });
-                self.set_block(q, p, &l_qp);
+                l.set_block(q, p, &l_qp);
             }
         }
         Ok(inverse_pivots)

@@ -41,6 +41,17 @@ pub struct ContactSolution<T: Real, const M: usize> {
 }
 
 impl<T: Real, const M: usize> ContactSolution<T, M> {
+    /// No contact.
+    pub(crate) fn empty() -> Self {
+        Self {
+            points: [ResolvedPoint::empty(); M],
+            forces_n: [Vector3::zeros(); M],
+            linear_forces_n: [Vector3::zeros(); M],
+            direction: None,
+            len: 0,
+        }
+    }
+
     /// Number of contacts solved.
     pub fn len(&self) -> usize {
         self.len
@@ -135,26 +146,24 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         &self,
         contacts: &[impl AsConstraint<T>],
     ) -> Result<ContactSolution<T, M>, ContactError> {
-        self.solve_contacts(contacts, None)
+        let mut solution = ContactSolution::empty();
+        self.solve_into(contacts, &mut SolveBuffers::new(), &mut solution)?;
+        Ok(solution)
     }
 
-    /// [`Self::contact_forces`], taking the point compliances of points
-    /// `memo` holds from it instead of the table, and leaving this set's in
-    /// it: a re-solve after a release in the same tick, or a tool at rest,
-    /// reads no compliance block again. The same result.
-    pub(crate) fn contact_forces_memo<const M: usize>(
+    /// [`Self::contact_forces`] into `solution`, with the working memory
+    /// `buffers` (the haptic path's: no copy of the solution or the
+    /// matrices): the point compliances of points `buffers` holds from the
+    /// last solve are taken from it instead of the table, and this set's
+    /// are left in it, so that a re-solve after a release in the same tick,
+    /// or a tool at rest, reads no compliance block again. The same
+    /// result. On `Err`, `solution` holds no solution.
+    pub(crate) fn solve_into<const M: usize>(
         &self,
         contacts: &[impl AsConstraint<T>],
-        memo: &mut ComplianceMemo<T, M>,
-    ) -> Result<ContactSolution<T, M>, ContactError> {
-        self.solve_contacts(contacts, Some(memo))
-    }
-
-    fn solve_contacts<const M: usize>(
-        &self,
-        contacts: &[impl AsConstraint<T>],
-        memo: Option<&mut ComplianceMemo<T, M>>,
-    ) -> Result<ContactSolution<T, M>, ContactError> {
+        buffers: &mut SolveBuffers<T, M>,
+        solution: &mut ContactSolution<T, M>,
+    ) -> Result<(), ContactError> {
         const {
             assert!(
                 M >= 1 && M <= MAX_CONTACT_CAPACITY,
@@ -168,13 +177,8 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 capacity: M,
             });
         }
-        let mut solution = ContactSolution {
-            points: [ResolvedPoint::empty(); M],
-            forces_n: [Vector3::zeros(); M],
-            linear_forces_n: [Vector3::zeros(); M],
-            direction: None,
-            len: m,
-        };
+        solution.len = m;
+        solution.direction = None;
         for (p, ((contact, point), d)) in contacts
             .iter()
             .zip(solution.points.iter_mut())
@@ -186,24 +190,33 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         }
         check_duplicates(contacts)?;
         if m == 0 {
-            return Ok(solution);
+            return Ok(());
         }
 
-        // The lower blocks of the point-compliance matrix, and its scale.
-        let remembered = memo
-            .as_deref()
-            .map(|memo| solution.points.map(|point| memo.position(&point)));
-        let mut matrix = ContactMatrix::zeros();
+        // The lower blocks of the point-compliance matrix, and its scale,
+        // into the buffer the last solve's factor used.
+        let remembered = solution.points.map(|point| buffers.position(&point));
+        let SolveBuffers {
+            matrices,
+            points,
+            len,
+            current,
+        } = buffers;
+        let [first, second] = matrices;
+        // `last`: the last set's compliances, then this set's factor.
+        let (last, matrix) = if *current == 0 {
+            (first, second)
+        } else {
+            (second, first)
+        };
         let mut scale = T::zero();
         for (q, pq) in solution.points.iter().enumerate().take(m) {
             for (p, pp) in solution.points.iter().enumerate().take(q + 1) {
-                let cached = remembered.and_then(|at| match (at.get(q), at.get(p)) {
-                    (Some(&Some(i)), Some(&Some(j))) if i >= j => Some((i, j)),
+                let cached = match (remembered.get(q), remembered.get(p)) {
+                    (Some(&Some(i)), Some(&Some(j))) if i >= j => last.block(i, j),
                     _ => None,
-                });
-                let block = cached
-                    .and_then(|(i, j)| memo.as_deref()?.matrix.block(i, j))
-                    .unwrap_or_else(|| self.point_compliance(pq, pp, p == q));
+                };
+                let block = cached.unwrap_or_else(|| self.point_compliance(pq, pp, p == q));
                 matrix.set_block(q, p, &block);
                 if p == q {
                     scale = block
@@ -214,17 +227,15 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 }
             }
         }
-        if let Some(memo) = memo {
-            memo.points = solution.points;
-            memo.len = m;
-            memo.matrix = matrix;
-        }
+        *points = solution.points;
+        *len = m;
+        *current = 1 - *current;
         let min_pivot = T::MIN_PIVOT_RATIO * scale;
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
         }
         matrix
-            .solve(&mut solution.linear_forces_n, m, min_pivot)
+            .solve(last, &mut solution.linear_forces_n, m, min_pivot)
             .map_err(|contact| ContactError::IllConditioned { contact })?;
         solution.forces_n = solution.linear_forces_n;
         if let Some(remap) = &self.remap {
@@ -249,7 +260,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         {
             return Err(ContactError::NonFiniteResult);
         }
-        Ok(solution)
+        Ok(())
     }
 
     /// `C_qp = Σ_a Σ_b β^q_a β^p_b C_{v^q_a v^p_b}` (3×3 row-major, m/N):
@@ -458,23 +469,30 @@ fn add_scaled<T: Real>(sum: &mut [[T; 3]; 3], w: T, block: &[T; 9], transposed: 
     }
 }
 
-/// The point compliances of the last contact set a tissue solved, before
-/// factorization, with its points (see
-/// [`PrecomputedModel::contact_forces_memo`]).
+/// The working memory of a contact solve (MODELS.md §2): two contact
+/// matrices used in turn, one holding the point compliances of the last
+/// set solved (before factorization) with its points, the other its LDLᵀ
+/// factor; the next solve assembles its matrix over that factor, reading
+/// the blocks of points it shares with the last set from the last matrix
+/// ([`PrecomputedModel::solve_into`]).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct ComplianceMemo<T: Real, const M: usize> {
+pub(crate) struct SolveBuffers<T: Real, const M: usize> {
+    matrices: [ContactMatrix<T, M>; 2],
+    /// The points of the last set, `len` of them, whose compliances
+    /// `matrices[current]` holds.
     points: [ResolvedPoint<T>; M],
     len: usize,
-    matrix: ContactMatrix<T, M>,
+    current: usize,
 }
 
-impl<T: Real, const M: usize> ComplianceMemo<T, M> {
-    /// Remembers nothing.
+impl<T: Real, const M: usize> SolveBuffers<T, M> {
+    /// Remembering no point.
     pub(crate) fn new() -> Self {
         Self {
+            matrices: [ContactMatrix::zeros(); 2],
             points: [ResolvedPoint::empty(); M],
             len: 0,
-            matrix: ContactMatrix::zeros(),
+            current: 0,
         }
     }
 

@@ -5,20 +5,22 @@
 
 use nalgebra::Vector3;
 
-use super::model::ComplianceMemo;
+use super::model::SolveBuffers;
 use super::{ContactSolution, PrecomputedModel, QuasiNonLinear};
 use crate::contact::{ContactSet, Refusal, SurfaceGeometry, Tissue};
 use crate::table::PrecomputedTable;
 use crate::{MAX_CONTACTS, Real};
 
 /// The pre-computed model as a tissue, with the last contact solution (for
-/// the deformation field at the physics rate) and its point compliances (a
-/// re-solve after a release reads no table block again).
+/// the deformation field at the physics rate) and the solve's working
+/// memory (a re-solve after a release reads no table block again).
 pub struct PrecomputedTissue<'a, T: Real, const M: usize> {
     model: PrecomputedModel<'a, T>,
     table: &'a PrecomputedTable<'a, T>,
-    solution: Option<ContactSolution<T, M>>,
-    memo: ComplianceMemo<T, M>,
+    /// The last solution, valid when `solved`.
+    solution: ContactSolution<T, M>,
+    solved: bool,
+    buffers: SolveBuffers<T, M>,
 }
 
 impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
@@ -28,8 +30,9 @@ impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
         Self {
             model: PrecomputedModel::new(*table),
             table,
-            solution: None,
-            memo: ComplianceMemo::new(),
+            solution: ContactSolution::empty(),
+            solved: false,
+            buffers: SolveBuffers::new(),
         }
     }
 
@@ -49,7 +52,7 @@ impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
     /// The last contact solution (for the deformation field at the physics
     /// rate), `None` before the first solve or after a fault.
     pub fn solution(&self) -> Option<&ContactSolution<T, M>> {
-        self.solution.as_ref()
+        self.solved.then_some(&self.solution)
     }
 }
 
@@ -65,21 +68,20 @@ impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
     }
 
     fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal> {
-        let solution = self
-            .model
-            .contact_forces_memo(set.as_slice(), &mut self.memo)
+        self.solved = false;
+        self.model
+            .solve_into(set.as_slice(), &mut self.buffers, &mut self.solution)
             .map_err(|e| e.contact().map_or(Refusal::Fault, Refusal::Contact))?;
-        for (c, g) in set.iter_mut().zip(solution.contact_forces_n()) {
+        self.solved = true;
+        for (c, g) in set.iter_mut().zip(self.solution.contact_forces_n()) {
             c.force_n = *g;
         }
-        let device_force_n = solution.device_force_n();
-        self.solution = Some(solution);
-        Ok(device_force_n)
+        Ok(self.solution.device_force_n())
     }
 
     fn forget(&mut self) {
-        self.solution = None;
-        self.memo.clear();
+        self.solved = false;
+        self.buffers.clear();
     }
 
     fn reset(&mut self) {

@@ -304,7 +304,10 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             let mut matrix = ContactMatrix::<T, 1>::zeros();
             // The rows of `c`: the columns of its (column-major) transpose.
             matrix.set_block(0, 0, &c.transpose().data.0);
-            let factorizes = matrix.solve(&mut [Vector3::zeros()], 1, T::zero()).is_ok();
+            let mut factor = ContactMatrix::zeros();
+            let factorizes = matrix
+                .solve(&mut factor, &mut [Vector3::zeros()], 1, T::zero())
+                .is_ok();
             if asym > sym_tol || !asym.finite() || !factorizes {
                 return Err(bad);
             }
