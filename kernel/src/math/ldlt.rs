@@ -123,32 +123,36 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         let mut pivots = [[T::zero(); 3]; M];
         let mut inverse_pivots = [[T::zero(); 3]; M];
         for p in 0..m {
-            // S = A_pp − Σ_r L_pr D_r L_prᵀ.
-            let mut s = self.at(p, p);
-            for (r, pivot) in pivots.iter().enumerate().take(p) {
-                let l_pr = l.at(p, r);
-                subtract_block_product(&mut s, &l_pr, &scale_columns(&l_pr, pivot));
-            }
-            let (unit, pivot, inverse) = ldlt3(&s, min_pivot).ok_or(p)?;
-            l.set_block(p, p, &unit);
-            if let (Some(d), Some(inv)) = (pivots.get_mut(p), inverse_pivots.get_mut(p)) {
-                *d = pivot;
-                *inv = inverse;
-            }
-            for q in p + 1..m {
-                // X = A_qp − Σ_r L_qr D_r L_prᵀ, then L_qp = X L_ppᵀ⁻¹ D_p⁻¹:
-                // each row x of X solves L_pp y = x, over D_p.
+            // `L_pp` and `D_p⁻¹`, set at `q = p`.
+            let mut unit = [[T::zero(); 3]; 3];
+            let mut inverse = [T::zero(); 3];
+            for q in p..m {
+                // X = A_qp − Σ_r L_qr D_r L_prᵀ (one copy of the products
+                // for the diagonal block and those below it).
                 let mut x = self.at(q, p);
                 for (r, pivot) in pivots.iter().enumerate().take(p) {
                     let w = scale_columns(&l.at(p, r), pivot);
                     subtract_block_product(&mut x, &l.at(q, r), &w);
                 }
-                let l_qp = x.map(|mut y| {
-                    y[1] -= unit[1][0] * y[0];
-                    y[2] -= unit[2][0] * y[0] + unit[2][1] * y[1];
-                    [y[0] * inverse[0], y[1] * inverse[1], y[2] * inverse[2]]
-                });
-                l.set_block(q, p, &l_qp);
+                if q == p {
+                    // X = L_pp D_p L_ppᵀ.
+                    let pivot;
+                    (unit, pivot, inverse) = ldlt3(&x, min_pivot).ok_or(p)?;
+                    if let (Some(d), Some(inv)) = (pivots.get_mut(p), inverse_pivots.get_mut(p)) {
+                        *d = pivot;
+                        *inv = inverse;
+                    }
+                    l.set_block(p, p, &unit);
+                } else {
+                    // L_qp = X L_ppᵀ⁻¹ D_p⁻¹: each row x of X solves
+                    // L_pp y = x, over D_p.
+                    let l_qp = x.map(|mut y| {
+                        y[1] -= unit[1][0] * y[0];
+                        y[2] -= unit[2][0] * y[0] + unit[2][1] * y[1];
+                        [y[0] * inverse[0], y[1] * inverse[1], y[2] * inverse[2]]
+                    });
+                    l.set_block(q, p, &l_qp);
+                }
             }
         }
         Ok(inverse_pivots)
