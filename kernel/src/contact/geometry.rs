@@ -462,14 +462,19 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         // The table's per-cell lists when they serve this radius (and the
         // motion is short, below), else the walk over the 27 cells around
         // each point; cells of the lists' grid or of the grid.
-        let served = self.index.candidates(to_m, radius_m);
-        let cell_of = |p: &Vector3<T>| match served {
-            Some(_) => self.index.list_cell_of(p),
-            None => self.index.cell_of(p),
+        let served = self.index.serves(radius_m);
+        let cell_of = |p: &Vector3<T>| {
+            if served {
+                self.index.list_cell_of(p)
+            } else {
+                self.index.cell_of(p)
+            }
         };
+        let to_cell = cell_of(to_m);
         let sweep = from_m.map(|from_m| {
             let from_in = within(from_m, &reach);
-            let ([a, b, c], [x, y, z]) = (cell_of(from_m), cell_of(to_m));
+            let from_cell = cell_of(from_m);
+            let ([a, b, c], [x, y, z]) = (from_cell, to_cell);
             // Corner by corner: an array comparison is a `memcmp` call on
             // the firmware target.
             let same_cell = a == x && b == y && c == z;
@@ -485,7 +490,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             // walk would meet (a longer one walks).
             let near = a.abs_diff(x) <= 1 && b.abs_diff(y) <= 1 && c.abs_diff(z) <= 1;
             let short = from_in && to_in && near;
-            let from_m = (!same_cell && from_in).then_some(*from_m);
+            let from_m = (!same_cell && from_in).then_some((*from_m, from_cell));
             (start_m, end_m, from_m, short)
         });
         let mut scan = Scan {
@@ -500,16 +505,17 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             covered: false,
         };
         let short = sweep.is_none_or(|(.., short)| short);
-        let lists = served.filter(|_| short);
+        let lists = (served && short).then(|| self.index.candidates_at(to_cell));
         match lists {
             Some(list) => {
                 if to_in {
                     self.visit_list(list, work, Pass::Tool, &mut scan);
                 }
-                if let Some((_, end_m, Some(from_m), _)) = &sweep {
-                    // The lists serve this radius and the motion is short.
+                if let Some((_, _, Some((_, from_cell)), _)) = &sweep {
+                    // The lists serve this radius and the motion is short:
+                    // its ends lie within the reach, unclipped.
                     self.index
-                        .for_each_candidate_list_between(from_m, end_m, |list| {
+                        .for_each_candidate_list_between(*from_cell, to_cell, |list| {
                             self.visit_list(list, work, Pass::Start, &mut scan)
                         });
                 }
@@ -519,7 +525,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 if to_in {
                     self.visit(to_m, &mut visited, work, Pass::Tool, &mut scan);
                 }
-                if let Some((_, _, Some(from_m), _)) = &sweep {
+                if let Some((_, _, Some((from_m, _)), _)) = &sweep {
                     self.visit(from_m, &mut visited, work, Pass::Start, &mut scan);
                 }
             }

@@ -489,25 +489,37 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// [`Self::max_cell_triangles`].
     #[inline]
     pub fn candidates(&self, p: &Vector3<T>, radius_m: T) -> Option<CandidateList<'a>> {
-        let served = self.candidate_radius_m.is_some_and(|r| radius_m <= r);
-        served
-            .then(|| CandidateList(self.cell_triangles_at(self.lists.linear(self.list_cell_of(p)))))
+        self.serves(radius_m)
+            .then(|| self.candidates_at(self.list_cell_of(p)))
     }
 
-    /// The candidate lists of a sweep from `a` to `b` (m) in neighbouring
-    /// cells (at most one apart on each axis): each cell of the box of
-    /// cells between the two points' cells (at most 8; every point of the
-    /// segment has its cell in it) but the cell of `b` (its list read
-    /// already, at the tool). `f` gets each list. For a tool the lists
-    /// serve (the caller has [`Self::candidates`]' list) and a short motion
-    /// (`SurfaceGeometry::detect` walks the cells for a longer one).
+    /// Whether the per-cell candidate lists serve a tool of radius
+    /// `radius_m` (m).
+    #[inline]
+    pub fn serves(&self, radius_m: T) -> bool {
+        self.candidate_radius_m.is_some_and(|r| radius_m <= r)
+    }
+
+    /// The candidate list of the lists' grid cell `c` ([`Self::list_cell_of`];
+    /// empty beyond the grid).
+    #[inline]
+    pub(crate) fn candidates_at(&self, c: [u32; 3]) -> CandidateList<'a> {
+        CandidateList(self.cell_triangles_at(self.lists.linear(c)))
+    }
+
+    /// The candidate lists of a sweep between the lists' grid cells `a` and
+    /// `b` ([`Self::list_cell_of`]), neighbours (at most one apart on each
+    /// axis): each cell of the box of cells between them (at most 8; every
+    /// point of a segment between points of `a` and `b` has its cell in
+    /// it) but `b` (its list read already, at the tool). `f` gets each
+    /// list. For a tool the lists serve ([`Self::serves`]) and a short
+    /// motion (`SurfaceGeometry::detect` walks the cells for a longer one).
     pub(crate) fn for_each_candidate_list_between(
         &self,
-        a: &Vector3<T>,
-        b: &Vector3<T>,
+        [ax, ay, az]: [u32; 3],
+        [bx, by, bz]: [u32; 3],
         mut f: impl FnMut(CandidateList<'a>),
     ) {
-        let ([ax, ay, az], [bx, by, bz]) = (self.list_cell_of(a), self.list_cell_of(b));
         let span = |p: u32, q: u32| (p.min(q), p.max(q));
         let ((x0, x1), (y0, y1), (z0, z1)) = (span(ax, bx), span(ay, by), span(az, bz));
         for k in z0..=z1 {
@@ -517,9 +529,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
                     // call on the firmware target.
                     let at_b = i == bx && j == by && k == bz;
                     if !at_b {
-                        f(CandidateList(
-                            self.cell_triangles_at(self.lists.linear([i, j, k])),
-                        ));
+                        f(self.candidates_at([i, j, k]));
                     }
                 }
             }
@@ -546,7 +556,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// max_query_triangles`. The larger of the two when the lists serve.
     pub fn max_detection_tests(&self, radius_m: T) -> u32 {
         let walk = self.max_query_triangles.saturating_mul(3);
-        if self.candidate_radius_m.is_some_and(|r| radius_m <= r) {
+        if self.serves(radius_m) {
             walk.max(self.max_cell_triangles.saturating_mul(9))
         } else {
             walk
