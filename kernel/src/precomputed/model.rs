@@ -146,6 +146,12 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         &self,
         contacts: &[impl AsConstraint<T>],
     ) -> Result<ContactSolution<T, M>, ContactError> {
+        const {
+            assert!(
+                M >= 1 && M <= MAX_CONTACT_CAPACITY,
+                "contact capacity M must be in 1..=MAX_CONTACT_CAPACITY"
+            )
+        };
         let mut solution = ContactSolution::empty();
         self.solve_into(contacts, &mut SolveBuffers::new(), &mut solution)?;
         Ok(solution)
@@ -157,19 +163,14 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// last solve are taken from it instead of the table, and this set's
     /// are left in it, so that a re-solve after a release in the same tick,
     /// or a tool at rest, reads no compliance block again. The same
-    /// result. On `Err`, `solution` holds no solution.
+    /// result. On `Err`, `solution` holds no solution. `M` is checked by
+    /// the callers (`1..=MAX_CONTACT_CAPACITY`).
     pub(crate) fn solve_into<const M: usize>(
         &self,
         contacts: &[impl AsConstraint<T>],
         buffers: &mut SolveBuffers<T, M>,
         solution: &mut ContactSolution<T, M>,
     ) -> Result<(), ContactError> {
-        const {
-            assert!(
-                M >= 1 && M <= MAX_CONTACT_CAPACITY,
-                "contact capacity M must be in 1..=MAX_CONTACT_CAPACITY"
-            )
-        };
         let m = contacts.len();
         if m > M {
             return Err(ContactError::TooManyContacts {

@@ -1,4 +1,4 @@
-//! The table file format, version 4: one definition shared by the host writer
+//! The table file format, version 6: one definition shared by the host writer
 //! and the kernel reader.
 //!
 //! ```text
