@@ -83,7 +83,7 @@ pub struct UnitCosts {
     pub walk: u64,
     /// To track one contact (projection, gap).
     pub track: u64,
-    /// Per contact solve, per cubed contact capacity (the block Cholesky
+    /// Per contact solve, per cubed contact capacity (the block LDLᵀ
     /// is `O(M³)`).
     pub solve_per_m3: u64,
     /// To track one contact on the dynamic model's deforming surface.

@@ -2,7 +2,7 @@
 //! simulator for haptic surgery training.
 //!
 //! Layers, each depending only on those above it in this list:
-//! - [`math`]: the scalar, the P1 element, the small dense Cholesky;
+//! - [`math`]: the scalar, the P1 element, the small dense LDLᵀ of the contact solve;
 //! - [`table`]: the byte format and the validated views (pre-computed,
 //!   tensor-mass, interface, collision index), checked once at load;
 //! - [`contact`]: the collision grid builder, detection and tracking, the one

@@ -74,10 +74,11 @@ fn near_surface(rng: &mut Lcg, table: &PrecomputedTable<'_, f64>, at_m: f64) -> 
 /// into it and lies within 2.25 radii of its plane: the penetration test's
 /// depth of 2 radii, and slack) is in the list of the point's cell, for
 /// 4000 points within 3 radii of the surface and beyond the grid's box;
-/// and the lists are short: the longest holds at most a sixth of the
-/// triangles the walk over 27 cells visits (measured: 24 of the 300
-/// surface triangles, against 366 triangle visits; 32 when the lists
-/// filed every triangle within 2.25 radii of a cell, whatever its normal).
+/// and the lists are short: the longest holds at most a fortieth of the
+/// triangles the walk over 27 cells visits (measured: 8 of the 300 surface
+/// triangles on the lists' grid of 8 × 8 × 8 cells, against 366 triangle
+/// visits; 32 when the lists filed every triangle within 2.25 radii of a
+/// grid cell, whatever its normal).
 #[test]
 fn every_triangle_within_reach_is_in_the_cell_list() {
     let file = cube_table(RADIUS_M);
@@ -119,7 +120,8 @@ fn every_triangle_within_reach_is_in_the_cell_list() {
         corners.len(),
         index.max_query_triangles()
     );
-    assert!(6 * longest <= index.max_query_triangles(), "{longest}");
+    assert!(40 * longest <= index.max_query_triangles(), "{longest}");
+    assert_eq!(index.list_grid().dims, [8, 8, 8]);
     // A larger tool than the lists serve walks the grid.
     assert!(
         index
@@ -133,9 +135,9 @@ fn every_triangle_within_reach_is_in_the_cell_list() {
 /// 1.5 radii per tick, from up to 3 radii off it) both find the same
 /// contact (point, normal and gap to 1e-12 m: the same triangle but where
 /// the point lies on an edge between coplanar ones) or none, while the
-/// lists test at most a quarter of the triangles (measured: 1386 contacts,
-/// 49 528 triangle tests against 260 477; 90 218 when the lists filed
-/// every triangle within 2.25 radii of a cell, whatever its normal).
+/// lists test at most a sixth of the triangles (measured: 1386 contacts,
+/// 28 286 triangle tests against 260 477; 90 218 when the lists filed
+/// every triangle within 2.25 radii of a grid cell, whatever its normal).
 #[test]
 fn detection_with_lists_finds_what_the_walk_finds() {
     let (listed_file, walked_file) = (cube_table(RADIUS_M), cube_table(0.0));
@@ -176,7 +178,7 @@ fn detection_with_lists_finds_what_the_walk_finds() {
     println!("{contacts} contacts; triangles tested: lists {tests_listed}, walk {tests_walked}");
     assert!(contacts > 500, "{contacts}");
     assert!(
-        4 * tests_listed <= tests_walked,
+        6 * tests_listed <= tests_walked,
         "{tests_listed} vs {tests_walked}"
     );
 }

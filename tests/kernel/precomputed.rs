@@ -459,3 +459,79 @@ proptest! {
         })?;
     }
 }
+
+/// A pre-computed tissue solves in its own buffers: two matrices used in
+/// turn, the last set's point compliances reused for points that did not
+/// change (`PrecomputedModel::solve_into`). Through a sequence that takes
+/// every path (four contacts found on the reference cube's top face; the
+/// second released, a re-solve from the remembered compliances; the same
+/// set again, at rest; the tools moved, new weights; a contact twice, an
+/// ill-conditioned set refused; forgotten; four again), each solve equals
+/// a fresh `contact_forces` of the same set bit for bit: forces, device
+/// force and the stored solution (whose entries past the set are empty).
+#[test]
+fn tissue_solves_equal_fresh_solves_through_its_buffers() {
+    use palpate_kernel::PrecomputedTable;
+    use palpate_kernel::contact::{Contact, ContactSet, ContactWork, SurfaceGeometry, Tissue};
+    use palpate_kernel::precomputed::PrecomputedTissue;
+    const RADIUS_M: f64 = 0.05;
+    let file = reference_cube_table(Precision::F64);
+    let table = PrecomputedTable::<f64>::load(file.bytes()).expect("table");
+    let model = PrecomputedModel::new(table);
+    let geometry = SurfaceGeometry::new(&table);
+    let mut tissue = PrecomputedTissue::<f64, MAX_CONTACTS>::new(&table);
+    // A sphere a third of its radius into the top face (z = 1 m) at `(x, y)`.
+    let contact = |tool: usize, x: f64, y: f64| -> Contact<f64> {
+        let tip = Vector3::new(x, y, 1.0 + RADIUS_M * (2.0 / 3.0));
+        geometry
+            .detect(tool, None, &tip, RADIUS_M, &mut ContactWork::default())
+            .expect("a contact on the top face")
+    };
+    let set_of = |contacts: &[Contact<f64>]| {
+        let mut set = ContactSet::<f64, MAX_CONTACTS>::new();
+        for c in contacts {
+            set.push(*c).expect("room");
+        }
+        set
+    };
+    let mut solves = 0;
+    let mut check = |tissue: &mut PrecomputedTissue<'_, f64, MAX_CONTACTS>,
+                     contacts: &[Contact<f64>]| {
+        let mut set = set_of(contacts);
+        let fresh = model.contact_forces::<MAX_CONTACTS>(contacts);
+        let solved = tissue.solve(&mut set);
+        solves += 1;
+        match (fresh, solved) {
+            (Ok(fresh), Ok(device_n)) => {
+                assert_eq!(device_n, fresh.device_force_n(), "solve {solves}");
+                let forces: Vec<_> = set.iter().map(|c| c.force_n).collect();
+                assert_eq!(forces, fresh.contact_forces_n(), "solve {solves}");
+                assert_eq!(tissue.solution(), Some(&fresh), "solve {solves}");
+                assert!(device_n.norm() > 0.0);
+            }
+            (Err(e), Err(_)) => assert!(matches!(e, ContactError::IllConditioned { .. })),
+            (fresh, solved) => panic!("solve {solves}: fresh {fresh:?}, tissue {solved:?}"),
+        }
+    };
+    let four = [
+        contact(0, 0.3, 0.3),
+        contact(1, 0.5, 0.45),
+        contact(2, 0.7, 0.3),
+        contact(3, 0.45, 0.7),
+    ];
+    check(&mut tissue, &four);
+    let three = [four[0], four[2], four[3]];
+    check(&mut tissue, &three);
+    check(&mut tissue, &three);
+    let moved = [
+        contact(0, 0.31, 0.29),
+        contact(2, 0.69, 0.32),
+        contact(3, 0.46, 0.71),
+    ];
+    check(&mut tissue, &moved);
+    check(&mut tissue, &[moved[0], moved[0]]);
+    assert_eq!(tissue.solution(), None);
+    tissue.forget();
+    check(&mut tissue, &four);
+    assert_eq!(solves, 6);
+}

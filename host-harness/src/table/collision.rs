@@ -89,16 +89,20 @@ pub fn collision_index(
     // still widens a box by at most a cell.
     let most_m = candidate_radius_m(&grid, f64::INFINITY) * (1.0 - 1e-6);
     let radius_m = candidate_radius_m(&grid, tool_radius_m).min(most_m);
+    // The lists' grid; the grid's cells fit the table's `u32` count, and
+    // `k` is at most `MAX_LIST_SUBDIVISION`: it is never `None` (the grid
+    // itself, `k = 1`, otherwise).
     let k = list_subdivision(&grid, radius_m);
+    let lists = grid.subdivided(k).unwrap_or(grid);
     let (cell_triangle_start, cell_triangle) = match precision {
-        Precision::F32 => candidate_lists::<f32>(&grid, k, positions, triangles, radius_m),
-        Precision::F64 => candidate_lists::<f64>(&grid, k, positions, triangles, radius_m),
+        Precision::F32 => candidate_lists::<f32>(&grid, lists.dims, positions, triangles, radius_m),
+        Precision::F64 => candidate_lists::<f64>(&grid, lists.dims, positions, triangles, radius_m),
     };
     let o = grid.origin_m;
     CollisionIndex {
         grid: [o.x, o.y, o.z, grid.cell_m, radius_m],
         dims: grid.dims,
-        list_dims: grid.dims.map(|d| d * k),
+        list_dims: lists.dims,
         cell_start,
         grid_vertex,
         vertex_triangle_start,
@@ -111,11 +115,13 @@ pub fn collision_index(
 
 /// The per-cell candidate lists (CSR starts, entries) of the surface
 /// `triangles` over `positions` for tools of radius up to `radius_m`, over
-/// `grid` subdivided `k` times, filed in the scalar `T` with the grid,
-/// positions and radius rounded to it, as the loader files them.
+/// the lists' grid of `list_dims` cells over `grid`'s box (a whole number of
+/// times `grid`'s), filed in the scalar `T` with the grid, positions and
+/// radius rounded to it, as the loader files them (from the grid record and
+/// `list_dims`).
 fn candidate_lists<T: Real>(
     grid: &Grid<f64>,
-    k: u32,
+    list_dims: [u32; 3],
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     radius_m: f64,
@@ -125,8 +131,7 @@ fn candidate_lists<T: Real>(
         cell_m: T::of_f64(grid.cell_m),
         dims: grid.dims,
     };
-    // `k` is at most `MAX_LIST_SUBDIVISION` and the grid's cells fit the
-    // table's `u32` count: no overflow.
+    let k = list_dims[0] / grid.dims[0].max(1);
     let grid = grid.subdivided(k).unwrap_or(grid);
     let positions: Vec<[T; 3]> = positions.iter().map(|p| p.map(T::of_f64)).collect();
     let radius_m = T::of_f64(radius_m);

@@ -412,8 +412,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// (a rigid support, no compliance) are not touchable.
     ///
     /// Candidates, when the table's per-cell lists serve `radius_m`
-    /// ([`SurfaceIndex::candidates`]): the list of `to_m`'s cell (every
-    /// triangle such a sphere there can touch or lie under) and, for the
+    /// ([`SurfaceIndex::candidates`]): the list of `to_m`'s cell of the
+    /// lists' grid (every triangle the tests below can find from a centre
+    /// there) and, for the
     /// sweep, the lists of the cells from `from_m`'s towards `to_m`'s
     /// (`SurfaceIndex::for_each_candidate_list_between`; a triangle in
     /// two of them is tested twice, which changes nothing: each test keeps
@@ -744,6 +745,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let [start_m, end_m] = segment;
         let [s0, s1] = s;
         let along = s0 / (s0 - s1);
+        // The pre-filter's product rounds apart from this quotient: the
+        // first of equals is kept by the quotient itself.
+        if best.as_ref().is_some_and(|(b, ..)| *b <= along) {
+            return;
+        }
         // The frame's gradients lie in the plane: the centre's point of the
         // segment weighs as its contact point, a radius below it.
         let x = start_m + (end_m - start_m) * along;

@@ -160,7 +160,13 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
 }
 
 /// A 3×3 block, row-major.
-type Block<T> = [[T; 3]; 3];
+pub(crate) type Block<T> = [[T; 3]; 3];
+
+/// Whether the symmetric 3×3 `s` (its lower triangle read) is positive
+/// definite: its `L D Lᵀ` has finite positive pivots.
+pub(crate) fn positive_definite3<T: Real>(s: &Block<T>) -> bool {
+    ldlt3(s, T::zero()).is_some()
+}
 
 /// `S = L D Lᵀ` of the symmetric 3×3 `s` (its lower triangle read):
 /// the unit lower `L`, `D` and `D⁻¹`; `None` if a pivot is not finite or

@@ -178,8 +178,11 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 capacity: M,
             });
         }
-        solution.len = m;
-        solution.direction = None;
+        // Entries past `m` hold nothing (no earlier solve's points).
+        *solution = ContactSolution {
+            len: m,
+            ..ContactSolution::empty()
+        };
         for (p, ((contact, point), d)) in contacts
             .iter()
             .zip(solution.points.iter_mut())
@@ -201,14 +204,14 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             matrices,
             points,
             len,
-            current,
+            second_current,
         } = buffers;
         let [first, second] = matrices;
         // `last`: the last set's compliances, then this set's factor.
-        let (last, matrix) = if *current == 0 {
-            (first, second)
-        } else {
+        let (last, matrix) = if *second_current {
             (second, first)
+        } else {
+            (first, second)
         };
         let mut scale = T::zero();
         for (q, pq) in solution.points.iter().enumerate().take(m) {
@@ -230,7 +233,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         }
         *points = solution.points;
         *len = m;
-        *current = 1 - *current;
+        *second_current = !*second_current;
         let min_pivot = T::MIN_PIVOT_RATIO * scale;
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
@@ -479,11 +482,11 @@ fn add_scaled<T: Real>(sum: &mut [[T; 3]; 3], w: T, block: &[T; 9], transposed: 
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SolveBuffers<T: Real, const M: usize> {
     matrices: [ContactMatrix<T, M>; 2],
-    /// The points of the last set, `len` of them, whose compliances
-    /// `matrices[current]` holds.
+    /// The points of the last set, `len` of them, whose compliances the
+    /// second matrix holds if `second_current`, else the first.
     points: [ResolvedPoint<T>; M],
     len: usize,
-    current: usize,
+    second_current: bool,
 }
 
 impl<T: Real, const M: usize> SolveBuffers<T, M> {
@@ -493,7 +496,7 @@ impl<T: Real, const M: usize> SolveBuffers<T, M> {
             matrices: [ContactMatrix::zeros(); 2],
             points: [ResolvedPoint::empty(); M],
             len: 0,
-            current: 0,
+            second_current: false,
         }
     }
 

@@ -7,9 +7,9 @@
 //! assembled from lists the kernel built itself. Both are then
 //! queried in bounded time: a query visits the 27 cells around a point,
 //! each holding at most [`SurfaceIndex::max_bucket`] vertices, each with at
-//! most [`SurfaceIndex::max_valence`] triangles; or, in a table (format 5),
-//! reads the candidate list of the point's cell, filed for a declared tool
-//! radius ([`SurfaceIndex::candidates`], at most
+//! most [`SurfaceIndex::max_valence`] triangles; or, in a table (format 6),
+//! reads the candidate list of the point's cell of the lists' finer grid,
+//! filed for a declared tool radius ([`SurfaceIndex::candidates`], at most
 //! [`SurfaceIndex::max_cell_triangles`] triangles). Each triangle's plane
 //! carries its barycentric frame ([`SurfaceIndex::weights`]).
 
@@ -480,10 +480,11 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             .unwrap_or(&[])
     }
 
-    /// The candidate triangles of the cell of `p` (m) for a tool of radius
-    /// `radius_m` (m): every triangle a sphere of that radius centred in
-    /// the cell can touch or lie under
-    /// ([`super::format::SectionKind::CellTriangle`]), ascending; `None`
+    /// The candidate triangles of the lists' cell of `p` (m) for a tool of
+    /// radius `radius_m` (m): every triangle a contact test can find from a
+    /// sphere of that radius centred in the cell (its centre over the
+    /// triangle, within the test's depth of its plane:
+    /// [`super::format::SectionKind::CellTriangle`]), ascending; `None`
     /// when the index has no lists or they serve a smaller radius (then a
     /// query walks the 27 cells around `p`). Bounded by
     /// [`Self::max_cell_triangles`].
@@ -807,21 +808,24 @@ pub(crate) fn corners_of<T: Real>(positions: &[[T; 3]], tri: &[u32; 3]) -> Optio
     Some([a?, b?, c?])
 }
 
-/// How far from a triangle's plane, in tool radii, the per-cell candidate
-/// lists reach ([`candidate_cells`]): the contact test's penetration depth
-/// (`contact::PENETRATION_DEPTH_RADII`, 2: a plane that far from the
-/// centre, with the centre over its triangle; the contact layer asserts it
-/// fits) plus a quarter radius of slack, beyond the sweep's reach in front
-/// of the plane (one radius).
+/// How far from a triangle's plane, on either side, in tool radii, the
+/// per-cell candidate lists reach ([`candidate_cells`]): the contact test's
+/// depth (`contact::PENETRATION_DEPTH_RADII`, 2: the penetration test takes
+/// a plane up to that far behind the centre, the check of the planes it
+/// does not reach up to that far in front, each with the centre over its
+/// triangle; the contact layer asserts it fits) plus a quarter radius of
+/// slack; the sweep's hit lies one radius in front.
 pub const CANDIDATE_MARGIN_RADII: f64 = 2.25;
 
 /// The part of a list cell's edge the candidate lists add on every axis
 /// ([`candidate_cells`]): the weight tolerance's reach past a triangle's
 /// edges (`WEIGHT_TOLERANCE` of an edge, a grid cell at most, on both
-/// weights of an edge: 2e-5 of a grid cell in f32) and the normal's
-/// rounding, with a margin: at least 1e-4 of a grid cell, whose list cells
-/// are at most [`super::format::MAX_LIST_SUBDIVISION`] times finer.
-pub const CANDIDATE_MARGIN_CELLS: f64 = 4e-4;
+/// weights of an edge: 2e-5 of a grid cell in f32), the loader's tolerance
+/// on a stored frame (1e-4 in units of the weights: 1e-4 of a grid cell)
+/// and the normal's rounding, with a margin: at least 2.5e-4 of a grid
+/// cell, whose list cells are at most
+/// [`super::format::MAX_LIST_SUBDIVISION`] times finer.
+pub const CANDIDATE_MARGIN_CELLS: f64 = 1e-3;
 
 /// The widest margin (m) by which candidate lists over `grid` (or a finer
 /// lists' grid of its box) widen a triangle's bounding box on an axis, for
@@ -834,10 +838,10 @@ pub fn candidate_margin_m<T: Real>(grid: &Grid<T>, radius_m: T) -> T {
 
 /// The tool radius (m) a table's candidate lists serve when asked for
 /// `tool_radius_m`: at most the cell edge over [`CANDIDATE_MARGIN_RADII`],
-/// so that a triangle's widened box spans at most 4 cells per axis (its
-/// box is at most an edge, at most a cell, wide; [`candidate_margin_m`] at
-/// most a cell): at most 64 lists per triangle. Negative or non-finite
-/// asks give 0.
+/// so that a triangle's widened box spans at most `k + 3` cells of the
+/// lists' grid per axis (its box is at most an edge, at most a grid cell,
+/// wide; [`candidate_margin_m`] at most a grid cell): at most `(k + 3)³`
+/// lists per triangle. Negative or non-finite asks give 0.
 pub fn candidate_radius_m<T: Real>(grid: &Grid<T>, tool_radius_m: T) -> T {
     let most = grid.cell_m * T::of_f64((1.0 - CANDIDATE_MARGIN_CELLS) / CANDIDATE_MARGIN_RADII);
     if tool_radius_m > T::zero() {
@@ -873,8 +877,9 @@ pub fn list_subdivision<T: Real>(grid: &Grid<T>, radius_m: T) -> u32 {
 /// The contact tests accept a triangle only from a sphere centre whose
 /// projection on its plane falls in it (within the weight tolerance) and
 /// that lies at most [`CANDIDATE_MARGIN_RADII`] radii from the plane (the
-/// sweep's hit, one radius in front; the penetration test, two behind):
-/// the triangle's prism along its unit normal `n`. Its box is the
+/// sweep's hit, one radius in front; the penetration test, two behind; the
+/// check of the planes it does not reach, two in front): the triangle's
+/// prism along its unit normal `n`, on both sides. Its box is the
 /// triangle's, widened on axis `i` by `2.25 r |n_i|`, and by
 /// [`CANDIDATE_MARGIN_CELLS`] of a cell of `grid` (the lists' grid) on
 /// every axis. A face along the

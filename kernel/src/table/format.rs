@@ -50,8 +50,12 @@
 //! ([`SectionKind::CellTriangleStart`], [`SectionKind::CellTriangle`]: the
 //! triangles a detection in a cell tests, filed against the tool radius the
 //! table declares in [`SectionKind::SurfaceGrid`], read as one list instead
-//! of a walk over 27 cells). A table of an earlier version is refused
-//! ([`super::LoadError::UnsupportedVersion`]), never misread.
+//! of a walk over 27 cells). 6 files the lists by each triangle's prism (its
+//! box widened along its normal, not on every axis: a contact test takes a
+//! triangle only from a centre over it) on a finer lists' grid, the second
+//! row of [`SectionKind::GridDims`] ([`MAX_LIST_SUBDIVISION`]). A table of
+//! an earlier version is refused ([`super::LoadError::UnsupportedVersion`]),
+//! never misread.
 //!
 //! ## Compressed compliance (version 3, additive)
 //!
@@ -338,10 +342,11 @@ pub enum SectionKind {
     /// bounding box widened on axis `i` by `2.25 r |n_i|` (`n` the unit
     /// normal: the centres the contact tests accept it from lie over the
     /// triangle, at most the penetration test's depth of 2 radii and slack
-    /// from its plane) and by 1e-4 of a cell on every axis (the weight
+    /// from its plane) and by 1e-3 of a list cell on every axis (the weight
     /// tolerance), each clamped to the grid as a query point is. So a
     /// sphere of at most that radius centred in a list cell finds in its
-    /// list every triangle it can touch or lie under. Checked at load (each
+    /// list every triangle a contact test can find from there (one it
+    /// touches or lies under, its centre over it). Checked at load (each
     /// listed triangle filed in its cell, as many entries as filings). The
     /// widening is at most a grid cell and a triangle built from a mesh at
     /// most a grid cell wide, so a triangle is in at most `(k + 3)³` lists

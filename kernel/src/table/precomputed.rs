@@ -1,6 +1,6 @@
 //! The validated, zero-copy view of a pre-computed table.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 
 use super::LoadError;
 use super::collision::{SurfaceIndex, SurfaceSections};
@@ -11,7 +11,7 @@ use super::format::{
 };
 use super::index::{FreeIndex, VertexIndex, VertexSlot};
 use crate::Real;
-use crate::math::ldlt::ContactMatrix;
+use crate::math::ldlt::positive_definite3;
 
 /// A pre-computed table that passed every load-time check; the step path
 /// takes only this type.
@@ -301,14 +301,9 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
             let scale = c.abs().max();
             let sym_tol = T::of_f64(1e-4) * scale;
             let asym = (c - c.transpose()).abs().max();
-            let mut matrix = ContactMatrix::<T, 1>::zeros();
             // The rows of `c`: the columns of its (column-major) transpose.
-            matrix.set_block(0, 0, &c.transpose().data.0);
-            let mut factor = ContactMatrix::zeros();
-            let factorizes = matrix
-                .solve(&mut factor, &mut [Vector3::zeros()], 1, T::zero())
-                .is_ok();
-            if asym > sym_tol || !asym.finite() || !factorizes {
+            let definite = positive_definite3(&c.transpose().data.0);
+            if asym > sym_tol || !asym.finite() || !definite {
                 return Err(bad);
             }
         }

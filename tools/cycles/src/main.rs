@@ -424,7 +424,7 @@ fn csv(model: &str, runs: &[Run<'_>], work: &[Work], w: u32) -> String {
 /// with a contact but no test or walk; `triangle` the largest `(cycles −
 /// base − contacts·track) / tests` of one-point ticks with tests; `walk`
 /// the same per edge crossed of one-point ticks with walks and no test;
-/// then the solve per solve per cubed capacity `M³` (the block Cholesky),
+/// then the solve per solve per cubed capacity `M³` (the block LDLᵀ),
 /// the largest `(cycles − base − M·track) / (solves·M³)` of ticks of loops
 /// of `M ≥ 2` points without test or walk, and the same per `M` (the
 /// dynamic model's solve, linear in the capacity).

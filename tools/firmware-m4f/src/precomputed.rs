@@ -4,7 +4,7 @@
 //!
 //! Memory: the table and the sequence are read in place from flash; the only
 //! static RAM is the displacement buffer (12 bytes per vertex, `.bss`); the
-//! contact state (`ContactSolution`) and the Cholesky blocks live on the stack
+//! contact state (`ContactSolution`) and the LDLᵀ matrices live on the stack
 //! for one step.
 
 use core::fmt::Write;
