@@ -116,7 +116,7 @@ static palpate_contact triangle_contact(uint32_t a, uint32_t b, uint32_t c, floa
 
 static void test_versions_and_messages(void) {
     CHECK(palpate_abi_version() == PALPATE_ABI_VERSION);
-    CHECK(PALPATE_TABLE_FORMAT_VERSION == 5);
+    CHECK(PALPATE_TABLE_FORMAT_VERSION == 6);
     /* Every code has its own message; an unknown number has one too. */
     const palpate_status codes[] = {PALPATE_STATUS_OK, PALPATE_STATUS_NULL_POINTER,
                                     PALPATE_STATUS_TABLE_CHECKSUM_MISMATCH,
