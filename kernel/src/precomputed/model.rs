@@ -8,8 +8,8 @@ use super::constraint::{AsConstraint, ContactError, ContactPoint, ResolvedPoint,
 use super::remap::QuasiNonLinear;
 use crate::math::ldlt::ContactMatrix;
 use crate::math::{Dispatch, Portable};
-use crate::table::PrecomputedTable;
 use crate::table::format::surface_block_index;
+use crate::table::{ComplianceBlocks, PrecomputedTable};
 use crate::{MAX_CONTACT_CAPACITY, Real};
 
 /// The pre-computed model over a validated table (RR-3510 §4, MODELS.md §2).
@@ -279,6 +279,26 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         p: &ResolvedPoint<T>,
         same: bool,
     ) -> [[T; 3]; 3] {
+        // The part's kind chosen once, not per block: a dense part's blocks
+        // are read in place.
+        match self.table.surface_blocks() {
+            ComplianceBlocks::Dense(blocks) => {
+                self.weighted_blocks(q, p, same, |j, _| blocks.get(j).copied())
+            }
+            coded => self.weighted_blocks(q, p, same, |j, column| coded.block(j, column)),
+        }
+    }
+
+    /// [`Self::point_compliance`] with the surface part's blocks read by
+    /// `block(index, column)`.
+    #[inline(always)]
+    fn weighted_blocks(
+        &self,
+        q: &ResolvedPoint<T>,
+        p: &ResolvedPoint<T>,
+        same: bool,
+        block: impl Fn(usize, usize) -> Option<[T; 9]>,
+    ) -> [[T; 3]; 3] {
         let mut sum = [[T::zero(); 3]; 3];
         for (i, (&a, &beta_a)) in q.touchable.iter().zip(&q.weights).enumerate().take(q.len) {
             let first = if same { i } else { 0 };
@@ -286,7 +306,11 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 if j < first {
                     continue;
                 }
-                let Some((block, transposed)) = self.table.stored_touchable_block(a, b) else {
+                let Some((index, column, transposed)) = self.table.stored_touchable_index(a, b)
+                else {
+                    continue;
+                };
+                let Some(block) = block(index, column) else {
                     continue;
                 };
                 let both = same && j > i;

@@ -237,24 +237,26 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         Some(if n <= k { block } else { block.transpose() })
     }
 
-    /// The stored block `C_lo,hi` of two touchable free indices `n`, `k`
-    /// (either order), row-major, m/N, and whether `C_nk` is its transpose
-    /// (`n > k`). `None` if either is not touchable. The haptic path's
-    /// form of [`Self::touchable_block_of`]: one block read straight from
-    /// the table (decoded if coded), returned by value so that a caller's
-    /// sum stays in registers.
+    /// Where the block `C_nk` of two touchable free indices `n`, `k` (either
+    /// order) is stored: the index of the stored block `C_lo,hi` in the
+    /// surface part ([`Self::surface_blocks`]: read it there, decoded if
+    /// coded), its column `hi`, and whether `C_nk` is its transpose
+    /// (`n > k`). `None` if either is not touchable. The haptic path's form
+    /// of [`Self::touchable_block_of`]: no block copied or decoded here.
     #[inline(always)]
-    pub fn stored_touchable_block(&self, n: FreeIndex, k: FreeIndex) -> Option<([T; 9], bool)> {
+    pub fn stored_touchable_index(
+        &self,
+        n: FreeIndex,
+        k: FreeIndex,
+    ) -> Option<(usize, usize, bool)> {
         let (lo, hi) = if n <= k { (n, k) } else { (k, n) };
-        if hi.get() >= self.touchable_count() {
-            return None;
-        }
-        let j = format::surface_block_index(lo.get(), hi.get());
-        let block = match self.surface {
-            ComplianceBlocks::Dense(blocks) => *blocks.get(j)?,
-            coded => coded.block(j, hi.get())?,
-        };
-        Some((block, n > k))
+        (hi.get() < self.touchable_count()).then(|| {
+            (
+                format::surface_block_index(lo.get(), hi.get()),
+                hi.get(),
+                n > k,
+            )
+        })
     }
 
     fn check_vertex_maps(&self) -> Result<(), LoadError> {
