@@ -131,8 +131,7 @@ fn candidate_lists<T: Real>(
         cell_m: T::of_f64(grid.cell_m),
         dims: grid.dims,
     };
-    let k = list_dims[0] / grid.dims[0].max(1);
-    let grid = grid.subdivided(k).unwrap_or(grid);
+    let grid = grid.lists(list_dims).unwrap_or(grid);
     let positions: Vec<[T; 3]> = positions.iter().map(|p| p.map(T::of_f64)).collect();
     let radius_m = T::of_f64(radius_m);
     let cells = grid.dims.iter().map(|&d| d as usize).product::<usize>();

@@ -25,8 +25,8 @@ use nalgebra::Vector3;
 use super::Contact;
 use crate::Real;
 use crate::table::{
-    CandidateList, InterfaceTable, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex,
-    VertexIndex, within,
+    InterfaceTable, PrecomputedTable, SurfaceIndex, TensorMassTable, TriangleIndex, VertexIndex,
+    within,
 };
 
 /// Triangle edges crossed at most per tick while sliding (a bound on the
@@ -510,14 +510,14 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         match lists {
             Some(list) => {
                 if to_in {
-                    self.visit_list(list, work, Pass::Tool, &mut scan);
+                    self.visit_triangles(list.as_slice(), work, Pass::Tool, &mut scan);
                 }
                 if let Some((_, _, Some((_, from_cell)), _)) = &sweep {
                     // The lists serve this radius and the motion is short:
                     // its ends lie within the reach, unclipped.
                     self.index
                         .for_each_candidate_list_between(*from_cell, to_cell, |list| {
-                            self.visit_list(list, work, Pass::Start, &mut scan)
+                            self.visit_triangles(list.as_slice(), work, Pass::Start, &mut scan)
                         });
                 }
             }
@@ -548,7 +548,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 scan.order = 0;
                 let pass = Pass::Covered { bound_m, order };
                 match lists {
-                    Some(list) => self.visit_list(list, work, pass, &mut scan),
+                    Some(list) => self.visit_triangles(list.as_slice(), work, pass, &mut scan),
                     None => self.visit(to_m, &mut Visited::new(), work, pass, &mut scan),
                 }
                 scan.covered
@@ -573,18 +573,6 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             entry_gap_m: contact.gap_m,
             ..contact
         })
-    }
-
-    /// Runs `pass` of `scan` once for each triangle of a cell's candidate
-    /// `list`, in its order.
-    fn visit_list(
-        &self,
-        list: CandidateList<'_>,
-        work: &mut ContactWork,
-        pass: Pass<T>,
-        scan: &mut Scan<T>,
-    ) {
-        self.visit_triangles(list.as_slice(), work, pass, scan);
     }
 
     /// Runs `pass` of `scan` once for each surface triangle around the

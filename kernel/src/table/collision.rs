@@ -131,6 +131,18 @@ impl<T: Real> Grid<T> {
         })
     }
 
+    /// The candidate lists' grid of `list_dims` cells per axis over this
+    /// grid's box ([`super::format::SectionKind::GridDims`]): this grid
+    /// [`Self::subdivided`] `k` times, `None` unless `list_dims` is `k`
+    /// times its cells on every axis with `k` in
+    /// `1..=`[`MAX_LIST_SUBDIVISION`]. The one rule of the loader and the
+    /// host's writer.
+    pub fn lists(&self, list_dims: [u32; 3]) -> Option<Self> {
+        let k = list_dims[0].checked_div(self.dims[0])?;
+        self.subdivided(k)
+            .filter(|l| l.dims == list_dims && k <= MAX_LIST_SUBDIVISION)
+    }
+
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
     pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
@@ -237,12 +249,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             cell_m,
             dims,
         };
-        // The lists' grid: `k` list cells per grid cell on every axis.
-        let k = list_dims[0].checked_div(dims[0]).unwrap_or(0);
-        let lists = grid
-            .subdivided(k)
-            .filter(|l| l.dims == list_dims && k <= MAX_LIST_SUBDIVISION)
-            .ok_or(grid_error(0))?;
+        let lists = grid.lists(list_dims).ok_or(grid_error(0))?;
         let geometry_ok = [x, y, z, cell_m, radius_m].iter().all(|v| v.finite())
             && cell_m > T::zero()
             && radius_m >= T::zero()

@@ -226,15 +226,9 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// `C_nk` for two free indices `n`, `k` ([`Self::touchable_block`] on
     /// checked indices), m/N. `None` if either is not touchable.
     pub fn touchable_block_of(&self, n: FreeIndex, k: FreeIndex) -> Option<Matrix3<T>> {
-        let (lo, hi) = if n <= k { (n, k) } else { (k, n) };
-        if hi.get() >= self.touchable_count() {
-            return None;
-        }
-        let raw = self
-            .surface
-            .block(format::surface_block_index(lo.get(), hi.get()), hi.get())?;
-        let block = Matrix3::from_row_slice(&raw);
-        Some(if n <= k { block } else { block.transpose() })
+        let (index, column, transposed) = self.stored_touchable_index(n, k)?;
+        let block = Matrix3::from_row_slice(&self.surface.block(index, column)?);
+        Some(if transposed { block.transpose() } else { block })
     }
 
     /// Where the block `C_nk` of two touchable free indices `n`, `k` (either
