@@ -388,21 +388,47 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         tip_m: &Vector3<T>,
         radius_m: T,
     ) -> Contact<T> {
-        let [a, b, c] = face.corners;
-        let point_m = a * weights[0] + b * weights[1] + c * weights[2];
-        Contact {
+        let mut contact = Contact {
             tool,
             triangle,
             vertices: face.vertices,
             weights,
             normal: face.normal,
-            point_m,
+            point_m: Vector3::zeros(),
             tip_m: *tip_m,
-            gap_m: (tip_m - point_m).dot(&face.normal) - radius_m,
+            gap_m: T::zero(),
             force_n: Vector3::zeros(),
             grip_offset_m: None,
             entry_gap_m: T::zero(),
-        }
+        };
+        self.place(&mut contact, triangle, face, weights, tip_m, radius_m);
+        contact
+    }
+
+    /// Moves `contact` to `weights` on `triangle` with the sphere (radius
+    /// `radius_m`) centred at `tip_m` (m), in place: its point, normal and
+    /// signed gap follow, its force is zero again; its tool, grip offset
+    /// and entry gap stay.
+    #[inline(always)]
+    fn place(
+        &self,
+        contact: &mut Contact<T>,
+        triangle: TriangleIndex,
+        face: &Face<T>,
+        weights: [T; 3],
+        tip_m: &Vector3<T>,
+        radius_m: T,
+    ) {
+        let [a, b, c] = face.corners;
+        let point_m = a * weights[0] + b * weights[1] + c * weights[2];
+        contact.triangle = triangle;
+        contact.vertices = face.vertices;
+        contact.weights = weights;
+        contact.normal = face.normal;
+        contact.point_m = point_m;
+        contact.tip_m = *tip_m;
+        contact.gap_m = (tip_m - point_m).dot(&face.normal) - radius_m;
+        contact.force_n = Vector3::zeros();
     }
 
     /// The contact of a sphere of radius `radius_m` whose centre moved from
@@ -797,34 +823,28 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// the sphere's lowest point `tip − r n` onto the surface, walking to
     /// the neighbouring triangle across any edge it falls outside of (at
     /// most [`MAX_WALK_STEPS`]; never straight back, which over a concave
-    /// fold would swing between the two triangles). Returns the moved
-    /// contact, with its signed gap (negative while the sphere penetrates).
-    /// A held contact ([`Contact::grip_offset_m`]) keeps its triangle and
-    /// weights (its point is where the surface has them now). `None` when
-    /// the triangle has left the surface (a cut or a tear removed its tet).
+    /// fold would swing between the two triangles). Moves `contact` in
+    /// place (no copy of it), with its signed gap (negative while the
+    /// sphere penetrates), and returns `true`. A held contact
+    /// ([`Contact::grip_offset_m`]) keeps its triangle and weights (its
+    /// point is where the surface has them now). `false`, with `contact`
+    /// unchanged, when the triangle has left the surface (a cut or a tear
+    /// removed its tet).
     pub fn track(
         &self,
-        contact: &Contact<T>,
+        contact: &mut Contact<T>,
         tip_m: &Vector3<T>,
         radius_m: T,
         work: &mut ContactWork,
-    ) -> Option<Contact<T>> {
+    ) -> bool {
         let tolerance = T::WEIGHT_TOLERANCE;
         let mut triangle = contact.triangle;
-        let mut face = self.face(triangle)?;
+        let Some(mut face) = self.face(triangle) else {
+            return false;
+        };
         if contact.grip_offset_m.is_some() {
-            return Some(Contact {
-                grip_offset_m: contact.grip_offset_m,
-                entry_gap_m: contact.entry_gap_m,
-                ..self.contact(
-                    contact.tool,
-                    triangle,
-                    &face,
-                    contact.weights,
-                    tip_m,
-                    radius_m,
-                )
-            });
+            self.place(contact, triangle, &face, contact.weights, tip_m, radius_m);
+            return true;
         }
         let mut came_from = None;
         // The weights on the current triangle (each step moves to the next
@@ -855,10 +875,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             (triangle, face) = next;
             w = self.tracked_weights(triangle, tip_m);
         }
-        let weights = clamp_weights(w);
-        Some(Contact {
-            entry_gap_m: contact.entry_gap_m,
-            ..self.contact(contact.tool, triangle, &face, weights, tip_m, radius_m)
-        })
+        self.place(contact, triangle, &face, clamp_weights(w), tip_m, radius_m);
+        true
     }
 }

@@ -61,17 +61,14 @@ impl<T: Real> Contact<T> {
         }
     }
 
-    /// This contact held where it is now: from here on the contact point
+    /// Holds this contact where it is now: from here on the contact point
     /// keeps its place on the triangle and its offset from the tool
     /// sphere's centre (the grip continues the imposed displacement
     /// `gap · normal` of the surface's triangle as it stands; a model that
     /// imposes along another normal, such as the dynamic tissue's rest
     /// normal, sees a step of about `|gap|` times the tilt between them).
-    pub fn gripped(self) -> Self {
-        Self {
-            grip_offset_m: Some(self.tip_m - self.point_m - self.normal * self.gap_m),
-            ..self
-        }
+    pub fn grip(&mut self) {
+        self.grip_offset_m = Some(self.tip_m - self.point_m - self.normal * self.gap_m);
     }
 }
 

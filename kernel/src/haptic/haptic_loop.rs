@@ -193,7 +193,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
         let mut refused = self.track_and_detect(tools);
-        let mut set = self.contact_set();
+        let mut set = ContactSet::new();
+        self.gather_contacts(&mut set);
         // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
         // the model refuses, and solve again. Each pass removes one.
         for _ in 0..=P {
@@ -241,27 +242,25 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             let gripping = tool.action == ToolAction::Grip;
             let closing = gripping && *was != ToolAction::Grip;
             let work = &mut self.counters.contact;
-            *slot = match slot {
+            match slot {
                 Some(c) => {
-                    let held = c.grip_offset_m.filter(|_| gripping);
-                    surface
-                        .track(
-                            &Contact {
-                                grip_offset_m: held,
-                                ..*c
-                            },
-                            tip,
-                            radius,
-                            work,
-                        )
-                        .filter(|c| c.grip_offset_m.is_some() || self.tissue.keeps(c.gap_m))
-                        .map(|c| if closing { c.gripped() } else { c })
+                    // Tracked in place (no copy of the contact record).
+                    if !gripping {
+                        c.grip_offset_m = None;
+                    }
+                    let kept = surface.track(c, tip, radius, work)
+                        && (c.grip_offset_m.is_some() || self.tissue.keeps(c.gap_m));
+                    if !kept {
+                        *slot = None;
+                    } else if closing {
+                        c.grip();
+                    }
                 }
                 None => {
                     let from = self.previous_m.as_ref().and_then(|prev| prev.get(p));
-                    surface.detect(p, from, tip, radius, work)
+                    *slot = surface.detect(p, from, tip, radius, work);
                 }
-            };
+            }
             if slot.is_some() {
                 if active < M {
                     active += 1;
@@ -282,15 +281,14 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         }
     }
 
-    /// The active contacts (at most `M` after tracking and detection, in
-    /// tool-point order).
-    fn contact_set(&self) -> ContactSet<T, M> {
-        let mut set = ContactSet::new();
+    /// Pushes the active contacts (at most `M` after tracking and
+    /// detection) to the empty `set`, in tool-point order (filled in place:
+    /// a returned set is a copy of all `M` records on the firmware target).
+    fn gather_contacts(&self, set: &mut ContactSet<T, M>) {
         for c in self.contacts.iter().flatten() {
             // Tracking and detection keep at most M: never refused here.
             let _ = set.push(*c);
         }
-        set
     }
 
     fn output(
@@ -366,7 +364,8 @@ impl<T: Real, B: PhysicsTissue<T, M>, const P: usize, const M: usize> HapticLoop
     /// (call it every `physics_every` ticks, after the tick). On failure the
     /// next tick latches a model fault (zero force) until [`Self::reset`].
     pub fn physics_update(&mut self) -> Result<StepReport<T>, PhysicsError> {
-        let set = self.contact_set();
+        let mut set = ContactSet::new();
+        self.gather_contacts(&mut set);
         let mut blades = Blades::new();
         if let Some(tips) = &self.previous_m {
             for (p, ((tip, action), contact)) in tips

@@ -30,15 +30,39 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         }
     }
 
-    /// Block `(q, p)` (row `r` of it is `[3q + r][3p .. 3p + 3]`), `None`
-    /// beyond `M`.
-    pub(crate) fn block(&self, q: usize, p: usize) -> Option<[[T; 3]; 3]> {
-        let rows = self.rows.get(q)?;
-        let mut block = [[T::zero(); 3]; 3];
-        for (out, row) in block.iter_mut().zip(rows) {
-            *out = *row.get(p)?;
+    /// Copies `from`'s block `(i, j)` to block `(q, p)`, row by row;
+    /// `false` (nothing copied) beyond `M`.
+    pub(crate) fn copy_block(
+        &mut self,
+        q: usize,
+        p: usize,
+        from: &Self,
+        i: usize,
+        j: usize,
+    ) -> bool {
+        let (Some(rows), Some(from_rows)) = (self.rows.get_mut(q), from.rows.get(i)) else {
+            return false;
+        };
+        for (row, from_row) in rows.iter_mut().zip(from_rows) {
+            let (Some(out), Some(values)) = (row.get_mut(p), from_row.get(j)) else {
+                return false;
+            };
+            *out = *values;
         }
-        Some(block)
+        true
+    }
+
+    /// The diagonal of block `(q, q)`, zero beyond `M`.
+    pub(crate) fn diagonal(&self, q: usize) -> [T; 3] {
+        let mut diagonal = [T::zero(); 3];
+        if let Some(rows) = self.rows.get(q) {
+            for (r, (d, row)) in diagonal.iter_mut().zip(rows).enumerate() {
+                if let Some(&c) = row.get(q).and_then(|b| b.get(r)) {
+                    *d = c;
+                }
+            }
+        }
+        diagonal
     }
 
     /// Sets block `(q, p)`; nothing beyond `M`.
@@ -52,10 +76,10 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         }
     }
 
-    /// Block `(q, p)`, zero beyond `M`: the factorization's form of
-    /// [`Self::block`], written out: through `block` the Cortex-M4F's
+    /// Block `(q, p)`, zero beyond `M`: the factorization's read, written
+    /// out (through a helper returning `Option` the Cortex-M4F's
     /// pre-computed haptic path grows by 520 bytes of `.text`, past its
-    /// 24 576-byte target (`tools/firmware-check.sh --c`).
+    /// 24 576-byte target: `tools/firmware-check.sh --c`).
     #[inline(always)]
     fn at(&self, q: usize, p: usize) -> Block<T> {
         let mut block = [[T::zero(); 3]; 3];

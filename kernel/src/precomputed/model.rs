@@ -26,18 +26,41 @@ pub struct PrecomputedModel<'a, T: Real> {
 /// input of [`PrecomputedModel::displacements`]. Size on the stack:
 /// `M · (3·4 + 3·size_of::<T>() + 3·size_of::<T>()) + …` bytes, see
 /// `size_of::<ContactSolution<f32, 4>>()` in the README.
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// Only the first `len` entries of each array belong to the solution (a
+/// solve writes those, not the rest): equality compares those.
+#[derive(Clone, Copy, Debug)]
 pub struct ContactSolution<T: Real, const M: usize> {
     points: [ResolvedPoint<T>; M],
-    /// The forces on the tool's side: the linear `g`, remapped when the
-    /// model is quasi-non-linear.
-    forces_n: [Vector3<T>; M],
+    /// The remapped forces of a quasi-non-linear model (when `forces` is
+    /// [`ToolForces::Remapped`]).
+    remapped_forces_n: [Vector3<T>; M],
     /// The linear `g`, which the displacement update superposes.
     linear_forces_n: [Vector3<T>; M],
-    /// `d̂` of a quasi-non-linear model's field: the direction of the
-    /// contact with the largest imposed displacement (`None`: linear).
-    direction: Option<Vector3<T>>,
+    /// Which of the two are the forces on the tool's side.
+    forces: ToolForces<T>,
     len: usize,
+}
+
+/// Which forces of a [`ContactSolution`] are on the tool's side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ToolForces<T> {
+    /// The linear `g` (the linear model: no copy of them).
+    Linear,
+    /// The remapped ones (the quasi-non-linear model), with `d̂` of its
+    /// field: the direction of the contact with the largest imposed
+    /// displacement (`None`: no contact displaced).
+    Remapped { direction: Option<Vector3<T>> },
+}
+
+impl<T: Real, const M: usize> PartialEq for ContactSolution<T, M> {
+    fn eq(&self, other: &Self) -> bool {
+        self.len == other.len
+            && self.forces == other.forces
+            && self.points.get(..self.len) == other.points.get(..other.len)
+            && self.linear_forces_n.get(..self.len) == other.linear_forces_n.get(..other.len)
+            && self.contact_forces_n() == other.contact_forces_n()
+    }
 }
 
 impl<T: Real, const M: usize> ContactSolution<T, M> {
@@ -45,9 +68,9 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
     pub(crate) fn empty() -> Self {
         Self {
             points: [ResolvedPoint::empty(); M],
-            forces_n: [Vector3::zeros(); M],
+            remapped_forces_n: [Vector3::zeros(); M],
             linear_forces_n: [Vector3::zeros(); M],
-            direction: None,
+            forces: ToolForces::Linear,
             len: 0,
         }
     }
@@ -66,7 +89,11 @@ impl<T: Real, const M: usize> ContactSolution<T, M> {
     /// the order the contacts were given (with its colinear amplitude
     /// remapped by `ψ` when the model is quasi-non-linear).
     pub fn contact_forces_n(&self) -> &[Vector3<T>] {
-        self.forces_n.get(..self.len).unwrap_or(&[])
+        let forces = match self.forces {
+            ToolForces::Linear => &self.linear_forces_n,
+            ToolForces::Remapped { .. } => &self.remapped_forces_n,
+        };
+        forces.get(..self.len).unwrap_or(&[])
     }
 
     /// `-Σ g_p`: the force the tissue applies to the tool, what the haptic
@@ -178,11 +205,9 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 capacity: M,
             });
         }
-        // Entries past `m` hold nothing (no earlier solve's points).
-        *solution = ContactSolution {
-            len: m,
-            ..ContactSolution::empty()
-        };
+        // Entries past `m` are not the solution's (no copy of the rest).
+        solution.len = m;
+        solution.forces = ToolForces::Linear;
         for (p, ((contact, point), d)) in contacts
             .iter()
             .zip(solution.points.iter_mut())
@@ -216,22 +241,23 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         let mut scale = T::zero();
         for (q, pq) in solution.points.iter().enumerate().take(m) {
             for (p, pp) in solution.points.iter().enumerate().take(q + 1) {
-                let cached = match (remembered.get(q), remembered.get(p)) {
-                    (Some(&Some(i)), Some(&Some(j))) if i >= j => last.block(i, j),
-                    _ => None,
+                let copied = match (remembered.get(q), remembered.get(p)) {
+                    (Some(&Some(i)), Some(&Some(j))) if i >= j => {
+                        matrix.copy_block(q, p, last, i, j)
+                    }
+                    _ => false,
                 };
-                let block = cached.unwrap_or_else(|| self.point_compliance(pq, pp, p == q));
-                matrix.set_block(q, p, &block);
+                if !copied {
+                    matrix.set_block(q, p, &self.point_compliance(pq, pp, p == q));
+                }
                 if p == q {
-                    scale = block
-                        .iter()
-                        .enumerate()
-                        .filter_map(|(i, row)| row.get(i))
-                        .fold(scale, |s, &c| s.larger(c));
+                    scale = matrix.diagonal(q).iter().fold(scale, |s, &c| s.larger(c));
                 }
             }
         }
-        *points = solution.points;
+        for (remembered, point) in points.iter_mut().zip(&solution.points).take(m) {
+            *remembered = *point;
+        }
         *len = m;
         *second_current = !*second_current;
         let min_pivot = T::MIN_PIVOT_RATIO * scale;
@@ -241,21 +267,29 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         matrix
             .solve(last, &mut solution.linear_forces_n, m, min_pivot)
             .map_err(|contact| ContactError::IllConditioned { contact })?;
-        solution.forces_n = solution.linear_forces_n;
         if let Some(remap) = &self.remap {
             let mut largest = T::zero();
-            for (g, contact) in solution.forces_n.iter_mut().zip(contacts).take(m) {
+            let mut largest_direction = None;
+            let forces = solution
+                .remapped_forces_n
+                .iter_mut()
+                .zip(&solution.linear_forces_n);
+            for ((g, linear), contact) in forces.zip(contacts).take(m) {
                 let d = contact.displacement_m();
+                *g = *linear;
                 if let Some(direction) = QuasiNonLinear::direction(&d) {
                     *g = remap.force(&direction, *g);
                     // `direction` is `d / |d|`, so `d·direction` is `|d|`.
                     let length = d.dot(&direction);
                     if length > largest {
                         largest = length;
-                        solution.direction = Some(direction);
+                        largest_direction = Some(direction);
                     }
                 }
             }
+            solution.forces = ToolForces::Remapped {
+                direction: largest_direction,
+            };
         }
         if !solution
             .contact_forces_n()
@@ -403,7 +437,11 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// The quasi-non-linear model's displacement remap of `rows` (m), in
     /// place; nothing for the linear model or a set without direction.
     fn remap_rows<const M: usize>(&self, solution: &ContactSolution<T, M>, rows: &mut [[T; 3]]) {
-        if let (Some(remap), Some(direction)) = (&self.remap, &solution.direction) {
+        let direction = match &solution.forces {
+            ToolForces::Remapped { direction } => direction.as_ref(),
+            ToolForces::Linear => None,
+        };
+        if let (Some(remap), Some(direction)) = (&self.remap, direction) {
             for u in rows {
                 *u = remap.displacement(direction, Vector3::from(*u)).into();
             }
