@@ -160,8 +160,12 @@ struct Scan<T> {
     covered: bool,
 }
 
-/// Planes the penetration test kept that the sphere does not reach.
-const UNREACHED_CAPACITY: usize = 16;
+/// Planes the penetration test keeps that the sphere does not reach: the
+/// longest candidate list of the built-in block (`palpate tables info`), so
+/// that with the lists the check needs no second pass. A longer list, or
+/// the walk, may take it. Each detection clears this buffer (a `memclr` of
+/// it on the firmware target: 16 cost about 50 cycles more per probe).
+const UNREACHED_CAPACITY: usize = 8;
 
 /// The penetration test's planes within the depth reach that the sphere
 /// does not reach (signed distance at least the radius): their nearest
@@ -484,6 +488,49 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         radius_m: T,
         work: &mut ContactWork,
     ) -> Option<Contact<T>> {
+        let mut contact = None;
+        self.detect_into(tool, from_m, to_m, radius_m, work, &mut contact);
+        contact
+    }
+
+    /// [`Self::detect`] into `contact` (the haptic loop's slot: the record
+    /// is written in place, not copied from a returned one).
+    pub(crate) fn detect_into(
+        &self,
+        tool: usize,
+        from_m: Option<&Vector3<T>>,
+        to_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+        contact: &mut Option<Contact<T>>,
+    ) {
+        *contact = None;
+        let Some((triangle, weights, found_inside)) = self.search(from_m, to_m, radius_m, work)
+        else {
+            return;
+        };
+        let Some(face) = self.face(triangle) else {
+            return;
+        };
+        // Found inside on a rigid support: no contact.
+        if found_inside && face.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
+            return;
+        }
+        let made = contact.insert(self.contact(tool, triangle, &face, weights, to_m, radius_m));
+        if found_inside {
+            made.entry_gap_m = made.gap_m;
+        }
+    }
+
+    /// The search of [`Self::detect`]: the triangle and weights of the
+    /// contact, and whether it was found inside (by the penetration test).
+    fn search(
+        &self,
+        from_m: Option<&Vector3<T>>,
+        to_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+    ) -> Option<(TriangleIndex, [T; 3], bool)> {
         let reach = self.index.reach(radius_m);
         let to_in = within(to_m, &reach);
         // The table's per-cell lists when they serve this radius (and the
@@ -558,8 +605,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             }
         }
         if let Some((_, triangle, weights)) = scan.hit {
-            let face = self.face(triangle)?;
-            return Some(self.contact(tool, triangle, &face, weights, to_m, radius_m));
+            return Some((triangle, weights, false));
         }
         let Nearest {
             distance_m,
@@ -590,15 +636,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 return None;
             }
         }
-        let face = self.face(triangle)?;
-        if face.vertices.iter().all(|&v| self.supports.is_fixed(v)) {
-            return None;
-        }
-        let contact = self.contact(tool, triangle, &face, weights, to_m, radius_m);
-        Some(Contact {
-            entry_gap_m: contact.gap_m,
-            ..contact
-        })
+        Some((triangle, weights, true))
     }
 
     /// Runs `pass` of `scan` once for each surface triangle around the

@@ -258,7 +258,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                 }
                 None => {
                     let from = self.previous_m.as_ref().and_then(|prev| prev.get(p));
-                    *slot = surface.detect(p, from, tip, radius, work);
+                    surface.detect_into(p, from, tip, radius, work, slot);
                 }
             }
             if slot.is_some() {

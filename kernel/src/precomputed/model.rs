@@ -307,6 +307,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// for `q = p` (`same`) the pair `a ≠ b` is one read of the stored block
     /// for both its terms, `β_a β_b (C_ab + C_abᵀ)`, so at most six reads
     /// instead of nine.
+    #[inline(always)]
     fn point_compliance(
         &self,
         q: &ResolvedPoint<T>,
