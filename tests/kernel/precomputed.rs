@@ -460,15 +460,18 @@ proptest! {
     }
 }
 
-/// A pre-computed tissue solves in its own buffers: two matrices used in
-/// turn, the last set's point compliances reused for points that did not
-/// change (`PrecomputedModel::solve_into`). Through a sequence that takes
-/// every path (four contacts found on the reference cube's top face; the
-/// second released, a re-solve from the remembered compliances; the same
-/// set again, at rest; the tools moved, new weights; a contact twice, an
-/// ill-conditioned set refused; forgotten; four again), each solve equals
-/// a fresh `contact_forces` of the same set bit for bit: forces, device
-/// force and the stored solution (whose entries past the set are empty).
+/// A pre-computed tissue solves in its own buffers: two matrices, the
+/// remembered point compliances reused for points that did not change, a
+/// set of remembered points in their order factorized in place without
+/// replacing them (`PrecomputedModel::solve_into`). Through a sequence that
+/// takes every path (four contacts found on the reference cube's top face;
+/// the second released, a re-solve from the remembered compliances; the
+/// same set again, at rest; the four again, still remembered; two of them
+/// in reverse order, half their blocks computed again; the tools moved,
+/// new weights; a contact twice, an ill-conditioned set refused;
+/// forgotten; four again), each solve equals a fresh `contact_forces` of
+/// the same set bit for bit: forces, device force and the stored solution
+/// (compared over the set's entries).
 #[test]
 fn tissue_solves_equal_fresh_solves_through_its_buffers() {
     use palpate_kernel::PrecomputedTable;
@@ -523,6 +526,8 @@ fn tissue_solves_equal_fresh_solves_through_its_buffers() {
     let three = [four[0], four[2], four[3]];
     check(&mut tissue, &three);
     check(&mut tissue, &three);
+    check(&mut tissue, &four);
+    check(&mut tissue, &[four[3], four[1]]);
     let moved = [
         contact(0, 0.31, 0.29),
         contact(2, 0.69, 0.32),
@@ -533,5 +538,5 @@ fn tissue_solves_equal_fresh_solves_through_its_buffers() {
     assert_eq!(tissue.solution(), None);
     tissue.forget();
     check(&mut tissue, &four);
-    assert_eq!(solves, 6);
+    assert_eq!(solves, 8);
 }

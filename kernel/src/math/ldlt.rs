@@ -93,10 +93,12 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         block
     }
 
-    /// Factorizes the leading `3m × 3m` part, `A = L D Lᵀ`, by 3×3 blocks
-    /// into `factor` (`L_qp` below the diagonal, the unit lower `L_pp` on
-    /// it; `A` is only read, `factor`'s upper blocks are not touched) and
-    /// solves `A g = d` in place of `d` (`m` is clamped to `M`): `L y = d`,
+    /// Factorizes the leading `3m × 3m` part of `A`, `A = L D Lᵀ`, by 3×3
+    /// blocks into this matrix (`L_qp` below the diagonal, the unit lower
+    /// `L_pp` on it; the upper blocks are not touched), with `A` the
+    /// matrix `a`, only read, or for `None` this matrix's own lower blocks
+    /// (in place: each block of `A` is read once, before its block of `L`
+    /// is written there), and solves `A g = d` in place of `d` (`m` is clamped to `M`): `L y = d`,
     /// `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two 3×3 blocks
     /// loads 18 scalars for 27 multiply-adds.
     ///
@@ -105,15 +107,15 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
     /// singular or ill-conditioned contact set). Work: about `(3m)³/6`
     /// multiply-adds and `3m` divisions.
     pub(crate) fn solve(
-        &self,
-        factor: &mut Self,
+        &mut self,
+        a: Option<&Self>,
         d: &mut [Vector3<T>; M],
         m: usize,
         min_pivot: T,
     ) -> Result<(), usize> {
         let m = m.min(M);
-        let inverse_pivots = self.factor(factor, m, min_pivot)?;
-        let l = &*factor;
+        let inverse_pivots = self.factor(a, m, min_pivot)?;
+        let l = &*self;
         // L y = d, block row by block row.
         for p in 0..m {
             let mut y = d.get(p).map_or([T::zero(); 3], |v| [v.x, v.y, v.z]);
@@ -144,9 +146,11 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
         Ok(())
     }
 
-    /// `A = L D Lᵀ` of the leading `m × m` blocks, `L` into `l`; returns
-    /// `D⁻¹` by block row (see [`Self::solve`] for the error).
-    fn factor(&self, l: &mut Self, m: usize, min_pivot: T) -> Result<[[T; 3]; M], usize> {
+    /// `A = L D Lᵀ` of the leading `m × m` blocks of `a` (`None`: of this
+    /// matrix), `L` into this matrix; returns `D⁻¹` by block row (see
+    /// [`Self::solve`] for the error).
+    fn factor(&mut self, a: Option<&Self>, m: usize, min_pivot: T) -> Result<[[T; 3]; M], usize> {
+        let l = self;
         let mut pivots = [[T::zero(); 3]; M];
         let mut inverse_pivots = [[T::zero(); 3]; M];
         for p in 0..m {
@@ -156,7 +160,7 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
             for q in p..m {
                 // X = A_qp − Σ_r L_qr D_r L_prᵀ (one copy of the products
                 // for the diagonal block and those below it).
-                let mut x = self.at(q, p);
+                let mut x = a.unwrap_or(&*l).at(q, p);
                 for (r, pivot) in pivots.iter().enumerate().take(p) {
                     let w = scale_columns(&l.at(p, r), pivot);
                     subtract_block_product(&mut x, &l.at(q, r), &w);

@@ -186,11 +186,12 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
 
     /// [`Self::contact_forces`] into `solution`, with the working memory
     /// `buffers` (the haptic path's: no copy of the solution or the
-    /// matrices): the point compliances of points `buffers` holds from the
-    /// last solve are taken from it instead of the table, and this set's
-    /// are left in it, so that a re-solve after a release in the same tick,
-    /// or a tool at rest, reads no compliance block again. The same
-    /// result. On `Err`, `solution` holds no solution. `M` is checked by
+    /// matrices): the point compliances of points `buffers` remembers are
+    /// taken from it instead of the table, and a set with other points
+    /// leaves its own there, so that a re-solve after a release in the same
+    /// tick, or the same contacts at the next tick (before or after their
+    /// releases: a re-solve keeps the larger set remembered), reads no
+    /// compliance block again. The same result. On `Err`, `solution` holds no solution. `M` is checked by
     /// the callers (`1..=MAX_CONTACT_CAPACITY`).
     pub(crate) fn solve_into<const M: usize>(
         &self,
@@ -232,12 +233,21 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             second_current,
         } = buffers;
         let [first, second] = matrices;
-        // `last`: the last set's compliances, then this set's factor.
+        // `last`: the last set's compliances; `matrix` this set's.
         let (last, matrix) = if *second_current {
             (second, first)
         } else {
             (first, second)
         };
+        // Every point remembered, in the last set's order (a re-solve after
+        // a release, tools at rest): the remembered matrix stays as it is,
+        // for the solves after this one.
+        let mut previous = None;
+        let subset = remembered.iter().take(m).all(|&at| {
+            let increasing = at.is_some_and(|i| previous.is_none_or(|p| i > p));
+            previous = at;
+            increasing
+        });
         let mut scale = T::zero();
         for (q, pq) in solution.points.iter().enumerate().take(m) {
             for (p, pp) in solution.points.iter().enumerate().take(q + 1) {
@@ -255,18 +265,24 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
                 }
             }
         }
-        for (remembered, point) in points.iter_mut().zip(&solution.points).take(m) {
-            *remembered = *point;
-        }
-        *len = m;
-        *second_current = !*second_current;
         let min_pivot = T::MIN_PIVOT_RATIO * scale;
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
         }
-        matrix
-            .solve(last, &mut solution.linear_forces_n, m, min_pivot)
-            .map_err(|contact| ContactError::IllConditioned { contact })?;
+        let factored = if subset {
+            // Factorized in place: `last` stays the remembered matrix.
+            matrix.solve(None, &mut solution.linear_forces_n, m, min_pivot)
+        } else {
+            // This set's compliances become the remembered ones, its
+            // factor goes where the last set's were.
+            for (remembered, point) in points.iter_mut().zip(&solution.points).take(m) {
+                *remembered = *point;
+            }
+            *len = m;
+            *second_current = !*second_current;
+            last.solve(Some(matrix), &mut solution.linear_forces_n, m, min_pivot)
+        };
+        factored.map_err(|contact| ContactError::IllConditioned { contact })?;
         if let Some(remap) = &self.remap {
             let mut largest = T::zero();
             let mut largest_direction = None;
@@ -537,11 +553,14 @@ fn add_scaled<T: Real>(sum: &mut [[T; 3]; 3], w: T, block: &[T; 9], transposed: 
 }
 
 /// The working memory of a contact solve (MODELS.md §2): two contact
-/// matrices used in turn, one holding the point compliances of the last
-/// set solved (before factorization) with its points, the other its LDLᵀ
-/// factor; the next solve assembles its matrix over that factor, reading
-/// the blocks of points it shares with the last set from the last matrix
-/// ([`PrecomputedModel::solve_into`]).
+/// matrices, one holding the remembered point compliances (of the last
+/// set with a point not remembered before) with their points, the other
+/// the last LDLᵀ factor. The next solve assembles its matrix over that
+/// factor, copying the blocks of remembered points; a set of remembered
+/// points only, in their order (a release, tools at rest), is factorized
+/// there in place and the remembered ones stay; any other set's factor
+/// goes over the remembered matrix, and its own matrix becomes the
+/// remembered one ([`PrecomputedModel::solve_into`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SolveBuffers<T: Real, const M: usize> {
     matrices: [ContactMatrix<T, M>; 2],
