@@ -160,12 +160,12 @@ struct Scan<T> {
     covered: bool,
 }
 
-/// Planes the penetration test keeps that the sphere does not reach: the
-/// longest candidate list of the built-in block (`palpate tables info`), so
-/// that with the lists the check needs no second pass. A longer list, or
-/// the walk, may take it. Each detection clears this buffer (a `memclr` of
-/// it on the firmware target: 16 cost about 50 cycles more per probe).
-const UNREACHED_CAPACITY: usize = 8;
+/// Planes the penetration test keeps that the sphere does not reach: 16,
+/// more than the longest candidate list of the built-in block, and enough
+/// that the 27-cell walk of a deforming surface rarely takes the second
+/// pass (with 8 the hybrid's worst 4-contact tick tested 1314 triangles,
+/// 192 512 cycles instead of about 150 000: `tools/cycles-check.sh --all`).
+const UNREACHED_CAPACITY: usize = 16;
 
 /// The penetration test's planes within the depth reach that the sphere
 /// does not reach (signed distance at least the radius): their nearest
