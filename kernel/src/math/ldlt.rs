@@ -98,8 +98,8 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
     /// `L_pp` on it; the upper blocks are not touched), with `A` the
     /// matrix `a`, only read, or for `None` this matrix's own lower blocks
     /// (in place: each block of `A` is read once, before its block of `L`
-    /// is written there), and solves `A g = d` in place of `d` (`m` is clamped to `M`): `L y = d`,
-    /// `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two 3×3 blocks
+    /// is written there), and solves `A g = d` in place of `d` (`m` is
+    /// clamped to `M`): `L y = d`, `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two 3×3 blocks
     /// loads 18 scalars for 27 multiply-adds.
     ///
     /// Returns `Err(p)` with the contact (block row) of the first pivot
@@ -260,5 +260,97 @@ fn subtract_transposed_product<T: Real>(y: &mut [T; 3], a: &Block<T>, v: &[T; 3]
         for (y_j, &a_ij) in y.iter_mut().zip(a_row) {
             *y_j -= a_ij * v_i;
         }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::indexing_slicing, clippy::expect_used)]
+mod tests {
+    use super::*;
+
+    const M: usize = 4;
+
+    /// The symmetric positive definite `A = B Bᵀ + 3m I` (12 × 12, m = 4)
+    /// of a fixed `B`, as a contact matrix (lower blocks) and as scalars.
+    fn spd() -> (ContactMatrix<f64, M>, [[f64; 12]; 12]) {
+        let b = |i: usize, j: usize| ((7 * i + 3 * j) % 11) as f64 / 11.0 - 0.4;
+        let mut dense = [[0.0; 12]; 12];
+        for (i, row) in dense.iter_mut().enumerate() {
+            for (j, a) in row.iter_mut().enumerate() {
+                *a = (0..12).map(|k| b(i, k) * b(j, k)).sum::<f64>();
+                if i == j {
+                    *a += 12.0;
+                }
+            }
+        }
+        let mut matrix = ContactMatrix::zeros();
+        for q in 0..M {
+            for p in 0..=q {
+                let block: Block<f64> =
+                    core::array::from_fn(|r| core::array::from_fn(|c| dense[3 * q + r][3 * p + c]));
+                matrix.set_block(q, p, &block);
+            }
+        }
+        (matrix, dense)
+    }
+
+    fn rhs() -> [Vector3<f64>; M] {
+        core::array::from_fn(|p| Vector3::new(1.0 + p as f64, -0.5 * p as f64, 0.25))
+    }
+
+    /// In place (`None`) and from another matrix (`Some`), the factor's
+    /// lower blocks and the solution are the same bits, and the solution
+    /// solves `A g = d` to 1e-13 of `|d|` (f64, a condition number below 2
+    /// here: rounding alone).
+    #[test]
+    fn in_place_factorization_equals_the_factorization_of_a_copy() {
+        let (a, dense) = spd();
+        let (mut from_copy, mut in_place) = (ContactMatrix::zeros(), a);
+        let (mut g1, mut g2) = (rhs(), rhs());
+        from_copy
+            .solve(Some(&a), &mut g1, M, 1e-9)
+            .expect("positive definite");
+        in_place
+            .solve(None, &mut g2, M, 1e-9)
+            .expect("positive definite");
+        assert_eq!(g1, g2);
+        for q in 0..M {
+            for p in 0..=q {
+                assert_eq!(from_copy.at(q, p), in_place.at(q, p), "block ({q}, {p})");
+            }
+        }
+        let d = rhs();
+        let g: [f64; 12] = core::array::from_fn(|i| g1[i / 3][i % 3]);
+        for (i, row) in dense.iter().enumerate() {
+            let ag: f64 = row.iter().zip(&g).map(|(a, g)| a * g).sum();
+            assert!((ag - d[i / 3][i % 3]).abs() <= 1e-13 * 3.0, "row {i}: {ag}");
+        }
+    }
+
+    /// A block row equal to an earlier one makes the matrix singular: both
+    /// forms refuse it at that contact.
+    #[test]
+    fn both_forms_refuse_a_singular_set_at_the_same_contact() {
+        let (mut a, _) = spd();
+        // Contact 2 a copy of contact 1 among the first three: its blocks
+        // against contacts 0 and 1, and its diagonal block, are contact 1's.
+        for p in 0..2 {
+            let mut block = [[0.0; 3]; 3];
+            for (r, row) in block.iter_mut().enumerate() {
+                *row = a.rows[1][r][p];
+            }
+            a.set_block(2, p, &block);
+        }
+        let mut diagonal = [[0.0; 3]; 3];
+        for (r, row) in diagonal.iter_mut().enumerate() {
+            *row = a.rows[1][r][1];
+        }
+        a.set_block(2, 1, &diagonal);
+        a.set_block(2, 2, &diagonal);
+        let (mut from_copy, mut in_place) = (ContactMatrix::zeros(), a);
+        let (mut g1, mut g2) = (rhs(), rhs());
+        let refused = from_copy.solve(Some(&a), &mut g1, M, 1e-9);
+        assert_eq!(refused, Err(2));
+        assert_eq!(in_place.solve(None, &mut g2, M, 1e-9), refused);
     }
 }

@@ -187,11 +187,12 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
     /// [`Self::contact_forces`] into `solution`, with the working memory
     /// `buffers` (the haptic path's: no copy of the solution or the
     /// matrices): the point compliances of points `buffers` remembers are
-    /// taken from it instead of the table, and a set with other points
-    /// leaves its own there, so that a re-solve after a release in the same
-    /// tick, or the same contacts at the next tick (before or after their
-    /// releases: a re-solve keeps the larger set remembered), reads no
-    /// compliance block again. The same result. On `Err`, `solution` holds no solution. `M` is checked by
+    /// taken from it instead of the table, and any set that is not
+    /// remembered points in their order leaves its own there, so that a
+    /// re-solve after a release in the same tick, or the same contacts at
+    /// the next tick (before or after their releases: a re-solve keeps the
+    /// larger set remembered), reads no compliance block again. The same
+    /// result. On `Err`, `solution` holds no solution. `M` is checked by
     /// the callers (`1..=MAX_CONTACT_CAPACITY`).
     pub(crate) fn solve_into<const M: usize>(
         &self,
@@ -233,7 +234,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             second_current,
         } = buffers;
         let [first, second] = matrices;
-        // `last`: the last set's compliances; `matrix` this set's.
+        // `last`: the remembered compliances; `matrix` this set's.
         let (last, matrix) = if *second_current {
             (second, first)
         } else {
@@ -554,8 +555,8 @@ fn add_scaled<T: Real>(sum: &mut [[T; 3]; 3], w: T, block: &[T; 9], transposed: 
 
 /// The working memory of a contact solve (MODELS.md §2): two contact
 /// matrices, one holding the remembered point compliances (of the last
-/// set with a point not remembered before) with their points, the other
-/// the last LDLᵀ factor. The next solve assembles its matrix over that
+/// set that was not remembered points in their order) with their points,
+/// the other the last LDLᵀ factor. The next solve assembles its matrix over that
 /// factor, copying the blocks of remembered points; a set of remembered
 /// points only, in their order (a release, tools at rest), is factorized
 /// there in place and the remembered ones stay; any other set's factor
@@ -564,8 +565,8 @@ fn add_scaled<T: Real>(sum: &mut [[T; 3]; 3], w: T, block: &[T; 9], transposed: 
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SolveBuffers<T: Real, const M: usize> {
     matrices: [ContactMatrix<T, M>; 2],
-    /// The points of the last set, `len` of them, whose compliances the
-    /// second matrix holds if `second_current`, else the first.
+    /// The remembered points, `len` of them, whose compliances the second
+    /// matrix holds if `second_current`, else the first.
     points: [ResolvedPoint<T>; M],
     len: usize,
     second_current: bool,

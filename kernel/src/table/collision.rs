@@ -146,23 +146,6 @@ impl<T: Real> Grid<T> {
     /// The cell containing `p` (m), clamped to the grid (a point outside
     /// maps to the nearest border cell; non-finite coordinates map to 0).
     pub fn cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
-        self.cell_by(p, |offset_m| offset_m / self.cell_m)
-    }
-
-    /// [`Self::cell_of`] by one division and three products: the same
-    /// cell, or a neighbour for a point within a few rounding errors of
-    /// their common face. For looking up the candidate lists, whose
-    /// filing covers [`CANDIDATE_MARGIN_CELLS`] of a cell beyond every
-    /// triangle's reach ([`candidate_cells`]); not for filing.
-    pub fn nearby_cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
-        let per_m = T::one() / self.cell_m;
-        self.cell_by(p, |offset_m| offset_m * per_m)
-    }
-
-    /// The cell of `p` (m) with `cells(x − origin)` its coordinate in
-    /// cells, clamped as [`Self::cell_of`].
-    #[inline(always)]
-    fn cell_by(&self, p: &Vector3<T>, cells: impl Fn(T) -> T) -> [u32; 3] {
         let mut cell = [0u32; 3];
         for ((c, (&x, &o)), &d) in cell
             .iter_mut()
@@ -170,7 +153,7 @@ impl<T: Real> Grid<T> {
             .zip(&self.dims)
         {
             // Truncation is the floor for the positive values it sees.
-            let f = cells(x - o);
+            let f = (x - o) / self.cell_m;
             let top = T::of_u32(d.saturating_sub(1));
             // NaN fails both comparisons and stays at 0.
             *c = if f > T::zero() {
@@ -638,12 +621,11 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         self.grid.cell_of(p)
     }
 
-    /// The candidate lists' cell of `p` (m), clamped as [`Self::cell_of`]
-    /// ([`Grid::nearby_cell_of`]: the cell containing it, or its neighbour
-    /// within rounding of their face): the cell of the grid itself for an
-    /// index without lists.
+    /// The candidate lists' cell containing `p` (m), clamped as
+    /// [`Self::cell_of`]: the cell of the grid itself for an index without
+    /// lists.
     pub fn list_cell_of(&self, p: &Vector3<T>) -> [u32; 3] {
-        self.lists.nearby_cell_of(p)
+        self.lists.cell_of(p)
     }
 
     /// The candidate lists' grid: the grid's box in cells `k` times finer
