@@ -444,17 +444,16 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// Candidates, when the table's per-cell lists serve `radius_m`
     /// ([`SurfaceIndex::candidates`]): the list of `to_m`'s cell of the
     /// lists' grid (every triangle the tests below can find from a centre
-    /// there) and, for the
-    /// sweep, the lists of the cells from `from_m`'s towards `to_m`'s
-    /// (`SurfaceIndex::for_each_candidate_list_between`; a triangle in
-    /// two of them is tested twice, which changes nothing: each test keeps
-    /// the first of equals). Otherwise (a deforming surface, or a tool
-    /// larger than the lists serve): the triangles around the surface
-    /// vertices in the 27 grid cells around `to_m` and, for the sweep,
-    /// around `from_m`, each tested once however many of its corners the
-    /// cells hold. In both, none around `from_m` when both points are in
-    /// the same cell, and none for a point more than a cell plus the radius
-    /// outside the grid. Bounded by
+    /// there) and, for the sweep, the lists of the cells from `from_m`'s
+    /// towards `to_m`'s (`SurfaceIndex::for_each_candidate_list_between`;
+    /// a triangle in two of them is tested twice, which changes nothing:
+    /// each test keeps the first of equals). Otherwise (a deforming
+    /// surface, or a tool larger than the lists serve): the triangles
+    /// around the surface vertices in the 27 grid cells around `to_m` and,
+    /// for the sweep, around `from_m`, each tested once however many of its
+    /// corners the cells hold. In both, none around `from_m` when both
+    /// points are in the same cell, and none for a point more than a cell
+    /// plus the radius outside the grid. Bounded by
     /// [`SurfaceIndex::max_detection_tests`] triangle tests (with the
     /// penetration test's second pass), most rejected by two dot products
     /// with the stored plane; the sweep and the penetration test share the

@@ -99,8 +99,8 @@ impl<T: Real, const M: usize> ContactMatrix<T, M> {
     /// matrix `a`, only read, or for `None` this matrix's own lower blocks
     /// (in place: each block of `A` is read once, before its block of `L`
     /// is written there), and solves `A g = d` in place of `d` (`m` is
-    /// clamped to `M`): `L y = d`, `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each product of two 3×3 blocks
-    /// loads 18 scalars for 27 multiply-adds.
+    /// clamped to `M`): `L y = d`, `z = D⁻¹ y`, `Lᵀ g = z`. By blocks, each
+    /// product of two 3×3 blocks loads 18 scalars for 27 multiply-adds.
     ///
     /// Returns `Err(p)` with the contact (block row) of the first pivot
     /// `D_jj` that is not finite or not greater than `min_pivot` (a

@@ -6,7 +6,8 @@
 //! surface triangle (barycentric weights `β^p_a` on vertices `v^p_a`), with
 //! imposed displacements `d_p`, the point compliance is
 //! `C_pq = Σ_a Σ_b β^p_a β^q_b C_{v^p_a v^q_b}` and the contact forces `g`
-//! solve the SPD system `Σ_q C_pq g_q = d_p` (a block LDLᵀ in the tissue's buffers, or on the stack).
+//! solve the SPD system `Σ_q C_pq g_q = d_p` (a block LDLᵀ in the tissue's
+//! buffers, or on the stack).
 //! The device receives `-Σ g_q`. The displacement of every vertex,
 //! `u_n = Σ_q Σ_b β^q_b C_{n v^q_b} g_q`, is a separate call so the haptic
 //! path can skip it. Superposing elementary deformations instead would
