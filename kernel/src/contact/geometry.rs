@@ -139,7 +139,7 @@ enum Pass<T> {
 }
 
 /// The state of one detection's passes (see [`SurfaceGeometry::detect`]).
-struct Scan<T> {
+struct Scan<'p, T> {
     /// The tool sphere's centre and radius, m.
     to_m: Vector3<T>,
     radius_m: T,
@@ -153,7 +153,7 @@ struct Scan<T> {
     /// The nearest plane the sphere reaches, under the centre.
     reached: Option<Nearest<T>>,
     /// The planes within the depth it does not reach.
-    unreached: Unreached<T>,
+    unreached: Unreached<'p, T>,
     /// Candidates tested so far in a [`Pass::Tool`] or [`Pass::Covered`].
     order: u32,
     /// The answer of a [`Pass::Covered`].
@@ -173,19 +173,26 @@ const UNREACHED_CAPACITY: usize = 16;
 /// in the test order, so that the check of [`SurfaceGeometry::detect`]
 /// (is one of them over the centre, nearer than the nearest reached?)
 /// needs no second pass ([`Pass::Covered`]) unless more came.
-struct Unreached<T> {
+struct Unreached<'p, T> {
     nearest_m: Option<T>,
     /// Each kept plane's triangle and place in the test order (its
     /// distance is computed again from the stored plane, bit for bit).
-    planes: heapless::Vec<(TriangleIndex, u32), UNREACHED_CAPACITY>,
+    planes: &'p mut UnreachedPlanes,
     overflowed: bool,
 }
 
-impl<T: Real> Unreached<T> {
-    fn new() -> Self {
+/// The planes [`Unreached`] keeps: a local of its own, so that the
+/// detection's state is not stored as one constant that the compiler
+/// zeroes whole, this buffer with it (a `memclr` of 133 bytes a probe
+/// on the Cortex-M4F).
+type UnreachedPlanes = heapless::Vec<(TriangleIndex, u32), UNREACHED_CAPACITY>;
+
+impl<'p, T: Real> Unreached<'p, T> {
+    /// None noted yet, into the empty `planes`.
+    fn new(planes: &'p mut UnreachedPlanes) -> Self {
         Self {
             nearest_m: None,
-            planes: heapless::Vec::new(),
+            planes,
             overflowed: false,
         }
     }
@@ -566,6 +573,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             let from_m = (!same_cell && from_in).then_some((*from_m, from_cell));
             (start_m, end_m, from_m, short)
         });
+        let mut planes = UnreachedPlanes::new();
         let mut scan = Scan {
             to_m: *to_m,
             radius_m,
@@ -573,7 +581,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             segment: sweep.map(|(start_m, end_m, ..)| [start_m, end_m]),
             hit: None,
             reached: None,
-            unreached: Unreached::new(),
+            unreached: Unreached::new(&mut planes),
             order: 0,
             covered: false,
         };
@@ -649,7 +657,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         visited: &mut Visited,
         work: &mut ContactWork,
         pass: Pass<T>,
-        scan: &mut Scan<T>,
+        scan: &mut Scan<'_, T>,
     ) {
         let mut chunk = heapless::Vec::<u32, WALK_CHUNK>::new();
         self.index.for_each_vertex_near(around, |v| {
@@ -679,7 +687,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         triangles: &[u32],
         work: &mut ContactWork,
         pass: Pass<T>,
-        scan: &mut Scan<T>,
+        scan: &mut Scan<'_, T>,
     ) {
         for &t in triangles {
             let t = TriangleIndex::checked(t);
@@ -698,7 +706,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     fn test(
         &self,
         pass: Pass<T>,
-        scan: &mut Scan<T>,
+        scan: &mut Scan<'_, T>,
         t: TriangleIndex,
         normal: Vector3<T>,
         offset: T,
