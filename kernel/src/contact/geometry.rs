@@ -551,7 +551,25 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             }
         };
         let to_cell = cell_of(to_m);
-        let sweep = from_m.map(|from_m| {
+        let mut planes = UnreachedPlanes::new();
+        let mut scan = Scan {
+            to_m: *to_m,
+            radius_m,
+            depth_m: radius_m * T::of_f64(PENETRATION_DEPTH_RADII),
+            segment: None,
+            hit: None,
+            reached: None,
+            unreached: Unreached::new(&mut planes),
+            order: 0,
+            covered: false,
+        };
+        // The sweep's start and its cell, when it lies within the reach
+        // and not in the tool's cell; whether the motion is short. Written
+        // into `scan` where they are found (no intermediate record: each
+        // copy of the segment is a dozen stores on the firmware target).
+        let mut start = None;
+        let mut short = true;
+        if let Some(from_m) = from_m {
             let from_in = within(from_m, &reach);
             let from_cell = cell_of(from_m);
             let ([a, b, c], [x, y, z]) = (from_cell, to_cell);
@@ -560,39 +578,27 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             let same_cell = a == x && b == y && c == z;
             // The swept segment, clipped to the reach of the grid when
             // exactly one end lies outside it (both outside: no candidate).
-            let (start_m, end_m) = match (from_in, to_in) {
-                (false, true) => (clip_towards(to_m, from_m, &reach), *to_m),
-                (true, false) => (*from_m, clip_towards(from_m, to_m, &reach)),
-                _ => (*from_m, *to_m),
-            };
+            scan.segment = Some(match (from_in, to_in) {
+                (false, true) => [clip_towards(to_m, from_m, &reach), *to_m],
+                (true, false) => [*from_m, clip_towards(from_m, to_m, &reach)],
+                _ => [*from_m, *to_m],
+            });
             // A motion between neighbouring cells within the reach: the
             // lists of the cells between its ends hold every triangle the
             // walk would meet (a longer one walks).
             let near = a.abs_diff(x) <= 1 && b.abs_diff(y) <= 1 && c.abs_diff(z) <= 1;
-            let short = from_in && to_in && near;
-            let from_m = (!same_cell && from_in).then_some((*from_m, from_cell));
-            (start_m, end_m, from_m, short)
-        });
-        let mut planes = UnreachedPlanes::new();
-        let mut scan = Scan {
-            to_m: *to_m,
-            radius_m,
-            depth_m: radius_m * T::of_f64(PENETRATION_DEPTH_RADII),
-            segment: sweep.map(|(start_m, end_m, ..)| [start_m, end_m]),
-            hit: None,
-            reached: None,
-            unreached: Unreached::new(&mut planes),
-            order: 0,
-            covered: false,
-        };
-        let short = sweep.is_none_or(|(.., short)| short);
+            short = from_in && to_in && near;
+            if !same_cell && from_in {
+                start = Some((*from_m, from_cell));
+            }
+        }
         let lists = (served && short).then(|| self.index.candidates_at(to_cell));
         match lists {
             Some(list) => {
                 if to_in {
                     self.visit_triangles(list.as_slice(), work, Pass::Tool, &mut scan);
                 }
-                if let Some((_, _, Some((_, from_cell)), _)) = &sweep {
+                if let Some((_, from_cell)) = &start {
                     // The lists serve this radius and the motion is short:
                     // its ends lie within the reach, unclipped.
                     self.index
@@ -606,7 +612,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                 if to_in {
                     self.visit(to_m, &mut visited, work, Pass::Tool, &mut scan);
                 }
-                if let Some((_, _, Some((from_m, _)), _)) = &sweep {
+                if let Some((from_m, _)) = &start {
                     self.visit(from_m, &mut visited, work, Pass::Start, &mut scan);
                 }
             }
