@@ -138,14 +138,21 @@ enum Pass<T> {
     },
 }
 
-/// The state of one detection's passes (see [`SurfaceGeometry::detect`]).
-struct Scan<'p, T> {
-    /// The tool sphere's centre and radius, m.
+/// The tool sphere of a detection, as its passes read it.
+#[derive(Clone, Copy)]
+struct Sphere<T> {
+    /// The centre and radius, m.
     to_m: Vector3<T>,
     radius_m: T,
     /// How far behind a plane the centre may lie and be found, m
     /// ([`PENETRATION_DEPTH_RADII`] radii).
     depth_m: T,
+}
+
+/// The state of one detection's passes (see [`SurfaceGeometry::detect`]).
+struct Scan<'p, T> {
+    /// The tool sphere (read once per list of candidates).
+    sphere: Sphere<T>,
     /// The swept segment, `None` without an earlier position.
     segment: Option<[Vector3<T>; 2]>,
     /// The sweep's earliest hit: `(along, triangle, weights)`.
@@ -553,9 +560,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         let to_cell = cell_of(to_m);
         let mut planes = UnreachedPlanes::new();
         let mut scan = Scan {
-            to_m: *to_m,
-            radius_m,
-            depth_m: radius_m * T::of_f64(PENETRATION_DEPTH_RADII),
+            sphere: Sphere {
+                to_m: *to_m,
+                radius_m,
+                depth_m: radius_m * T::of_f64(PENETRATION_DEPTH_RADII),
+            },
             segment: None,
             hit: None,
             reached: None,
@@ -695,6 +704,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         pass: Pass<T>,
         scan: &mut Scan<'_, T>,
     ) {
+        // Read once (kept in registers across the loop, where the tests'
+        // writes into `scan` would have it read again per candidate).
+        let sphere = scan.sphere;
         for &t in triangles {
             let t = TriangleIndex::checked(t);
             let Some((normal, offset)) = self.index.plane(t) else {
@@ -703,7 +715,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             // At most `max_detection_tests` per detection, P per tick: no
             // wrap.
             work.triangles_tested = work.triangles_tested.wrapping_add(1);
-            self.test(pass, scan, t, normal, offset);
+            self.test(pass, &sphere, scan, t, normal, offset);
         }
     }
 
@@ -712,17 +724,17 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     fn test(
         &self,
         pass: Pass<T>,
+        sphere: &Sphere<T>,
         scan: &mut Scan<'_, T>,
         t: TriangleIndex,
         normal: Vector3<T>,
         offset: T,
     ) {
-        let Scan {
+        let Sphere {
             to_m,
             radius_m,
             depth_m,
-            ..
-        } = *scan;
+        } = *sphere;
         match pass {
             Pass::Start => {
                 if let Some(segment) = &scan.segment {
