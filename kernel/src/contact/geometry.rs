@@ -181,7 +181,9 @@ const UNREACHED_CAPACITY: usize = 16;
 /// (is one of them over the centre, nearer than the nearest reached?)
 /// needs no second pass ([`Pass::Covered`]) unless more came.
 struct Unreached<'p, T> {
-    nearest_m: Option<T>,
+    /// The nearest noted plane's distance, m; +∞ before the first (a
+    /// noted plane lies within the depth reach: finite).
+    nearest_m: T,
     /// Each kept plane's triangle and place in the test order (its
     /// distance is computed again from the stored plane, bit for bit).
     planes: &'p mut UnreachedPlanes,
@@ -198,7 +200,7 @@ impl<'p, T: Real> Unreached<'p, T> {
     /// None noted yet, into the empty `planes`.
     fn new(planes: &'p mut UnreachedPlanes) -> Self {
         Self {
-            nearest_m: None,
+            nearest_m: T::of_f64(f64::INFINITY),
             planes,
             overflowed: false,
         }
@@ -207,8 +209,8 @@ impl<'p, T: Real> Unreached<'p, T> {
     /// Notes triangle `t`, its plane `distance_m` from the centre, the
     /// `order`-th tested.
     fn note(&mut self, t: TriangleIndex, distance_m: T, order: u32) {
-        if self.nearest_m.is_none_or(|u| distance_m < u) {
-            self.nearest_m = Some(distance_m);
+        if distance_m < self.nearest_m {
+            self.nearest_m = distance_m;
         }
         if self.planes.push((t, order)).is_err() {
             self.overflowed = true;
@@ -636,7 +638,9 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
             order,
         } = scan.reached.take()?;
         let bound_m = distance_m.abs();
-        if scan.unreached.nearest_m.is_some_and(|u| u <= bound_m) {
+        let unreached = &scan.unreached;
+        let noted = !unreached.planes.is_empty() || unreached.overflowed;
+        if noted && unreached.nearest_m <= bound_m {
             let covered = if scan.unreached.overflowed {
                 // The second pass, over the same candidates in the same order.
                 scan.order = 0;
