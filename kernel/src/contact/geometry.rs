@@ -297,7 +297,9 @@ fn clamp_weights<T: Real>(w: [T; 3]) -> [T; 3] {
     let c = w.map(|x| if x > T::zero() { x } else { T::zero() });
     let sum = c[0] + c[1] + c[2];
     if sum > T::zero() {
-        c.map(|x| x / sum)
+        // One division (14 cycles on the Cortex-M4F), three products.
+        let inverse = T::one() / sum;
+        c.map(|x| x * inverse)
     } else {
         [T::one() / T::of_f64(3.0); 3]
     }
