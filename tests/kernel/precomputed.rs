@@ -475,7 +475,7 @@ proptest! {
 #[test]
 fn tissue_solves_equal_fresh_solves_through_its_buffers() {
     use palpate_kernel::PrecomputedTable;
-    use palpate_kernel::contact::{Contact, ContactSet, ContactWork, SurfaceGeometry, Tissue};
+    use palpate_kernel::contact::{Contact, ContactRefs, ContactWork, SurfaceGeometry, Tissue};
     use palpate_kernel::precomputed::PrecomputedTissue;
     const RADIUS_M: f64 = 0.05;
     let file = reference_cube_table(Precision::F64);
@@ -490,17 +490,15 @@ fn tissue_solves_equal_fresh_solves_through_its_buffers() {
             .detect(tool, None, &tip, RADIUS_M, &mut ContactWork::default())
             .expect("a contact on the top face")
     };
-    let set_of = |contacts: &[Contact<f64>]| {
-        let mut set = ContactSet::<f64, MAX_CONTACTS>::new();
-        for c in contacts {
-            set.push(*c).expect("room");
-        }
-        set
-    };
     let mut solves = 0;
     let mut check = |tissue: &mut PrecomputedTissue<'_, f64, MAX_CONTACTS>,
                      contacts: &[Contact<f64>]| {
-        let mut set = set_of(contacts);
+        // The loop lends its records: a copy of the contacts here.
+        let mut records = contacts.to_vec();
+        let mut set = ContactRefs::<f64, MAX_CONTACTS>::new();
+        for c in &mut records {
+            set.push(c).expect("room");
+        }
         let fresh = model.contact_forces::<MAX_CONTACTS>(contacts);
         let solved = tissue.solve(&mut set);
         solves += 1;

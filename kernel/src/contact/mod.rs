@@ -16,5 +16,5 @@ mod tissue;
 pub use geometry::{
     ContactWork, MAX_WALK_STEPS, PENETRATION_DEPTH_RADII, Supports, SurfaceGeometry,
 };
-pub use set::{Contact, ContactSet};
+pub use set::{Contact, ContactRefs, ContactSet};
 pub use tissue::{Refusal, Tissue};

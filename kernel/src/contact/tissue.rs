@@ -6,7 +6,7 @@
 
 use nalgebra::Vector3;
 
-use super::{ContactSet, SurfaceGeometry};
+use super::{Contact, SurfaceGeometry};
 use crate::Real;
 
 /// Why a contact set was not solved.
@@ -25,10 +25,11 @@ pub trait Tissue<T: Real, const M: usize> {
     /// Whether a tracked contact with signed gap `gap_m` (m) stays before
     /// the solve (the solve then releases adhesive contacts).
     fn keeps(&self, gap_m: T) -> bool;
-    /// Solves contact set `set`: writes each contact's
-    /// [`super::Contact::force_n`] and returns the force on the hand (the
+    /// Solves contact set `set` (at most `M`, in tool-point order; the
+    /// loop's own records, [`super::ContactRefs`]): writes each contact's
+    /// [`Contact::force_n`] and returns the force on the hand (the
     /// tissue's reaction on the tool), N. Bounded.
-    fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal>;
+    fn solve(&mut self, set: &mut [&mut Contact<T>]) -> Result<Vector3<T>, Refusal>;
     /// Called once at the start of every tick (a clock for models that
     /// extrapolate between physics updates).
     fn begin_tick(&mut self) {}

@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 
 use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
 use super::tool::{ToolAction, ToolInput};
-use crate::contact::{Contact, ContactSet, ContactWork, Refusal, Tissue};
+use crate::contact::{Contact, ContactRefs, ContactSet, ContactWork, Refusal, Tissue};
 use crate::hybrid::HybridTissue;
 use crate::math::{Dispatch, Portable};
 use crate::precomputed::{ContactSolution, PrecomputedTissue};
@@ -193,20 +193,28 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
         let mut refused = self.track_and_detect(tools);
-        let mut set = ContactSet::new();
-        self.gather_contacts(&mut set);
+        // The active contacts, lent to the solve in tool-point order (no
+        // copy of them); those it releases are dropped after it.
+        let mut set = ContactRefs::<T, M>::new();
+        for c in self.contacts.iter_mut().flatten() {
+            // Tracking and detection keep at most M: never refused here.
+            let _ = set.push(c);
+        }
+        let mut dropped = [false; P];
         // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
         // the model refuses, and solve again. Each pass removes one.
+        let mut solved = None;
         for _ in 0..=P {
             self.counters.solves = self.counters.solves.saturating_add(1);
-            let dropped = match self.tissue.solve(&mut set) {
+            let tool = match self.tissue.solve(&mut set) {
                 Ok(device_force_n) => {
                     let adhesive = set
                         .iter()
                         .find(|c| c.grip_offset_m.is_none() && c.force_n.dot(&c.normal) > T::zero())
                         .map(|c| c.tool);
                     let Some(tool) = adhesive else {
-                        return self.output(Ok(device_force_n), dt, refused);
+                        solved = Some(device_force_n);
+                        break;
                     };
                     tool
                 }
@@ -217,8 +225,20 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                 }
                 Err(Refusal::Fault) => break,
             };
-            self.drop_contact(dropped);
-            set.retain(|c| c.tool != dropped);
+            if let Some(d) = dropped.get_mut(tool) {
+                *d = true;
+            }
+            set.retain(|c| c.tool != tool);
+        }
+        // The loan ends here (the set's drop would hold it to the end).
+        drop(set);
+        if let Some(device_force_n) = solved {
+            for (slot, &d) in self.contacts.iter_mut().zip(&dropped) {
+                if d {
+                    *slot = None;
+                }
+            }
+            return self.output(Ok(device_force_n), dt, refused);
         }
         self.contacts = [None; P];
         self.tissue.forget();
@@ -273,12 +293,6 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         self.previous_m = Some(tools.map(|t| t.position_m));
         self.actions = tools.map(|t| t.action);
         refused
-    }
-
-    fn drop_contact(&mut self, p: usize) {
-        if let Some(slot) = self.contacts.get_mut(p) {
-            *slot = None;
-        }
     }
 
     /// Pushes the active contacts (at most `M` after tracking and

@@ -16,7 +16,9 @@ use nalgebra::Vector3;
 
 use super::region::{CondensedRegion, HybridBuffers, HybridError};
 use super::surface::{HybridSurface, HybridSurfaceBuffers, SlotRegion};
-use crate::contact::{Contact, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue};
+use crate::contact::{
+    Contact, ContactRefs, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue,
+};
 use crate::precomputed::ContactSolution;
 use crate::table::{InterfaceTable, PrecomputedTable, VertexIndex};
 use crate::tensor_mass::{
@@ -225,29 +227,38 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
 
     /// The tensor-mass region's contacts by its tissue, the pre-computed
     /// region's by the condensed solve; the hand feels their sum.
-    fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal> {
+    fn solve(&mut self, set: &mut [&mut Contact<T>]) -> Result<Vector3<T>, Refusal> {
         if self.fault().is_some() {
             return Err(Refusal::Fault);
         }
+        // The tensor-mass region's contacts in its own frame (copies), the
+        // pre-computed region's as they are; each sub-set's place in `set`.
         let mut dynamic_set: ContactSet<T, M> = ContactSet::new();
         let mut dynamic_index = [0usize; M];
-        let mut precomputed_set: ContactSet<T, M> = ContactSet::new();
-        let mut precomputed_index = [0usize; M];
+        let mut precomputed_index: heapless::Vec<usize, M> = heapless::Vec::new();
         for (q, c) in set.iter().enumerate() {
-            let (target, index, contact) = match self.to_dynamic(c) {
-                Some(local) => (&mut dynamic_set, &mut dynamic_index, local),
-                None => (&mut precomputed_set, &mut precomputed_index, *c),
-            };
-            if let Some(slot) = index.get_mut(target.len()) {
-                *slot = q;
-            }
             // Each sub-set holds at most as many as `set`.
-            let _ = target.push(contact);
+            match self.to_dynamic(c) {
+                Some(local) => {
+                    if let Some(slot) = dynamic_index.get_mut(dynamic_set.len()) {
+                        *slot = q;
+                    }
+                    let _ = dynamic_set.push(local);
+                }
+                None => {
+                    let _ = precomputed_index.push(q);
+                }
+            }
         }
         let mut device_force_n = Vector3::zeros();
         if !dynamic_set.is_empty() {
-            device_force_n += Tissue::<T, M>::solve(&mut self.dynamic, &mut dynamic_set)
+            let mut local = ContactRefs::<T, M>::new();
+            for c in &mut dynamic_set {
+                let _ = local.push(c);
+            }
+            device_force_n += Tissue::<T, M>::solve(&mut self.dynamic, &mut local)
                 .map_err(|r| remap(r, &dynamic_index))?;
+            drop(local);
             for (c, &q) in dynamic_set.iter().zip(&dynamic_index) {
                 if let Some(original) = set.get_mut(q) {
                     original.force_n = c.force_n;
@@ -255,9 +266,16 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
             }
         }
         self.solution = None;
-        if !precomputed_set.is_empty() {
+        if !precomputed_index.is_empty() {
             // The surface stands at the background: a contact's gap is
             // already the displacement beyond it, what `C⁰` answers.
+            let mut precomputed_set = ContactRefs::<T, M>::new();
+            let mut next = precomputed_index.iter().peekable();
+            for (q, c) in set.iter_mut().enumerate() {
+                if next.next_if(|&&i| i == q).is_some() {
+                    let _ = precomputed_set.push(&mut **c);
+                }
+            }
             let solution = self
                 .region
                 .precomputed()
@@ -267,10 +285,8 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
                         remap(Refusal::Contact(i), &precomputed_index)
                     })
                 })?;
-            for (g, &q) in solution.contact_forces_n().iter().zip(&precomputed_index) {
-                if let Some(original) = set.get_mut(q) {
-                    original.force_n = *g;
-                }
+            for (g, c) in solution.contact_forces_n().iter().zip(&mut precomputed_set) {
+                c.force_n = *g;
             }
             device_force_n += solution.device_force_n();
             self.solution = Some(solution);

@@ -89,6 +89,22 @@ impl<T: Real> AsConstraint<T> for Contact<T> {
     }
 }
 
+/// A constraint held elsewhere (the haptic loop's contacts, lent to the
+/// solve: [`crate::contact::ContactRefs`]).
+impl<T: Real, C: AsConstraint<T>> AsConstraint<T> for &mut C {
+    fn point(&self) -> ContactPoint<T> {
+        (**self).point()
+    }
+
+    fn displacement_m(&self) -> Vector3<T> {
+        (**self).displacement_m()
+    }
+
+    fn on_surface_triangle(&self) -> bool {
+        (**self).on_surface_triangle()
+    }
+}
+
 impl<T: Real> Constraint<T> {
     /// A contact at a touchable vertex.
     pub fn at_vertex(vertex: u32, displacement_m: Vector3<T>) -> Self {

@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 
 use super::model::SolveBuffers;
 use super::{ContactSolution, PrecomputedModel, QuasiNonLinear};
-use crate::contact::{ContactSet, Refusal, SurfaceGeometry, Tissue};
+use crate::contact::{Contact, Refusal, SurfaceGeometry, Tissue};
 use crate::table::PrecomputedTable;
 use crate::{MAX_CONTACTS, Real};
 
@@ -67,10 +67,10 @@ impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
         gap_m < T::zero()
     }
 
-    fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal> {
+    fn solve(&mut self, set: &mut [&mut Contact<T>]) -> Result<Vector3<T>, Refusal> {
         self.solved = false;
         self.model
-            .solve_into(set.as_slice(), &mut self.buffers, &mut self.solution)
+            .solve_into(&*set, &mut self.buffers, &mut self.solution)
             .map_err(|e| e.contact().map_or(Refusal::Fault, Refusal::Contact))?;
         self.solved = true;
         for (c, g) in set.iter_mut().zip(self.solution.contact_forces_n()) {

@@ -840,7 +840,7 @@ impl<T: Real, const P: usize, const M: usize, D: Dispatch> Tissue<T, M>
     /// (module docs); the force of the last update carries over while the
     /// contact stays on or next to the triangle it held (they share a
     /// vertex).
-    fn solve(&mut self, set: &mut ContactSet<T, M>) -> Result<Vector3<T>, Refusal> {
+    fn solve(&mut self, set: &mut [&mut Contact<T>]) -> Result<Vector3<T>, Refusal> {
         if self.fault.is_some() || self.model.fault().is_some() {
             return Err(Refusal::Fault);
         }
