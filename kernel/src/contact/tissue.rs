@@ -22,6 +22,11 @@ pub enum Refusal {
 pub trait Tissue<T: Real, const M: usize> {
     /// The surface as it stands now.
     fn geometry(&self) -> SurfaceGeometry<'_, T>;
+    /// `f` of the surface as it stands now ([`Self::geometry`]): a tissue
+    /// that keeps its surface lends it instead of building one per tick.
+    fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R {
+        f(&self.geometry())
+    }
     /// Whether a tracked contact with signed gap `gap_m` (m) stays before
     /// the solve (the solve then releases adhesive contacts).
     fn keeps(&self, gap_m: T) -> bool;

@@ -251,47 +251,57 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
     /// contacts the capacity `M` refused.
     fn track_and_detect(&mut self, tools: &[ToolInput<T>; P]) -> u8 {
         let radius = self.config.radius_m;
-        let surface = self.tissue.geometry();
-        let mut refused = 0u8;
-        let mut active = 0usize;
-        for (p, (tool, was)) in tools.iter().zip(&self.actions).enumerate() {
-            let Some(slot) = self.contacts.get_mut(p) else {
-                continue;
-            };
-            let tip = &tool.position_m;
-            let gripping = tool.action == ToolAction::Grip;
-            let closing = gripping && *was != ToolAction::Grip;
-            let work = &mut self.counters.contact;
-            match slot {
-                Some(c) => {
-                    // Tracked in place (no copy of the contact record).
-                    if !gripping {
-                        c.grip_offset_m = None;
+        let Self {
+            tissue,
+            contacts,
+            counters,
+            previous_m,
+            actions,
+            ..
+        } = self;
+        let refused = tissue.with_geometry(|surface| {
+            let mut refused = 0u8;
+            let mut active = 0usize;
+            for (p, (tool, was)) in tools.iter().zip(actions.iter()).enumerate() {
+                let Some(slot) = contacts.get_mut(p) else {
+                    continue;
+                };
+                let tip = &tool.position_m;
+                let gripping = tool.action == ToolAction::Grip;
+                let closing = gripping && *was != ToolAction::Grip;
+                let work = &mut counters.contact;
+                match slot {
+                    Some(c) => {
+                        // Tracked in place (no copy of the contact record).
+                        if !gripping {
+                            c.grip_offset_m = None;
+                        }
+                        let kept = surface.track(c, tip, radius, work)
+                            && (c.grip_offset_m.is_some() || tissue.keeps(c.gap_m));
+                        if !kept {
+                            *slot = None;
+                        } else if closing {
+                            c.grip();
+                        }
                     }
-                    let kept = surface.track(c, tip, radius, work)
-                        && (c.grip_offset_m.is_some() || self.tissue.keeps(c.gap_m));
-                    if !kept {
+                    None => {
+                        let from = previous_m.as_ref().and_then(|prev| prev.get(p));
+                        surface.detect_into(p, from, tip, radius, work, slot);
+                    }
+                }
+                if slot.is_some() {
+                    if active < M {
+                        active += 1;
+                    } else {
                         *slot = None;
-                    } else if closing {
-                        c.grip();
+                        refused = refused.saturating_add(1);
                     }
                 }
-                None => {
-                    let from = self.previous_m.as_ref().and_then(|prev| prev.get(p));
-                    surface.detect_into(p, from, tip, radius, work, slot);
-                }
             }
-            if slot.is_some() {
-                if active < M {
-                    active += 1;
-                } else {
-                    *slot = None;
-                    refused = refused.saturating_add(1);
-                }
-            }
-        }
-        self.previous_m = Some(tools.map(|t| t.position_m));
-        self.actions = tools.map(|t| t.action);
+            refused
+        });
+        *previous_m = Some(tools.map(|t| t.position_m));
+        *actions = tools.map(|t| t.action);
         refused
     }
 
