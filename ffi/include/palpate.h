@@ -79,7 +79,7 @@
  `palpate_abi_version()` with it at start-up to catch a header and a
  library of different versions.
  */
-#define PALPATE_ABI_VERSION 3
+#define PALPATE_ABI_VERSION 4
 
 /*
  The table format version this library reads (`palpate tables build`
@@ -134,14 +134,14 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 360
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 390
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 330
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 350
 #endif
 
 #if defined(PALPATE_POINTER_64)
