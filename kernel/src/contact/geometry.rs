@@ -759,7 +759,10 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                     let plane = (normal, offset, distance);
                     self.sweep_test(t, plane, segment, radius_m, &mut scan.hit);
                 }
-                if distance.abs() <= depth_m && normal != Vector3::zeros() {
+                // A sweep hit decides the detection (`search`): from the
+                // first, the penetration test's record is not read.
+                let open = scan.hit.is_none();
+                if open && distance.abs() <= depth_m && normal != Vector3::zeros() {
                     if distance < radius_m {
                         self.nearest_test(t, distance, &to_m, scan.order, &mut scan.reached);
                     } else {
