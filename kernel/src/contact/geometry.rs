@@ -759,12 +759,16 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                     let plane = (normal, offset, distance);
                     self.sweep_test(t, plane, segment, radius_m, &mut scan.hit);
                 }
-                // A sweep hit decides the detection (`search`): from the
-                // first, the penetration test's record is not read.
-                let open = scan.hit.is_none();
-                if open && distance.abs() <= depth_m && normal != Vector3::zeros() {
+                if distance.abs() <= depth_m && normal != Vector3::zeros() {
                     if distance < radius_m {
-                        self.nearest_test(t, distance, &to_m, scan.order, &mut scan.reached);
+                        // A sweep hit decides the detection (`search`):
+                        // from the first, the nearest reached plane is not
+                        // read. (Tested here, where the sphere reaches the
+                        // plane, not per candidate: a walk over hundreds of
+                        // candidates without a hit would pay it on each.)
+                        if scan.hit.is_none() {
+                            self.nearest_test(t, distance, &to_m, scan.order, &mut scan.reached);
+                        }
                     } else {
                         scan.unreached.note(t, distance, scan.order);
                     }
