@@ -3,8 +3,10 @@
 //! grid ([`grid`], used by the host's table writer and by the deforming
 //! surface of the tensor-mass model), detection and tracking on a surface
 //! ([`SurfaceGeometry`]), the one [`Contact`] type that flows from detection
-//! to the tissue solve to the force, its bounded set ([`ContactSet`]), and
-//! the [`Tissue`] trait each model implements for the haptic loop.
+//! to the tissue solve to the force, its bounded sets (the loop's records
+//! lent to a solve, [`ContactRefs`]; copies for a physics update,
+//! [`ContactSet`]), and the [`Tissue`] trait each model implements for the
+//! haptic loop.
 //!
 //! Depends on [`crate::math`] and [`crate::table`] only.
 
