@@ -17,12 +17,17 @@
 #   emulator's C with cmake and its Rust bindings with bindgen (libclang);
 # - cargo-deny (licenses, bans, sources, advisories; `deny.toml`), built from
 #   crates.io with `cargo install --locked` (about 3-5 min the first time).
-# Idempotent; a fast no-op when all is present.
+# Idempotent; a fast no-op when all is present. cargo-deny builds (CPU)
+# while apt-get downloads and unpacks (network, disk): side by side.
 set -euo pipefail
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
 rustup component add llvm-tools rustfmt clippy
-command -v cargo-deny >/dev/null || cargo install cargo-deny --locked --version 0.20.2
+deny_pid=""
+if ! command -v cargo-deny >/dev/null; then
+    cargo install cargo-deny --locked --version 0.20.2 &
+    deny_pid=$!
+fi
 
 missing=()
 command -v qemu-system-arm >/dev/null || missing+=(qemu-system-arm)
@@ -49,6 +54,9 @@ if [ ${#missing[@]} -gt 0 ]; then
     $sudo apt-get update -qq
     $sudo env DEBIAN_FRONTEND=noninteractive \
         apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+if [ -n "$deny_pid" ]; then
+    wait "$deny_pid"
 fi
 qemu-system-arm --version | head -1
 valgrind --version

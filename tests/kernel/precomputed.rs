@@ -475,7 +475,9 @@ proptest! {
 #[test]
 fn tissue_solves_equal_fresh_solves_through_its_buffers() {
     use palpate_kernel::PrecomputedTable;
-    use palpate_kernel::contact::{Contact, ContactRefs, ContactWork, SurfaceGeometry, Tissue};
+    use palpate_kernel::contact::{
+        Contact, ContactRefs, ContactWork, SurfaceGeometry, Tissue, lend,
+    };
     use palpate_kernel::precomputed::PrecomputedTissue;
     const RADIUS_M: f64 = 0.05;
     let file = reference_cube_table(Precision::F64);
@@ -495,10 +497,8 @@ fn tissue_solves_equal_fresh_solves_through_its_buffers() {
                      contacts: &[Contact<f64>]| {
         // The loop lends its records: a copy of the contacts here.
         let mut records = contacts.to_vec();
-        let mut set = ContactRefs::<f64, MAX_CONTACTS>::new();
-        for c in &mut records {
-            set.push(c).expect("room");
-        }
+        let mut set: ContactRefs<'_, f64, MAX_CONTACTS> = lend(&mut records);
+        assert_eq!(set.len(), contacts.len());
         let fresh = model.contact_forces::<MAX_CONTACTS>(contacts);
         let solved = tissue.solve(&mut set);
         solves += 1;
@@ -520,6 +520,10 @@ fn tissue_solves_equal_fresh_solves_through_its_buffers() {
         contact(2, 0.7, 0.3),
         contact(3, 0.45, 0.7),
     ];
+    // `lend` lends at most its capacity, in order.
+    let mut records = four;
+    let two: ContactRefs<'_, f64, 2> = lend(&mut records);
+    assert_eq!(two.iter().map(|c| c.tool).collect::<Vec<_>>(), [0, 1]);
     check(&mut tissue, &four);
     let three = [four[0], four[2], four[3]];
     check(&mut tissue, &three);

@@ -157,7 +157,8 @@ struct Scan<'p, T> {
     segment: Option<[Vector3<T>; 2]>,
     /// The sweep's earliest hit: `(along, triangle, weights)`.
     hit: Option<(T, TriangleIndex, [T; 3])>,
-    /// The nearest plane the sphere reaches, under the centre.
+    /// The nearest plane the sphere reaches, under the centre (not kept
+    /// once `hit` is `Some`: unused then).
     reached: Option<Nearest<T>>,
     /// The planes within the depth it does not reach.
     unreached: Unreached<'p, T>,
@@ -641,7 +642,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         } = scan.reached.take()?;
         let bound_m = distance_m.abs();
         let unreached = &scan.unreached;
-        let noted = !unreached.planes.is_empty() || unreached.overflowed;
+        // Every note keeps its plane or overflows a full list.
+        let noted = !unreached.planes.is_empty();
         if noted && unreached.nearest_m <= bound_m {
             let covered = if scan.unreached.overflowed {
                 // The second pass, over the same candidates in the same order.

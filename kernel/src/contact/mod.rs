@@ -18,5 +18,5 @@ mod tissue;
 pub use geometry::{
     ContactWork, MAX_WALK_STEPS, PENETRATION_DEPTH_RADII, Supports, SurfaceGeometry,
 };
-pub use set::{Contact, ContactRefs, ContactSet};
+pub use set::{Contact, ContactRefs, ContactSet, lend};
 pub use tissue::{Refusal, Tissue};

@@ -34,7 +34,8 @@ pub struct Contact<T> {
     /// `gap · normal`.
     pub gap_m: T,
     /// Force the tool applies to the tissue here, N, written by the
-    /// tissue's solve (zero before it; `force · normal > 0` is adhesive:
+    /// tissue's solve into the loop's record (zero from detection or
+    /// tracking until the tick's solve; `force · normal > 0` is adhesive:
     /// the tool would pull, which only a grip may).
     pub force_n: Vector3<T>,
     /// `Some` while a grasper's jaw holds the contact point (MODELS.md §6):
@@ -84,3 +85,16 @@ pub type ContactSet<T, const M: usize> = heapless::Vec<Contact<T>, M>;
 /// haptic loop lends its own records: a copied set is 104 bytes a contact
 /// copied every tick, 150 cycles each on the Cortex-M4F.
 pub type ContactRefs<'c, T, const M: usize> = heapless::Vec<&'c mut Contact<T>, M>;
+
+/// The first `M` of `contacts`, lent as a [`ContactRefs`] (the rest are
+/// left out: the callers hold at most `M`).
+pub fn lend<'c, T: Real, const M: usize>(
+    contacts: impl IntoIterator<Item = &'c mut Contact<T>>,
+) -> ContactRefs<'c, T, M> {
+    let mut set = ContactRefs::new();
+    for c in contacts.into_iter().take(M) {
+        // At most `M`: room.
+        let _ = set.push(c);
+    }
+    set
+}

@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 
 use super::safety::{BadLimits, OutputStatus, SafetyFault, SafetyLimits, Supervisor};
 use super::tool::{ToolAction, ToolInput};
-use crate::contact::{Contact, ContactRefs, ContactSet, ContactWork, Refusal, Tissue};
+use crate::contact::{Contact, ContactRefs, ContactSet, ContactWork, Refusal, Tissue, lend};
 use crate::hybrid::HybridTissue;
 use crate::math::{Dispatch, Portable};
 use crate::precomputed::{ContactSolution, PrecomputedTissue};
@@ -137,7 +137,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         &self.tissue
     }
 
-    /// Each tool point's contact.
+    /// Each tool point's contact, with the force the last tick's solve
+    /// wrote ([`Contact::force_n`]).
     pub fn contacts(&self) -> &[Option<Contact<T>>; P] {
         &self.contacts
     }
@@ -195,11 +196,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         let mut refused = self.track_and_detect(tools);
         // The active contacts, lent to the solve in tool-point order (no
         // copy of them); those it releases are dropped after it.
-        let mut set = ContactRefs::<T, M>::new();
-        for c in self.contacts.iter_mut().flatten() {
-            // Tracking and detection keep at most M: never refused here.
-            let _ = set.push(c);
-        }
+        // Tracking and detection keep at most M.
+        let mut set: ContactRefs<'_, T, M> = lend(self.contacts.iter_mut().flatten());
         let mut dropped = [false; P];
         // Solve; release adhesive contacts (pulling, g·n > 0) or contacts
         // the model refuses, and solve again. Each pass removes one.

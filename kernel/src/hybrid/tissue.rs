@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 use super::region::{CondensedRegion, HybridBuffers, HybridError};
 use super::surface::{HybridSurface, HybridSurfaceBuffers, SlotRegion};
 use crate::contact::{
-    Contact, ContactRefs, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue,
+    Contact, ContactRefs, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue, lend,
 };
 use crate::precomputed::ContactSolution;
 use crate::table::{InterfaceTable, PrecomputedTable, VertexIndex};
@@ -228,22 +228,20 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
     /// The tensor-mass region's contacts by its tissue, the pre-computed
     /// region's by the condensed solve; the hand feels their sum.
     fn solve(&mut self, set: &mut [&mut Contact<T>]) -> Result<Vector3<T>, Refusal> {
-        if self.fault().is_some() {
+        if self.fault().is_some() || set.len() > M {
             return Err(Refusal::Fault);
         }
         // The tensor-mass region's contacts in its own frame (copies), the
         // pre-computed region's as they are; each sub-set's place in `set`.
         let mut dynamic_set: ContactSet<T, M> = ContactSet::new();
-        let mut dynamic_index = [0usize; M];
+        let mut dynamic_index: heapless::Vec<usize, M> = heapless::Vec::new();
         let mut precomputed_index: heapless::Vec<usize, M> = heapless::Vec::new();
         for (q, c) in set.iter().enumerate() {
             // Each sub-set holds at most as many as `set`.
             match self.to_dynamic(c) {
                 Some(local) => {
-                    if let Some(slot) = dynamic_index.get_mut(dynamic_set.len()) {
-                        *slot = q;
-                    }
                     let _ = dynamic_set.push(local);
+                    let _ = dynamic_index.push(q);
                 }
                 None => {
                     let _ = precomputed_index.push(q);
@@ -252,10 +250,7 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
         }
         let mut device_force_n = Vector3::zeros();
         if !dynamic_set.is_empty() {
-            let mut local = ContactRefs::<T, M>::new();
-            for c in &mut dynamic_set {
-                let _ = local.push(c);
-            }
+            let mut local: ContactRefs<'_, T, M> = lend(&mut dynamic_set);
             device_force_n += Tissue::<T, M>::solve(&mut self.dynamic, &mut local)
                 .map_err(|r| remap(r, &dynamic_index))?;
             drop(local);
@@ -269,13 +264,13 @@ impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, 
         if !precomputed_index.is_empty() {
             // The surface stands at the background: a contact's gap is
             // already the displacement beyond it, what `C⁰` answers.
-            let mut precomputed_set = ContactRefs::<T, M>::new();
+            // Lent in their order (`precomputed_index` increases).
             let mut next = precomputed_index.iter().peekable();
-            for (q, c) in set.iter_mut().enumerate() {
-                if next.next_if(|&&i| i == q).is_some() {
-                    let _ = precomputed_set.push(&mut **c);
-                }
-            }
+            let picked = set
+                .iter_mut()
+                .enumerate()
+                .filter_map(|(q, c)| next.next_if(|&&i| i == q).map(|_| &mut **c));
+            let mut precomputed_set: ContactRefs<'_, T, M> = lend(picked);
             let solution = self
                 .region
                 .precomputed()
