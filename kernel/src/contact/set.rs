@@ -75,9 +75,10 @@ impl<T: Real> Contact<T> {
     }
 }
 
-/// At most `M` contacts, in tool-point order: what flows from detection
-/// through the tissue solve to the force (`heapless::Vec`: capacity a
-/// const generic, pushes beyond it refused, never a panic).
+/// At most `M` contacts, in tool-point order, copied: what a physics update
+/// takes (the solve takes the loop's records themselves, [`ContactRefs`];
+/// `heapless::Vec`: capacity a const generic, pushes beyond it refused,
+/// never a panic).
 pub type ContactSet<T, const M: usize> = heapless::Vec<Contact<T>, M>;
 
 /// At most `M` contacts held where they are, in tool-point order: the set a

@@ -20,13 +20,10 @@ pub enum Refusal {
 
 /// A tissue model the haptic loop drives.
 pub trait Tissue<T: Real, const M: usize> {
-    /// The surface as it stands now.
-    fn geometry(&self) -> SurfaceGeometry<'_, T>;
-    /// `f` of the surface as it stands now ([`Self::geometry`]): a tissue
-    /// that keeps its surface lends it instead of building one per tick.
-    fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R {
-        f(&self.geometry())
-    }
+    /// `f` of the surface as it stands now: a tissue that keeps its
+    /// surface lends it (no copy per tick), one whose surface moves
+    /// assembles it from its current buffers.
+    fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R;
     /// Whether a tracked contact with signed gap `gap_m` (m) stays before
     /// the solve (the solve then releases adhesive contacts).
     fn keeps(&self, gap_m: T) -> bool;

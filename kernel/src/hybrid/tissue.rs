@@ -210,12 +210,12 @@ impl<'a, 's, T: Real, const P: usize, const M: usize> HybridTissue<'a, 's, T, P,
 }
 
 impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, '_, T, P, M> {
-    fn geometry(&self) -> SurfaceGeometry<'_, T> {
-        self.surface.geometry(Supports::Hybrid {
+    fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R {
+        f(&self.surface.geometry(Supports::Hybrid {
             precomputed: self.region.precomputed().table(),
             dynamic: self.dynamic.model().table(),
             interface: self.region.interface(),
-        })
+        }))
     }
 
     /// The tensor-mass surface follows a held contact, and the pre-computed

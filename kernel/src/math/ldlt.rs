@@ -332,21 +332,12 @@ mod tests {
     #[test]
     fn both_forms_refuse_a_singular_set_at_the_same_contact() {
         let (mut a, _) = spd();
-        // Contact 2 a copy of contact 1 among the first three: its blocks
-        // against contacts 0 and 1, and its diagonal block, are contact 1's.
-        for p in 0..2 {
-            let mut block = [[0.0; 3]; 3];
-            for (r, row) in block.iter_mut().enumerate() {
-                *row = a.rows[1][r][p];
-            }
+        // Contact 2 a copy of contact 1 among the first three: `A_2p = A_1p`
+        // for `p < 2`, and `A_22 = A_12 = A_11`.
+        for (p, from) in [(0, 0), (1, 1), (2, 1)] {
+            let block: Block<f64> = core::array::from_fn(|r| a.rows[1][r][from]);
             a.set_block(2, p, &block);
         }
-        let mut diagonal = [[0.0; 3]; 3];
-        for (r, row) in diagonal.iter_mut().enumerate() {
-            *row = a.rows[1][r][1];
-        }
-        a.set_block(2, 1, &diagonal);
-        a.set_block(2, 2, &diagonal);
         let (mut from_copy, mut in_place) = (ContactMatrix::zeros(), a);
         let (mut g1, mut g2) = (rhs(), rhs());
         let refused = from_copy.solve(Some(&a), &mut g1, M, 1e-9);

@@ -59,10 +59,6 @@ impl<'a, T: Real, const M: usize> PrecomputedTissue<'a, T, M> {
 }
 
 impl<T: Real, const M: usize> Tissue<T, M> for PrecomputedTissue<'_, T, M> {
-    fn geometry(&self) -> SurfaceGeometry<'_, T> {
-        self.surface
-    }
-
     fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R {
         f(&self.surface)
     }

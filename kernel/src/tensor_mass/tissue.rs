@@ -825,9 +825,10 @@ fn carried<T: Real, const P: usize>(
 impl<T: Real, const P: usize, const M: usize, D: Dispatch> Tissue<T, M>
     for DynamicTissue<'_, '_, T, P, D>
 {
-    fn geometry(&self) -> SurfaceGeometry<'_, T> {
-        self.surface
-            .geometry(Supports::TensorMass(self.model.table()))
+    fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R {
+        f(&self
+            .surface
+            .geometry(Supports::TensorMass(self.model.table())))
     }
 
     /// The surface follows a held contact, so the gap says nothing about
