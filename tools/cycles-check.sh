@@ -96,12 +96,21 @@ for spec in "${models[@]}"; do
     done
     feature=()
     [ "$features" != - ] && feature=(--features "$features")
+    # The device builds (each a fat-LTO link on one core) run side by side.
     (
         cd tools/cycles-m4f
         PALPATE_CYCLES_RECORDINGS="$(IFS=:; echo "${dirs[*]}")" CARGO_TARGET_DIR="target/$model" \
             cargo build -q --release "${feature[@]}"
-    )
+    ) &
+    pids+=($!)
 done
+for pid in "${pids[@]}"; do
+    wait "$pid" || {
+        echo "FAIL: a device build of tools/cycles-m4f (above)" >&2
+        exit 1
+    }
+done
+pids=()
 
 # The three emulations run side by side (each one core).
 for spec in "${models[@]}"; do

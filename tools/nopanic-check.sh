@@ -18,7 +18,9 @@
 #   step with each integrator, displacements; the haptic loop over
 #   HybridTissue (new, tick_tools, physics_update, reset).
 # The tables are built from the firmware example's box by tools/box-table.sh
-# and (the hybrid's three) tools/hybrid-tables.sh.
+# and (the hybrid's three) tools/hybrid-tables.sh, into target/nopanic (its
+# own folder: .ci/run runs this check beside the firmware checks, which build
+# the same tables into target/firmware).
 #
 # On failure it rebuilds with `--features locate` (a panic handler that links)
 # and lists every call into a panic function with its source line, from the
@@ -26,11 +28,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$PWD"
-table="$(tools/box-table.sh)"
-table_f16="$(tools/box-table.sh --compress f16)"
-table_q16="$(tools/box-table.sh --compress q16)"
-tensor_table="$(tools/box-table.sh --tensor-mass)"
-hybrid_tables="$(tools/hybrid-tables.sh)"
+tables=target/nopanic
+table="$(tools/box-table.sh "$tables/box-table.bin")"
+table_f16="$(tools/box-table.sh --compress f16 "$tables/box-table-f16.bin")"
+table_q16="$(tools/box-table.sh --compress q16 "$tables/box-table-q16.bin")"
+tensor_table="$(tools/box-table.sh --tensor-mass "$tables/box-tensor-table.bin")"
+hybrid_tables="$(tools/hybrid-tables.sh "$tables/hybrid")"
 export PALPATE_TABLE="$table" PALPATE_TABLE_F16="$table_f16" PALPATE_TABLE_Q16="$table_q16" \
     PALPATE_TENSOR_TABLE="$tensor_table" PALPATE_HYBRID_TABLES="$hybrid_tables"
 cd tools/nopanic-check
