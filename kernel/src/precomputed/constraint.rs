@@ -273,6 +273,8 @@ impl core::error::Error for ContactError {}
 
 /// A contact point resolved against a table: up to three touchable free
 /// indices with weights. Fixed vertices (zero compliance) are dropped.
+/// Invariant: the entries past `len` are [`Self::empty`]'s (touchable
+/// index 0, weight zero).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ResolvedPoint<T> {
     pub(crate) touchable: [FreeIndex; 3],
@@ -284,7 +286,8 @@ impl<T: Real> ResolvedPoint<T> {
     /// A point with no term.
     pub(crate) fn empty() -> Self {
         Self {
-            // Placeholders, never read: `terms` stops at `len`.
+            // Placeholders past `len`: `terms` stops there; the point
+            // compliance reads them, with their zero weight.
             touchable: [FreeIndex::checked(0); 3],
             weights: [T::zero(); 3],
             len: 0,

@@ -356,16 +356,15 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         block: impl Fn(usize, usize) -> Option<[T; 9]>,
     ) -> [[T; 3]; 3] {
         let mut sum = [[T::zero(); 3]; 3];
-        for (i, (&a, &beta_a)) in q.touchable.iter().zip(&q.weights).enumerate().take(q.len) {
+        // All three terms, those past `len` too: their weight is zero, so
+        // they add zero (a trip count that does not depend on `len`).
+        for (i, (&a, &beta_a)) in q.touchable.iter().zip(&q.weights).enumerate() {
             let first = if same { i } else { 0 };
-            for (j, (&b, &beta_b)) in p.touchable.iter().zip(&p.weights).enumerate().take(p.len) {
+            for (j, (&b, &beta_b)) in p.touchable.iter().zip(&p.weights).enumerate() {
                 if j < first {
                     continue;
                 }
-                let Some((index, column, transposed)) = self.table.stored_touchable_index(a, b)
-                else {
-                    continue;
-                };
+                let (index, column, transposed) = PrecomputedTable::<T>::stored_block_index(a, b);
                 let Some(block) = block(index, column) else {
                     continue;
                 };

@@ -235,22 +235,28 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
     /// order) is stored: the index of the stored block `C_lo,hi` in the
     /// surface part ([`Self::surface_blocks`]: read it there, decoded if
     /// coded), its column `hi`, and whether `C_nk` is its transpose
-    /// (`n > k`). `None` if either is not touchable. The haptic path's form
-    /// of [`Self::touchable_block_of`]: no block copied or decoded here.
-    #[inline(always)]
+    /// (`n > k`). `None` if either is not touchable.
     pub fn stored_touchable_index(
         &self,
         n: FreeIndex,
         k: FreeIndex,
     ) -> Option<(usize, usize, bool)> {
+        (n.get().max(k.get()) < self.touchable_count()).then(|| Self::stored_block_index(n, k))
+    }
+
+    /// [`Self::stored_touchable_index`] of indices known to be touchable
+    /// (a resolved contact point's, [`crate::precomputed`]): the haptic
+    /// path's form, without the check (the load checked that the blocks of
+    /// every touchable pair are counted without overflow). No block is
+    /// copied or decoded here.
+    #[inline(always)]
+    pub fn stored_block_index(n: FreeIndex, k: FreeIndex) -> (usize, usize, bool) {
         let (lo, hi) = if n <= k { (n, k) } else { (k, n) };
-        (hi.get() < self.touchable_count()).then(|| {
-            (
-                format::surface_block_index(lo.get(), hi.get()),
-                hi.get(),
-                n > k,
-            )
-        })
+        (
+            format::surface_block_index(lo.get(), hi.get()),
+            hi.get(),
+            n > k,
+        )
     }
 
     fn check_vertex_maps(&self) -> Result<(), LoadError> {
