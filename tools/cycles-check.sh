@@ -68,10 +68,17 @@ if [ ${#only_models[@]} -gt 0 ]; then
     for spec in "${models[@]}"; do
         read -r model _ <<<"$spec"
         for m in "${only_models[@]}"; do
-            [ "$m" = "$model" ] && chosen+=("$spec")
+            if [ "$m" = "$model" ]; then
+                chosen+=("$spec")
+                break
+            fi
         done
     done
-    if [ ${#chosen[@]} != ${#only_models[@]} ]; then
+    unknown=0
+    for m in "${only_models[@]}"; do
+        case "$m" in precomputed | dynamic | hybrid) ;; *) unknown=1 ;; esac
+    done
+    if [ "$unknown" = 1 ]; then
         echo "--model: one of precomputed, dynamic, hybrid" >&2
         exit 2
     fi
@@ -104,12 +111,14 @@ for spec in "${models[@]}"; do
     ) &
     pids+=($!)
 done
+built=0
 for pid in "${pids[@]}"; do
-    wait "$pid" || {
-        echo "FAIL: a device build of tools/cycles-m4f (above)" >&2
-        exit 1
-    }
+    wait "$pid" || built=1
 done
+if [ "$built" != 0 ]; then
+    echo "FAIL: a device build of tools/cycles-m4f (above)" >&2
+    exit 1
+fi
 pids=()
 
 # The three emulations run side by side (each one core).

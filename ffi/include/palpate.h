@@ -346,7 +346,8 @@ enum palpate_status
    */
   PALPATE_STATUS_TABLE_UNEXPECTED_SECTION = 131,
   /*
-   Compressed table: a column scale is not finite and > 0 (`LoadError::BadScale`).
+   Compressed table: a column scale is not finite and > 0, or too large for the codes
+   (`LoadError::BadScale`).
    */
   PALPATE_STATUS_TABLE_BAD_SCALE = 132,
   /*

@@ -111,7 +111,8 @@ pub enum Status {
     TableUnknownEncoding = 130,
     /// Table section not used by its compliance encoding (`LoadError::UnexpectedSection`).
     TableUnexpectedSection = 131,
-    /// Compressed table: a column scale is not finite and > 0 (`LoadError::BadScale`).
+    /// Compressed table: a column scale is not finite and > 0, or too large for the codes
+    /// (`LoadError::BadScale`).
     TableBadScale = 132,
     /// Compressed table: a fixed-point code is -32768 (`LoadError::BadCode`).
     TableBadCode = 133,
@@ -244,7 +245,7 @@ impl Status {
             }
             Self::TableUnknownEncoding => c"compressed table: unknown block encoding",
             Self::TableUnexpectedSection => c"table section not used by its compliance encoding",
-            Self::TableBadScale => c"compressed table: a column scale is not finite and > 0",
+            Self::TableBadScale => c"compressed table: a column scale is not finite and > 0, or too large for the codes",
             Self::TableBadCode => c"compressed table: a fixed-point code is -32768",
             Self::TableBadKeptBlocks => c"compressed table: kept-block bitmap inconsistent",
             Self::TableDroppedDiagonal => {

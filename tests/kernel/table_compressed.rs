@@ -178,6 +178,10 @@ fn bad_scales_and_codes_are_refused() {
             (true, f64::NAN),
             (false, -1.0),
             (false, f64::INFINITY),
+            // Finite, but a code near the largest (65504 in f16, 32767
+            // in q16) times it passes f32's 3.4e38.
+            (true, 1e35),
+            (false, 3e34),
         ] {
             let mut t = tiny(code);
             part(&mut t, surface).scales[2] = bad;

@@ -25,6 +25,17 @@ enum Code {
     Q16,
 }
 
+impl Code {
+    /// The largest magnitude a valid code decodes to: binary16's largest
+    /// finite value, or the fixed point's 32767.
+    fn largest(self) -> f32 {
+        match self {
+            Code::F16 => 65504.0,
+            Code::Q16 => 32767.0,
+        }
+    }
+}
+
 /// The value of a [`Code::Q16`] code: the code as a two's complement
 /// `i16` (exact in `f32`).
 #[inline(always)]
@@ -393,7 +404,11 @@ fn load_part<'a, T: Real>(
     let scales: &'a [T] = c.section(part.scale)?;
     let codes: &'a [[u16; 9]] = c.section(part.codes)?;
     let kept: Option<&'a [[u32; 2]]> = c.optional_section(part.kept)?;
-    if let Some(column) = scales.iter().position(|&s| !(s.finite() && s > T::zero())) {
+    // A scale that a valid code would take past the scalar's range is
+    // refused too: every decoded block is then finite.
+    let largest = T::of_f32(code.largest());
+    let scale_ok = |s: T| s.finite() && s > T::zero() && (s * largest).finite();
+    if let Some(column) = scales.iter().position(|&s| !scale_ok(s)) {
         return Err(LoadError::BadScale {
             kind: part.scale,
             column: column as u32,

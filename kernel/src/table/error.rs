@@ -210,7 +210,8 @@ pub enum LoadError {
         /// The section.
         kind: SectionKind,
     },
-    /// A per-column scale of a coded compliance part is not finite and > 0.
+    /// A per-column scale of a coded compliance part is not finite and > 0,
+    /// or so large that a valid code times it is not finite.
     BadScale {
         /// The scale section.
         kind: SectionKind,
@@ -365,7 +366,7 @@ impl fmt::Display for LoadError {
             ),
             LoadError::BadScale { kind, column } => write!(
                 f,
-                "section {} column {column}: scale not finite and > 0",
+                "section {} column {column}: scale not finite and > 0, or too large for the codes",
                 kind.name()
             ),
             LoadError::BadCode { kind, index } => write!(

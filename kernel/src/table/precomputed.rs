@@ -246,11 +246,12 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
 
     /// [`Self::stored_touchable_index`] of indices known to be touchable
     /// (a resolved contact point's, [`crate::precomputed`]): the haptic
-    /// path's form, without the check (the load checked that the blocks of
-    /// every touchable pair are counted without overflow). No block is
-    /// copied or decoded here.
+    /// path's form, without the check. For touchable indices the index lies
+    /// within the surface part, whose block count the load checked; for
+    /// others it names another block or none. No block is copied or
+    /// decoded here.
     #[inline(always)]
-    pub fn stored_block_index(n: FreeIndex, k: FreeIndex) -> (usize, usize, bool) {
+    pub(crate) fn stored_block_index(n: FreeIndex, k: FreeIndex) -> (usize, usize, bool) {
         let (lo, hi) = if n <= k { (n, k) } else { (k, n) };
         (
             format::surface_block_index(lo.get(), hi.get()),
