@@ -19,8 +19,7 @@
 #   HybridTissue (new, tick_tools, physics_update, reset).
 # The tables are built from the firmware example's box by tools/box-table.sh
 # and (the hybrid's three) tools/hybrid-tables.sh, into target/nopanic (its
-# own folder: .ci/run runs this check beside the firmware checks, which build
-# the same tables into target/firmware).
+# own folder: the firmware checks build theirs into target/firmware).
 #
 # On failure it rebuilds with `--features locate` (a panic handler that links)
 # and lists every call into a panic function with its source line, from the

@@ -15,24 +15,17 @@
 #   libnewlib-arm-none-eabi: newlib-nano), from apt-get;
 # - cmake and libclang-dev (apt-get): tools/cycles builds the Unicorn
 #   emulator's C with cmake and its Rust bindings with bindgen (libclang);
-# - cargo-deny (tools/install-deny.sh: built from crates.io, about 3-5 min the
-#   first time), unless `--no-deny` (.ci/run builds it beside its other steps).
+# - cargo-deny (licenses, bans, sources, advisories; `deny.toml`), built from
+#   crates.io with `cargo install --locked` (about 3-5 min the first time).
 # Idempotent; a fast no-op when all is present. cargo-deny builds (CPU)
 # while apt-get downloads and unpacks (network, disk): side by side.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-deny=1
-case "${1:-}" in
-    --no-deny) deny=0 ;;
-    "") ;;
-    *) echo "usage: tools/setup.sh [--no-deny]" >&2; exit 2 ;;
-esac
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
 rustup component add llvm-tools rustfmt clippy
 deny_pid=""
-if [ "$deny" = 1 ]; then
-    tools/install-deny.sh &
+if ! command -v cargo-deny >/dev/null; then
+    cargo install cargo-deny --locked --version 0.20.2 &
     deny_pid=$!
 fi
 
@@ -69,3 +62,4 @@ qemu-system-arm --version | head -1
 valgrind --version
 cmake --version | head -1
 arm-none-eabi-gcc --version | head -1
+cargo deny --version
