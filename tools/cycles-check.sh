@@ -44,7 +44,11 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --all) all=1 ;;
         --profile) profile=(--profile "$2"); shift ;;
-        --model) only_models+=("$2"); shift ;;
+        --model)
+            # Each model once.
+            [[ " ${only_models[*]} " == *" $2 "* ]] || only_models+=("$2")
+            shift
+            ;;
         --compress) compress=(--compress "$2"); shift ;;
         --target-report-only) target_flag=--warn-limit ;;
         *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--model M]... [--compress CODE] [--target-report-only]" >&2; exit 2 ;;
@@ -68,17 +72,10 @@ if [ ${#only_models[@]} -gt 0 ]; then
     for spec in "${models[@]}"; do
         read -r model _ <<<"$spec"
         for m in "${only_models[@]}"; do
-            if [ "$m" = "$model" ]; then
-                chosen+=("$spec")
-                break
-            fi
+            [ "$m" = "$model" ] && chosen+=("$spec")
         done
     done
-    unknown=0
-    for m in "${only_models[@]}"; do
-        case "$m" in precomputed | dynamic | hybrid) ;; *) unknown=1 ;; esac
-    done
-    if [ "$unknown" = 1 ]; then
+    if [ ${#chosen[@]} != ${#only_models[@]} ]; then
         echo "--model: one of precomputed, dynamic, hybrid" >&2
         exit 2
     fi

@@ -18,14 +18,16 @@
 # - cargo-deny (licenses, bans, sources, advisories; `deny.toml`), built from
 #   crates.io with `cargo install --locked` (about 3-5 min the first time).
 # Idempotent; a fast no-op when all is present. cargo-deny builds (CPU)
-# while apt-get downloads and unpacks (network, disk): side by side.
+# while apt-get downloads and unpacks (network, disk), side by side, when a C
+# compiler is there already (its `ring` dependency compiles C); else after.
 set -euo pipefail
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
 rustup component add llvm-tools rustfmt clippy
+install_deny() { cargo install cargo-deny --locked --version 0.20.2; }
 deny_pid=""
-if ! command -v cargo-deny >/dev/null; then
-    cargo install cargo-deny --locked --version 0.20.2 &
+if ! command -v cargo-deny >/dev/null && command -v cc >/dev/null; then
+    install_deny &
     deny_pid=$!
 fi
 
@@ -57,6 +59,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 if [ -n "$deny_pid" ]; then
     wait "$deny_pid"
+elif ! command -v cargo-deny >/dev/null; then
+    install_deny
 fi
 qemu-system-arm --version | head -1
 valgrind --version

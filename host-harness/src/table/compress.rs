@@ -33,7 +33,8 @@ use anyhow::{Context, bail, ensure};
 use bytemuck::Zeroable;
 use nalgebra::Vector3;
 use palpate_kernel::table::format::{
-    BlockEncoding, CompressionRecord, KEPT_BITS, PROBE_SET_EVERY_TOUCHABLE, surface_block_index,
+    self, BlockEncoding, CompressionRecord, KEPT_BITS, PROBE_SET_EVERY_TOUCHABLE,
+    surface_block_index,
 };
 use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
@@ -63,7 +64,7 @@ impl BlockCode {
     fn scale(self, largest: f64) -> f64 {
         let scale = match self {
             BlockCode::F16 => largest,
-            BlockCode::Q16 => largest / 32767.0,
+            BlockCode::Q16 => largest / f64::from(format::Q16_LARGEST_CODE),
         };
         if largest > 0.0 {
             f64::from(scale as f32)
@@ -148,7 +149,8 @@ pub fn f16_bits(x: f64) -> u16 {
 /// The q16 code of `x` (in quanta): `round(x)`, ties to even, clamped to
 /// `−32767..=32767`, as its two's complement bits.
 fn q16_code(x: f64) -> u16 {
-    (x.round_ties_even().clamp(-32767.0, 32767.0) as i16).cast_unsigned()
+    let largest = f64::from(format::Q16_LARGEST_CODE);
+    (x.round_ties_even().clamp(-largest, largest) as i16).cast_unsigned()
 }
 
 /// One coded compliance part as written: a scale per column, the kept

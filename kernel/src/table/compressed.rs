@@ -26,12 +26,11 @@ enum Code {
 }
 
 impl Code {
-    /// The largest magnitude a valid code decodes to: binary16's largest
-    /// finite value, or the fixed point's 32767.
+    /// The largest magnitude a valid code decodes to.
     fn largest(self) -> f32 {
         match self {
-            Code::F16 => 65504.0,
-            Code::Q16 => 32767.0,
+            Code::F16 => format::F16_LARGEST_CODE,
+            Code::Q16 => format::Q16_LARGEST_CODE,
         }
     }
 }

@@ -471,6 +471,14 @@ pub enum SectionKind {
     InteriorKept = 56,
 }
 
+/// The largest magnitude of a [`BlockEncoding::Q16`] code (`i16` in
+/// `−32767..=32767`).
+pub const Q16_LARGEST_CODE: f32 = 32767.0;
+
+/// The largest magnitude a [`BlockEncoding::F16`] code decodes to
+/// (binary16's largest finite value).
+pub const F16_LARGEST_CODE: f32 = 65504.0;
+
 /// How one compliance part (surface or interior) is stored: the values of
 /// [`CompressionRecord::surface_encoding`] and
 /// [`CompressionRecord::interior_encoding`] (module docs).
