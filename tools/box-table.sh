@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the f32 table of the firmware example's mesh (tools/firmware-m4f/mesh/box.*)
-# with the host CLI (dev profile: `cargo test --workspace` has already built it
-# in CI) and prints its path. Used by firmware-check.sh and nopanic-check.sh.
+# with the host CLI (tools/palpate.sh: in CI the binary `cargo test --workspace`
+# built) and prints its path. Used by firmware-check.sh and nopanic-check.sh.
 #
 #   tools/box-table.sh [OUT]                  pre-computed table (default OUT:
 #                                             target/firmware/box-table.bin)
@@ -28,6 +28,6 @@ elif [[ "${1:-}" == --compress ]]; then
 fi
 out="${1:-$out_default}"
 mkdir -p "$(dirname "$out")"
-cargo run -q -p palpate -- tables build tools/firmware-m4f/mesh/box.node \
+tools/palpate.sh tables build tools/firmware-m4f/mesh/box.node \
     --young 3000 --poisson 0.45 --fix 'z<0.001' --precision f32 "${kind[@]}" --quiet -o "$out" >&2
 echo "$PWD/$out"

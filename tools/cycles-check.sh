@@ -56,8 +56,7 @@ while [ $# -gt 0 ]; do
     shift
 done
 
-cargo build -q -p palpate
-palpate="$root/target/debug/palpate"
+palpate="$(tools/palpate.sh --path)"
 (cd tools/cycles && cargo build -q --release)
 counter="$root/tools/cycles/target/release/palpate-cycles"
 

@@ -26,7 +26,7 @@ table="$(tools/box-table.sh)"
 tensor_table="$(tools/box-table.sh --tensor-mass)"
 hybrid_tables="$(tools/hybrid-tables.sh)"
 replay="$out/host-replay.txt"
-cargo run -q -p palpate -- precomputed replay "$table" tools/firmware-m4f/sequence.txt >"$replay"
+tools/palpate.sh precomputed replay "$table" tools/firmware-m4f/sequence.txt >"$replay"
 
 memcheck=(valgrind --tool=memcheck --error-exitcode=1 -q)
 cc -std=c11 -pedantic -O1 -g -Wall -Wextra -Werror -Iffi/include ffi/tests/c/abi_test.c "$lib" \

@@ -57,7 +57,7 @@ c_mode() {
     mkdir -p "$c_out"
     local table host_txt="$out/c-host.txt" firmware_txt="$out/c-firmware.txt"
     table="$(tools/box-table.sh)"
-    cargo run -q -p palpate -- precomputed replay "$table" tools/firmware-m4f/sequence.txt >"$host_txt"
+    tools/palpate.sh precomputed replay "$table" tools/firmware-m4f/sequence.txt >"$host_txt"
 
     # The library for the M4F (release: LTO, panic = "abort"), and again with the
     # link-time proof's panic handler; copied apart (one artifact path per target).
@@ -142,7 +142,7 @@ fi
 
 if [[ "${1:-}" == --hybrid ]]; then
     mode=hybrid
-    tables="$(tools/hybrid-tables.sh)" # host CLI, dev profile; prints the tables' folder
+    tables="$(tools/hybrid-tables.sh)" # host CLI (tools/palpate.sh); prints the tables' folder
     sequence="$root/tools/firmware-m4f/hybrid-sequence.txt"
     host=(scene replay-hybrid "$tables" "$sequence")
     build=(env PALPATE_HYBRID_TABLES="$tables" cargo build -q --release --features hybrid)
@@ -153,7 +153,7 @@ else
         compress=(--compress "${2:?usage: tools/firmware-check.sh --compress f16|q16}")
         mode="precomputed-$2"
     fi
-    table="$(tools/box-table.sh "${compress[@]}")" # host CLI, dev profile; prints the table path
+    table="$(tools/box-table.sh "${compress[@]}")" # host CLI (tools/palpate.sh); prints the table path
     sequence="$root/tools/firmware-m4f/sequence.txt"
     host=(precomputed replay "$table" "$sequence")
     build=(env PALPATE_TABLE="$table" cargo build -q --release)
@@ -161,7 +161,7 @@ fi
 host_txt="$out/$mode-host.txt"
 firmware_txt="$out/$mode-firmware.txt"
 
-cargo run -q -p palpate -- "${host[@]}" >"$host_txt"
+tools/palpate.sh "${host[@]}" >"$host_txt"
 
 cd tools/firmware-m4f
 "${build[@]}"
