@@ -9,6 +9,7 @@
 
 pub mod bench;
 pub mod budget;
+pub mod callgrind;
 pub mod chart;
 pub mod demo;
 pub mod dispatch;

@@ -516,7 +516,35 @@ fn budget_ticks_stay_within_the_static_bound() {
     for (scene, trajectory) in [("built-in", "strike"), ("built-in-dynamic", "slide")] {
         let dir = temp(&format!("budget-{scene}"));
         budget_within_bound(scene, trajectory, &dir, 900);
+        if scene == "built-in" && palpate::callgrind::STARTS_INSTRUMENTATION {
+            same_counts_from_the_first_tick(scene, trajectory, &dir);
+        }
     }
+}
+
+/// The budget's probe (coarse mesh) left in `dir` by a `palpate budget`
+/// run, measured again instrumented from the process's start and from the
+/// first tick (the client request): the same count at every tick, exactly
+/// (callgrind collects only the ticks either way; the second start only
+/// spares the dumps the start-up's code).
+fn same_counts_from_the_first_tick(scene: &str, trajectory: &str, dir: &std::path::Path) {
+    use palpate::budget::{InstrumentFrom, measure_from};
+    let exe = std::path::Path::new(env!("CARGO_BIN_EXE_palpate"));
+    let args: Vec<String> = [
+        "budget",
+        scene,
+        "--probe",
+        dir.join("table-0.bin").to_str().unwrap(),
+        dir.join(format!("{trajectory}-0.csv")).to_str().unwrap(),
+        "0",
+    ]
+    .map(String::from)
+    .to_vec();
+    let counts = [InstrumentFrom::Start, InstrumentFrom::FirstTick]
+        .map(|from| measure_from(exe, &args, &dir.join(format!("cg-{from:?}")), from).unwrap());
+    assert!(counts[0].len() > 900, "{} ticks", counts[0].len());
+    assert!(counts[0].iter().all(|&ir| ir > 0));
+    assert_eq!(counts[0], counts[1]);
 }
 
 /// `palpate budget` on a hybrid scene (a 6 × 6 × 3-cell block whose
