@@ -4,17 +4,22 @@
 # names when set (CI sets it to the one `cargo test --workspace` built), else the
 # package's dev-profile build, built first if stale.
 #
-# Why the variable: `cargo build -p palpate` resolves features for that one package,
-# without the test build's dev-dependencies (bitflags, either, serde, toml and zerocopy
-# get fewer features), so right after `cargo test --workspace` it compiles faer, its
-# gemm crates and the harness again: about 140 s of a fresh CI.
+# Why the variable: `cargo test --workspace` resolves dependency features across every
+# member of the workspace and their dev-dependencies, `cargo build -p palpate` for that
+# one package (bitflags, either, serde, toml and zerocopy get fewer features), so right
+# after the tests the latter compiles faer, its gemm crates and the harness again: about
+# 140 s of a fresh CI.
 set -euo pipefail
 if [[ -n "${PALPATE_BIN:-}" ]]; then
     bin="$PALPATE_BIN"
+    if [[ ! -x "$bin" ]]; then
+        echo "tools/palpate.sh: PALPATE_BIN=$bin is not an executable" >&2
+        exit 1
+    fi
 else
     root="$(cd "$(dirname "$0")/.." && pwd)"
     (cd "$root" && cargo build -q -p palpate)
-    bin="$root/target/debug/palpate"
+    bin="${CARGO_TARGET_DIR:-$root/target}/debug/palpate"
 fi
 if [[ "${1:-}" == --path ]]; then
     echo "$bin"

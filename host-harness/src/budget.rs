@@ -546,6 +546,13 @@ pub fn measure_from(
             .with_context(|| format!("{}: no summary line", path.display()))?;
         dumps.push((n, ir));
     }
+    // A child that never reached its first tick (instrumentation not
+    // started) dumps nothing: an error, never a row of zero ticks.
+    anyhow::ensure!(
+        !dumps.is_empty(),
+        "callgrind counted no tick in {}",
+        work_dir.display()
+    );
     dumps.sort_unstable();
     Ok(dumps.into_iter().map(|(_, ir)| ir).collect())
 }

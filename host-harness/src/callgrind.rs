@@ -7,9 +7,10 @@
 //! callgrind has instrumented, so this makes the dumps, most of a budget's
 //! time, cheaper.
 //!
-//! The second module of the host that allows `unsafe`: the request is the
-//! magic instruction sequence of `valgrind/valgrind.h` (x86-64), which
-//! outside Valgrind leaves every register as it was.
+//! The host's second module that allows `unsafe` (with `dispatch.rs`): the
+//! request is the magic instruction sequence of `valgrind/valgrind.h`
+//! (x86-64), which outside Valgrind leaves every register but the flags as
+//! it was.
 
 #![allow(unsafe_code)]
 

@@ -28,7 +28,8 @@
 //! wider vectors): `tests/host/dispatch.rs` checks that every level's step
 //! equals the portable one bit for bit.
 //!
-//! The one module of the host that allows `unsafe`: calling a
+//! One of the host's two modules that allow `unsafe` (the other is
+//! `callgrind.rs`'s client request): calling a
 //! `#[target_feature]` function from code compiled without the feature.
 
 #![allow(unsafe_code)]

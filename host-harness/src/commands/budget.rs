@@ -147,6 +147,13 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             ];
             let irs = measure(&exe, &probe_args, &work_dir.join(format!("cg-{name}-{s}")))?;
             let work = std::fs::read_to_string(csv.with_extension("work"))?;
+            // The probe writes one work line per tick it ran.
+            anyhow::ensure!(
+                irs.len() == work.lines().count(),
+                "{name}: callgrind counted {} ticks, the probe ran {}",
+                irs.len(),
+                work.lines().count()
+            );
             let mut max_work = [0u32; 3];
             for line in work.lines() {
                 for (m, v) in max_work.iter_mut().zip(line.split(',')) {
