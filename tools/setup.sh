@@ -20,13 +20,33 @@
 # Idempotent; a fast no-op when all is present. cargo-deny builds (CPU)
 # while apt-get downloads and unpacks (network, disk), side by side, when a C
 # compiler is there already (its `ring` dependency compiles C); else after.
+#
+#   tools/setup.sh               everything
+#   tools/setup.sh --no-deny     everything but cargo-deny
+#   tools/setup.sh --deny-only   cargo-deny only (after the rest: it needs a C compiler)
+#
+# .ci/run takes the last two apart: it builds cargo-deny at the lowest CPU
+# priority beside its other steps, on the cores they leave idle.
 set -euo pipefail
+deny=yes
+rest=yes
+case "${1:-}" in
+    "") ;;
+    --no-deny) deny=no ;;
+    --deny-only) rest=no ;;
+    *) echo "usage: tools/setup.sh [--no-deny | --deny-only]" >&2; exit 2 ;;
+esac
+install_deny() { cargo install cargo-deny --locked --version 0.20.2; }
+if [ "$rest" = no ]; then
+    command -v cargo-deny >/dev/null || install_deny
+    cargo deny --version
+    exit 0
+fi
 
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
 rustup component add llvm-tools rustfmt clippy
-install_deny() { cargo install cargo-deny --locked --version 0.20.2; }
 deny_pid=""
-if ! command -v cargo-deny >/dev/null && command -v cc >/dev/null; then
+if [ "$deny" = yes ] && ! command -v cargo-deny >/dev/null && command -v cc >/dev/null; then
     install_deny &
     deny_pid=$!
 fi
@@ -59,11 +79,13 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 if [ -n "$deny_pid" ]; then
     wait "$deny_pid"
-elif ! command -v cargo-deny >/dev/null; then
+elif [ "$deny" = yes ] && ! command -v cargo-deny >/dev/null; then
     install_deny
 fi
 qemu-system-arm --version | head -1
 valgrind --version
 cmake --version | head -1
 arm-none-eabi-gcc --version | head -1
-cargo deny --version
+if [ "$deny" = yes ]; then
+    cargo deny --version
+fi
