@@ -37,8 +37,9 @@ case "${1:-}" in
     *) echo "usage: tools/setup.sh [--no-deny | --deny-only]" >&2; exit 2 ;;
 esac
 install_deny() { cargo install cargo-deny --locked --version 0.20.2; }
+have_deny() { command -v cargo-deny >/dev/null; }
 if [ "$rest" = no ]; then
-    command -v cargo-deny >/dev/null || install_deny
+    have_deny || install_deny
     cargo deny --version
     exit 0
 fi
@@ -46,7 +47,7 @@ fi
 rustup target add thumbv7em-none-eabihf x86_64-unknown-none
 rustup component add llvm-tools rustfmt clippy
 deny_pid=""
-if [ "$deny" = yes ] && ! command -v cargo-deny >/dev/null && command -v cc >/dev/null; then
+if [ "$deny" = yes ] && ! have_deny && command -v cc >/dev/null; then
     install_deny &
     deny_pid=$!
 fi
@@ -79,7 +80,7 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 if [ -n "$deny_pid" ]; then
     wait "$deny_pid"
-elif [ "$deny" = yes ] && ! command -v cargo-deny >/dev/null; then
+elif [ "$deny" = yes ] && ! have_deny; then
     install_deny
 fi
 qemu-system-arm --version | head -1

@@ -250,8 +250,8 @@ pub fn measure_ticks(
                 remap: &word,
             });
             let dumps = work_dir.join(format!("cg-{}-{points}", model.name()));
+            // Never empty: `measure` refuses a probe that counted no tick.
             let irs = measure(exe, &args, &dumps)?;
-            anyhow::ensure!(!irs.is_empty(), "callgrind counted no tick");
             counts.push(TickCount {
                 model,
                 scene: scene_name.clone(),
