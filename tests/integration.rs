@@ -1,7 +1,7 @@
 //! Every workspace integration test, in one binary whose modules mirror the
 //! source tree: `kernel::…` (the `no_std` kernel), `host::…` (the harness),
 //! `ffi::…` (the C ABI), `tools::…` (the shared script crate, the C
-//! example's sequence). Each module states the independent
+//! example's sequence, the documents' links). Each module states the independent
 //! truth it checks against; the shared readers of the reference data are in
 //! `src/lib.rs`.
 
@@ -61,6 +61,7 @@ mod kernel {
 }
 
 mod tools {
+    mod docs_links;
     mod firmware_c;
     mod script;
     mod script_ticks;
