@@ -4,7 +4,7 @@
 //!
 //! A loop has `tool_points` tool points (1 to `PALPATE_TOOL_POINTS`, fixed
 //! at creation). The kernel's loop is built for `PALPATE_TOOL_POINTS`; the
-//! points beyond `tool_points` are parked at [`PARKED_M`], outside every
+//! points beyond `tool_points` are parked at `PARKED_M` (1e30 m), outside every
 //! mesh's collision grid, from creation on, so they never touch (the
 //! detection of a point outside the grid's reach visits no triangle), and
 //! one build of the loop serves devices with one to four points.

@@ -45,7 +45,7 @@ pub struct Contact {
 
 impl AsConstraint<f32> for Contact {
     /// A kind other than `Vertex` is a triangle: the solve checks the kinds
-    /// first ([`check_kinds`]).
+    /// first (`check_kinds`).
     fn point(&self) -> ContactPoint<f32> {
         if self.kind == ContactKind::Vertex as u32 {
             let [v, _, _] = self.vertices;

@@ -424,7 +424,7 @@ impl Matrix {
     /// the trajectories: every relaxation at [`Matrix::max_relax_steps`],
     /// every trial and trajectory run to its end. Not counted: the Newton
     /// references, the `ω_max` estimates and the timing loops (each about
-    /// 40 ms: [`STEP_SAMPLING`]).
+    /// 40 ms: `STEP_SAMPLING`).
     pub fn tet_step_bound(&self, bodies: &[Body]) -> anyhow::Result<u64> {
         let tets = |b: &Body| b.mesh.tets.len() as u64;
         let cases = (self.loads.len() * self.levels.len()) as u64;

@@ -2,7 +2,7 @@
 //! zones where cutting or large deformation may happen ([`crate::session::zones`]) become
 //! tensor-mass regions with a margin of element rings, the rest is pre-computed.
 //!
-//! Data flow: scene zones + mesh → [`geometry`] (which tets each zone takes) → [`plan`]
+//! Data flow: scene zones + mesh → [`geometry`] (which tets each zone takes) → [`mod@plan`]
 //! ([`Partition`]: regions, connection nodes, laws, refusals) → [`cost`] (table sizes, timed
 //! steps, stable steps) → [`report`] (`palpate scene plan`, text or JSON).
 //!

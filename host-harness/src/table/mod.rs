@@ -4,7 +4,7 @@
 //! tensor-mass arrays (RR-3510 §5; [`tensor_mass`]), the collision index
 //! ([`collision`]), the compressed compliance ([`compress`]: 16-bit codes,
 //! dropped far-field blocks, the error measured at build time), the table
-//! file writer ([`file`]) and reader ([`load`]),
+//! file writer ([`mod@file`]) and reader ([`load`]),
 //! the size and memory estimate checked before a build ([`estimate`]).
 
 pub mod build;

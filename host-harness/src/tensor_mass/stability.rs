@@ -152,8 +152,8 @@ fn forces_at_rest(model: &TensorMassModel<'_, '_, f64>) -> Vec<[f64; 3]> {
 }
 
 /// `ω_max = sqrt(λ_max(M⁻¹K))` by power iteration (500 iterations from the
-/// [`perturbation`] pattern), rad/s, `K` the tangent stiffness at rest
-/// ([`rest_tangent_forces`]; the stiffness itself for the linear law).
+/// `perturbation` pattern), rad/s, `K` the tangent stiffness at rest
+/// (`rest_tangent_forces`; the stiffness itself for the linear law).
 pub fn omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     model.reset();
     let n = model.modes().len();
@@ -469,14 +469,14 @@ fn rk4_radius(re: f64, im: f64) -> f64 {
 
 /// `ω_max = sqrt(λ_max(M⁻¹K))`, rad/s, over the free vertices with mass, by
 /// the Lanczos iteration on the symmetric `M^{-1/2} K M^{-1/2}` from the
-/// [`perturbation`] pattern (three vectors, no reorthogonalization): its
+/// `perturbation` pattern (three vectors, no reorthogonalization): its
 /// largest Ritz value never exceeds `λ_max` (to rounding, Paige 1980) and
 /// grows towards it, converging far faster than the power iteration of
 /// [`omega_max`] when the top of the spectrum is clustered, as on a fine
 /// mesh. Stops when the Ritz value grew by at most [`LANCZOS_TOLERANCE`]
 /// over [`LANCZOS_WINDOW`] steps, at an invariant subspace, or after
 /// [`LANCZOS_MAX_STEPS`] steps. `K` is the model's tangent stiffness at
-/// rest ([`rest_tangent_forces`]).
+/// rest (`rest_tangent_forces`).
 pub fn lanczos_omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     model.reset();
     let n = model.modes().len();

@@ -480,7 +480,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// products, with its stored frame ([`SurfaceIndex::weights`]).
     ///
     /// Sweep: an end outside that reach is first moved along the segment to
-    /// where the segment leaves it ([`clip_towards`], computed from the end
+    /// where the segment leaves it (`clip_towards`, computed from the end
     /// inside): no triangle can be hit beyond it, and a far end (a tool
     /// sample at 1e10 m) would otherwise swamp the intersection's
     /// arithmetic, in f32 every digit of the part near the surface.
@@ -494,8 +494,8 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// [`Contact::entry_gap_m`] its penetration; else there is none (also
     /// when the nearest is a rigid support). A barycentric test is spent
     /// only on planes the sphere reaches, and on the others only when one
-    /// of them is nearer than the nearest reached ([`Unreached`], or a
-    /// second pass, [`Pass::Covered`], when more than it keeps came): a
+    /// of them is nearer than the nearest reached (`Unreached`, or a
+    /// second pass, `Pass::Covered`, when more than it keeps came): a
     /// tool hovering within the depth reach costs two dot products per
     /// candidate.
     pub fn detect(

@@ -56,7 +56,7 @@ pub enum ComplianceBlocks<'a, T: Real> {
 }
 
 /// A coded compliance part: codes, per-column scales, and which blocks are
-/// kept. Invariants from [`load_parts`]: the scales are finite and `> 0`,
+/// kept. Invariants from `load_parts`: the scales are finite and `> 0`,
 /// no code is an infinity or NaN (f16) or −32768 (q16), the kept-block
 /// bitmap is consistent and counts exactly the stored codes (without one,
 /// every block is stored, or none: the codes are then empty, and a block's
