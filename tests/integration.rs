@@ -63,6 +63,7 @@ mod kernel {
 mod tools {
     mod docs_links;
     mod firmware_c;
+    mod house;
     mod script;
     mod script_ticks;
 }

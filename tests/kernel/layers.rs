@@ -14,6 +14,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use palpate_tests::source::{code_only, is_ident};
+
 /// The folders, lowest first, with their rank; equal ranks are peers.
 const LAYERS: [(&str, u32); 7] = [
     ("math", 0),
@@ -45,91 +47,6 @@ fn layer_name(segment: &str) -> Option<&'static str> {
 /// `from` may name `to`: the same folder, or a lower rank.
 fn allowed(from: &str, to: &str) -> bool {
     from == to || matches!((rank(from), rank(to)), (Some(a), Some(b)) if b < a)
-}
-
-/// The source with comments (line, doc and nested block comments) and the
-/// contents of string and character literals blanked out, so only code is
-/// left. Lifetimes (`'a`) are kept.
-fn code_only(source: &str) -> String {
-    let chars: Vec<char> = source.chars().collect();
-    let mut out = String::with_capacity(source.len());
-    let mut i = 0;
-    let at = |k: usize| chars.get(k).copied().unwrap_or('\0');
-    while i < chars.len() {
-        let (c, next) = (at(i), at(i + 1));
-        if c == '/' && next == '/' {
-            while i < chars.len() && at(i) != '\n' {
-                i += 1;
-            }
-        } else if c == '/' && next == '*' {
-            let mut depth = 0;
-            loop {
-                if i >= chars.len() {
-                    break;
-                }
-                if at(i) == '/' && at(i + 1) == '*' {
-                    depth += 1;
-                    i += 2;
-                } else if at(i) == '*' && at(i + 1) == '/' {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    i += 1;
-                }
-            }
-            out.push(' ');
-        } else if c == 'r' && (next == '"' || next == '#') && !is_ident(at(i.wrapping_sub(1))) {
-            // Raw string r"…" or r#"…"#.
-            let mut j = i + 1;
-            let mut hashes = 0;
-            while at(j) == '#' {
-                hashes += 1;
-                j += 1;
-            }
-            if at(j) != '"' {
-                out.push(c);
-                i += 1;
-                continue;
-            }
-            j += 1;
-            let closing = format!("\"{}", "#".repeat(hashes));
-            let rest: String = chars[j..].iter().collect();
-            let end = rest.find(&closing).map_or(chars.len(), |k| {
-                j + rest[..k].chars().count() + closing.chars().count()
-            });
-            out.push_str("\"\"");
-            i = end;
-        } else if c == '"' {
-            i += 1;
-            while i < chars.len() && at(i) != '"' {
-                i += if at(i) == '\\' { 2 } else { 1 };
-            }
-            i += 1;
-            out.push_str("\"\"");
-        } else if c == '\'' && next == '\\' {
-            // An escaped character literal: '\n', '\'', '\u{..}'.
-            i += 2;
-            while i < chars.len() && at(i) != '\'' {
-                i += 1;
-            }
-            i += 1;
-            out.push_str("' '");
-        } else if c == '\'' && at(i + 2) == '\'' {
-            i += 3;
-            out.push_str("' '");
-        } else {
-            out.push(c);
-            i += 1;
-        }
-    }
-    out
-}
-
-fn is_ident(c: char) -> bool {
-    c.is_alphanumeric() || c == '_'
 }
 
 /// The identifier starting at byte `i` of `s` (may be empty).

@@ -4,6 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
+pub mod source;
+
 use palpate::session::{Keyframe, Scene, ToolState, Trajectory};
 
 /// The independent reference data committed with the tests
