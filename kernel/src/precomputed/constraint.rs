@@ -43,7 +43,7 @@ pub trait AsConstraint<T: Real> {
     /// The contact as detection or tracking made it on this table's
     /// surface (the haptic path): its triangle's corners are checked
     /// indices of a surface triangle and its weights the clamped ones of
-    /// detection, so the solve resolves it from them ([`resolve`]) without
+    /// detection, so the solve resolves it from them without
     /// the raw-index checks and the surface look-up of
     /// [`ContactError::NotSurfaceTriangle`]. Scripted input keeps the
     /// default, `None`, and is checked in full.

@@ -81,7 +81,7 @@ const _: () = assert!(HEADER_LEN == 112);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
 pub struct SectionEntry {
-    /// A [`SectionKind`] value.
+    /// A [`super::SectionKind`] value.
     pub kind: u32,
     /// Bytes per element (e.g. 36 for an `f32` 3×3 block).
     pub elem_bytes: u32,

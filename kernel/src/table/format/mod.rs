@@ -57,8 +57,36 @@
 //! an earlier version is refused ([`super::LoadError::UnsupportedVersion`]),
 //! never misread.
 //!
+//! ## Compressed compliance (version 3, additive)
 //!
-//! The compressed compliance of version 3 is described in [`encoding`].
+//! A pre-computed table may store its compliance blocks compressed, to fit a
+//! microcontroller's flash. It is the same table kind and version: the
+//! [`SectionKind::ComplianceEncoding`] section (one [`CompressionRecord`])
+//! says, for each of the two compliance parts, which [`BlockEncoding`]
+//! stores it. Without that section (every table written before it existed)
+//! both parts are [`BlockEncoding::Scalar`]. A kernel that predates it
+//! refuses a compressed table (`unknown section kind 50`), never misreads it.
+//!
+//! A part stored as [`BlockEncoding::Scalar`] is the section above
+//! ([`SectionKind::ComplianceSurface`], [`SectionKind::ComplianceInterior`]).
+//! A part stored as [`BlockEncoding::F16`] or [`BlockEncoding::Q16`] replaces
+//! it by three sections (`X` = surface or interior):
+//! - `X-scale`: one scale per column `k` (touchable vertex), m/N, finite and
+//!   `> 0`, in the table scalar;
+//! - `X-codes`: `[u16; 9]` per *stored* block, in the dense layout's block
+//!   order (column by column as above) with the dropped blocks left out.
+//!   Block entry `e` of column `k` is `decode(code) · scale[k]`: for F16,
+//!   `decode` is the IEEE 754 binary16 value of the code ([`f16_to_f32`];
+//!   infinities and NaNs are refused at load); for Q16 it is the code as a
+//!   two's complement `i16` in `−32767..=32767` (`−32768` is refused);
+//! - `X-kept` (only when some blocks were dropped, not all: without it
+//!   `X-codes` holds every block, or none when all were dropped): which
+//!   blocks of the dense layout are stored, one bit per block (bit `j % 32` of word `j / 32`,
+//!   least significant first), each word followed by the number of bits set
+//!   in the words before it (a rank directory, so a block is found in
+//!   constant time: [`kept_position`]). A dropped block is zero. Bits past
+//!   the block count are zero, the ranks are exact, the bits set are the
+//!   `X-codes` count, and every diagonal block `C_kk` is kept.
 
 mod encoding;
 mod header;
