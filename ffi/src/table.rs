@@ -54,7 +54,7 @@ pub enum TableKind {
     Interface = 3,
 }
 
-// The kinds are the header's values (`table/format.rs`).
+// The kinds are the header's values (`table/format/section.rs`).
 const _: () = assert!(
     TableKind::Precomputed as u32 == KernelKind::Precomputed as u32
         && TableKind::TensorMass as u32 == KernelKind::TensorMass as u32

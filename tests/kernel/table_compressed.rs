@@ -1,5 +1,5 @@
 //! Compressed compliance tables in the kernel (`kernel/src/table/compressed.rs`; the format's
-//! "Compressed compliance" in `kernel/src/table/format.rs`): the binary16 decode against
+//! compressed compliance in `kernel/src/table/format/encoding.rs`): the binary16 decode against
 //! hand-computed bit patterns and, for every code, against the formula evaluated in f64; the
 //! kept-block rank against a plain count; the blocks the view decodes against the codes and
 //! scales written; and every refusal of a bad compressed table, behind a valid checksum, with

@@ -2,7 +2,7 @@
 //! array is computed (issue 12), and the limits a build checks them against.
 //!
 //! A pre-computed table stores `B = S(S+1)/2 + (F−S)·S` compliance blocks of 3×3 scalars
-//! (`F` free, `S` touchable vertices; `kernel/src/table/format.rs`): quadratic in the mesh. A
+//! (`F` free, `S` touchable vertices; `kernel/src/table/format/mod.rs`): quadratic in the mesh. A
 //! 40³-cell box with its base fixed (68 921 vertices, 7 921 touchable) has 5.0·10⁸ blocks, an
 //! 18 GB f32 table whose build once aborted the process on a 33.8 GB allocation. [`TableEstimate::table_bytes`] is the
 //! file's layout (the format's own section counts, [`SectionKind::expected_count`]) from these

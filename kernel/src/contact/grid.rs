@@ -346,14 +346,8 @@ fn fitted_grid<T: Real>(
     } else {
         floor_m
     };
-    let dims_for = |cell: T| extent.map(|e| ((e / cell).floor().as_f64() as u32).saturating_add(1));
     for _ in 0..MAX_CELL_GROWTHS {
-        let dims = dims_for(cell_m);
-        let grid = Grid {
-            origin_m: lo,
-            cell_m,
-            dims: [dims.x, dims.y, dims.z],
-        };
+        let grid = Grid::covering(lo, &extent, cell_m);
         if grid.cell_count().is_some_and(|n| n <= capacity) {
             return grid;
         }

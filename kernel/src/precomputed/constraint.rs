@@ -40,12 +40,15 @@ pub trait AsConstraint<T: Real> {
     fn point(&self) -> ContactPoint<T>;
     /// Imposed displacement `d_p` of the point from rest, m.
     fn displacement_m(&self) -> Vector3<T>;
-    /// `true` when a triangle point names a triangle of this table's
-    /// surface by construction (found by detection or tracking on it), so
-    /// the solve skips the surface look-up of [`ContactError::NotSurfaceTriangle`]
-    /// on the haptic path. Scripted input keeps the default, `false`.
-    fn on_surface_triangle(&self) -> bool {
-        false
+    /// The contact as detection or tracking made it on this table's
+    /// surface (the haptic path): its triangle's corners are checked
+    /// indices of a surface triangle and its weights the clamped ones of
+    /// detection, so the solve resolves it from them without
+    /// the raw-index checks and the surface look-up of
+    /// [`ContactError::NotSurfaceTriangle`]. Scripted input keeps the
+    /// default, `None`, and is checked in full.
+    fn detected(&self) -> Option<&Contact<T>> {
+        None
     }
 }
 
@@ -84,8 +87,8 @@ impl<T: Real> AsConstraint<T> for Contact<T> {
 
     /// A contact is made by detection or tracking on the tissue's surface:
     /// its triangle is one of the surface's.
-    fn on_surface_triangle(&self) -> bool {
-        true
+    fn detected(&self) -> Option<&Contact<T>> {
+        Some(self)
     }
 }
 
@@ -100,8 +103,8 @@ impl<T: Real, C: AsConstraint<T>> AsConstraint<T> for &mut C {
         (**self).displacement_m()
     }
 
-    fn on_surface_triangle(&self) -> bool {
-        (**self).on_surface_triangle()
+    fn detected(&self) -> Option<&Contact<T>> {
+        (**self).detected()
     }
 }
 
@@ -294,6 +297,18 @@ impl<T: Real> ResolvedPoint<T> {
         }
     }
 
+    /// Appends the term `(touchable, weight)` (none past three).
+    fn push(&mut self, touchable: FreeIndex, weight: T) {
+        if let (Some(t), Some(b)) = (
+            self.touchable.get_mut(self.len),
+            self.weights.get_mut(self.len),
+        ) {
+            *t = touchable;
+            *b = weight;
+            self.len += 1;
+        }
+    }
+
     /// The `(touchable index, weight)` pairs, at most three.
     pub(crate) fn terms(&self) -> impl Iterator<Item = (FreeIndex, T)> + '_ {
         self.touchable
@@ -304,35 +319,62 @@ impl<T: Real> ResolvedPoint<T> {
     }
 }
 
-/// Validates contact `index` against `table` (see [`ContactError`]).
+/// Validates contact `index` against `table` (see [`ContactError`]): its
+/// displacement, then a detected contact's point from its checked indices
+/// ([`AsConstraint::detected`]), any other's in full.
 pub(crate) fn resolve<T: Real>(
     table: &PrecomputedTable<'_, T>,
     index: usize,
     contact: &impl AsConstraint<T>,
 ) -> Result<ResolvedPoint<T>, ContactError> {
-    let contact_index = index;
     if !contact.displacement_m().iter().all(|x| x.finite()) {
-        return Err(ContactError::NonFiniteInput {
-            contact: contact_index,
-        });
+        return Err(ContactError::NonFiniteInput { contact: index });
     }
-    let touchable = table.touchable_count();
-    let lookup = |vertex: u32| -> Result<Option<FreeIndex>, ContactError> {
-        match table.slot(vertex) {
-            None => Err(ContactError::VertexOutOfRange {
-                contact: contact_index,
-                vertex,
-            }),
-            Some(VertexSlot::Fixed) => Ok(None),
-            Some(VertexSlot::Free(i)) if i.get() < touchable => Ok(Some(i)),
-            Some(VertexSlot::Free(_)) => Err(ContactError::NotOnSurface {
-                contact: contact_index,
-                vertex,
-            }),
-        }
-    };
+    match contact.detected() {
+        Some(detected) => resolve_detected(table, index, detected),
+        None => resolve_point(table, index, contact.point()),
+    }
+}
+
+/// A detected contact's point ([`AsConstraint::detected`]): each corner's
+/// slot read with its checked index (no range check of a raw index, no
+/// repeated-corner or surface look-up: the corners are those of a surface
+/// triangle). Its weights are detection's, clamped to `[0, 1]` and
+/// normalized, finite when its displacement is (which [`resolve`]
+/// checked); of the full weight checks, only the sum can fail for them
+/// (all zero, when the clamp's sum overflowed), and only it is made. The
+/// same point, or the same error, as [`resolve_point`] gives such a
+/// contact.
+fn resolve_detected<T: Real>(
+    table: &PrecomputedTable<'_, T>,
+    index: usize,
+    contact: &Contact<T>,
+) -> Result<ResolvedPoint<T>, ContactError> {
+    if !sums_to_one(&contact.weights) {
+        return Err(ContactError::BadWeights { contact: index });
+    }
     let mut point = ResolvedPoint::empty();
-    match contact.point() {
+    for (&vertex, &w) in contact.vertices.iter().zip(contact.weights.iter()) {
+        let slot = table.vertex_slot_of(vertex);
+        if let Some(free) = touchable(table, index, vertex.as_u32(), slot)? {
+            point.push(free, w);
+        }
+    }
+    Ok(point)
+}
+
+/// A point given from outside (a scripted constraint), checked in full:
+/// weights finite, each in `[0, 1]` and summing to one, vertices in range,
+/// distinct, touchable or fixed, and a triangle of the table's surface.
+fn resolve_point<T: Real>(
+    table: &PrecomputedTable<'_, T>,
+    index: usize,
+    given: ContactPoint<T>,
+) -> Result<ResolvedPoint<T>, ContactError> {
+    let contact_index = index;
+    let lookup = |vertex: u32| touchable(table, contact_index, vertex, table.slot(vertex));
+    let mut point = ResolvedPoint::empty();
+    match given {
         ContactPoint::Vertex(vertex) => {
             let slot = lookup(vertex)?.ok_or(ContactError::FixedVertex {
                 contact: contact_index,
@@ -349,9 +391,8 @@ pub(crate) fn resolve<T: Real>(
                 });
             }
             let tol = T::WEIGHT_TOLERANCE;
-            let sum = weights.iter().fold(T::zero(), |a, &w| a + w);
             let in_range = weights.iter().all(|&w| w >= -tol && w <= T::one() + tol);
-            if !in_range || (sum - T::one()).abs() > tol {
+            if !in_range || !sums_to_one(&weights) {
                 return Err(ContactError::BadWeights {
                     contact: contact_index,
                 });
@@ -363,25 +404,17 @@ pub(crate) fn resolve<T: Real>(
                 });
             }
             for (&vertex, &w) in vertices.iter().zip(weights.iter()) {
-                if let Some(slot) = lookup(vertex)?
-                    && let (Some(t), Some(b)) = (
-                        point.touchable.get_mut(point.len),
-                        point.weights.get_mut(point.len),
-                    )
-                {
-                    *t = slot;
-                    *b = w;
-                    point.len += 1;
+                if let Some(slot) = lookup(vertex)? {
+                    point.push(slot, w);
                 }
             }
             // Every vertex is in range here (`lookup` refused the others).
-            let on_surface = contact.on_surface_triangle()
-                || match vertices.map(|v| table.vertex(v)) {
-                    [Some(a), Some(b), Some(c)] => {
-                        table.surface_index().find_triangle([a, b, c]).is_some()
-                    }
-                    _ => false,
-                };
+            let on_surface = match vertices.map(|v| table.vertex(v)) {
+                [Some(a), Some(b), Some(c)] => {
+                    table.surface_index().find_triangle([a, b, c]).is_some()
+                }
+                _ => false,
+            };
             if !on_surface {
                 return Err(ContactError::NotSurfaceTriangle {
                     contact: contact_index,
@@ -391,6 +424,29 @@ pub(crate) fn resolve<T: Real>(
         }
     }
     Ok(point)
+}
+
+/// The touchable free index of `vertex` of contact `contact`, given its
+/// `slot` in `table` (`None`: out of range); `None` for a fixed vertex
+/// (zero compliance).
+fn touchable<T: Real>(
+    table: &PrecomputedTable<'_, T>,
+    contact: usize,
+    vertex: u32,
+    slot: Option<VertexSlot>,
+) -> Result<Option<FreeIndex>, ContactError> {
+    match slot {
+        None => Err(ContactError::VertexOutOfRange { contact, vertex }),
+        Some(VertexSlot::Fixed) => Ok(None),
+        Some(VertexSlot::Free(i)) if i.get() < table.touchable_count() => Ok(Some(i)),
+        Some(VertexSlot::Free(_)) => Err(ContactError::NotOnSurface { contact, vertex }),
+    }
+}
+
+/// `Σ_a β_a` within [`Real::WEIGHT_TOLERANCE`] of one (`false` for a NaN).
+fn sums_to_one<T: Real>(weights: &[T; 3]) -> bool {
+    let sum = weights.iter().fold(T::zero(), |a, &w| a + w);
+    (sum - T::one()).abs() <= T::WEIGHT_TOLERANCE
 }
 
 /// The first vertex that occurs twice in `vertices`, if any.

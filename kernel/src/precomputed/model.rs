@@ -210,6 +210,34 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
         // Entries past `m` are not the solution's (no copy of the rest).
         solution.len = m;
         solution.forces = ToolForces::Linear;
+        self.resolve_all(contacts, solution)?;
+        if m == 0 {
+            return Ok(());
+        }
+        self.factor_and_solve(buffers, solution, m)?;
+        if let Some(remap) = &self.remap {
+            remap_forces(remap, contacts, solution, m);
+        }
+        if !solution
+            .contact_forces_n()
+            .iter()
+            .all(|g| g.iter().all(|x| x.finite()))
+        {
+            return Err(ContactError::NonFiniteResult);
+        }
+        Ok(())
+    }
+
+    /// The first stage of [`Self::solve_into`]: each contact's resolved
+    /// point and imposed displacement `d_p` (into the linear forces, which
+    /// the solve overwrites with `g`), and no two vertex contacts on one
+    /// vertex.
+    #[inline(always)]
+    fn resolve_all<const M: usize>(
+        &self,
+        contacts: &[impl AsConstraint<T>],
+        solution: &mut ContactSolution<T, M>,
+    ) -> Result<(), ContactError> {
         for (p, ((contact, point), d)) in contacts
             .iter()
             .zip(solution.points.iter_mut())
@@ -219,11 +247,20 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             *point = resolve(&self.table, p, contact)?;
             *d = contact.displacement_m();
         }
-        check_duplicates(contacts)?;
-        if m == 0 {
-            return Ok(());
-        }
+        check_duplicates(contacts)
+    }
 
+    /// The second stage of [`Self::solve_into`] for `m ≥ 1` contacts: the
+    /// point-compliance matrix assembled over the last solve's factor
+    /// ([`Self::assemble`]), factorized and solved for the linear forces
+    /// `g` in place of `d`, with `buffers` updated ([`SolveBuffers`]).
+    #[inline(always)]
+    fn factor_and_solve<const M: usize>(
+        &self,
+        buffers: &mut SolveBuffers<T, M>,
+        solution: &mut ContactSolution<T, M>,
+        m: usize,
+    ) -> Result<(), ContactError> {
         // The lower blocks of the point-compliance matrix, and its scale,
         // into the buffer the last solve's factor used.
         // Where the remembered points hold this set's; the entries past
@@ -253,23 +290,7 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             previous = at;
             increasing
         });
-        let mut scale = T::zero();
-        for (q, pq) in solution.points.iter().enumerate().take(m) {
-            for (p, pp) in solution.points.iter().enumerate().take(q + 1) {
-                let copied = match (remembered.get(q), remembered.get(p)) {
-                    (Some(&Some(i)), Some(&Some(j))) if i >= j => {
-                        matrix.copy_block(q, p, last, i, j)
-                    }
-                    _ => false,
-                };
-                if !copied {
-                    matrix.set_block(q, p, &self.point_compliance(pq, pp, p == q));
-                }
-                if p == q {
-                    scale = matrix.diagonal(q).iter().fold(scale, |s, &c| s.larger(c));
-                }
-            }
-        }
+        let scale = self.assemble(&solution.points, &remembered, last, matrix, m);
         let min_pivot = T::MIN_PIVOT_RATIO * scale;
         if scale <= T::zero() || !scale.finite() {
             return Err(ContactError::IllConditioned { contact: 0 });
@@ -287,39 +308,41 @@ impl<'a, T: Real> PrecomputedModel<'a, T> {
             *second_current = !*second_current;
             last.solve(Some(matrix), &mut solution.linear_forces_n, m, min_pivot)
         };
-        factored.map_err(|contact| ContactError::IllConditioned { contact })?;
-        if let Some(remap) = &self.remap {
-            let mut largest = T::zero();
-            let mut largest_direction = None;
-            let forces = solution
-                .remapped_forces_n
-                .iter_mut()
-                .zip(&solution.linear_forces_n);
-            for ((g, linear), contact) in forces.zip(contacts).take(m) {
-                let d = contact.displacement_m();
-                *g = *linear;
-                if let Some(direction) = QuasiNonLinear::direction(&d) {
-                    *g = remap.force(&direction, *g);
-                    // `direction` is `d / |d|`, so `d·direction` is `|d|`.
-                    let length = d.dot(&direction);
-                    if length > largest {
-                        largest = length;
-                        largest_direction = Some(direction);
+        factored.map_err(|contact| ContactError::IllConditioned { contact })
+    }
+
+    /// The lower blocks of the point-compliance matrix of the first `m`
+    /// `points` into `matrix`, each block copied from `last` where both its
+    /// points are `remembered` there in order (`copy_block`), else computed
+    /// from the table ([`Self::point_compliance`]); returns its scale, the
+    /// largest diagonal entry, m/N.
+    #[inline(always)]
+    fn assemble<const M: usize>(
+        &self,
+        points: &[ResolvedPoint<T>; M],
+        remembered: &[Option<usize>; M],
+        last: &ContactMatrix<T, M>,
+        matrix: &mut ContactMatrix<T, M>,
+        m: usize,
+    ) -> T {
+        let mut scale = T::zero();
+        for (q, pq) in points.iter().enumerate().take(m) {
+            for (p, pp) in points.iter().enumerate().take(q + 1) {
+                let copied = match (remembered.get(q), remembered.get(p)) {
+                    (Some(&Some(i)), Some(&Some(j))) if i >= j => {
+                        matrix.copy_block(q, p, last, i, j)
                     }
+                    _ => false,
+                };
+                if !copied {
+                    matrix.set_block(q, p, &self.point_compliance(pq, pp, p == q));
+                }
+                if p == q {
+                    scale = matrix.diagonal(q).iter().fold(scale, |s, &c| s.larger(c));
                 }
             }
-            solution.forces = ToolForces::Remapped {
-                direction: largest_direction,
-            };
         }
-        if !solution
-            .contact_forces_n()
-            .iter()
-            .all(|g| g.iter().all(|x| x.finite()))
-        {
-            return Err(ContactError::NonFiniteResult);
-        }
-        Ok(())
+        scale
     }
 
     /// `C_qp = Σ_a Σ_b β^q_a β^p_b C_{v^q_a v^p_b}` (3×3 row-major, m/N):
@@ -595,6 +618,41 @@ impl<T: Real, const M: usize> SolveBuffers<T, M> {
     fn position(&self, point: &ResolvedPoint<T>) -> Option<usize> {
         self.points.iter().take(self.len).position(|p| p == point)
     }
+}
+
+/// The last stage of [`PrecomputedModel::solve_into`] for a
+/// quasi-non-linear model: each of the first `m` linear forces remapped
+/// along its contact's imposed displacement (`remap.force`), and the
+/// direction of the largest displacement kept for the field.
+#[inline(always)]
+fn remap_forces<T: Real, const M: usize>(
+    remap: &QuasiNonLinear<T>,
+    contacts: &[impl AsConstraint<T>],
+    solution: &mut ContactSolution<T, M>,
+    m: usize,
+) {
+    let mut largest = T::zero();
+    let mut largest_direction = None;
+    let forces = solution
+        .remapped_forces_n
+        .iter_mut()
+        .zip(&solution.linear_forces_n);
+    for ((g, linear), contact) in forces.zip(contacts).take(m) {
+        let d = contact.displacement_m();
+        *g = *linear;
+        if let Some(direction) = QuasiNonLinear::direction(&d) {
+            *g = remap.force(&direction, *g);
+            // `direction` is `d / |d|`, so `d·direction` is `|d|`.
+            let length = d.dot(&direction);
+            if length > largest {
+                largest = length;
+                largest_direction = Some(direction);
+            }
+        }
+    }
+    solution.forces = ToolForces::Remapped {
+        direction: largest_direction,
+    };
 }
 
 /// Two vertex contacts on one vertex make the system exactly singular; name them.

@@ -24,6 +24,24 @@ const SLOT_OF_KIND: [u8; 64] = {
     slots
 };
 
+impl RawHeader {
+    /// The checks that come before any other, on the header alone: the
+    /// magic and the format version. The loader starts with them, and a
+    /// reader that has only the header so far (the host reading a file
+    /// header first) calls them before reading on.
+    pub fn check_identity(&self) -> Result<(), LoadError> {
+        if self.magic != format::MAGIC {
+            return Err(LoadError::BadMagic);
+        }
+        if self.format_version != format::FORMAT_VERSION {
+            return Err(LoadError::UnsupportedVersion {
+                found: self.format_version,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// A table whose header, directory and checksum are valid, with every section
 /// located (bounds and alignment checked) but not yet viewed.
 pub(crate) struct Container<'a> {

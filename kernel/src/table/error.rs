@@ -243,7 +243,57 @@ pub enum LoadError {
 }
 
 impl fmt::Display for LoadError {
+    /// The message of the stage of the load that found the error: the
+    /// container (length, identity, checksum, header, directory), a
+    /// section's contents (the element named), or the compliance and its
+    /// encoding.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadError::TooShort { .. }
+            | LoadError::BadMagic
+            | LoadError::UnsupportedVersion { .. }
+            | LoadError::LengthMismatch { .. }
+            | LoadError::ChecksumMismatch { .. }
+            | LoadError::ScalarMismatch { .. }
+            | LoadError::WrongTableKind { .. }
+            | LoadError::BadConnection { .. }
+            | LoadError::InconsistentHeader
+            | LoadError::BadMaterial
+            | LoadError::UnknownSection { .. }
+            | LoadError::DuplicateSection { .. }
+            | LoadError::MissingSection { .. }
+            | LoadError::SectionSize { .. }
+            | LoadError::SectionBounds { .. }
+            | LoadError::Misaligned { .. } => self.fmt_container(f),
+            LoadError::BadVertexMap { .. }
+            | LoadError::BadTriangle { .. }
+            | LoadError::NonFinite { .. }
+            | LoadError::BadEdges { .. }
+            | LoadError::BadTet { .. }
+            | LoadError::BadMeshTriangle { .. }
+            | LoadError::BadSurfaceGrid { .. }
+            | LoadError::BadSurfacePlane { .. }
+            | LoadError::BadVertexTriangles { .. }
+            | LoadError::BadTetTriangle { .. }
+            | LoadError::BadVertexData { .. }
+            | LoadError::BadTetMaterial { .. }
+            | LoadError::BadCellTriangles { .. }
+            | LoadError::BadTetLanes { .. } => self.fmt_contents(f),
+            LoadError::NotPositiveDefinite { .. }
+            | LoadError::BadCompressionRecord
+            | LoadError::UnknownEncoding { .. }
+            | LoadError::UnexpectedSection { .. }
+            | LoadError::BadScale { .. }
+            | LoadError::BadCode { .. }
+            | LoadError::BadKeptBlocks { .. }
+            | LoadError::DroppedDiagonal { .. } => self.fmt_compliance(f),
+        }
+    }
+}
+
+impl LoadError {
+    /// The container's errors: length, identity, checksum, header and directory.
+    fn fmt_container(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
             LoadError::TooShort { len } => write!(f, "table too short ({len} bytes)"),
             LoadError::BadMagic => f.write_str("not a Palpate table (bad magic)"),
@@ -289,6 +339,14 @@ impl fmt::Display for LoadError {
                 "section {} is misaligned in memory (align the table buffer to 16 bytes)",
                 kind.name()
             ),
+            // The other stages' (see `fmt`).
+            _ => Ok(()),
+        }
+    }
+
+    /// A section's contents: the element that is wrong.
+    fn fmt_contents(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
             LoadError::BadVertexMap { vertex } => {
                 write!(f, "vertex {vertex}: free-vertex/vertex-slot maps disagree")
             }
@@ -347,6 +405,14 @@ impl fmt::Display for LoadError {
                 f,
                 "tet {tet}: its tet-lanes entry differs from its tet-shape and tet-material entries (or a lane past the last tet is not zero)"
             ),
+            // The other stages' (see `fmt`).
+            _ => Ok(()),
+        }
+    }
+
+    /// The compliance and its encoding.
+    fn fmt_compliance(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
             LoadError::NotPositiveDefinite { touchable } => write!(
                 f,
                 "compliance block C_kk of touchable index {touchable} is not symmetric positive definite"
@@ -383,6 +449,8 @@ impl fmt::Display for LoadError {
                 f,
                 "compliance block C_kk of touchable index {touchable} was dropped (every diagonal block must be stored)"
             ),
+            // The other stages' (see `fmt`).
+            _ => Ok(()),
         }
     }
 }

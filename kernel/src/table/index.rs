@@ -130,3 +130,23 @@ pub(crate) fn span(start: u32, end: u32) -> Range<usize> {
 pub(crate) fn csr_row(starts: &[u32], row: usize) -> Option<Range<usize>> {
     Some(span(*starts.get(row)?, *starts.get(row.checked_add(1)?)?))
 }
+
+/// `true` if `starts` begins at 0, never decreases and ends at `total`: the
+/// row starts of a CSR list of `total` entries.
+pub(crate) fn csr_ok(starts: &[u32], total: usize) -> bool {
+    starts.first() == Some(&0)
+        && starts.windows(2).all(|w| w.first() <= w.get(1))
+        && starts.last().map(|&x| x as usize) == Some(total)
+}
+
+/// The largest row of a CSR list.
+pub fn max_row(starts: &[u32]) -> u32 {
+    starts
+        .windows(2)
+        .map(|w| match w {
+            [a, b] => b.saturating_sub(*a),
+            _ => 0,
+        })
+        .max()
+        .unwrap_or(0)
+}

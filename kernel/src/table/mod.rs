@@ -1,7 +1,7 @@
 //! Offline tables: the byte format ([`format`]), load errors ([`LoadError`]) and
 //! the validated, zero-copy views the step path uses ([`PrecomputedTable`],
 //! [`TensorMassTable`], and the collision index of a surface,
-//! [`SurfaceIndex`]). Depends only on [`crate::math`].
+//! [`SurfaceIndex`], over a [`Grid`]). Depends only on [`crate::math`].
 //!
 //! A table is bytes until [`PrecomputedTable::load`] has checked it once
 //! (magic, version, sizes, alignment, CRC-32, finite values, positive definite
@@ -11,28 +11,34 @@
 //! [`TriangleIndex`], [`TetIndex`], [`EdgeIndex`], [`FreeIndex`]) instead of
 //! raw `u32`s: the format's sentinels stay inside this module.
 
+mod candidates;
 mod collision;
 mod compressed;
 mod container;
 mod error;
 pub mod format;
+mod grid;
 mod index;
 mod interface;
+mod plane;
 mod precomputed;
 mod tensor_mass;
 
-pub(crate) use collision::BuiltLists;
-pub use collision::{
-    CANDIDATE_MARGIN_CELLS, CANDIDATE_MARGIN_RADII, CandidateList, DEAD_TRIANGLE, Grid, Plane,
-    SurfaceIndex, candidate_cells, candidate_margin_m, candidate_radius_m, list_subdivision,
-    max_row, within,
+pub(crate) use candidates::for_each_candidate_filing;
+pub use candidates::{
+    CANDIDATE_MARGIN_CELLS, CANDIDATE_MARGIN_RADII, candidate_cells, candidate_margin_m,
+    candidate_radius_m, list_subdivision,
 };
-pub(crate) use collision::{for_each_candidate_filing, plane_record};
+pub(crate) use collision::BuiltLists;
+pub use collision::{CandidateList, DEAD_TRIANGLE, SurfaceIndex};
 pub use compressed::{CodedBlocks, ComplianceBlocks};
 pub use error::LoadError;
+pub use grid::{CellBox, Grid, neighbours, within};
 pub(crate) use index::span;
-pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot};
+pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot, max_row};
 pub use interface::InterfaceTable;
+pub use plane::Plane;
+pub(crate) use plane::plane_record;
 pub use precomputed::PrecomputedTable;
 pub use tensor_mass::{TensorMassTable, TetLanes};
 

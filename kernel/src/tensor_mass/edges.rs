@@ -20,8 +20,8 @@
 //! cylinder of issue 15, 8160 edges take 2051 groups (8204 lanes, 1.005×;
 //! every edge in its lower row would take 10 048 lanes, 1.23×).
 
-use super::force::{mul, mul_transposed};
 use crate::Real;
+use crate::math::block::{mul, mul_transposed};
 use crate::table::{TensorMassTable, span};
 
 /// Edges per group: one 128-bit vector of f32, one 256-bit of f64.

@@ -3,8 +3,6 @@
 //! the edges (each edge stored once, `K_ji = K_ijᵀ`, in the groups of
 //! [`super::edges`]).
 
-use core::ops::{Add, Mul};
-
 use nalgebra::Vector3;
 
 use super::coupling::CouplingForces;
@@ -14,6 +12,7 @@ use super::stvk::TetPass;
 use super::stvk_terms::NonLinearTerms;
 use crate::Real;
 use crate::math::Dispatch;
+use crate::math::block::mul;
 
 /// Everything the internal-force pass of a step reads, for the configured
 /// [`ElasticLaw`] and optional incompressibility penalty.
@@ -106,30 +105,6 @@ pub(crate) struct Stiffness<'t, T> {
 /// `[T; 3]` as a vector.
 pub(crate) fn vec3<T: Real>(v: &[T; 3]) -> Vector3<T> {
     Vector3::new(v[0], v[1], v[2])
-}
-
-/// `K x` for a row-major 3×3 `K`, of scalars or of lanes
-/// ([`super::edges`]).
-#[inline(always)]
-pub(crate) fn mul<S: Copy + Add<Output = S> + Mul<Output = S>>(k: &[S; 9], x: &[S; 3]) -> [S; 3] {
-    [
-        k[0] * x[0] + k[1] * x[1] + k[2] * x[2],
-        k[3] * x[0] + k[4] * x[1] + k[5] * x[2],
-        k[6] * x[0] + k[7] * x[1] + k[8] * x[2],
-    ]
-}
-
-/// `Kᵀ x` for a row-major 3×3 `K`, of scalars or of lanes.
-#[inline(always)]
-pub(crate) fn mul_transposed<S: Copy + Add<Output = S> + Mul<Output = S>>(
-    k: &[S; 9],
-    x: &[S; 3],
-) -> [S; 3] {
-    [
-        k[0] * x[0] + k[3] * x[1] + k[6] * x[2],
-        k[1] * x[0] + k[4] * x[1] + k[7] * x[2],
-        k[2] * x[0] + k[5] * x[1] + k[8] * x[2],
-    ]
 }
 
 impl<T: Real> Stiffness<'_, T> {
