@@ -10,6 +10,7 @@ use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 use palpate_kernel::{PrecomputedTable, Real};
 
 use super::condense::{Condensed, condense};
+use super::estimate::{HybridEstimate, PrecomputedRegion};
 use super::split::RegionSplit;
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::element::shape_gradients;
@@ -18,6 +19,7 @@ use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, BuiltTable, Stages, TableKindOptions, precomputed};
 use crate::table::compliance::Solver;
+use crate::table::estimate::SizeLimits;
 use crate::table::file::{Precision, Section, write_container};
 use crate::table::load::TableFile;
 use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
@@ -40,6 +42,9 @@ pub struct HybridOptions {
     pub point_loads: Vec<(u32, [f64; 3])>,
     /// Which tets' mass the connection nodes carry.
     pub connection_mass: ConnectionMass,
+    /// What the tables and the build may take ([`SizeLimits::system`] by default), checked
+    /// against their estimate ([`HybridEstimate`]) before anything is built.
+    pub limits: SizeLimits,
 }
 
 /// The lumped mass of the connection nodes in the tensor-mass region.
@@ -71,6 +76,7 @@ impl HybridOptions {
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+            limits: SizeLimits::system(),
         }
     }
 
@@ -88,6 +94,7 @@ impl HybridOptions {
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+            limits: SizeLimits::system(),
         })
     }
 
@@ -140,17 +147,27 @@ pub fn build_hybrid(
     let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
 
     // The pre-computed region: connection nodes and vertices outside it fixed.
-    let pmesh = split.precomputed_mesh(mesh);
-    let mut pfixed = fixed.clone();
-    for (v, f) in pfixed.iter_mut().enumerate() {
-        *f |= !split.in_precomputed[v] || split.dynamic_index[v].is_some();
-    }
-    if pfixed.iter().all(|&f| f) {
+    let region = PrecomputedRegion::of(mesh, &split, &fixed);
+    if region.fixed.iter().all(|&f| f) {
         bail!(
             "{source}: the pre-computed region has no free vertex (every one is fixed or connects)"
         );
     }
-    let surface = boundary_surface(&pmesh);
+    // Every table's size and the build's peak, before any is built.
+    HybridEstimate::of(
+        mesh,
+        &split,
+        &fixed,
+        &region,
+        build.list_tool_radius_m(),
+        build.precision,
+    )
+    .check(&options.limits, source)?;
+    let PrecomputedRegion {
+        mesh: pmesh,
+        fixed: pfixed,
+        surface,
+    } = region;
     let region_tets = |dynamic: bool| {
         let flags = &split.dynamic_tet;
         (0..flags.len()).filter(move |&t| flags[t] == dynamic)

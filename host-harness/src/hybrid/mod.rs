@@ -9,6 +9,7 @@
 
 pub mod build;
 pub mod condense;
+pub mod estimate;
 pub mod owned;
 pub mod run;
 pub mod split;

@@ -13,6 +13,7 @@ use super::run::{precomputed_options, tensor_mass_options};
 use super::{DynamicSpec, ModelSpec, Scene};
 use crate::experiment::scenes::penalty_n;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
+use crate::table::estimate::SizeLimits;
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
@@ -167,6 +168,13 @@ pub fn hybrid_tables(
         precision,
     )
     .with_tet_materials(materials);
+    let options = HybridOptions {
+        limits: SizeLimits {
+            print_estimate: true,
+            ..options.limits
+        },
+        ..options
+    };
     build_hybrid(mesh, report, &partition.dynamic, &options).with_context(|| scene.source.clone())
 }
 

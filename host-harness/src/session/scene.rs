@@ -397,8 +397,9 @@ struct SceneFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct GeneratedFile {
-    #[serde(alias = "box")]
+    #[serde(alias = "box", deserialize_with = "exact::three")]
     box_m: [f64; 3],
+    #[serde(deserialize_with = "exact::three")]
     cells: [usize; 3],
 }
 
@@ -472,8 +473,10 @@ struct ToolFile {
     #[serde(default = "default_radius")]
     radius_m: f64,
     kind: Option<KindsFile>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     jaw_axis: Option<[f64; 3]>,
     grip_opening_m: Option<f64>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     blade_m: Option<[f64; 3]>,
 }
 
@@ -1487,4 +1490,31 @@ fn check_dynamic(d: &DynamicSpec, physics_period_s: f64) -> Result<(), (String, 
         ));
     }
     Ok(())
+}
+
+/// Arrays of exactly three numbers in a scene file: `[x, y, z]` with a fourth (or a second
+/// missing) is an error naming the key (the parser's message shows its line), never truncated.
+pub(crate) mod exact {
+    use serde::de::{Deserialize, Deserializer, Error};
+
+    /// A `[a, b, c]` array: three elements, no more, no fewer.
+    pub(crate) fn three<'de, D, T>(deserializer: D) -> Result<[T; 3], D::Error>
+    where
+        D: Deserializer<'de>,
+        T: Deserialize<'de>,
+    {
+        let items = Vec::<T>::deserialize(deserializer)?;
+        let len = items.len();
+        <[T; 3]>::try_from(items)
+            .map_err(|_| D::Error::invalid_length(len, &"exactly 3 numbers, [x, y, z]"))
+    }
+
+    /// [`three`] of an optional key (with `#[serde(default)]`).
+    pub(crate) fn three_opt<'de, D, T>(deserializer: D) -> Result<Option<[T; 3]>, D::Error>
+    where
+        D: Deserializer<'de>,
+        T: Deserialize<'de>,
+    {
+        three(deserializer).map(Some)
+    }
 }
