@@ -43,6 +43,20 @@ pub const MAX_CHART_TET_STEPS: u64 = 20_000_000_000;
 /// the mesh. Use a coarser mesh or fewer steps above it.
 pub const MAX_RUN_TET_STEPS: u64 = 5_000_000_000;
 
+/// Most multiply-adds of a compliance computed by conjugate gradients (`tables build --solver
+/// cg`), estimated before the first solve (`table::compliance::check_cg_work`): 10¹².
+///
+/// CG is the check of the default sparse Cholesky, for small meshes: it solves `3S` systems
+/// (`S` touchable vertices) of a few hundred iterations each, where Cholesky factorizes once.
+/// At about [`SECONDS_PER_MULTIPLY_ADD`] the limit is about 20 minutes; the 40³-cell box
+/// (7 921 touchable vertices) is about 10¹⁴, refused, where its run went past two minutes with
+/// nothing printed.
+pub const MAX_CG_MULTIPLY_ADDS: u64 = 1_000_000_000_000;
+
+/// Upper figure of one sparse multiply-add's time on the host, s (the printed duration of the
+/// CG estimate).
+pub const SECONDS_PER_MULTIPLY_ADD: f64 = 1e-9;
+
 /// Upper figure of one tet-step's time on the host, s (the printed duration of an estimate).
 pub const SECONDS_PER_TET_STEP: f64 = 60e-9;
 

@@ -143,26 +143,12 @@ pub fn build_hybrid(
     let n = mesh.positions.len();
     let build = &options.build;
     let materials = build.materials_for(mesh.tets.len())?;
-    let (fixed, _) = fixed_vertices(&mesh.positions, &build.fix, &report.unreferenced_vertices);
-    let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
-
-    // The pre-computed region: connection nodes and vertices outside it fixed.
-    let region = PrecomputedRegion::of(mesh, &split, &fixed);
-    if region.fixed.iter().all(|&f| f) {
-        bail!(
-            "{source}: the pre-computed region has no free vertex (every one is fixed or connects)"
-        );
-    }
-    // Every table's size and the build's peak, before any is built.
-    HybridEstimate::of(
-        mesh,
-        &split,
-        &fixed,
-        &region,
-        build.list_tool_radius_m(),
-        build.precision,
-    )
-    .check(&options.limits, source)?;
+    let Prepared {
+        fixed,
+        split,
+        region,
+        ..
+    } = prepare(mesh, report, dynamic_tet, options)?;
     let PrecomputedRegion {
         mesh: pmesh,
         fixed: pfixed,
@@ -292,6 +278,65 @@ impl HybridTables {
         InterfaceTable::<T>::load(self.interface.bytes()).context("interface")?;
         Ok(())
     }
+}
+
+/// What [`build_hybrid`] knows before it builds a table: the scene's fixed vertices, the split,
+/// the pre-computed region and the estimate, checked.
+struct Prepared {
+    fixed: Vec<bool>,
+    split: RegionSplit,
+    region: PrecomputedRegion,
+    estimate: HybridEstimate,
+}
+
+/// The split of `mesh` by `dynamic_tet` and the estimate of its tables, checked against
+/// `options.limits` (the estimate printed if they ask): every refusal of a hybrid that does not
+/// need its arrays, linear in the mesh.
+fn prepare(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    dynamic_tet: &[bool],
+    options: &HybridOptions,
+) -> anyhow::Result<Prepared> {
+    let source = &report.source;
+    let build = &options.build;
+    let (fixed, _) = fixed_vertices(&mesh.positions, &build.fix, &report.unreferenced_vertices);
+    let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
+    // The pre-computed region: connection nodes and vertices outside it fixed.
+    let region = PrecomputedRegion::of(mesh, &split, &fixed);
+    if region.fixed.iter().all(|&f| f) {
+        bail!(
+            "{source}: the pre-computed region has no free vertex (every one is fixed or connects)"
+        );
+    }
+    let estimate = HybridEstimate::of(
+        mesh,
+        &split,
+        &fixed,
+        &region,
+        build.list_tool_radius_m(),
+        build.precision,
+    );
+    estimate.check(&options.limits, source)?;
+    Ok(Prepared {
+        fixed,
+        split,
+        region,
+        estimate,
+    })
+}
+
+/// Checks, without building anything, that [`build_hybrid`] of the same arguments would start:
+/// the split is a hybrid, the pre-computed region has a free vertex, and the tables' estimate
+/// is within `options.limits`. Returns the estimate. For a command that builds hybrids late in
+/// a long run (`palpate chart`), before it starts.
+pub fn check_hybrid(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    dynamic_tet: &[bool],
+    options: &HybridOptions,
+) -> anyhow::Result<HybridEstimate> {
+    Ok(prepare(mesh, report, dynamic_tet, options)?.estimate)
 }
 
 /// Serializes the interface table (`TableKind::Interface`).

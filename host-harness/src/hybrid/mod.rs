@@ -15,5 +15,5 @@ pub mod run;
 pub mod split;
 pub mod stability;
 
-pub use build::{ConnectionMass, HybridOptions, HybridTables, build_hybrid};
+pub use build::{ConnectionMass, HybridOptions, HybridTables, build_hybrid, check_hybrid};
 pub use split::RegionSplit;

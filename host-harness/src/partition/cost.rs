@@ -214,16 +214,25 @@ pub fn costs(
                         .incompressibility_n
                         .unwrap_or_else(|| crate::experiment::scenes::penalty_n(&sub, &default))
                 });
-                let step_s =
-                    tensor_mass_step_s(&sub, &surface.triangles, &arrays, options, law, gamma)
-                        .with_context(|| format!("timing dynamic region {}", region.id))?;
+                let critical_dt_s = stable_step_s(&sub, &surface.triangles, &arrays, options)
+                    .with_context(|| format!("the stable step of dynamic region {}", region.id))?;
+                // A step the region is stable at: a tenth of a millisecond, far below the limit
+                // of any mesh the real-time loop runs, or half the region's limit if a stiff
+                // material makes it lower (the cost of a step does not depend on its length).
+                let dt_s = critical_dt_s.map_or(1e-4, |dt| (0.5 * dt).min(1e-4));
+                let step_s = tensor_mass_step_s(
+                    &sub,
+                    &surface.triangles,
+                    &arrays,
+                    options,
+                    (law, gamma),
+                    dt_s,
+                )
+                .with_context(|| format!("timing dynamic region {}", region.id))?;
                 RegionCost {
                     table_bytes: table_bytes(TableKind::TensorMass),
                     step_cost_s: step_s + update_s,
-                    critical_dt_s: stable_step_s(&sub, &surface.triangles, &arrays, options)
-                        .with_context(|| {
-                            format!("the stable step of dynamic region {}", region.id)
-                        })?,
+                    critical_dt_s,
                 }
             }
         });
@@ -256,8 +265,8 @@ fn tensor_mass_step_s(
     triangles: &[[u32; 3]],
     arrays: &TensorMassArrays,
     options: &CostOptions,
-    law: ElasticLaw,
-    gamma: Option<f64>,
+    (law, gamma): (ElasticLaw, Option<f64>),
+    dt_s: f64,
 ) -> anyhow::Result<f64> {
     let bytes = write_tensor_mass_table(sub, triangles, arrays, Precision::F32);
     let table = TensorMassTable::<f32>::load(&bytes)?;
@@ -270,9 +279,7 @@ fn tensor_mass_step_s(
     .with_incompressibility(gamma.map(|g| g as f32))
     .with_gravity(Vector3::new(0.0, 0.0, -9.81));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
-    // A step the region is stable at: a tenth of a millisecond is far below the limit of any
-    // mesh the real-time loop runs, and the cost of a step does not depend on its length.
-    let dt_s = 1e-4;
+    let dt_s = dt_s as f32;
     for _ in 0..WARMUP_STEPS {
         model.step(options.integrator, dt_s)?;
     }

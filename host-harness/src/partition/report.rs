@@ -114,6 +114,7 @@ impl PlanReport {
         report: &MeshReport,
         partition: &Partition,
     ) -> anyhow::Result<PlanReport> {
+        scene.check_on_mesh(mesh)?;
         let options = cost_options(scene, mesh, report)?;
         let (fixed, _) = fixed_vertices(&mesh.positions, &scene.fix, &report.unreferenced_vertices);
         let (region_costs, interface, estimate) = costs(mesh, &fixed, partition, &options)?;

@@ -44,6 +44,7 @@ impl SceneModel {
     /// whose zones make tets dynamic needs `[model] kind = "dynamic"` for
     /// their step: otherwise a one-line error naming the scene.
     pub fn of(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Self> {
+        scene.check_on_mesh(mesh)?;
         if scene.zones.is_empty() {
             return Ok(match scene.model {
                 ModelSpec::Precomputed => Self::Precomputed,
@@ -168,7 +169,10 @@ pub fn hybrid_tables(
         precision,
     )
     .with_tet_materials(materials);
+    // The pre-computed region's candidate lists serve the scene's tool, as a pre-computed
+    // scene's table does (`precomputed_options`).
     let options = HybridOptions {
+        build: options.build.with_tool_radius(scene.tool.radius_m),
         limits: SizeLimits {
             print_estimate: true,
             ..options.limits

@@ -87,7 +87,7 @@ pub fn read_positions_csv(
         positions_file_bytes(vertices),
         "a positions file of this mesh (MAX_POSITION_LINE_BYTES per vertex)",
     )
-    .with_context(|| path.display().to_string())?;
+    .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .trim(csv::Trim::All)
