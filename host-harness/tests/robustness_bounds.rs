@@ -369,7 +369,11 @@ fn a_hybrid_too_large_is_refused_before_building_and_marked_by_plan() {
     ]);
     assert_one_line_error(
         &out,
-        &["pre-computed region", "MAX_TABLE_FILE_BYTES", "refused before building"],
+        &[
+            "pre-computed region",
+            "MAX_TABLE_FILE_BYTES",
+            "refused before building",
+        ],
     );
     assert!(!out_dir.exists());
     let out = palpate(&[

@@ -1341,7 +1341,13 @@ pub fn preflight(bodies: &[Body], out: &Path) -> anyhow::Result<()> {
     let existing = out
         .ancestors()
         .find(|p| p.as_os_str().is_empty() || p.exists())
-        .map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p })
+        .map(|p| {
+            if p.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                p
+            }
+        })
         .unwrap_or(Path::new("."));
     if !existing.is_dir() {
         anyhow::bail!(

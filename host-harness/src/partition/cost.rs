@@ -41,9 +41,9 @@ use palpate_kernel::tensor_mass::{
 
 use super::plan::{Partition, RegionModel};
 use crate::fem::material::{Material, TetMaterials};
+use crate::fix::FixPredicate;
 use crate::hybrid::RegionSplit;
 use crate::hybrid::estimate::{HybridEstimate, PrecomputedRegion};
-use crate::fix::FixPredicate;
 use crate::mesh::generate::box_mesh;
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, build};

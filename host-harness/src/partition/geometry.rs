@@ -287,7 +287,13 @@ pub fn clip_segment(a: V3, b: V3, lo: V3, hi: V3) -> Option<(V3, V3)> {
             return None;
         }
     }
-    let at = |t: f64| if t <= 0.5 { a + d * t } else { b - d * (1.0 - t) };
+    let at = |t: f64| {
+        if t <= 0.5 {
+            a + d * t
+        } else {
+            b - d * (1.0 - t)
+        }
+    };
     Some((
         if t0 == 0.0 { a } else { at(t0) },
         if t1 == 1.0 { b } else { at(t1) },

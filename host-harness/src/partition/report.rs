@@ -9,9 +9,9 @@ use serde::Serialize;
 
 use super::cost::{CostOptions, InterfaceCost, RegionCost, costs};
 use super::plan::{Partition, RegionModel};
-use crate::limits::{MAX_TABLE_FILE_BYTES, mem_available_bytes};
 use crate::fix::fixed_vertices;
 use crate::limits::human_bytes;
+use crate::limits::{MAX_TABLE_FILE_BYTES, mem_available_bytes};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::session::{ModelSpec, Scene};
 
@@ -214,7 +214,10 @@ impl PlanReport {
                     ))
             );
             if let Some(refused) = &r.refused {
-                let _ = writeln!(s, "  REFUSED: a session would not build this table: {refused}");
+                let _ = writeln!(
+                    s,
+                    "  REFUSED: a session would not build this table: {refused}"
+                );
             }
             let _ = writeln!(s, "  why: {}", r.why);
         }
@@ -229,7 +232,10 @@ impl PlanReport {
                 i.update_s
             );
             if let Some(refused) = &i.refused {
-                let _ = writeln!(s, "  REFUSED: a session would not build this table: {refused}");
+                let _ = writeln!(
+                    s,
+                    "  REFUSED: a session would not build this table: {refused}"
+                );
             }
         } else {
             let _ = writeln!(s, "interface: none (a single model)");

@@ -67,7 +67,8 @@ use std::path::Path;
 
 use super::scene::MAX_TOOL_POINTS;
 use crate::limits::{
-    MAX_TOOL_COORDINATE_M, MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S, read_bounded,
+    MAX_TOOL_COORDINATE_M, MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S,
+    read_bounded,
 };
 
 /// The header line's fields, in order, of a file without the tool columns.

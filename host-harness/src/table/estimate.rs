@@ -167,7 +167,12 @@ impl TableEstimate {
         if kind != TableKind::Precomputed {
             return estimate;
         }
-        let index = collision_index(&mesh.positions, &surface.triangles, tool_radius_m, precision);
+        let index = collision_index(
+            &mesh.positions,
+            &surface.triangles,
+            tool_radius_m,
+            precision,
+        );
         let grid = GridCounts {
             cells: index.cell_start.len() as u64 - 1,
             list_starts: index.cell_triangle_start.len() as u64,
@@ -441,12 +446,12 @@ impl SizeLimits {
 /// What to do instead of a table of `kind` refused for its size.
 pub fn instead(kind: TableKind) -> &'static str {
     match kind {
-            TableKind::Precomputed => {
-                "use the tensor-mass model (tables build --kind tensor-mass, or [model] kind = \"dynamic\" in a scene), a coarser mesh, or fix more of the surface (fewer touchable vertices)"
-            }
-            TableKind::TensorMass => "use a coarser mesh",
-            TableKind::Interface => {
-                "make the dynamic zones smaller or simpler (fewer connection nodes), or use a coarser mesh"
-            }
+        TableKind::Precomputed => {
+            "use the tensor-mass model (tables build --kind tensor-mass, or [model] kind = \"dynamic\" in a scene), a coarser mesh, or fix more of the surface (fewer touchable vertices)"
+        }
+        TableKind::TensorMass => "use a coarser mesh",
+        TableKind::Interface => {
+            "make the dynamic zones smaller or simpler (fewer connection nodes), or use a coarser mesh"
+        }
     }
 }

@@ -11,30 +11,30 @@ use core::time::Duration;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use palpate::chart::{GivenMesh, Matrix};
 use palpate::fem::material::Material;
 use palpate::fix::{FixPredicate, fixed_vertices};
+use palpate::hybrid::estimate::{HybridEstimate, PrecomputedRegion};
+use palpate::hybrid::{HybridOptions, RegionSplit, build_hybrid, check_hybrid};
 use palpate::limits::{
     MAX_HAPTIC_HZ, MAX_MESH_FILE_BYTES, MAX_SESSION_TICKS, MAX_TABLE_FILE_BYTES,
     MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S, parse_mem_available, read_bounded,
 };
-use palpate::chart::{GivenMesh, Matrix};
-use palpate::hybrid::estimate::{HybridEstimate, PrecomputedRegion};
-use palpate::hybrid::{HybridOptions, RegionSplit, build_hybrid, check_hybrid};
 use palpate::limits::{MAX_POSITION_LINE_BYTES, MAX_RUN_TET_STEPS, MAX_ZONE_PATH_SEGMENTS};
 use palpate::mesh::generate::box_mesh;
-use palpate::session::zones::merge_collinear;
-use palpate::tensor_mass::evaluate::{positions_file_bytes, read_positions_csv};
-use palpate::tensor_mass::stability::{CRITICAL_DT_STEPS, critical_dt_of_mesh};
-use palpate_kernel::tensor_mass::Integrator;
 use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
 use palpate::session::run::{check_scene_table, run_session, tick_count};
+use palpate::session::zones::merge_collinear;
 use palpate::session::{MeshSource, Scene, Trajectory};
 use palpate::table::build::{BuildOptions, build_with_limits};
 use palpate::table::compliance::{Solver, check_cg_work};
 use palpate::table::estimate::{SizeLimits, TableEstimate};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
+use palpate::tensor_mass::evaluate::{positions_file_bytes, read_positions_csv};
+use palpate::tensor_mass::stability::{CRITICAL_DT_STEPS, critical_dt_of_mesh};
 use palpate_kernel::table::format::{HEADER_LEN, RawHeader};
+use palpate_kernel::tensor_mass::Integrator;
 
 /// An empty folder of its own for test `name`.
 fn fresh_dir(name: &str) -> PathBuf {
@@ -574,10 +574,15 @@ fn critical_dt_and_run_beyond_the_work_limit_are_refused_before_building() {
     let err = critical_dt_of_mesh(&mesh, &report, &options, 0.0, Integrator::SymplecticEuler)
         .expect_err("refused")
         .to_string();
-    assert!(err.contains("dynamic critical-dt: 384000 tets x 60500 steps"), "{err}");
+    assert!(
+        err.contains("dynamic critical-dt: 384000 tets x 60500 steps"),
+        "{err}"
+    );
     assert!(err.contains("MAX_RUN_TET_STEPS"), "{err}");
-    // 384 000 tets × 60 500 steps = 2.3e10 > 5e9.
-    assert!(384_000u64 * CRITICAL_DT_STEPS > MAX_RUN_TET_STEPS);
+    // 384 000 tets × 60 500 steps = 2.3e10, above the 5e9 of the limit.
+    assert_eq!(CRITICAL_DT_STEPS, 60_500);
+    let limit = format!("the limit of {:.0e} tet-steps", MAX_RUN_TET_STEPS as f64);
+    assert!(err.contains(&limit), "{err}");
     let err = palpate::limits::check_tet_steps("dynamic run", 6, u64::MAX, "fewer")
         .expect_err("refused")
         .to_string();
@@ -638,7 +643,11 @@ fn path_zones_are_merged_and_bounded() {
     let mut csv = String::from("t,tool,x,y,z\n");
     for k in 0..=MAX_ZONE_PATH_SEGMENTS + 1 {
         let y = if k % 2 == 0 { 0.01 } else { 0.02 };
-        csv.push_str(&format!("{},0,{},{y},0.05\n", k as f64 * 1e-3, 1e-5 * k as f64));
+        csv.push_str(&format!(
+            "{},0,{},{y},0.05\n",
+            k as f64 * 1e-3,
+            1e-5 * k as f64
+        ));
     }
     std::fs::write(dir.join("log.csv"), csv).expect("trajectory");
     let scene = format!(

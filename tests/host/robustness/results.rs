@@ -9,14 +9,14 @@ use std::path::Path;
 use nalgebra::Vector3;
 use palpate::fem::material::{Material, TetMaterials};
 use palpate::limits::MAX_TOOL_COORDINATE_M;
+use palpate::mesh::generate::box_mesh;
+use palpate::mesh::{MeshFormat, MeshReport, TetMesh, read_mesh, read_mesh_bytes};
 use palpate::partition::cost::{CostOptions, costs};
 use palpate::partition::geometry::TetGrid;
 use palpate::partition::{Partition, PlanInput, PlanReport, plan};
+use palpate::session::Scene;
 use palpate::session::model::hybrid_tables;
 use palpate::session::{Trajectory, Zone, ZoneKind, ZoneShape};
-use palpate::mesh::generate::box_mesh;
-use palpate::mesh::{MeshFormat, MeshReport, TetMesh, read_mesh, read_mesh_bytes};
-use palpate::session::Scene;
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::compliance::Solver;
 use palpate::table::file::Precision;
@@ -268,8 +268,7 @@ fn plan_table_bytes_are_the_built_tables_sizes() {
     let (mesh, report) = scene.load_mesh().expect("mesh");
     let partition = Partition::of_scene(&scene, &mesh, &report).expect("partition");
     let plan = PlanReport::new(&scene, &mesh, &report, &partition).expect("plan");
-    let built =
-        hybrid_tables(&scene, &mesh, &report, &partition, Precision::F32).expect("tables");
+    let built = hybrid_tables(&scene, &mesh, &report, &partition, Precision::F32).expect("tables");
     assert_eq!(plan.regions[0].model, "precomputed");
     assert_eq!(
         plan.regions[0].table_bytes,
@@ -326,7 +325,10 @@ fn plan_costs_take_the_materials_per_tet() {
     let uniform = dt(TetMaterials::uniform(soft, mesh.tets.len()));
     let regions: Vec<u32> = partition.dynamic.iter().map(|&d| u32::from(d)).collect();
     let stiffer = dt(TetMaterials::from_regions(soft, &regions, &[(1, stiff)]));
-    assert!(((uniform / stiffer) / 100.0 - 1.0).abs() < 1e-6, "{uniform} {stiffer}");
+    assert!(
+        ((uniform / stiffer) / 100.0 - 1.0).abs() < 1e-6,
+        "{uniform} {stiffer}"
+    );
 }
 
 /// A trajectory position of 1e39 m (beyond f32) passed the checks and
@@ -338,15 +340,14 @@ fn trajectory_values_beyond_the_coordinate_bound_name_the_line() {
     let err = Trajectory::from_csv_str("t,tool,x,y,z\n0,0,0,0,0\n1,0,1e39,0,0\n", "t.csv", 1)
         .expect_err("refused")
         .to_string();
-    assert!(err.starts_with("t.csv: line 3: x = 1e39 m is out of range"), "{err}");
+    assert!(
+        err.starts_with("t.csv: line 3: x = 1e39 m is out of range"),
+        "{err}"
+    );
     assert!(err.contains("MAX_TOOL_COORDINATE_M"), "{err}");
-    let err = Trajectory::from_csv_str(
-        "t,tool,x,y,z,jaw_m,cut\n0,0,0,0,0,1e39,0\n",
-        "t.csv",
-        1,
-    )
-    .expect_err("refused")
-    .to_string();
+    let err = Trajectory::from_csv_str("t,tool,x,y,z,jaw_m,cut\n0,0,0,0,0,1e39,0\n", "t.csv", 1)
+        .expect_err("refused")
+        .to_string();
     assert!(err.starts_with("t.csv: line 2: jaw_m = 1e39 m"), "{err}");
     Trajectory::from_csv_str(
         &format!("t,tool,x,y,z\n0,0,{MAX_TOOL_COORDINATE_M},0,-1000\n"),
@@ -433,6 +434,10 @@ fn a_capsule_with_far_endpoints_takes_the_same_tets() {
     let c = [0.015625, 0.0234375, 0.03125];
     for d in [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0]] {
         let at = |s: f64| [0, 1, 2].map(|i| c[i] + s * d[i]);
-        assert_eq!(taken(at(-1e12), at(1e12)), taken(at(-10.0), at(10.0)), "{d:?}");
+        assert_eq!(
+            taken(at(-1e12), at(1e12)),
+            taken(at(-10.0), at(10.0)),
+            "{d:?}"
+        );
     }
 }
