@@ -13,6 +13,8 @@
 //! - `palpate bench`: [`MAX_BENCH_SAMPLES`] and [`MAX_BENCH_SAMPLE_S`] per measurement, and the
 //!   run's estimated duration against [`MAX_BENCH_ESTIMATE_S`] (`bench::run::check`), before any
 //!   table is built; its pre-computed table is checked as any table build.
+//! - Offline runs (`dynamic run`, `dynamic critical-dt`, plain or `--scene`): their tet-steps
+//!   against [`MAX_RUN_TET_STEPS`] ([`check_tet_steps`]), before the tables are built.
 //! - `palpate chart`: its work bound (`chart::Matrix::tet_step_bound` and the volume
 //!   experiments') against [`MAX_CHART_TET_STEPS`].
 
@@ -30,6 +32,71 @@ use std::path::Path;
 /// tet count makes it larger, is refused before it starts.
 pub const MAX_CHART_TET_STEPS: u64 = 20_000_000_000;
 
+/// Most tet-steps (one tet's force evaluation per step) of one offline run of the tensor-mass
+/// or hybrid model: `dynamic run` (`--steps` × tets), `dynamic critical-dt` (its bisection's
+/// `tensor_mass::stability::CRITICAL_DT_STEPS` × tets, for a hybrid twice: the coupled model and its region alone):
+/// 5·10⁹.
+///
+/// At the host's 20–60 ns per tet-step ([`SECONDS_PER_TET_STEP`] is the upper figure) that is
+/// 2–5 minutes; `critical-dt` on a 6 144-tet cylinder is 3.7·10⁸. A 40³-cell box (384 000 tets)
+/// is 2.3·10¹⁰ for `critical-dt`, refused; `--steps 18446744073709551615` is refused whatever
+/// the mesh. Use a coarser mesh or fewer steps above it.
+pub const MAX_RUN_TET_STEPS: u64 = 5_000_000_000;
+
+/// Most multiply-adds of a compliance computed by conjugate gradients (`tables build --solver
+/// cg`), estimated before the first solve (`table::compliance::check_cg_work`): 10¹².
+///
+/// CG is the check of the default sparse Cholesky, for small meshes: it solves `3S` systems
+/// (`S` touchable vertices) of a few hundred iterations each, where Cholesky factorizes once.
+/// At about [`SECONDS_PER_MULTIPLY_ADD`] the limit is about 20 minutes; the 40³-cell box
+/// (7 921 touchable vertices) is about 10¹⁴, refused, where its run went past two minutes with
+/// nothing printed.
+pub const MAX_CG_MULTIPLY_ADDS: u64 = 1_000_000_000_000;
+
+/// Upper figure of one sparse multiply-add's time on the host, s (the printed duration of the
+/// CG estimate).
+pub const SECONDS_PER_MULTIPLY_ADD: f64 = 1e-9;
+
+/// Upper figure of one tet-step's time on the host, s (the printed duration of an estimate).
+pub const SECONDS_PER_TET_STEP: f64 = 60e-9;
+
+/// An offline run whose estimate is longer than this, s, prints it on stderr before it starts
+/// (shorter runs print nothing: their output is the contract).
+pub const PRINT_ESTIMATE_ABOVE_S: f64 = 10.0;
+
+/// Checks the work of an offline run, `tets` × `steps` tet-steps, against
+/// [`MAX_RUN_TET_STEPS`] before it starts: refused above it with the figures and `instead` (what
+/// to do); printed on stderr (`what`: estimate) when longer than [`PRINT_ESTIMATE_ABOVE_S`].
+pub fn check_tet_steps(what: &str, tets: u64, steps: u64, instead: &str) -> anyhow::Result<()> {
+    let work = tets.saturating_mul(steps);
+    let seconds = work as f64 * SECONDS_PER_TET_STEP;
+    let figures = format!(
+        "{tets} tets x {steps} steps = {work:.3e} tet-steps, up to about {seconds:.0} s",
+        work = work as f64
+    );
+    if work > MAX_RUN_TET_STEPS {
+        anyhow::bail!(
+            "{what}: {figures}: above the limit of {MAX_RUN_TET_STEPS:.0e} tet-steps \
+             (MAX_RUN_TET_STEPS): refused before starting; {instead}",
+            MAX_RUN_TET_STEPS = MAX_RUN_TET_STEPS as f64
+        );
+    }
+    if seconds > PRINT_ESTIMATE_ABOVE_S {
+        eprintln!("{what}: estimate: {figures}");
+    }
+    Ok(())
+}
+
+/// Most segments of a `path` zone (summed over its tool points, after the samples on one
+/// straight segment are merged into it): 10 000.
+///
+/// The partition tests the tets near each segment (`partition::geometry`), about 0.5 ms a
+/// segment for a 2 cm radius on the built-in block: 10 000 segments are seconds. A straight
+/// move sampled at 1 kHz is one segment; a recorded device log at 1 kHz is one segment a
+/// sample (a minute is 60 000): resample it more coarsely for a zone, a sample every millimetre
+/// or so.
+pub const MAX_ZONE_PATH_SEGMENTS: usize = 10_000;
+
 /// Largest haptic rate a scene accepts (`[rates] haptic_hz`), Hz.
 ///
 /// Haptic devices servo at 1 kHz (the default, and what the kernel's budget is measured at);
@@ -46,6 +113,16 @@ pub const MAX_HAPTIC_HZ: f64 = 10_000.0;
 /// hour at [`MAX_HAPTIC_HZ`] is [`MAX_SESSION_TICKS`] ticks, about 2 GB of CSV; at the default
 /// 1 kHz, about 200 MB. Split a longer log into several trajectories.
 pub const MAX_TRAJECTORY_SPAN_S: f64 = 3600.0;
+
+/// Largest magnitude of a trajectory's tool coordinate or jaw opening (`x`, `y`, `z`,
+/// `jaw_m`), m: 1 km.
+///
+/// The kernel runs in f32, whose largest value is 3.4·10³⁸: a position of 1e39 m became
+/// infinite and faulted every tick. A surgical scene spans well under a metre; 1 km leaves room
+/// for a mesh placed in a larger frame while keeping every product of the contact search
+/// (squared distances, 10⁶ m²) far inside f32. A trajectory in millimetres of a mesh in metres
+/// still reads (up to 1 km); the scene's mesh and its trajectory share units.
+pub const MAX_TOOL_COORDINATE_M: f64 = 1000.0;
 
 /// Largest magnitude of a trajectory time, s: 2³² s (136 years, so Unix timestamps from a
 /// device log fit).
@@ -118,6 +195,13 @@ pub const MAX_TABLE_FILE_BYTES: u64 = 4 << 30;
 /// A one-hour log of 4 tool points sampled at 1 kHz is about 0.7 GB of CSV; the samples cost
 /// about 1.5 times the file again in memory.
 pub const MAX_TRAJECTORY_FILE_BYTES: u64 = 1 << 30;
+
+/// Longest line of a positions file (`stvk forces --deformed`: one `x,y,z` line per mesh
+/// vertex), bytes: 256. Three `f64` written in full take at most 3 × 24 characters with their
+/// separators; the rest is room for spaces. A positions file is refused past this many bytes
+/// per vertex of its mesh (and past [`MAX_MESH_FILE_BYTES`]) before it is parsed: `/dev/zero`
+/// given as one once grew the process to 23 GB.
+pub const MAX_POSITION_LINE_BYTES: u64 = 256;
 
 /// Largest contact-sequence file (`precomputed replay`), bytes: 256 MiB. A step of four
 /// contacts is a line of about 160 bytes: a million steps fit.

@@ -5,8 +5,8 @@
 mod common;
 
 use common::{
-    assert_one_line_error, build_cube, build_cube_table, build_table, palpate, palpate_with_stdin,
-    stderr, temp,
+    assert_one_line_error, build_cube, build_cube_table, build_table, fresh_dir, palpate,
+    palpate_with_stdin, reference, stderr, temp,
 };
 use core::time::Duration;
 use std::process::Command;
@@ -340,4 +340,123 @@ fn a_vtk_series_too_large_is_refused_before_the_run() {
     );
     assert!(!out_csv.exists() && !series.exists());
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A 40³-cell box (68 921 vertices) with a 1-cm dynamic zone.
+const BIG_HYBRID: &str = "fix = [\"z<0.001\"]\n[generated]\nbox_m = [0.4, 0.4, 0.4]\n\
+    cells = [40, 40, 40]\n[material]\nyoung_pa = 3000.0\npoisson = 0.45\n[model]\n\
+    kind = \"dynamic\"\ndamping_per_s = 0\n[[zone]]\nkind = \"cut\"\nshape = \"box\"\nmin_m = [0.0, 0.0, 0.39]\n\
+    max_m = [0.01, 0.01, 0.4]\n[partition]\nmargin_rings = 0\n";
+
+/// That scene aborted `scene tables`, `dynamic run --scene` and `dynamic
+/// critical-dt --scene` on a 32 GB allocation (exit 134), and `scene plan`
+/// printed its 18 GB table with exit 0 without saying a session refuses it.
+/// Now each command refuses it before building, with the estimate; the plan
+/// marks the table refused, in text and in JSON.
+#[test]
+fn a_hybrid_too_large_is_refused_before_building_and_marked_by_plan() {
+    let dir = fresh_dir("big-hybrid");
+    let scene = dir.join("big.toml");
+    std::fs::write(&scene, BIG_HYBRID).expect("scene");
+    let scene = scene.to_str().expect("path");
+    let out_dir = dir.join("tables");
+    let out = palpate(&[
+        "scene",
+        "tables",
+        scene,
+        "--out-dir",
+        out_dir.to_str().expect("path"),
+    ]);
+    assert_one_line_error(
+        &out,
+        &[
+            "pre-computed region",
+            "MAX_TABLE_FILE_BYTES",
+            "refused before building",
+        ],
+    );
+    assert!(!out_dir.exists());
+    let out = palpate(&[
+        "dynamic",
+        "run",
+        "--scene",
+        scene,
+        "--damping",
+        "0",
+        "--integrator",
+        "symplectic",
+        "--dt",
+        "1e-4",
+        "--steps",
+        "1",
+        "--json",
+    ]);
+    assert_one_line_error(&out, &["MAX_TABLE_FILE_BYTES", "refused before building"]);
+    let out = palpate(&[
+        "dynamic",
+        "critical-dt",
+        "--scene",
+        scene,
+        "--damping",
+        "0",
+        "--integrator",
+        "symplectic",
+        "--json",
+    ]);
+    assert_one_line_error(&out, &["MAX_RUN_TET_STEPS", "refused before starting"]);
+
+    let out = palpate(&["scene", "plan", scene, "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let plan: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let refused = plan["regions"][0]["refused"].as_str().expect("refused");
+    assert!(refused.contains("MAX_TABLE_FILE_BYTES"), "{refused}");
+    assert!(plan["regions"][0]["table_bytes"].as_u64().expect("bytes") > 4 << 30);
+    assert!(plan["regions"][1]["refused"].is_null());
+    let out = palpate(&["scene", "plan", scene]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("REFUSED"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `dynamic run --steps 18446744073709551615` was accepted; `stvk forces
+/// --deformed /dev/zero` grew to 23 GB. Both are refused at once.
+#[test]
+fn unbounded_steps_and_positions_are_refused() {
+    let cube = reference("meshes/cube.msh");
+    let out = palpate(&[
+        "dynamic",
+        "run",
+        &cube,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--density",
+        "1000",
+        "--fix",
+        "z<0.001",
+        "--damping",
+        "0",
+        "--integrator",
+        "symplectic",
+        "--dt",
+        "1e-4",
+        "--steps",
+        "18446744073709551615",
+        "--json",
+    ]);
+    assert_one_line_error(&out, &["dynamic run", "MAX_RUN_TET_STEPS"]);
+    let out = palpate(&[
+        "stvk",
+        "forces",
+        &cube,
+        "--young",
+        "5000",
+        "--poisson",
+        "0.45",
+        "--deformed",
+        "/dev/zero",
+        "--json",
+    ]);
+    assert_one_line_error(&out, &["/dev/zero", "MAX_POSITION_LINE_BYTES"]);
 }

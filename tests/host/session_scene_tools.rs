@@ -179,7 +179,7 @@ fn every_tool_cutting_and_tearing_error_names_the_key() {
         ),
         (
             tool("jaw_axis = [1, 0]\n"),
-            "bad.toml: line 7: invalid length 2, expected an array of length 3",
+            "bad.toml: line 7: jaw_axis: invalid length 2, expected exactly 3 numbers, [x, y, z]",
         ),
         (
             format!("{BASE_SCENE}[cutting]\ncapacity = 8\n"),

@@ -165,7 +165,7 @@ fn tool_columns_round_trip_bit_for_bit() {
         s(0.0, 1, -0.0, true),
         s(0.001, 1, f64::MIN_POSITIVE, true),
         s(0.30000000000000004, 0, 5e-324, false),
-        s(0.4, 0, 1e300, true),
+        s(0.4, 0, 999.9999999999999, true),
     ];
     let t = Trajectory::from_samples(samples.clone(), 2).unwrap();
     assert!(t.has_tool_columns());

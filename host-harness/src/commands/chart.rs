@@ -145,6 +145,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     );
     // The work bound, checked before anything runs, and its time here.
     let bodies = matrix.bodies()?;
+    chart::preflight(&bodies, &args.out)?;
     let volume_relaxations: usize = protocols
         .iter()
         .map(|&p| volume_bend::relaxations_bound(&scene, p, &controls))

@@ -42,7 +42,7 @@ pub fn run(command: StvkCommand) -> anyhow::Result<()> {
         } => {
             json.require("stvk forces")?;
             let (mesh, report) = read_mesh(&path)?;
-            let deformed_m = read_positions_csv(&deformed)?;
+            let deformed_m = read_positions_csv(&deformed, mesh.positions.len())?;
             anyhow::ensure!(
                 deformed_m.len() == mesh.positions.len(),
                 "{}: {} lines of deformed positions, expected one x,y,z line per vertex of {} ({} vertices)",

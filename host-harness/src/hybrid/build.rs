@@ -10,6 +10,7 @@ use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 use palpate_kernel::{PrecomputedTable, Real};
 
 use super::condense::{Condensed, condense};
+use super::estimate::{HybridEstimate, PrecomputedRegion};
 use super::split::RegionSplit;
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::element::shape_gradients;
@@ -18,6 +19,7 @@ use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, BuiltTable, Stages, TableKindOptions, precomputed};
 use crate::table::compliance::Solver;
+use crate::table::estimate::SizeLimits;
 use crate::table::file::{Precision, Section, write_container};
 use crate::table::load::TableFile;
 use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
@@ -40,6 +42,9 @@ pub struct HybridOptions {
     pub point_loads: Vec<(u32, [f64; 3])>,
     /// Which tets' mass the connection nodes carry.
     pub connection_mass: ConnectionMass,
+    /// What the tables and the build may take ([`SizeLimits::system`] by default), checked
+    /// against their estimate ([`HybridEstimate`]) before anything is built.
+    pub limits: SizeLimits,
 }
 
 /// The lumped mass of the connection nodes in the tensor-mass region.
@@ -71,6 +76,7 @@ impl HybridOptions {
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+            limits: SizeLimits::system(),
         }
     }
 
@@ -88,6 +94,7 @@ impl HybridOptions {
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+            limits: SizeLimits::system(),
         })
     }
 
@@ -136,21 +143,17 @@ pub fn build_hybrid(
     let n = mesh.positions.len();
     let build = &options.build;
     let materials = build.materials_for(mesh.tets.len())?;
-    let (fixed, _) = fixed_vertices(&mesh.positions, &build.fix, &report.unreferenced_vertices);
-    let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
-
-    // The pre-computed region: connection nodes and vertices outside it fixed.
-    let pmesh = split.precomputed_mesh(mesh);
-    let mut pfixed = fixed.clone();
-    for (v, f) in pfixed.iter_mut().enumerate() {
-        *f |= !split.in_precomputed[v] || split.dynamic_index[v].is_some();
-    }
-    if pfixed.iter().all(|&f| f) {
-        bail!(
-            "{source}: the pre-computed region has no free vertex (every one is fixed or connects)"
-        );
-    }
-    let surface = boundary_surface(&pmesh);
+    let Prepared {
+        fixed,
+        split,
+        region,
+        ..
+    } = prepare(mesh, report, dynamic_tet, options)?;
+    let PrecomputedRegion {
+        mesh: pmesh,
+        fixed: pfixed,
+        surface,
+    } = region;
     let region_tets = |dynamic: bool| {
         let flags = &split.dynamic_tet;
         (0..flags.len()).filter(move |&t| flags[t] == dynamic)
@@ -275,6 +278,65 @@ impl HybridTables {
         InterfaceTable::<T>::load(self.interface.bytes()).context("interface")?;
         Ok(())
     }
+}
+
+/// What [`build_hybrid`] knows before it builds a table: the scene's fixed vertices, the split,
+/// the pre-computed region and the estimate, checked.
+struct Prepared {
+    fixed: Vec<bool>,
+    split: RegionSplit,
+    region: PrecomputedRegion,
+    estimate: HybridEstimate,
+}
+
+/// The split of `mesh` by `dynamic_tet` and the estimate of its tables, checked against
+/// `options.limits` (the estimate printed if they ask): every refusal of a hybrid that does not
+/// need its arrays, linear in the mesh.
+fn prepare(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    dynamic_tet: &[bool],
+    options: &HybridOptions,
+) -> anyhow::Result<Prepared> {
+    let source = &report.source;
+    let build = &options.build;
+    let (fixed, _) = fixed_vertices(&mesh.positions, &build.fix, &report.unreferenced_vertices);
+    let split = RegionSplit::new(mesh, &fixed, dynamic_tet).with_context(|| source.clone())?;
+    // The pre-computed region: connection nodes and vertices outside it fixed.
+    let region = PrecomputedRegion::of(mesh, &split, &fixed);
+    if region.fixed.iter().all(|&f| f) {
+        bail!(
+            "{source}: the pre-computed region has no free vertex (every one is fixed or connects)"
+        );
+    }
+    let estimate = HybridEstimate::of(
+        mesh,
+        &split,
+        &fixed,
+        &region,
+        build.list_tool_radius_m(),
+        build.precision,
+    );
+    estimate.check(&options.limits, source)?;
+    Ok(Prepared {
+        fixed,
+        split,
+        region,
+        estimate,
+    })
+}
+
+/// Checks, without building anything, that [`build_hybrid`] of the same arguments would start:
+/// the split is a hybrid, the pre-computed region has a free vertex, and the tables' estimate
+/// is within `options.limits`. Returns the estimate. For a command that builds hybrids late in
+/// a long run (`palpate chart`), before it starts.
+pub fn check_hybrid(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    dynamic_tet: &[bool],
+    options: &HybridOptions,
+) -> anyhow::Result<HybridEstimate> {
+    Ok(prepare(mesh, report, dynamic_tet, options)?.estimate)
 }
 
 /// Serializes the interface table (`TableKind::Interface`).

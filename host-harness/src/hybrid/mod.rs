@@ -9,10 +9,11 @@
 
 pub mod build;
 pub mod condense;
+pub mod estimate;
 pub mod owned;
 pub mod run;
 pub mod split;
 pub mod stability;
 
-pub use build::{ConnectionMass, HybridOptions, HybridTables, build_hybrid};
+pub use build::{ConnectionMass, HybridOptions, HybridTables, build_hybrid, check_hybrid};
 pub use split::RegionSplit;

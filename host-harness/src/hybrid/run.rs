@@ -24,6 +24,7 @@ pub fn run(
     dynamic_tet: &[bool],
     options: &RunOptions,
 ) -> anyhow::Result<RunOutput> {
+    crate::tensor_mass::run::check_run_steps(mesh, options)?;
     if !(options.dt_s.is_finite() && options.dt_s > 0.0) {
         bail!("--dt must be finite and > 0 s, got {}", options.dt_s);
     }

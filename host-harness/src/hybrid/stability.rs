@@ -11,7 +11,9 @@ use crate::mesh::{MeshReport, TetMesh};
 use crate::table::build::BuildOptions;
 use crate::table::file::Precision;
 use crate::tensor_mass::run::{diagonal, host_params};
-use crate::tensor_mass::stability::{CriticalDt, critical_dt, critical_dt_of_mesh};
+use crate::tensor_mass::stability::{
+    CriticalDt, check_critical_dt_work, critical_dt, critical_dt_of_mesh,
+};
 
 /// The critical step of the hybrid and of its tensor-mass region alone.
 #[derive(Serialize, Debug)]
@@ -37,6 +39,8 @@ pub fn critical_dt_of_hybrid(
     damping_per_s: f64,
     integrator: Integrator,
 ) -> anyhow::Result<HybridCriticalDt> {
+    // The coupled model's measurement and its region's alone.
+    check_critical_dt_work(mesh.tets.len(), 2)?;
     let mut options = options.clone();
     options.build.precision = Precision::F64;
     let tables = build_hybrid(mesh, report, dynamic_tet, &options)?;

@@ -1,9 +1,12 @@
 //! What each planned region costs: its table's size, its predicted step time and, for a
 //! tensor-mass region, its largest stable step (MODELS.md §3, §5).
 //!
-//! - Table sizes come from the mesh's counts ([`TableEstimate`], f32 tables as the sessions
-//!   build them) of the region's sub-mesh with its connection nodes fixed (the interface
-//!   imposes their displacement). The interface table follows [`interface_table_bytes`].
+//! - Table sizes: the pre-computed region's and the interface's are the hybrid build's own
+//!   estimate ([`HybridEstimate`], f32 tables as the sessions build them), which the build
+//!   checks against the limits before it starts; a tensor-mass region's, its sub-mesh's with
+//!   its connection nodes fixed (the interface imposes their displacement).
+//! - Materials: the scene's per tet (`[material]` and `[[region]]`s), as the sessions take
+//!   them, in every region's table, timing and stable step.
 //! - A tensor-mass region's step: its sub-mesh's f32 table built in memory, stepped alone under
 //!   gravity ([`TIMED_STEPS`] steps after [`WARMUP_STEPS`], the median of the single steps),
 //!   plus the interface update: the `9c²` multiply-adds of the condensed stiffness `S`
@@ -18,7 +21,7 @@
 //!   computes, so a tick adds nothing per connection node; the update is listed once more as
 //!   the region's share of each physics step).
 //! - A tensor-mass region's stable step: `ω_max` of its f64 linear model at rest (Lanczos,
-//!   [`lanczos_omega_max`]) and the integrator's condition ([`integrator_limit`]), the
+//!   `stable_step_of_model`, the scene check's own computation), the
 //!   connection nodes fixed. The coupled limit (`dynamic critical-dt --scene`) is measured at
 //!   or above the all-tensor-mass model's (README "The hybrid model").
 
@@ -32,21 +35,25 @@ use palpate_kernel::math::dense::dot;
 use palpate_kernel::precomputed::{Constraint, PrecomputedModel};
 use palpate_kernel::table::format::TableKind;
 use palpate_kernel::table::{PrecomputedTable, TensorMassTable};
-use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, TensorMassModel};
+use palpate_kernel::tensor_mass::{
+    DynamicParams, ElasticLaw, Integrator, TensorMassModel, VertexMode,
+};
 
 use super::plan::{Partition, RegionModel};
 use crate::fem::material::{Material, TetMaterials};
 use crate::fix::FixPredicate;
+use crate::hybrid::RegionSplit;
+use crate::hybrid::estimate::{HybridEstimate, PrecomputedRegion};
 use crate::mesh::generate::box_mesh;
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, build};
 use crate::table::compliance::Solver;
-use crate::table::estimate::{TableCounts, TableEstimate};
+use crate::table::estimate::TableEstimate;
 use crate::table::file::Precision;
 use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 use crate::tensor_mass::OwnedState;
 use crate::tensor_mass::run::diagonal;
-use crate::tensor_mass::stability::{integrator_limit, lanczos_omega_max};
+use crate::tensor_mass::stability::stable_step_of_model;
 
 /// Steps of a tensor-mass region run before timing.
 pub const WARMUP_STEPS: usize = 20;
@@ -63,11 +70,14 @@ pub const MAX_TIMED_CONNECTIONS: usize = 1024;
 /// The stored scalar of the tables the sessions run (f32).
 const PRECISION: Precision = Precision::F32;
 
-/// How the regions are timed: the scene's material and dynamic settings.
-#[derive(Clone, Copy, Debug)]
+/// How the regions are timed: the scene's materials and dynamic settings.
+#[derive(Clone, Debug)]
 pub struct CostOptions {
-    /// Young's modulus and Poisson ratio.
-    pub material: Material,
+    /// Young's modulus and Poisson ratio of every tet of the mesh (the scene's `[material]`
+    /// and `[[region]]`s, `Scene::tet_materials`: the sessions' materials).
+    pub materials: TetMaterials,
+    /// The radius the pre-computed table's candidate lists serve (the scene's tool), m.
+    pub tool_radius_m: f64,
     /// Density, kg/m³.
     pub density_kg_m3: f64,
     /// The tensor-mass regions' integrator.
@@ -99,29 +109,10 @@ pub struct InterfaceCost {
     /// Free vertices of the pre-computed region with the connection nodes counted fixed
     /// (`F_P`).
     pub precomputed_free: u64,
-    /// The interface table's size, bytes ([`interface_table_bytes`], f32).
+    /// The interface table's size, bytes ([`HybridEstimate::interface`], f32).
     pub table_bytes: u64,
     /// One interface update (`9c²` multiply-adds), s.
     pub update_s: f64,
-}
-
-/// The size of the interface table, bytes: its layout from the counts (`table/estimate.rs`,
-/// the format's sections: `c` connection vertices, the `3c × 3c` condensed stiffness, the
-/// `3F_P × 3c` response of the pre-computed region's free vertices, their load displacements,
-/// the connection forces, one entry per mesh vertex), in scalars of `precision`.
-pub fn interface_table_bytes(
-    c: u64,
-    free_precomputed: u64,
-    vertices: u64,
-    precision: Precision,
-) -> u64 {
-    let counts = TableCounts {
-        vertices,
-        free: free_precomputed,
-        connections: c,
-        ..TableCounts::default()
-    };
-    TableEstimate::new(TableKind::Interface, precision, counts).table_bytes
 }
 
 /// A region's tets as a mesh of their own (vertices renumbered in ascending order of the
@@ -146,20 +137,37 @@ pub fn sub_mesh(mesh: &TetMesh, tets: &[u32]) -> (TetMesh, Vec<u32>) {
 }
 
 /// The costs of every region of `partition` (in its order) and of the interface. `fixed`: per
-/// mesh vertex, whether the scene fixes it.
+/// mesh vertex, whether the scene fixes it. The pre-computed region's and the interface's
+/// table sizes are the hybrid build's own estimate ([`HybridEstimate`], checked before it
+/// builds), returned with the costs (`None` unless the partition is a hybrid).
 pub fn costs(
     mesh: &TetMesh,
     fixed: &[bool],
     partition: &Partition,
     options: &CostOptions,
-) -> anyhow::Result<(Vec<RegionCost>, InterfaceCost)> {
+) -> anyhow::Result<(Vec<RegionCost>, InterfaceCost, Option<HybridEstimate>)> {
     let mut connection = vec![false; mesh.positions.len()];
     for &v in &partition.connection_nodes {
         connection[v as usize] = true;
     }
+    let hybrid = partition.dynamic.iter().any(|&d| d) && partition.dynamic.iter().any(|&d| !d);
+    let estimate = if hybrid {
+        let split = RegionSplit::new(mesh, fixed, &partition.dynamic)?;
+        let region = PrecomputedRegion::of(mesh, &split, fixed);
+        Some(HybridEstimate::of(
+            mesh,
+            &split,
+            fixed,
+            &region,
+            options.tool_radius_m,
+            PRECISION,
+        ))
+    } else {
+        None
+    };
     let c = partition.connection_nodes.len();
     let update_s = if c > 0 { interface_update_s(c) } else { 0.0 };
-    let mut precomputed_free = 0;
+    let default = options.materials.default_material();
     let mut out = Vec::with_capacity(partition.regions.len());
     for region in &partition.regions {
         let (sub, ids) = sub_mesh(mesh, &region.tets);
@@ -168,56 +176,74 @@ pub fn costs(
             .map(|&v| fixed[v as usize] || connection[v as usize])
             .collect();
         let surface = boundary_surface(&sub);
-        let counts = TableCounts::of(&sub, &MeshReport::default(), &sub_fixed, &surface);
+        let table_bytes = |kind| {
+            TableEstimate::of_surface(
+                kind,
+                PRECISION,
+                &sub,
+                &sub_fixed,
+                &surface,
+                options.tool_radius_m,
+            )
+            .table_bytes
+        };
         out.push(match region.model {
-            RegionModel::Precomputed => {
-                precomputed_free = counts.free;
-                RegionCost {
-                    table_bytes: TableEstimate::new(TableKind::Precomputed, PRECISION, counts)
-                        .table_bytes,
-                    step_cost_s: contact_solve_s(&options.material)? + update_s,
-                    critical_dt_s: None,
-                }
-            }
+            RegionModel::Precomputed => RegionCost {
+                table_bytes: match &estimate {
+                    Some(e) => e.precomputed.table_bytes,
+                    None => table_bytes(TableKind::Precomputed),
+                },
+                step_cost_s: contact_solve_s(&default)? + update_s,
+                critical_dt_s: None,
+            },
             RegionModel::TensorMass {
                 law,
                 incompressibility,
             } => {
+                let materials = options
+                    .materials
+                    .subset(region.tets.iter().map(|&t| t as usize));
                 let arrays = TensorMassArrays::new(
                     &sub,
-                    &TetMaterials::uniform(options.material, sub.tets.len()),
+                    &materials,
                     options.density_kg_m3,
-                    sub_fixed,
+                    sub_fixed.clone(),
                 );
                 let gamma = incompressibility.then(|| {
-                    options.incompressibility_n.unwrap_or_else(|| {
-                        crate::experiment::scenes::penalty_n(&sub, &options.material)
-                    })
+                    options
+                        .incompressibility_n
+                        .unwrap_or_else(|| crate::experiment::scenes::penalty_n(&sub, &default))
                 });
-                let step_s =
-                    tensor_mass_step_s(&sub, &surface.triangles, &arrays, options, law, gamma)
-                        .with_context(|| format!("timing dynamic region {}", region.id))?;
+                let critical_dt_s = stable_step_s(&sub, &surface.triangles, &arrays, options)
+                    .with_context(|| format!("the stable step of dynamic region {}", region.id))?;
+                // A step the region is stable at: a tenth of a millisecond, far below the limit
+                // of any mesh the real-time loop runs, or half the region's limit if a stiff
+                // material makes it lower (the cost of a step does not depend on its length).
+                let dt_s = critical_dt_s.map_or(1e-4, |dt| (0.5 * dt).min(1e-4));
+                let step_s = tensor_mass_step_s(
+                    &sub,
+                    &surface.triangles,
+                    &arrays,
+                    options,
+                    (law, gamma),
+                    dt_s,
+                )
+                .with_context(|| format!("timing dynamic region {}", region.id))?;
                 RegionCost {
-                    table_bytes: TableEstimate::new(TableKind::TensorMass, PRECISION, counts)
-                        .table_bytes,
+                    table_bytes: table_bytes(TableKind::TensorMass),
                     step_cost_s: step_s + update_s,
-                    critical_dt_s: stable_step_s(&sub, &surface.triangles, &arrays, options)?,
+                    critical_dt_s,
                 }
             }
         });
     }
     let interface = InterfaceCost {
         connection_nodes: c as u64,
-        precomputed_free,
-        table_bytes: interface_table_bytes(
-            c as u64,
-            precomputed_free,
-            mesh.positions.len() as u64,
-            PRECISION,
-        ),
+        precomputed_free: estimate.map_or(0, |e| e.interface.counts.free),
+        table_bytes: estimate.map_or(0, |e| e.interface.table_bytes),
         update_s,
     };
-    Ok((out, interface))
+    Ok((out, interface, estimate))
 }
 
 /// The median of `samples` single timings, s, of `f`.
@@ -239,8 +265,8 @@ fn tensor_mass_step_s(
     triangles: &[[u32; 3]],
     arrays: &TensorMassArrays,
     options: &CostOptions,
-    law: ElasticLaw,
-    gamma: Option<f64>,
+    (law, gamma): (ElasticLaw, Option<f64>),
+    dt_s: f64,
 ) -> anyhow::Result<f64> {
     let bytes = write_tensor_mass_table(sub, triangles, arrays, Precision::F32);
     let table = TensorMassTable::<f32>::load(&bytes)?;
@@ -253,9 +279,7 @@ fn tensor_mass_step_s(
     .with_incompressibility(gamma.map(|g| g as f32))
     .with_gravity(Vector3::new(0.0, 0.0, -9.81));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
-    // A step the region is stable at: a tenth of a millisecond is far below the limit of any
-    // mesh the real-time loop runs, and the cost of a step does not depend on its length.
-    let dt_s = 1e-4;
+    let dt_s = dt_s as f32;
     for _ in 0..WARMUP_STEPS {
         model.step(options.integrator, dt_s)?;
     }
@@ -283,9 +307,18 @@ fn stable_step_s(
     let mut state = OwnedState::for_table(&table);
     let params = DynamicParams::linear(options.damping_per_s, diagonal(&sub.positions));
     let mut model = TensorMassModel::new(table, state.buffers(), params)?;
-    let omega = lanczos_omega_max(&mut model);
-    Ok((omega.is_finite() && omega > 0.0)
-        .then(|| integrator_limit(options.integrator, omega, options.damping_per_s).0))
+    let moving = (0..model.modes().len())
+        .any(|v| model.modes()[v] == VertexMode::Free && model.masses_kg()[v] > 0.0);
+    if !moving {
+        return Ok(None);
+    }
+    let step = stable_step_of_model(
+        &mut model,
+        options.materials.default_material().young_pa,
+        options.damping_per_s,
+        options.integrator,
+    )?;
+    Ok(Some(step.limit_dt_s))
 }
 
 /// One interface update (`9c²` multiply-adds: the `3c` row products of the condensed

@@ -13,7 +13,9 @@
 //!   golden-section search of [`GOLDEN_ITERATIONS`] steps (the parameter to 2·10⁻¹³).
 //!
 //! Candidates come from [`TetGrid`], a uniform grid of the tets' bounding boxes, so a zone
-//! costs the tets near it, not the mesh.
+//! costs the tets near it, not the mesh. A segment is clipped to the mesh's bounding box grown
+//! by the radius first ([`clip_segment`]), and most candidates are decided from their vertices
+//! ([`capsule_meets_tet`]) without the search.
 
 use nalgebra::Vector3;
 
@@ -34,6 +36,8 @@ type TetPoints = [V3; 4];
 pub struct TetGrid<'a> {
     mesh: &'a TetMesh,
     origin: V3,
+    /// The mesh's bounding box's upper corner (`origin` is the lower), m.
+    upper: V3,
     cell_m: f64,
     dims: [usize; 3],
     start: Vec<u32>,
@@ -89,6 +93,7 @@ impl<'a> TetGrid<'a> {
         Self {
             mesh,
             origin: lo,
+            upper: hi,
             cell_m,
             dims,
             start: count,
@@ -147,11 +152,20 @@ impl<'a> TetGrid<'a> {
     }
 
     /// Marks in `met` the tets within `radius_m − ε` of the segment `a`–`b`.
+    ///
+    /// The segment is first clipped to the mesh's bounding box grown by the radius (only that
+    /// part can come within the radius of a tet): a segment with far endpoints (`±1e12` m) is
+    /// then searched over its part near the mesh, not over a parameter whose resolution is
+    /// metres. Each candidate tet is decided from its vertices when they suffice
+    /// ([`capsule_meets_tet`]).
     fn capsule(&self, a: V3, b: V3, radius_m: f64, met: &mut [bool]) {
         let r = V3::repeat(radius_m);
+        let Some((a, b)) = clip_segment(a, b, self.origin - r, self.upper + r) else {
+            return;
+        };
         let reach = radius_m - self.tolerance_m;
         self.visit(a.inf(&b) - r, a.sup(&b) + r, met, |p| {
-            segment_tet_distance(a, b, p) < reach
+            capsule_meets_tet(a, b, reach, p)
         });
     }
 
@@ -248,6 +262,80 @@ pub fn box_meets_tet(lo: V3, hi: V3, p: &TetPoints, eps: f64) -> bool {
         || units
             .iter()
             .any(|u| edges.iter().any(|e| separated(u.cross(e)))))
+}
+
+/// The part of the segment `a`–`b` inside the box `[lo, hi]` (Liang-Barsky), `None` if it
+/// misses the box. The parameters are computed from the endpoints and the clipped points from
+/// the nearer endpoint, so a point near the box keeps the precision of the input.
+pub fn clip_segment(a: V3, b: V3, lo: V3, hi: V3) -> Option<(V3, V3)> {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for i in 0..3 {
+        if d[i] == 0.0 {
+            if a[i] < lo[i] || a[i] > hi[i] {
+                return None;
+            }
+            continue;
+        }
+        let (mut u, mut v) = ((lo[i] - a[i]) / d[i], (hi[i] - a[i]) / d[i]);
+        if u > v {
+            core::mem::swap(&mut u, &mut v);
+        }
+        t0 = t0.max(u);
+        t1 = t1.min(v);
+        if t0 > t1 {
+            return None;
+        }
+    }
+    let at = |t: f64| {
+        if t <= 0.5 {
+            a + d * t
+        } else {
+            b - d * (1.0 - t)
+        }
+    };
+    Some((
+        if t0 == 0.0 { a } else { at(t0) },
+        if t1 == 1.0 { b } else { at(t1) },
+    ))
+}
+
+/// Whether the tet `p` comes within `reach` of the segment `a`–`b` (m), deciding from its
+/// vertices when they suffice and by [`segment_tet_distance`] otherwise.
+///
+/// A vertex within `reach` decides yes. The squared distance to a convex set, `g`, has a
+/// 2-Lipschitz gradient, so at any point `x = Σλᵢvᵢ` of the tet
+/// `g(x) ≥ Σλᵢ g(vᵢ) − Σλᵢ|vᵢ − x|² ≥ minᵢ g(vᵢ) − L²` (`L` the tet's longest edge): when that
+/// bound is at least `reach²`, no point of the tet is within `reach`, and the answer is no
+/// without the search.
+pub fn capsule_meets_tet(a: V3, b: V3, reach: f64, p: &TetPoints) -> bool {
+    let nearest_sq = p
+        .iter()
+        .map(|&q| point_segment_distance_sq(q, a, b))
+        .fold(f64::INFINITY, f64::min);
+    if nearest_sq < reach * reach {
+        return true;
+    }
+    let longest_sq = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+        .iter()
+        .map(|&(i, j)| (p[i] - p[j]).norm_squared())
+        .fold(0.0, f64::max);
+    if nearest_sq - longest_sq >= reach * reach {
+        return false;
+    }
+    segment_tet_distance(a, b, p) < reach
+}
+
+/// Squared distance from `q` to the segment `a`–`b`, m².
+fn point_segment_distance_sq(q: V3, a: V3, b: V3) -> f64 {
+    let d = b - a;
+    let len_sq = d.norm_squared();
+    let t = if len_sq > 0.0 {
+        ((q - a).dot(&d) / len_sq).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (q - (a + d * t)).norm_squared()
 }
 
 /// Distance from the segment `a`–`b` to the tet `p` (0 where they meet), m: golden-section

@@ -8,9 +8,10 @@ use palpate_kernel::tensor_mass::Integrator;
 use serde::Serialize;
 
 use super::cost::{CostOptions, InterfaceCost, RegionCost, costs};
-use super::plan::Partition;
+use super::plan::{Partition, RegionModel};
 use crate::fix::fixed_vertices;
 use crate::limits::human_bytes;
+use crate::limits::{MAX_TABLE_FILE_BYTES, mem_available_bytes};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::session::{ModelSpec, Scene};
 
@@ -31,8 +32,12 @@ pub struct RegionReport {
     pub connection_nodes: usize,
     /// Vertex-connected pieces.
     pub pieces: usize,
-    /// Its table, bytes (f32).
+    /// Its table, bytes (f32): for the pre-computed region, the estimate the hybrid build
+    /// checks before it starts.
     pub table_bytes: u64,
+    /// Why a session would refuse to build this table (above the largest table file, or the
+    /// hybrid build's peak above the memory available now), or `null` when it fits.
+    pub refused: Option<String>,
     /// Predicted time of a step (tensor-mass, with the interface update) or a tick
     /// (pre-computed: the contact solve, with the interface solves), s.
     pub step_cost_s: f64,
@@ -51,6 +56,8 @@ pub struct InterfaceReport {
     pub precomputed_free: u64,
     /// The interface table, bytes (f32).
     pub table_bytes: u64,
+    /// Why a session would refuse to build it (see [`RegionReport::refused`]), or `null`.
+    pub refused: Option<String>,
     /// One interface update, s.
     pub update_s: f64,
 }
@@ -74,18 +81,23 @@ pub struct PlanReport {
     pub mesh_vertices: usize,
 }
 
-/// The cost options of `scene`: its material, and its dynamic settings when `[model]` is
-/// dynamic, else symplectic Euler without damping (its undamped bound `2/ω_max`).
-pub fn cost_options(scene: &Scene) -> anyhow::Result<CostOptions> {
-    let material = scene
-        .elastic_material()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", scene.source))?;
+/// The cost options of `scene` on `mesh`: its materials per tet (`Scene::tet_materials`, the
+/// sessions' own, with their checks), its tool's radius, and its dynamic settings when
+/// `[model]` is dynamic, else symplectic Euler without damping (its undamped bound
+/// `2/ω_max`).
+pub fn cost_options(
+    scene: &Scene,
+    mesh: &TetMesh,
+    report: &MeshReport,
+) -> anyhow::Result<CostOptions> {
+    let materials = scene.tet_materials(mesh, report)?;
     let (integrator, damping_per_s, incompressibility_n) = match &scene.model {
         ModelSpec::Dynamic(d) => (d.integrator, d.damping_per_s, d.incompressibility_n),
         ModelSpec::Precomputed => (Integrator::SymplecticEuler, 0.0, None),
     };
     Ok(CostOptions {
-        material,
+        materials,
+        tool_radius_m: scene.tool.radius_m,
         density_kg_m3: scene.material.density_kg_m3,
         integrator,
         damping_per_s,
@@ -102,9 +114,36 @@ impl PlanReport {
         report: &MeshReport,
         partition: &Partition,
     ) -> anyhow::Result<PlanReport> {
-        let options = cost_options(scene)?;
+        scene.check_on_mesh(mesh)?;
+        let options = cost_options(scene, mesh, report)?;
         let (fixed, _) = fixed_vertices(&mesh.positions, &scene.fix, &report.unreferenced_vertices);
-        let (region_costs, interface) = costs(mesh, &fixed, partition, &options)?;
+        let (region_costs, interface, estimate) = costs(mesh, &fixed, partition, &options)?;
+        // What the session's build would say: each table against the largest table file,
+        // and the hybrid build's peak against the memory available now.
+        let short_of_memory = estimate.and_then(|e| {
+            let available = mem_available_bytes()?;
+            (e.peak_bytes > available).then(|| {
+                format!(
+                    "the hybrid build needs about {} of memory, only {} is available \
+                     (MemAvailable)",
+                    human_bytes(e.peak_bytes),
+                    human_bytes(available)
+                )
+            })
+        });
+        let refused = |bytes: u64, built_with_hybrid: bool| -> Option<String> {
+            if bytes > MAX_TABLE_FILE_BYTES {
+                Some(format!(
+                    "{} is above the largest table file, {} (MAX_TABLE_FILE_BYTES)",
+                    human_bytes(bytes),
+                    human_bytes(MAX_TABLE_FILE_BYTES)
+                ))
+            } else if built_with_hybrid {
+                short_of_memory.clone()
+            } else {
+                None
+            }
+        };
         Ok(PlanReport {
             regions: partition
                 .regions
@@ -119,13 +158,17 @@ impl PlanReport {
                     connection_nodes: r.connection_nodes,
                     pieces: r.pieces,
                     table_bytes: c.table_bytes,
+                    refused: refused(c.table_bytes, r.model == RegionModel::Precomputed),
                     step_cost_s: c.step_cost_s,
                     critical_dt_s: c.critical_dt_s,
                     why: r.why.clone(),
                 })
                 .collect(),
             connection_nodes: partition.connection_nodes.len(),
-            interface: interface_report(&interface),
+            interface: InterfaceReport {
+                refused: refused(interface.table_bytes, interface.connection_nodes > 0),
+                ..interface_report(&interface)
+            },
             margin_rings: scene.partition.margin_rings,
             integrator: options.integrator.name(),
             mesh_tets: mesh.tets.len(),
@@ -170,6 +213,12 @@ impl PlanReport {
                         self.integrator
                     ))
             );
+            if let Some(refused) = &r.refused {
+                let _ = writeln!(
+                    s,
+                    "  REFUSED: a session would not build this table: {refused}"
+                );
+            }
             let _ = writeln!(s, "  why: {}", r.why);
         }
         let i = &self.interface;
@@ -182,6 +231,12 @@ impl PlanReport {
                 human_bytes(i.table_bytes),
                 i.update_s
             );
+            if let Some(refused) = &i.refused {
+                let _ = writeln!(
+                    s,
+                    "  REFUSED: a session would not build this table: {refused}"
+                );
+            }
         } else {
             let _ = writeln!(s, "interface: none (a single model)");
         }
@@ -199,5 +254,6 @@ fn interface_report(i: &InterfaceCost) -> InterfaceReport {
             0
         },
         update_s: i.update_s,
+        refused: None,
     }
 }

@@ -18,6 +18,7 @@ use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
 use crate::table::build::build;
 use crate::table::compress::Compression;
+use crate::table::estimate::SizeLimits;
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
 use std::io::Write as _;
@@ -43,6 +44,7 @@ impl SceneModel {
     /// whose zones make tets dynamic needs `[model] kind = "dynamic"` for
     /// their step: otherwise a one-line error naming the scene.
     pub fn of(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Self> {
+        scene.check_on_mesh(mesh)?;
         if scene.zones.is_empty() {
             return Ok(match scene.model {
                 ModelSpec::Precomputed => Self::Precomputed,
@@ -167,6 +169,16 @@ pub fn hybrid_tables(
         precision,
     )
     .with_tet_materials(materials);
+    // The pre-computed region's candidate lists serve the scene's tool, as a pre-computed
+    // scene's table does (`precomputed_options`).
+    let options = HybridOptions {
+        build: options.build.with_tool_radius(scene.tool.radius_m),
+        limits: SizeLimits {
+            print_estimate: true,
+            ..options.limits
+        },
+        ..options
+    };
     build_hybrid(mesh, report, &partition.dynamic, &options).with_context(|| scene.source.clone())
 }
 

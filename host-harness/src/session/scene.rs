@@ -397,8 +397,9 @@ struct SceneFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct GeneratedFile {
-    #[serde(alias = "box")]
+    #[serde(alias = "box", deserialize_with = "exact::three")]
     box_m: [f64; 3],
+    #[serde(deserialize_with = "exact::three")]
     cells: [usize; 3],
 }
 
@@ -472,8 +473,10 @@ struct ToolFile {
     #[serde(default = "default_radius")]
     radius_m: f64,
     kind: Option<KindsFile>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     jaw_axis: Option<[f64; 3]>,
     grip_opening_m: Option<f64>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     blade_m: Option<[f64; 3]>,
 }
 
@@ -607,6 +610,12 @@ pub const DEFAULT_PHYSICS_EVERY: u32 = 1;
 pub const DEFAULT_JAW_AXIS: [f64; 3] = [1.0, 0.0, 0.0];
 /// Default grasper grip opening, in tool radii: `grip_opening_m = 2.5 × radius_m`.
 pub const DEFAULT_GRIP_OPENING_RADII: f64 = 2.5;
+/// Largest tool radius, as a fraction of the mesh's largest bounding-box extent: 0.5, a tool
+/// sphere as wide as the body. A larger one (`radius_m = 1.0` on a 12 cm block) covers the
+/// whole body from any side: the contact search faulted every tick. Checked once the mesh is
+/// loaded ([`Scene::check_on_mesh`]).
+pub const MAX_TOOL_RADIUS_FRACTION: f64 = 0.5;
+
 /// Default cutter blade, m: 1 cm straight down from the tool point.
 pub const DEFAULT_BLADE_M: [f64; 3] = [0.0, 0.0, -0.01];
 /// Longest cutter blade, m.
@@ -690,6 +699,34 @@ impl Default for SafetyFile {
 }
 
 impl Scene {
+    /// The checks of the scene that need its loaded `mesh`: `[tool] radius_m` at most
+    /// [`MAX_TOOL_RADIUS_FRACTION`] of the mesh's largest bounding-box extent.
+    pub fn check_on_mesh(&self, mesh: &TetMesh) -> Result<(), SceneError> {
+        let (lo, hi) = mesh.positions.iter().fold(
+            ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(lo, hi), p| {
+                (
+                    [0, 1, 2].map(|i| lo[i].min(p[i])),
+                    [0, 1, 2].map(|i| hi[i].max(p[i])),
+                )
+            },
+        );
+        let extent = (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
+        let most = MAX_TOOL_RADIUS_FRACTION * extent;
+        if self.tool.radius_m > most {
+            return Err(SceneError::Invalid {
+                file: self.source.clone(),
+                key: format!("[tool] radius_m = {}", self.tool.radius_m),
+                msg: format!(
+                    "above {MAX_TOOL_RADIUS_FRACTION} of the mesh's largest extent ({extent} m): \
+                     at most {most} m (MAX_TOOL_RADIUS_FRACTION); a tool wider than the body \
+                     touches all of it"
+                ),
+            });
+        }
+        Ok(())
+    }
+
     /// The scene of `palpate demo`: a 12 × 12 × 6 cm generated block (12 × 12 × 6 cells: 1183
     /// vertices, 5184 tets), E = 3000 Pa, ν = 0.45, density 1000 kg/m³, base fixed (`z<0.0001`),
     /// the pre-computed model, 1 tool point of radius 2 mm, 1 kHz haptic rate with a physics
@@ -872,7 +909,7 @@ impl Scene {
                 .filter(|span| span.start > 0 || !err.message().starts_with("missing field"))
                 .and_then(|span| text.get(..span.start))
                 .map(|before| before.matches('\n').count() + 1),
-            msg: err.message().trim().replace('\n', "; "),
+            msg: with_array_key(text, &err),
         })?;
         let invalid = |key: &str, msg: String| SceneError::Invalid {
             file: source.to_owned(),
@@ -1487,4 +1524,51 @@ fn check_dynamic(d: &DynamicSpec, physics_period_s: f64) -> Result<(), (String, 
         ));
     }
     Ok(())
+}
+
+/// Arrays of exactly three numbers in a scene file: `[x, y, z]` with a fourth (or a second
+/// missing) is an error naming the key (the parser's message shows its line), never truncated.
+pub(crate) mod exact {
+    use serde::de::{Deserialize, Deserializer, Error};
+
+    /// A `[a, b, c]` array: three elements, no more, no fewer.
+    pub(crate) fn three<'de, D, T>(deserializer: D) -> Result<[T; 3], D::Error>
+    where
+        D: Deserializer<'de>,
+        T: Deserialize<'de>,
+    {
+        let items = Vec::<T>::deserialize(deserializer)?;
+        let len = items.len();
+        <[T; 3]>::try_from(items)
+            .map_err(|_| D::Error::invalid_length(len, &"exactly 3 numbers, [x, y, z]"))
+    }
+
+    /// [`three`] of an optional key (with `#[serde(default)]`).
+    pub(crate) fn three_opt<'de, D, T>(deserializer: D) -> Result<Option<[T; 3]>, D::Error>
+    where
+        D: Deserializer<'de>,
+        T: Deserialize<'de>,
+    {
+        three(deserializer).map(Some)
+    }
+}
+
+/// The parser's message of `err` on one line; for an array of the wrong length
+/// ([`exact::three`]), preceded by its key as written on its line (`min_m: invalid length 4,
+/// ...`).
+fn with_array_key(text: &str, err: &toml::de::Error) -> String {
+    let msg = err.message().trim().replace('\n', "; ");
+    let key = err
+        .span()
+        .filter(|_| msg.starts_with("invalid length"))
+        .and_then(|span| {
+            let start = text.get(..span.start)?.rfind('\n').map_or(0, |i| i + 1);
+            let line = text.get(start..)?.lines().next()?;
+            let key = line.split_once('=')?.0.trim();
+            (!key.is_empty()).then(|| key.to_owned())
+        });
+    match key {
+        Some(key) => format!("{key}: {msg}"),
+        None => msg,
+    }
 }

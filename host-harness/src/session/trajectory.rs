@@ -39,7 +39,8 @@
 //! sample's value), so a blade switches exactly at a sample's time, never between samples.
 //!
 //! Rules checked by [`Trajectory::read`] (each error names the file and the line):
-//! - every value is finite; `jaw_m` is ≥ 0; `cut` is `0` or `1`;
+//! - every value is finite; `jaw_m` is ≥ 0; `cut` is `0` or `1`; every coordinate and `jaw_m`
+//!   is within ±`MAX_TOOL_COORDINATE_M` (1 km: in range of the kernel's f32 with room);
 //! - time never decreases from one line to the next, whatever the tool point: the file is one
 //!   time-ordered stream, as a device log is. Samples of different tool points may share a time,
 //!   and so may two samples of the same point: that is a jump (see [`Trajectory::positions_at`]);
@@ -66,7 +67,8 @@ use std::path::Path;
 
 use super::scene::MAX_TOOL_POINTS;
 use crate::limits::{
-    MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S, read_bounded,
+    MAX_TOOL_COORDINATE_M, MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S,
+    read_bounded,
 };
 
 /// The header line's fields, in order, of a file without the tool columns.
@@ -171,6 +173,16 @@ pub enum LineProblem {
         /// `t`, `x`, `y`, `z` or `jaw_m`.
         column: &'static str,
         /// The value read.
+        value: f64,
+    },
+    /// A finite coordinate or jaw opening beyond ±[`MAX_TOOL_COORDINATE_M`].
+    #[error(
+        "{column} = {value:e} m is out of range: a tool coordinate or jaw opening is within ±{MAX_TOOL_COORDINATE_M} m (MAX_TOOL_COORDINATE_M); give the trajectory in metres"
+    )]
+    CoordinateOutOfRange {
+        /// `x`, `y`, `z` or `jaw_m`.
+        column: &'static str,
+        /// The value read, m.
         value: f64,
     },
     /// A negative jaw opening.
@@ -351,6 +363,12 @@ impl<'a> Builder<'a> {
         }
         if sample.jaw_m.is_finite() && sample.jaw_m < 0.0 {
             self.soft(line, LineProblem::NegativeJaw(sample.jaw_m))?;
+        }
+        if let Some(&(column, value)) = values[1..]
+            .iter()
+            .find(|(_, v)| v.is_finite() && v.abs() > MAX_TOOL_COORDINATE_M)
+        {
+            self.soft(line, LineProblem::CoordinateOutOfRange { column, value })?;
         }
         if let Some((previous_line, previous_s)) = self.previous
             && sample.t_s < previous_s

@@ -27,7 +27,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use super::scene::exact;
 use super::trajectory::Trajectory;
+use crate::limits::MAX_ZONE_PATH_SEGMENTS;
 
 /// Default [`PartitionSpec::margin_rings`]: element rings around the zones, so that the
 /// pre-computed region sees only deformation within the linear model's range (about 10 % of the
@@ -161,10 +163,15 @@ impl Default for PartitionSpec {
 pub(crate) struct ZoneFile {
     kind: String,
     shape: String,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     min_m: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     max_m: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     center_m: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     a_m: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::three_opt")]
     b_m: Option<[f64; 3]>,
     radius_m: Option<f64>,
     trajectory: Option<PathBuf>,
@@ -320,9 +327,24 @@ fn zone(
                     e.to_string().replace('\n', "; "),
                 )
             })?;
+            let polylines = polylines(&read);
+            let segments: usize = polylines.iter().map(|l| l.len().saturating_sub(1)).sum();
+            if segments > MAX_ZONE_PATH_SEGMENTS {
+                return Err((
+                    key(&format!(
+                        "trajectory = {:?}",
+                        trajectory.display().to_string()
+                    )),
+                    format!(
+                        "{segments} segments once its collinear runs are merged, more than \
+                         {MAX_ZONE_PATH_SEGMENTS} (MAX_ZONE_PATH_SEGMENTS): resample it more \
+                         coarsely (a zone needs a sample every millimetre or so, not every tick)"
+                    ),
+                ));
+            }
             ZoneShape::Path {
                 trajectory,
-                polylines: polylines(&read),
+                polylines,
                 radius_m,
             }
         }
@@ -330,7 +352,10 @@ fn zone(
     Ok(Zone { kind, shape })
 }
 
-/// Per tool point, its samples' positions in file order without consecutive repeats.
+/// Per tool point, its samples' positions in file order without consecutive repeats, each run
+/// of samples on one straight segment (to [`COLLINEAR_TOLERANCE`] of the path's size) merged
+/// into that segment ([`merge_collinear`]): a trajectory sampled at 1 kHz along straight moves
+/// is a few segments, not thousands.
 fn polylines(trajectory: &Trajectory) -> Vec<Vec<[f64; 3]>> {
     let mut lines = vec![Vec::new(); trajectory.tool_count()];
     for s in trajectory.samples() {
@@ -340,5 +365,66 @@ fn polylines(trajectory: &Trajectory) -> Vec<Vec<[f64; 3]>> {
             line.push(s.position_m);
         }
     }
+    let (lo, hi) = lines.iter().flatten().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                [0, 1, 2].map(|i| lo[i].min(p[i])),
+                [0, 1, 2].map(|i| hi[i].max(p[i])),
+            )
+        },
+    );
+    let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
+    let tolerance_m = COLLINEAR_TOLERANCE * diagonal;
     lines
+        .into_iter()
+        .map(|line| merge_collinear(&line, tolerance_m))
+        .collect()
+}
+
+/// Relative distance, to the path's bounding-box diagonal, within which a sample counts as on
+/// the segment through its neighbours: 10⁻¹², a thousandth of the partition's own tolerance
+/// (10⁻⁹ of the mesh's diagonal) for a path the size of the mesh.
+pub const COLLINEAR_TOLERANCE: f64 = 1e-12;
+
+/// Most samples one merged segment spans ([`merge_collinear`]'s work is this many distance
+/// tests per sample at most).
+const MAX_MERGED_RUN: usize = 1024;
+
+/// `line` with every sample within `tolerance_m` of the segment from the last kept sample to a
+/// later one dropped (greedily, at most [`MAX_MERGED_RUN`] samples a segment): the union of
+/// capsules around it differs from the original's by at most `tolerance_m`.
+pub fn merge_collinear(line: &[[f64; 3]], tolerance_m: f64) -> Vec<[f64; 3]> {
+    let Some(&first) = line.first() else {
+        return Vec::new();
+    };
+    let near = |p: [f64; 3], a: [f64; 3], b: [f64; 3]| {
+        let d = [0, 1, 2].map(|i| b[i] - a[i]);
+        let q = [0, 1, 2].map(|i| p[i] - a[i]);
+        let len_sq: f64 = d.iter().map(|x| x * x).sum();
+        let t = if len_sq > 0.0 {
+            ((0..3).map(|i| q[i] * d[i]).sum::<f64>() / len_sq).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (0..3).map(|i| (q[i] - t * d[i]).powi(2)).sum::<f64>() <= tolerance_m * tolerance_m
+    };
+    let mut kept = vec![first];
+    let mut start = 0;
+    let mut end = 1;
+    while end < line.len() {
+        // Extend the segment from `start` to `end + 1` while every sample between stays on it.
+        let next = end + 1;
+        let extends = next < line.len()
+            && next - start <= MAX_MERGED_RUN
+            && (start + 1..next).all(|k| near(line[k], line[start], line[next]));
+        if extends {
+            end = next;
+        } else {
+            kept.push(line[end]);
+            start = end;
+            end += 1;
+        }
+    }
+    kept
 }

@@ -121,6 +121,15 @@ impl BuildOptions {
         }
     }
 
+    /// The tool radius a pre-computed table's candidate lists serve, m
+    /// ([`DEFAULT_LIST_TOOL_RADIUS_M`] for tensor-mass options).
+    pub fn list_tool_radius_m(&self) -> f64 {
+        match self.kind {
+            TableKindOptions::Precomputed { tool_radius_m, .. } => tool_radius_m,
+            TableKindOptions::TensorMass { .. } => DEFAULT_LIST_TOOL_RADIUS_M,
+        }
+    }
+
     /// The same options with candidate lists for tools of radius up to
     /// `tool_radius_m` (m); nothing changes for a tensor-mass table.
     pub fn with_tool_radius(self, tool_radius_m: f64) -> Self {
@@ -435,14 +444,10 @@ pub(crate) fn precomputed(
     )
     .with_context(|| format!("{}: computing the compliance table", report.source))?;
     let arrays_time = start.elapsed();
-    let tool_radius_m = match options.kind {
-        TableKindOptions::Precomputed { tool_radius_m, .. } => tool_radius_m,
-        TableKindOptions::TensorMass { .. } => DEFAULT_LIST_TOOL_RADIUS_M,
-    };
     let collision = collision_index(
         &mesh.positions,
         &surface.triangles,
-        tool_radius_m,
+        options.list_tool_radius_m(),
         options.precision,
     );
     let (tet_lame, vertex_slot) = (materials.lame(), ordering.slot_entries());

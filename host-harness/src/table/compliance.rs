@@ -167,6 +167,7 @@ pub fn compute_compliance(
             }
         }
         Solver::Cg => {
+            check_cg_work(s as u64, dof as u64, a.compute_nnz() as u64)?;
             let cg = JacobiCg::new(a.as_ref());
             let inv_diag = cg.inv_diag();
             ensure!(
@@ -196,4 +197,38 @@ pub fn compute_compliance(
     }
     bar.finish_and_clear();
     Ok(out)
+}
+
+/// Checks the estimated work of the CG compliance, `3S` solves of about `sqrt(dof)` iterations
+/// (Jacobi-preconditioned CG on an elastic stiffness converges in `O(h⁻¹)` iterations, at most
+/// `sqrt(dof)` for a 3-D mesh) of one product with `A` (`nnz` multiply-adds) each, against
+/// [`crate::limits::MAX_CG_MULTIPLY_ADDS`], before the first solve: refused above it with the
+/// figures, printed on stderr when longer than
+/// [`crate::limits::PRINT_ESTIMATE_ABOVE_S`].
+pub fn check_cg_work(touchable: u64, dof: u64, nnz: u64) -> anyhow::Result<()> {
+    use crate::limits::{MAX_CG_MULTIPLY_ADDS, PRINT_ESTIMATE_ABOVE_S, SECONDS_PER_MULTIPLY_ADD};
+    let iterations = (dof as f64).sqrt().ceil() as u64;
+    let work = touchable
+        .saturating_mul(3)
+        .saturating_mul(iterations)
+        .saturating_mul(nnz);
+    let seconds = work as f64 * SECONDS_PER_MULTIPLY_ADD;
+    let figures = format!(
+        "{} solves x about {iterations} iterations x {nnz} non-zeros = {:.3e} multiply-adds, \
+         about {seconds:.0} s",
+        3 * touchable,
+        work as f64
+    );
+    if work > MAX_CG_MULTIPLY_ADDS {
+        anyhow::bail!(
+            "compliance by CG: {figures}: above the limit of {:.0e} (MAX_CG_MULTIPLY_ADDS): \
+             refused before the first solve; use --solver cholesky (the default), or a coarser \
+             mesh",
+            MAX_CG_MULTIPLY_ADDS as f64
+        );
+    }
+    if seconds > PRINT_ESTIMATE_ABOVE_S {
+        eprintln!("compliance by CG: estimate: {figures}");
+    }
+    Ok(())
 }

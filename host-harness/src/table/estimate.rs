@@ -30,10 +30,10 @@
 //! [`SectionKind::expected_count`]: palpate_kernel::table::format::SectionKind::expected_count
 
 use bytemuck::Zeroable;
-use palpate_kernel::table::format::{RawHeader, TableKind};
+use palpate_kernel::table::format::{RawHeader, SectionKind, TableKind};
 
 use super::build::{BuildOptions, TableKindOptions};
-use super::collision::CELLS_PER_SURFACE_VERTEX;
+use super::collision::{CELLS_PER_SURFACE_VERTEX, collision_index};
 use super::file::{Precision, layout};
 use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
 use crate::mesh::{MeshReport, Surface, TetMesh};
@@ -150,6 +150,44 @@ impl TableEstimate {
         estimate
     }
 
+    /// The estimate of a table of `kind` in `precision` for `mesh` with `fixed` vertices and
+    /// boundary `surface` (no unreferenced vertex counted), a pre-computed table's collision
+    /// grid built (linear in the surface) so that its size is the file's exactly rather than
+    /// the grid's bound: what a hybrid build checks and `scene plan` reports.
+    pub fn of_surface(
+        kind: TableKind,
+        precision: Precision,
+        mesh: &TetMesh,
+        fixed: &[bool],
+        surface: &Surface,
+        tool_radius_m: f64,
+    ) -> Self {
+        let counts = TableCounts::of(mesh, &MeshReport::default(), fixed, surface);
+        let estimate = Self::new(kind, precision, counts);
+        if kind != TableKind::Precomputed {
+            return estimate;
+        }
+        let index = collision_index(
+            &mesh.positions,
+            &surface.triangles,
+            tool_radius_m,
+            precision,
+        );
+        let grid = GridCounts {
+            cells: index.cell_start.len() as u64 - 1,
+            list_starts: index.cell_triangle_start.len() as u64,
+            list_entries: index.cell_triangle.len() as u64,
+        };
+        let exact = layout_bytes(kind, precision, &counts, Some(&grid)).unwrap_or(u64::MAX);
+        // The peak holds the table twice (module doc): take the bound's excess off it.
+        let excess = estimate.table_bytes.saturating_sub(exact);
+        Self {
+            table_bytes: exact,
+            peak_bytes: estimate.peak_bytes.saturating_sub(excess.saturating_mul(2)),
+            ..estimate
+        }
+    }
+
     /// The estimate of a table of `kind` stored in `precision` for `counts`.
     pub fn new(kind: TableKind, precision: Precision, counts: TableCounts) -> Self {
         let c = counts;
@@ -262,10 +300,25 @@ fn precision_name(p: Precision) -> &'static str {
 /// the format's section counts. The grid's cell count is its bound. `u64::MAX` when a count
 /// does not fit the header's `u32` or the sum overflows.
 fn file_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> u64 {
-    layout_bytes(kind, precision, c).unwrap_or(u64::MAX)
+    layout_bytes(kind, precision, c, None).unwrap_or(u64::MAX)
 }
 
-fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Option<u64> {
+/// A built collision grid's counts, which replace their bounds in [`layout_bytes`].
+struct GridCounts {
+    /// Grid cells.
+    cells: u64,
+    /// Entries of `cell-triangle-start` (list cells + 1).
+    list_starts: u64,
+    /// Entries of `cell-triangle`.
+    list_entries: u64,
+}
+
+fn layout_bytes(
+    kind: TableKind,
+    precision: Precision,
+    c: &TableCounts,
+    grid: Option<&GridCounts>,
+) -> Option<u64> {
     let u32_of = |x: u64| u32::try_from(x).ok();
     let scalar_bytes = precision.scalar_bytes();
     let mut header = RawHeader {
@@ -279,11 +332,13 @@ fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Optio
             header.free_count = u32_of(c.free)?;
             header.touchable_count = u32_of(c.touchable)?;
             header.surface_vertex_count = u32_of(c.surface_vertices)?;
-            header.grid_cell_count = u32_of(
-                c.surface_vertices
+            header.grid_cell_count = u32_of(match grid {
+                Some(g) => g.cells,
+                None => c
+                    .surface_vertices
                     .max(1)
                     .checked_mul(CELLS_PER_SURFACE_VERTEX as u64)?,
-            )?;
+            })?;
         }
         TableKind::TensorMass => {
             // Every face once: each interior face is shared by two tets.
@@ -305,10 +360,13 @@ fn layout_bytes(kind: TableKind, precision: Precision, c: &TableCounts) -> Optio
     let sizes = kind
         .sections()
         .iter()
-        .map(|section| {
-            section
-                .expected_count(&header)?
-                .checked_mul(u64::from(section.elem_bytes(scalar_bytes)))
+        .map(|&section| {
+            let count = match (section, grid) {
+                (SectionKind::CellTriangleStart, Some(g)) => g.list_starts,
+                (SectionKind::CellTriangle, Some(g)) => g.list_entries,
+                _ => section.expected_count(&header)?,
+            };
+            count.checked_mul(u64::from(section.elem_bytes(scalar_bytes)))
         })
         .collect::<Option<Vec<u64>>>()?;
     layout(&sizes).map(|(_, file_len)| file_len)
@@ -342,12 +400,32 @@ impl SizeLimits {
     /// gives the estimate, the limit and what to do instead; otherwise prints the estimate if
     /// asked.
     pub fn check(&self, estimate: &TableEstimate, source: &str) -> anyhow::Result<()> {
+        let source = if source.is_empty() {
+            String::new()
+        } else {
+            format!("{source}: ")
+        };
+        let Some(reason) = self.refusal(estimate) else {
+            if self.print_estimate {
+                eprintln!("{source}estimate: {}", estimate.describe());
+            }
+            return Ok(());
+        };
+        anyhow::bail!(
+            "{source}{}; {reason}: refused before building; {}",
+            estimate.describe(),
+            instead(estimate.kind)
+        )
+    }
+
+    /// Why `estimate` is above a limit (the limit, for people), or `None` when it fits.
+    pub fn refusal(&self, estimate: &TableEstimate) -> Option<String> {
         let table = estimate.table_bytes;
         let over_max = self.max_table_bytes.filter(|&max| table > max);
         let short_of = self
             .available_bytes
             .filter(|&available| estimate.peak_bytes > available);
-        let reason = if table > MAX_TABLE_FILE_BYTES {
+        if table > MAX_TABLE_FILE_BYTES {
             Some(format!(
                 "the table is above the largest table file, {} (MAX_TABLE_FILE_BYTES)",
                 human_bytes(MAX_TABLE_FILE_BYTES)
@@ -361,30 +439,19 @@ impl SizeLimits {
                     human_bytes(available)
                 )
             })
-        };
-        let source = if source.is_empty() {
-            String::new()
-        } else {
-            format!("{source}: ")
-        };
-        let Some(reason) = reason else {
-            if self.print_estimate {
-                eprintln!("{source}estimate: {}", estimate.describe());
-            }
-            return Ok(());
-        };
-        let instead = match estimate.kind {
-            TableKind::Precomputed => {
-                "use the tensor-mass model (tables build --kind tensor-mass, or [model] kind = \"dynamic\" in a scene), a coarser mesh, or fix more of the surface (fewer touchable vertices)"
-            }
-            TableKind::TensorMass => "use a coarser mesh",
-            TableKind::Interface => {
-                "make the dynamic zones smaller or simpler (fewer connection nodes), or use a coarser mesh"
-            }
-        };
-        anyhow::bail!(
-            "{source}{}; {reason}: refused before building; {instead}",
-            estimate.describe()
-        )
+        }
+    }
+}
+
+/// What to do instead of a table of `kind` refused for its size.
+pub fn instead(kind: TableKind) -> &'static str {
+    match kind {
+        TableKind::Precomputed => {
+            "use the tensor-mass model (tables build --kind tensor-mass, or [model] kind = \"dynamic\" in a scene), a coarser mesh, or fix more of the surface (fewer touchable vertices)"
+        }
+        TableKind::TensorMass => "use a coarser mesh",
+        TableKind::Interface => {
+            "make the dynamic zones smaller or simpler (fewer connection nodes), or use a coarser mesh"
+        }
     }
 }

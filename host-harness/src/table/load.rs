@@ -117,16 +117,37 @@ impl TableFile {
     }
 
     /// Reads a table for a report (`tables info`), which shows what is wrong
-    /// with a damaged table: a regular file of at most
-    /// [`MAX_TABLE_FILE_BYTES`] is read whole whatever its header says;
-    /// anything else goes through [`TableFile::read`] (refused unless its
-    /// header is right).
+    /// with a damaged table, its header first: a regular file whose header is
+    /// not a table's (or that is shorter than one) is reported from those
+    /// bytes alone, never read further; one whose header declares at most
+    /// [`MAX_TABLE_FILE_BYTES`] and no fewer bytes than the file has (a
+    /// truncated table) is read whole; anything else goes through
+    /// [`TableFile::read`] (refused unless its header is right, with the
+    /// figures).
     pub fn read_for_report(path: &Path) -> anyhow::Result<Self> {
-        let small_file = std::fs::metadata(path)
-            .is_ok_and(|meta| meta.is_file() && meta.len() <= MAX_TABLE_FILE_BYTES);
-        if !small_file {
+        let Some(real) = std::fs::metadata(path)
+            .ok()
+            .filter(|meta| meta.is_file() && meta.len() <= MAX_TABLE_FILE_BYTES)
+            .map(|meta| meta.len())
+        else {
+            return Self::read(path);
+        };
+        let name = path.display();
+        let mut file = File::open(path).with_context(|| format!("{name}: cannot read"))?;
+        let mut head = [0u8; HEADER_LEN];
+        let got =
+            read_up_to(&mut file, &mut head).with_context(|| format!("{name}: cannot read"))?;
+        if got < HEADER_LEN {
+            return Ok(Self::from_bytes(&head[..got]));
+        }
+        let h: RawHeader = bytemuck::pod_read_unaligned(&head);
+        if h.check_identity().is_err() {
+            return Ok(Self::from_bytes(&head));
+        }
+        if h.file_len > MAX_TABLE_FILE_BYTES || real > h.file_len {
             return Self::read(path);
         }
+        drop(file);
         let bytes = read_bounded(
             path,
             MAX_TABLE_FILE_BYTES,

@@ -74,13 +74,24 @@ pub fn forces_and_energy(
 }
 
 /// Reads deformed positions: one line `x,y,z` (m) per mesh vertex, input
-/// order, no header. Errors name the file and the line.
-pub fn read_positions_csv(path: &std::path::Path) -> anyhow::Result<Vec<[f64; 3]>> {
+/// order, no header, for a mesh of `vertices` vertices. The read is bounded
+/// by [`positions_file_bytes`] of them before anything is parsed (a device
+/// such as `/dev/zero` is read no further). Errors name the file and the
+/// line.
+pub fn read_positions_csv(
+    path: &std::path::Path,
+    vertices: usize,
+) -> anyhow::Result<Vec<[f64; 3]>> {
+    let bytes = crate::limits::read_bounded(
+        path,
+        positions_file_bytes(vertices),
+        "a positions file of this mesh (MAX_POSITION_LINE_BYTES per vertex)",
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .trim(csv::Trim::All)
-        .from_path(path)
-        .with_context(|| path.display().to_string())?;
+        .from_reader(bytes.as_slice());
     let mut positions = Vec::new();
     for (index, record) in reader.deserialize::<[f64; 3]>().enumerate() {
         let line = index + 1;
@@ -94,4 +105,14 @@ pub fn read_positions_csv(path: &std::path::Path) -> anyhow::Result<Vec<[f64; 3]
         positions.push(p);
     }
     Ok(positions)
+}
+
+/// The largest positions file of a mesh of `vertices` vertices, bytes:
+/// [`MAX_POSITION_LINE_BYTES`](crate::limits::MAX_POSITION_LINE_BYTES) per
+/// vertex, within [`MAX_MESH_FILE_BYTES`](crate::limits::MAX_MESH_FILE_BYTES).
+pub fn positions_file_bytes(vertices: usize) -> u64 {
+    (vertices as u64)
+        .saturating_add(1)
+        .saturating_mul(crate::limits::MAX_POSITION_LINE_BYTES)
+        .min(crate::limits::MAX_MESH_FILE_BYTES)
 }

@@ -80,6 +80,7 @@ pub fn run_with(
     options: &RunOptions,
     dispatch: impl Dispatch,
 ) -> anyhow::Result<RunOutput> {
+    check_run_steps(mesh, options)?;
     let table = BuildOptions {
         precision: options.precision,
         ..options.table.clone()
@@ -141,6 +142,17 @@ fn run_in<T: Real>(
 /// An f64 triple in `T` (rounded to nearest for f32).
 fn vector<T: Real>(v: [f64; 3]) -> Vector3<T> {
     Vector3::from(v.map(T::of_f64))
+}
+
+/// Checks `options.steps` on `mesh` against the offline runs' work limit
+/// ([`crate::limits::check_tet_steps`]) before anything is built.
+pub fn check_run_steps(mesh: &TetMesh, options: &RunOptions) -> anyhow::Result<()> {
+    crate::limits::check_tet_steps(
+        "dynamic run",
+        mesh.tets.len() as u64,
+        u64::try_from(options.steps).unwrap_or(u64::MAX),
+        "give fewer --steps or use a coarser mesh",
+    )
 }
 
 /// Steps `steps` times with `step`, which steps and, on success, writes

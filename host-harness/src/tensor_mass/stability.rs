@@ -23,6 +23,14 @@ pub const ENERGY_GROWTH_LIMIT: f64 = 1e6;
 /// Bisection halvings of the bracket (relative width 2⁻³⁰ of the start).
 pub const BISECTIONS: usize = 30;
 
+/// Most iterations of the power iteration of [`omega_max`] (each one force pass).
+pub const POWER_ITERATIONS: usize = 500;
+
+/// Steps (force passes) of one critical-step measurement at most: the power iteration's and
+/// [`BISECTIONS`] trials of [`TRIAL_STEPS`] steps (checked against
+/// [`crate::limits::MAX_RUN_TET_STEPS`] before it starts).
+pub const CRITICAL_DT_STEPS: u64 = (POWER_ITERATIONS + BISECTIONS * TRIAL_STEPS) as u64;
+
 /// The JSON object `dynamic critical-dt --json` prints.
 #[derive(Serialize, Debug)]
 pub struct CriticalDt {
@@ -172,7 +180,7 @@ pub fn omega_max(model: &mut TensorMassModel<'_, '_, f64>) -> f64 {
     let mut f = vec![[0.0; 3]; n];
     let at_rest = forces_at_rest(model);
     let mut lambda = 0.0;
-    for _ in 0..500 {
+    for _ in 0..POWER_ITERATIONS {
         rest_tangent_forces(model, &at_rest, &mut x, &mut f);
         let mut norm = 0.0;
         for v in 0..n {
@@ -238,6 +246,7 @@ pub fn critical_dt_of_mesh(
     damping_per_s: f64,
     integrator: Integrator,
 ) -> anyhow::Result<CriticalDt> {
+    check_critical_dt_work(mesh.tets.len(), 1)?;
     with_moving_model(mesh, report, options, damping_per_s, |model| {
         let young_pa = options.material.young_pa;
         // Checked before the bisection, which would run its every trial on
@@ -257,6 +266,19 @@ pub fn critical_dt_of_mesh(
         }
         Ok(result)
     })
+}
+
+/// Checks `measurements` critical-step measurements on `tets` tets
+/// ([`CRITICAL_DT_STEPS`] steps each) against the offline runs' work limit
+/// before anything is built.
+pub fn check_critical_dt_work(tets: usize, measurements: u64) -> anyhow::Result<()> {
+    crate::limits::check_tet_steps(
+        "dynamic critical-dt",
+        tets as u64,
+        CRITICAL_DT_STEPS.saturating_mul(measurements),
+        "use a coarser mesh (the bisection's steps are fixed); a dynamic scene's session checks \
+         its dt_s against the Lanczos estimate of the stable step, linear in the mesh",
+    )
 }
 
 /// Builds the f64 model of `mesh` (the tensor-mass table `options`,
@@ -368,13 +390,26 @@ pub fn stable_step_limit(
         bail!("the damping must be finite and >= 0 1/s, got {damping_per_s}");
     }
     with_moving_model(mesh, report, options, damping_per_s, |model| {
-        let omega = checked_omega(lanczos_omega_max(model), options.material.young_pa)?;
-        let (limit_dt_s, rule) = integrator_limit(integrator, omega, damping_per_s);
-        Ok(StableStep {
-            omega_max: omega,
-            limit_dt_s,
-            rule,
-        })
+        stable_step_of_model(model, options.material.young_pa, damping_per_s, integrator)
+    })
+}
+
+/// The largest stable step of `integrator` with damping `damping_per_s` (1/s) on `model` (f64,
+/// at rest): `ω_max` by Lanczos, checked finite and positive (an error naming E `young_pa`,
+/// Pa, otherwise), and the integrator's condition. The one computation of [`stable_step_limit`]
+/// (a scene's check) and of `scene plan`'s tensor-mass regions.
+pub fn stable_step_of_model(
+    model: &mut TensorMassModel<'_, '_, f64>,
+    young_pa: f64,
+    damping_per_s: f64,
+    integrator: Integrator,
+) -> anyhow::Result<StableStep> {
+    let omega = checked_omega(lanczos_omega_max(model), young_pa)?;
+    let (limit_dt_s, rule) = integrator_limit(integrator, omega, damping_per_s);
+    Ok(StableStep {
+        omega_max: omega,
+        limit_dt_s,
+        rule,
     })
 }
 

@@ -11,22 +11,30 @@ use core::time::Duration;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use palpate::chart::{GivenMesh, Matrix};
 use palpate::fem::material::Material;
 use palpate::fix::{FixPredicate, fixed_vertices};
+use palpate::hybrid::estimate::{HybridEstimate, PrecomputedRegion};
+use palpate::hybrid::{HybridOptions, RegionSplit, build_hybrid, check_hybrid};
 use palpate::limits::{
     MAX_HAPTIC_HZ, MAX_MESH_FILE_BYTES, MAX_SESSION_TICKS, MAX_TABLE_FILE_BYTES,
     MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S, parse_mem_available, read_bounded,
 };
+use palpate::limits::{MAX_POSITION_LINE_BYTES, MAX_RUN_TET_STEPS, MAX_ZONE_PATH_SEGMENTS};
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
 use palpate::session::run::{check_scene_table, run_session, tick_count};
+use palpate::session::zones::merge_collinear;
 use palpate::session::{MeshSource, Scene, Trajectory};
 use palpate::table::build::{BuildOptions, build_with_limits};
-use palpate::table::compliance::Solver;
+use palpate::table::compliance::{Solver, check_cg_work};
 use palpate::table::estimate::{SizeLimits, TableEstimate};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
+use palpate::tensor_mass::evaluate::{positions_file_bytes, read_positions_csv};
+use palpate::tensor_mass::stability::{CRITICAL_DT_STEPS, critical_dt_of_mesh};
 use palpate_kernel::table::format::{HEADER_LEN, RawHeader};
+use palpate_kernel::tensor_mass::Integrator;
 
 /// An empty folder of its own for test `name`.
 fn fresh_dir(name: &str) -> PathBuf {
@@ -484,4 +492,223 @@ fn oversized_tables_are_refused_before_building() {
     };
     let built = build_with_limits(&mesh, &report, &options, &limits).expect("at the limits");
     assert!(built.bytes.len() as u64 <= estimate.table_bytes);
+}
+
+/// The tets of `mesh` whose centroid lies in the box `[lo, hi]` (m).
+fn tets_in(mesh: &TetMesh, lo: [f64; 3], hi: [f64; 3]) -> Vec<bool> {
+    (0..mesh.tets.len())
+        .map(|t| {
+            let c = mesh.tet_centroid(t);
+            (0..3).all(|i| c[i] > lo[i] && c[i] < hi[i])
+        })
+        .collect()
+}
+
+/// A 40³-cell box (68 921 vertices) with one 1-cm cell dynamic aborted
+/// `session run`, `scene tables`, `dynamic run --scene` and `critical-dt
+/// --scene` on a 32 GB allocation: the hybrid build skipped the size
+/// estimate `tables build` makes. Now every table of the hybrid is estimated
+/// first and the build is refused before any array is computed, naming the
+/// table and the limit. The estimate's block count is the hand count: the
+/// box's 7 921 free surface vertices less the 7 of the dynamic cell on the
+/// surface (fixed as connection nodes or outside the region), against its
+/// 67 240 free vertices less the cell's 8.
+#[test]
+fn a_hybrid_too_large_is_refused_before_building() {
+    let mesh = box_mesh([40, 40, 40], [0.4; 3]);
+    let report = MeshReport {
+        source: "box40".into(),
+        ..MeshReport::default()
+    };
+    let dynamic = tets_in(&mesh, [0.0, 0.0, 0.39], [0.01, 0.01, 0.4]);
+    assert_eq!(dynamic.iter().filter(|&&d| d).count(), 6);
+    let options = HybridOptions::new(
+        Material::new(3000.0, 0.45).expect("material"),
+        1000.0,
+        vec!["z<0.001".parse().expect("predicate")],
+        Precision::F32,
+    );
+    let err = match build_hybrid(&mesh, &report, &dynamic, &options) {
+        Ok(_) => panic!("a 18 GB pre-computed table was built"),
+        Err(e) => e.to_string(),
+    };
+    for needle in [
+        "box40: ",
+        "pre-computed region",
+        "MAX_TABLE_FILE_BYTES",
+        "refused before building",
+        "coarser mesh",
+    ] {
+        assert!(err.contains(needle), "{needle:?} not in {err}");
+    }
+    let err_check = check_hybrid(&mesh, &report, &dynamic, &options)
+        .expect_err("the check refuses it too")
+        .to_string();
+    assert_eq!(err_check, err);
+    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 0.001).collect();
+    let split = RegionSplit::new(&mesh, &fixed, &dynamic).expect("split");
+    let region = PrecomputedRegion::of(&mesh, &split, &fixed);
+    let estimate = HybridEstimate::of(&mesh, &split, &fixed, &region, 0.002, Precision::F32);
+    let (s, f) = (7921u64 - 7, 67_240u64 - 8);
+    assert_eq!(estimate.precomputed.counts.touchable, s);
+    assert_eq!(estimate.precomputed.counts.free, f);
+    assert_eq!(estimate.precomputed.blocks, s * (s + 1) / 2 + (f - s) * s);
+    assert!(estimate.precomputed.table_bytes > MAX_TABLE_FILE_BYTES);
+    assert_eq!(estimate.interface.counts.connections, 7);
+}
+
+/// `dynamic critical-dt` on that box ran past two minutes with nothing
+/// printed, and `dynamic run --steps 18446744073709551615` was accepted: the
+/// work (tets × steps) is checked against `MAX_RUN_TET_STEPS` before the
+/// table is built.
+#[test]
+fn critical_dt_and_run_beyond_the_work_limit_are_refused_before_building() {
+    let mesh = box_mesh([40, 40, 40], [0.4; 3]);
+    let report = MeshReport::default();
+    let options = BuildOptions::tensor_mass(
+        Material::new(3000.0, 0.45).expect("material"),
+        1000.0,
+        vec!["z<0.001".parse().expect("predicate")],
+        Precision::F64,
+    );
+    let err = critical_dt_of_mesh(&mesh, &report, &options, 0.0, Integrator::SymplecticEuler)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("dynamic critical-dt: 384000 tets x 60500 steps"),
+        "{err}"
+    );
+    assert!(err.contains("MAX_RUN_TET_STEPS"), "{err}");
+    // 384 000 tets × 60 500 steps = 2.3e10, above the 5e9 of the limit.
+    assert_eq!(CRITICAL_DT_STEPS, 60_500);
+    let limit = format!("the limit of {:.0e} tet-steps", MAX_RUN_TET_STEPS as f64);
+    assert!(err.contains(&limit), "{err}");
+    let err = palpate::limits::check_tet_steps("dynamic run", 6, u64::MAX, "fewer")
+        .expect_err("refused")
+        .to_string();
+    assert!(err.contains("MAX_RUN_TET_STEPS"), "{err}");
+    palpate::limits::check_tet_steps("dynamic run", 6, 1000, "fewer").expect("small run");
+}
+
+/// `stvk forces --deformed /dev/zero` grew to 23 GB: a positions file is
+/// read up to `MAX_POSITION_LINE_BYTES` per vertex of its mesh.
+#[test]
+fn a_positions_file_is_read_bounded_by_its_mesh() {
+    let err = read_positions_csv(Path::new("/dev/zero"), 100)
+        .expect_err("refused")
+        .to_string();
+    assert!(err.contains("MAX_POSITION_LINE_BYTES"), "{err}");
+    assert_eq!(positions_file_bytes(100), 101 * MAX_POSITION_LINE_BYTES);
+}
+
+/// `tables info` read a 1 GiB file of garbage whole before checking its
+/// header (12 s, 2 GB). The header is read first: a file whose header is
+/// not a table's is reported from its header alone.
+#[test]
+fn tables_info_reads_the_header_first() {
+    let dir = fresh_dir("info-header");
+    let path = dir.join("garbage.tbl");
+    let file = std::fs::File::create(&path).expect("file");
+    file.set_len(1 << 30).expect("sparse 1 GiB");
+    drop(file);
+    let read = TableFile::read_for_report(&path).expect("reported");
+    assert_eq!(read.bytes().len(), HEADER_LEN);
+    let report = read.info("garbage.tbl").expect_err("not a table");
+    assert!(!report.is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A `path` zone tested every tet near every segment: a trajectory sampled at
+/// 1 kHz along a straight cut is thousands of segments. Samples on one
+/// straight segment are merged into it; a path that stays above
+/// `MAX_ZONE_PATH_SEGMENTS` is refused when the scene is read, naming the
+/// zone.
+#[test]
+fn path_zones_are_merged_and_bounded() {
+    // 7 201 samples 10 µm apart on a line: one merged segment per 1 024 samples at most.
+    let line: Vec<[f64; 3]> = (0..7201)
+        .map(|k| [0.03 + 1e-5 * k as f64, 0.06, 0.056])
+        .collect();
+    let merged = merge_collinear(&line, 1e-12 * 0.072);
+    assert!(merged.len() <= 9, "{}", merged.len());
+    assert_eq!(merged.first(), line.first());
+    assert_eq!(merged.last(), line.last());
+    // A zigzag keeps every corner.
+    let zigzag: Vec<[f64; 3]> = (0..50)
+        .map(|k| [1e-3 * k as f64, 1e-3 * (k % 2) as f64, 0.0])
+        .collect();
+    assert_eq!(merge_collinear(&zigzag, 1e-15), zigzag);
+
+    let dir = fresh_dir("long-path");
+    let mut csv = String::from("t,tool,x,y,z\n");
+    for k in 0..=MAX_ZONE_PATH_SEGMENTS + 1 {
+        let y = if k % 2 == 0 { 0.01 } else { 0.02 };
+        csv.push_str(&format!(
+            "{},0,{},{y},0.05\n",
+            k as f64 * 1e-3,
+            1e-5 * k as f64
+        ));
+    }
+    std::fs::write(dir.join("log.csv"), csv).expect("trajectory");
+    let scene = format!(
+        "{GENERATED}[model]\nkind = \"dynamic\"\ndamping_per_s = 0\n[[zone]]\nkind = \"cut\"\nshape = \"path\"\n\
+         trajectory = \"log.csv\"\nradius_m = 0.02\n"
+    );
+    let err = Scene::from_toml_str(&scene, &dir)
+        .expect_err("refused")
+        .to_string();
+    assert!(err.contains("MAX_ZONE_PATH_SEGMENTS"), "{err}");
+    assert!(err.contains("[[zone]] 1"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `palpate chart` failed late: an unwritable `--out` after the whole study,
+/// a mesh too small for the hybrid at step 88 of 212. Both are checked
+/// before the study starts.
+#[test]
+fn chart_preflight_refuses_before_the_study() {
+    let given = GivenMesh {
+        label: "one-cell".into(),
+        mesh: box_mesh([1, 1, 1], [0.01; 3]),
+        report: MeshReport::default(),
+        fix: vec!["z<0.001".parse().expect("predicate")],
+        load_on: Vec::new(),
+        material: Material::new(3000.0, 0.45).expect("material"),
+    };
+    let dir = fresh_dir("chart-preflight");
+    let bodies = Matrix::quick().on(given).bodies().expect("bodies");
+    let err = palpate::chart::preflight(&bodies, &dir.join("out"))
+        .expect_err("no hybrid")
+        .to_string();
+    assert!(err.contains("mesh one-cell: no hybrid model"), "{err}");
+    let file = dir.join("file.txt");
+    std::fs::write(&file, "keep").expect("file");
+    let err = palpate::chart::preflight(&[], &file.join("out"))
+        .expect_err("not a folder")
+        .to_string();
+    assert!(err.contains("is not a folder"), "{err}");
+    palpate::chart::preflight(&[], &dir.join("new").join("out")).expect("writable");
+    assert!(!dir.join("new").exists(), "the check creates nothing");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `tables build --solver cg` on the 40³ box ran past two minutes with
+/// nothing printed. CG's work (`3S` solves of about `sqrt(dof)` products
+/// with `A`) is estimated before its first solve and refused above
+/// `MAX_CG_MULTIPLY_ADDS`: a 20³ box (a 0.5 GB table the size limits
+/// accept) is 1.7·10¹² multiply-adds.
+#[test]
+fn compliance_by_cg_beyond_its_work_limit_is_refused() {
+    let mesh = box_mesh([20, 20, 20], [0.2; 3]);
+    let options = BuildOptions::precomputed(
+        Material::new(3000.0, 0.45).expect("material"),
+        vec!["z<0.001".parse().expect("predicate")],
+        Solver::Cg,
+        Precision::F32,
+    );
+    let err = build_with_limits(&mesh, &MeshReport::default(), &options, &UNLIMITED)
+        .expect_err("refused");
+    let err = format!("{err:#}");
+    assert!(err.contains("MAX_CG_MULTIPLY_ADDS"), "{err}");
+    check_cg_work(100, 600, 30_000).expect("a small mesh");
 }

@@ -7,10 +7,16 @@
 use std::path::Path;
 
 use nalgebra::Vector3;
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
+use palpate::limits::MAX_TOOL_COORDINATE_M;
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshFormat, MeshReport, TetMesh, read_mesh, read_mesh_bytes};
+use palpate::partition::cost::{CostOptions, costs};
+use palpate::partition::geometry::TetGrid;
+use palpate::partition::{Partition, PlanInput, PlanReport, plan};
 use palpate::session::Scene;
+use palpate::session::model::hybrid_tables;
+use palpate::session::{Trajectory, Zone, ZoneKind, ZoneShape};
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::compliance::Solver;
 use palpate::table::file::Precision;
@@ -248,4 +254,190 @@ fn an_msh_node_id_of_zero_is_named_as_written() {
         "{msg}"
     );
     assert!(!msg.contains("-1"), "{msg}");
+}
+
+/// `scene plan` printed a pre-computed table 1.46× the size of the one the
+/// session builds on the built-in hybrid (its grid's bound, another vertex
+/// numbering), and tables a session refuses with exit 0. Plan's figures are
+/// now the hybrid build's own estimate, with the collision grid built:
+/// equal to the built tables' sizes (to the byte: the layout is the
+/// writer's, from the same counts), and nothing refused here.
+#[test]
+fn plan_table_bytes_are_the_built_tables_sizes() {
+    let scene = Scene::built_in_hybrid();
+    let (mesh, report) = scene.load_mesh().expect("mesh");
+    let partition = Partition::of_scene(&scene, &mesh, &report).expect("partition");
+    let plan = PlanReport::new(&scene, &mesh, &report, &partition).expect("plan");
+    let built = hybrid_tables(&scene, &mesh, &report, &partition, Precision::F32).expect("tables");
+    assert_eq!(plan.regions[0].model, "precomputed");
+    assert_eq!(
+        plan.regions[0].table_bytes,
+        built.precomputed.bytes().len() as u64
+    );
+    assert_eq!(
+        plan.interface.table_bytes,
+        built.interface.bytes().len() as u64
+    );
+    assert!(plan.regions.iter().all(|r| r.refused.is_none()));
+    assert!(plan.interface.refused.is_none());
+}
+
+/// `scene plan` costed every region with the scene's `[material]` alone: a
+/// region 10⁴ times stiffer still showed its soft critical step. The costs
+/// take the materials per tet: the dynamic region's step scales as
+/// `1/sqrt(E)` (ω² = k/m, the mass unchanged), a factor of 100 to the
+/// Lanczos tolerance (1e-10 on ω², so 1e-6 here).
+#[test]
+fn plan_costs_take_the_materials_per_tet() {
+    let mesh = box_mesh([4, 4, 4], [0.04; 3]);
+    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 1e-9).collect();
+    let zones = [Zone {
+        kind: ZoneKind::Cut,
+        shape: ZoneShape::Box {
+            min_m: [0.0, 0.0, 0.02],
+            max_m: [0.02, 0.02, 0.04],
+        },
+    }];
+    let partition = plan(&PlanInput {
+        mesh: &mesh,
+        fixed: &fixed,
+        zones: &zones,
+        margin_rings: 0,
+        poisson: 0.3,
+        scene: "scene.toml",
+        mesh_name: "block",
+    })
+    .expect("partition");
+    let soft = Material::new(3000.0, 0.3).expect("material");
+    let stiff = Material::new(3e7, 0.3).expect("material");
+    let options = |materials| CostOptions {
+        materials,
+        tool_radius_m: 0.002,
+        density_kg_m3: 1000.0,
+        integrator: Integrator::SymplecticEuler,
+        damping_per_s: 0.0,
+        incompressibility_n: None,
+    };
+    let dt = |materials| {
+        let (regions, _, _) = costs(&mesh, &fixed, &partition, &options(materials)).expect("costs");
+        regions[1].critical_dt_s.expect("a dynamic region")
+    };
+    let uniform = dt(TetMaterials::uniform(soft, mesh.tets.len()));
+    let regions: Vec<u32> = partition.dynamic.iter().map(|&d| u32::from(d)).collect();
+    let stiffer = dt(TetMaterials::from_regions(soft, &regions, &[(1, stiff)]));
+    assert!(
+        ((uniform / stiffer) / 100.0 - 1.0).abs() < 1e-6,
+        "{uniform} {stiffer}"
+    );
+}
+
+/// A trajectory position of 1e39 m (beyond f32) passed the checks and
+/// faulted 7 101 of 7 201 ticks with exit 0. Coordinates and jaw openings
+/// are within ±1 km (`MAX_TOOL_COORDINATE_M`), checked at parse, naming the
+/// line.
+#[test]
+fn trajectory_values_beyond_the_coordinate_bound_name_the_line() {
+    let err = Trajectory::from_csv_str("t,tool,x,y,z\n0,0,0,0,0\n1,0,1e39,0,0\n", "t.csv", 1)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.starts_with("t.csv: line 3: x = 1e39 m is out of range"),
+        "{err}"
+    );
+    assert!(err.contains("MAX_TOOL_COORDINATE_M"), "{err}");
+    let err = Trajectory::from_csv_str("t,tool,x,y,z,jaw_m,cut\n0,0,0,0,0,1e39,0\n", "t.csv", 1)
+        .expect_err("refused")
+        .to_string();
+    assert!(err.starts_with("t.csv: line 2: jaw_m = 1e39 m"), "{err}");
+    Trajectory::from_csv_str(
+        &format!("t,tool,x,y,z\n0,0,{MAX_TOOL_COORDINATE_M},0,-1000\n"),
+        "t.csv",
+        1,
+    )
+    .expect("1 km is in range");
+}
+
+/// `min_m = [0, 0, 0, 0]` was read as its first three numbers. An array of
+/// the wrong length is refused, the parser's message showing its key.
+#[test]
+fn scene_arrays_of_the_wrong_length_are_refused() {
+    let base = "fix = [\"z<0.001\"]\n[generated]\nbox_m = [0.1, 0.1, 0.05]\ncells = [2, 2, 1]\n\
+                [material]\nyoung_pa = 3000.0\npoisson = 0.45\n";
+    for (extra, key) in [
+        (
+            "[model]\nkind = \"dynamic\"\n[[zone]]\nkind = \"cut\"\nshape = \"box\"\n\
+             min_m = [0, 0, 0, 0]\nmax_m = [0.01, 0.01, 0.01]\n",
+            "min_m",
+        ),
+        ("[tool]\nblade_m = [0, 0, -0.01, 5]\n", "blade_m"),
+        ("[tool]\njaw_axis = [1, 0]\n", "jaw_axis"),
+    ] {
+        let err = Scene::from_toml_str_named(&format!("{base}{extra}"), "s.toml", Path::new("."))
+            .expect_err(extra)
+            .to_string();
+        assert!(err.contains(key) && err.contains("exactly 3"), "{err}");
+    }
+    let err = Scene::from_toml_str_named(
+        &base.replace("[2, 2, 1]", "[2, 2, 1, 9]"),
+        "s.toml",
+        Path::new("."),
+    )
+    .expect_err("cells")
+    .to_string();
+    assert!(err.contains("cells") && err.contains("exactly 3"), "{err}");
+}
+
+/// `[tool] radius_m = 1.0` on a 12-cm block was accepted and faulted every
+/// tick. A radius above half the mesh's largest extent is refused, naming
+/// the key.
+#[test]
+fn a_tool_wider_than_the_body_is_refused() {
+    let text = |radius: f64| {
+        format!(
+            "fix = [\"z<0.001\"]\n[generated]\nbox_m = [0.04, 0.12, 0.06]\ncells = [2, 4, 2]\n\
+             [material]\nyoung_pa = 3000.0\npoisson = 0.45\n[tool]\nradius_m = {radius}\n"
+        )
+    };
+    let scene = Scene::from_toml_str_named(&text(1.0), "s.toml", Path::new(".")).expect("scene");
+    let (mesh, _) = scene.load_mesh().expect("mesh");
+    let err = scene.check_on_mesh(&mesh).expect_err("refused").to_string();
+    assert!(
+        err.starts_with("s.toml: [tool] radius_m = 1: above 0.5 of the mesh's largest extent"),
+        "{err}"
+    );
+    assert!(err.contains("MAX_TOOL_RADIUS_FRACTION"), "{err}");
+    let scene = Scene::from_toml_str_named(&text(0.06), "s.toml", Path::new(".")).expect("scene");
+    scene.check_on_mesh(&mesh).expect("half the block's length");
+}
+
+/// A capsule zone from −10¹² to 10¹² m took other tets than the same line
+/// from −10 to 10 m (the search along a 2·10¹² m segment resolved metres).
+/// The segment is clipped to the mesh's box first: the same tets, on an
+/// axis and on a diagonal whose endpoints are exact in f64.
+#[test]
+fn a_capsule_with_far_endpoints_takes_the_same_tets() {
+    let mesh = box_mesh([4, 4, 4], [0.04; 3]);
+    let grid = TetGrid::new(&mesh);
+    let taken = |a: [f64; 3], b: [f64; 3]| {
+        let mut flags = vec![false; mesh.tets.len()];
+        let n = grid.select(
+            &ZoneShape::Capsule {
+                a_m: a,
+                b_m: b,
+                radius_m: 0.006,
+            },
+            &mut flags,
+        );
+        assert!(n > 0);
+        flags
+    };
+    let c = [0.015625, 0.0234375, 0.03125];
+    for d in [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0]] {
+        let at = |s: f64| [0, 1, 2].map(|i| c[i] + s * d[i]);
+        assert_eq!(
+            taken(at(-1e12), at(1e12)),
+            taken(at(-10.0), at(10.0)),
+            "{d:?}"
+        );
+    }
 }
