@@ -1,5 +1,5 @@
 //! Offline tables (the host side of `palpate_kernel::table`): the one build
-//! pipeline for both kinds ([`build`]), the compliance
+//! pipeline for both kinds ([`build`], taking [`options`]), the compliance
 //! computation of the pre-computed model (Cotin RR-3510 §4; [`compliance`],
 //! [`cg`]), the tensor-mass arrays (RR-3510 §5; [`tensor_mass`]), the
 //! collision index ([`collision`]), the compressed compliance ([`compress`]:
@@ -16,5 +16,6 @@ pub mod compress;
 pub mod estimate;
 pub mod file;
 pub mod load;
+pub mod options;
 pub mod precision;
 pub mod tensor_mass;
