@@ -34,6 +34,7 @@
 pub mod plot;
 pub mod report;
 pub mod select;
+pub mod series;
 pub mod stability;
 pub mod svg_text;
 pub mod ticks;
