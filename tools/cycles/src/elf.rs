@@ -4,8 +4,9 @@
 use object::read::elf::ElfFile32;
 use object::{Object, ObjectSegment, ObjectSymbol, SymbolKind};
 
-use crate::emulate::CODE_REGION_END;
-
+/// Where the code region (flash) ends: loads below are charged the wait
+/// states.
+pub const CODE_REGION_END: u64 = 0x2000_0000;
 /// Where RAM starts (the Cortex-M SRAM region).
 const RAM_START: u64 = 0x2000_0000;
 /// Granule of the mapped regions (Unicorn maps whole pages).

@@ -32,12 +32,9 @@ use unicorn_engine::{
     Arch, ArmCpuModel, HookType, MemType, Mode, Prot, RegisterARM, Unicorn, uc_error,
 };
 
-use crate::elf::Program;
+use crate::elf::{CODE_REGION_END, Program};
 use crate::timing::{Class, Costs, time};
 
-/// Where the code region (flash) ends: loads below are charged the wait
-/// states.
-pub const CODE_REGION_END: u64 = 0x2000_0000;
 /// The System Control Space page (CPACR at `0xE000_ED88`).
 const SCS: u64 = 0xE000_E000;
 /// Semihosting operations used.
