@@ -75,7 +75,7 @@ pub struct CostOptions {
     /// Their mass-proportional damping, 1/s.
     pub damping_per_s: f64,
     /// Their incompressibility penalty `γ`, N, where they take it (`None`: the
-    /// experiments' default, `crate::experiment::scenes::penalty_n` of the region).
+    /// experiments' default, `crate::fem::penalty::penalty_n` of the region).
     pub incompressibility_n: Option<f64>,
 }
 
@@ -190,9 +190,9 @@ pub fn costs(
                     sub_fixed,
                 );
                 let gamma = incompressibility.then(|| {
-                    options.incompressibility_n.unwrap_or_else(|| {
-                        crate::experiment::scenes::penalty_n(&sub, &options.material)
-                    })
+                    options
+                        .incompressibility_n
+                        .unwrap_or_else(|| crate::fem::penalty::penalty_n(&sub, &options.material))
                 });
                 let step_s =
                     tensor_mass_step_s(&sub, &surface.triangles, &arrays, options, law, gamma)
