@@ -61,7 +61,7 @@ pub fn read_tetgen(
     let nf = format!("{source}.node");
     let ef = format!("{source}.ele");
     let (positions, base) = read_node(node, &nf)?;
-    let (tets, tet_regions) = read_ele(ele, &ef)?;
+    let Ele { tets, tet_regions } = read_ele(ele, &ef)?;
     let raw = RawMesh {
         positions,
         node_ids: None,
@@ -135,11 +135,18 @@ fn read_node(node: &[u8], nf: &str) -> Result<(Vec<[f64; 3]>, i64), MeshError> {
     Ok((positions, base))
 }
 
+/// An `.ele` file as read.
+struct Ele {
+    /// Each tet's first 4 node indices, as written.
+    tets: Vec<[i64; 4]>,
+    /// Where the tets have attributes, the first of each as its region id.
+    tet_regions: Option<Vec<u32>>,
+}
+
 /// The `.ele` file `ele` (named `ef` in messages): the header `M
 /// [nodes_per_tet [nattr]]` (4 or 10 nodes), then `M` tets, read by their
-/// first 4 nodes (the corners). Returns the tets as written and, where the
-/// tets have attributes, the first of each as its region id.
-fn read_ele(ele: &[u8], ef: &str) -> Result<(Vec<[i64; 4]>, Option<Vec<u32>>), MeshError> {
+/// first 4 nodes (the corners).
+fn read_ele(ele: &[u8], ef: &str) -> Result<Ele, MeshError> {
     let mut it = lines(ele);
     let (hl, h) = it.next().ok_or_else(|| MeshError::Parse {
         file: ef.to_string(),
@@ -197,5 +204,8 @@ fn read_ele(ele: &[u8], ef: &str) -> Result<(Vec<[i64; 4]>, Option<Vec<u32>>), M
             regions.push(region);
         }
     }
-    Ok((tets, (nattr > 0).then_some(regions)))
+    Ok(Ele {
+        tets,
+        tet_regions: (nattr > 0).then_some(regions),
+    })
 }
