@@ -13,8 +13,8 @@ use plotters::prelude::*;
 
 use palpate_kernel::tensor_mass::Integrator;
 
-use super::report::trajectory_points;
 use super::select::pareto_front;
+use super::series::{cost_series, log_slope, trajectory_points};
 use super::stability::{Map, Outcome};
 use super::{Load, Model, Study};
 use crate::experiment::volume_bend::{Protocol, SceneResult};
@@ -362,40 +362,6 @@ fn trajectory_chart<DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
     Ok(())
-}
-
-/// Least-squares slope of `log y` against `log x`.
-pub fn log_slope(points: &[(f64, f64)]) -> f64 {
-    let logs: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-        .map(|p| (p.0.ln(), p.1.ln()))
-        .collect();
-    let n = logs.len() as f64;
-    let mx = logs.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = logs.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxy: f64 = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = logs.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
-    sxy / sxx
-}
-
-/// Per model, the median time per step on each mesh against its vertex count.
-pub fn cost_series(study: &Study, model: Model) -> Vec<(f64, f64)> {
-    let mut meshes: Vec<(usize, Vec<f64>)> = Vec::new();
-    for r in study.runs.iter().filter(|r| r.model == model) {
-        match meshes.iter_mut().find(|m| m.0 == r.vertices) {
-            Some(m) => m.1.push(r.step_s),
-            None => meshes.push((r.vertices, vec![r.step_s])),
-        }
-    }
-    meshes.sort_by_key(|m| m.0);
-    meshes
-        .into_iter()
-        .map(|(v, mut t)| {
-            t.sort_by(f64::total_cmp);
-            (v as f64, t[t.len() / 2])
-        })
-        .collect()
 }
 
 /// Time per step against vertices, log-log, slope in the legend.

@@ -2,11 +2,11 @@
 
 use core::fmt::Write;
 
-use super::plot::{cost_series, log_slope};
 use super::select::{cheapest_within, pareto_front};
+use super::series::{cost_series, log_slope, trajectory_points};
 use super::stability::Outcome;
 use super::ticks::TickCounts;
-use super::trajectory::{REFINEMENT, Trajectory};
+use super::trajectory::REFINEMENT;
 use super::{Load, Model, Run, Study};
 
 /// Error bounds of the report's "cheapest within" columns.
@@ -23,21 +23,6 @@ pub fn points(study: &Study, load: Load, level: f64) -> (Vec<&Run>, Vec<(f64, f6
     let points = runs
         .iter()
         .map(|r| (r.step_s, r.tip_error.unwrap_or(f64::NAN)))
-        .collect();
-    (runs, points)
-}
-
-/// The trajectories of one load with an error, as (cost, error) points:
-/// compute time per simulated second (s) and trajectory error.
-pub fn trajectory_points(study: &Study, load: Load) -> (Vec<&Trajectory>, Vec<(f64, f64)>) {
-    let runs: Vec<&Trajectory> = study
-        .trajectories
-        .iter()
-        .filter(|t| t.load == load && t.error.is_some())
-        .collect();
-    let points = runs
-        .iter()
-        .map(|t| (t.cost_per_simulated_s, t.error.unwrap_or(f64::NAN)))
         .collect();
     (runs, points)
 }

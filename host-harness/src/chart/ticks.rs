@@ -15,7 +15,7 @@
 //! - the tensor-mass models on the same block, dynamic
 //!   (`built-in-dynamic`), with the model's law: linear, St
 //!   Venant-Kirchhoff, St Venant-Kirchhoff + the penalty
-//!   ([`crate::experiment::scenes::penalty_n`] of the block);
+//!   ([`crate::fem::penalty::penalty_n`] of the block);
 //! - the hybrid on the built-in hybrid organ (`built-in-hybrid`, probes in
 //!   place of its grasper and cutter), its tensor-mass region St
 //!   Venant-Kirchhoff as the chart's ([`super::HYBRID_LAW`]).
@@ -35,8 +35,8 @@ use serde::Serialize;
 
 use super::{HYBRID_LAW, Model, Progress};
 use crate::budget::{HOST_IR, budget_table, chosen_trajectories, measure, probe_remapped};
-use crate::experiment::scenes::penalty_n;
 use crate::fem::material::Material;
+use crate::fem::penalty::penalty_n;
 use crate::session::model::{SceneModel, SceneTables};
 use crate::session::scene::ModelSpec;
 use crate::session::scene::{MAX_TOOL_POINTS, ToolSpec};

@@ -3,7 +3,7 @@
 //! [`palpate::budget`]; `--probe` is the child process callgrind measures.
 
 use core::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use palpate::budget::{
@@ -59,6 +59,10 @@ pub struct BudgetArgs {
 
 /// `palpate budget`: measure every generated trajectory on the scene's mesh
 /// (and, for a generated box, at half its resolution) under callgrind.
+///
+/// Stages: `--record` ([`record_ticks`]) or `--probe` ([`run_probe`])
+/// instead of a measure; else every size measured ([`measure_sizes`]), the
+/// rows printed ([`print_rows`]), and a count above its bound an error.
 pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     let BudgetArgs {
         scene: scene_arg,
@@ -75,49 +79,105 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         with_probes(&mut scene, points)?;
     }
     if let Some(dir) = record_dir {
-        let compression = compress.map(|code| Compression {
-            code,
-            drop_below: 0.0,
-            contact: ContactBlocks::Coded,
-        });
-        let runs = record(&scene, dir, only, compression)?;
-        let mut text = format!("recorded in {}:\n", dir.display());
-        for run in runs {
-            let _ = writeln!(text, "  {run}");
-        }
-        stdout::print(&text)?;
-        return Ok(());
+        return record_ticks(&scene, dir, only, *compress);
     }
     let sizes = mesh_sizes(&scene);
     if let Some([table_path, trajectory_path, size]) = probe_paths.as_deref() {
-        // The model of the mesh the parent built these tables for.
-        let size: usize = size.to_string_lossy().parse().context("--probe SIZE")?;
-        scene.mesh = sizes
-            .get(size)
-            .context("--probe SIZE out of range")?
-            .clone();
-        let (mesh, report) = scene.load_mesh()?;
-        let model = SceneModel::of(&scene, &mesh, &report)?;
-        let tables = SceneTables::read(model, table_path)?;
-        let trajectory = Trajectory::read(trajectory_path, scene.tool.points)?;
-        let counters = probe(&tables, &scene, &trajectory)
-            .with_context(|| table_path.display().to_string())?
-            .counters;
-        let lines: Vec<String> = counters
-            .iter()
-            .map(|c| {
-                format!(
-                    "{},{},{}",
-                    c.contact.triangles_tested, c.contact.walk_steps, c.solves
-                )
-            })
-            .collect();
-        std::fs::write(trajectory_path.with_extension("work"), lines.join("\n"))?;
+        return run_probe(&mut scene, &sizes, table_path, trajectory_path, size);
+    }
+    let rows = measure_sizes(&mut scene, scene_arg, work_dir, only, sizes)?;
+    if *json {
+        stdout::println(&serde_json::to_string(&rows)?)?;
         return Ok(());
     }
+    print_rows(&rows)?;
+    if let Some(r) = rows.iter().find(|r| r.max_ir > r.bound_ir) {
+        bail!(
+            "{} on {}: {} instructions exceed the bound {}",
+            r.trajectory,
+            r.mesh,
+            r.max_ir,
+            r.bound_ir
+        );
+    }
+    Ok(())
+}
+
+/// `--record DIR`: writes the scene's tables (compressed with `compress`,
+/// nothing dropped, the contact blocks coded), the ticks of the `only`
+/// trajectories (all without) and the host's output of each tick into
+/// `dir`, and prints what it recorded.
+fn record_ticks(
+    scene: &Scene,
+    dir: &Path,
+    only: &[String],
+    compress: Option<BlockCode>,
+) -> anyhow::Result<()> {
+    let compression = compress.map(|code| Compression {
+        code,
+        drop_below: 0.0,
+        contact: ContactBlocks::Coded,
+    });
+    let runs = record(scene, dir, only, compression)?;
+    let mut text = format!("recorded in {}:\n", dir.display());
+    for run in runs {
+        let _ = writeln!(text, "  {run}");
+    }
+    stdout::print(&text)?;
+    Ok(())
+}
+
+/// `--probe TABLE TRAJECTORY SIZE`, the process callgrind measures: the
+/// ticks of the trajectory on the table built for mesh `sizes[SIZE]`, each
+/// tick's work (triangles tested, walk steps, solves) written beside the
+/// trajectory (`.work`).
+fn run_probe(
+    scene: &mut Scene,
+    sizes: &[MeshSource],
+    table_path: &Path,
+    trajectory_path: &Path,
+    size: &Path,
+) -> anyhow::Result<()> {
+    // The model of the mesh the parent built these tables for.
+    let size: usize = size.to_string_lossy().parse().context("--probe SIZE")?;
+    scene.mesh = sizes
+        .get(size)
+        .context("--probe SIZE out of range")?
+        .clone();
+    let (mesh, report) = scene.load_mesh()?;
+    let model = SceneModel::of(scene, &mesh, &report)?;
+    let tables = SceneTables::read(model, table_path)?;
+    let trajectory = Trajectory::read(trajectory_path, scene.tool.points)?;
+    let counters = probe(&tables, scene, &trajectory)
+        .with_context(|| table_path.display().to_string())?
+        .counters;
+    let lines: Vec<String> = counters
+        .iter()
+        .map(|c| {
+            format!(
+                "{},{},{}",
+                c.contact.triangles_tested, c.contact.walk_steps, c.solves
+            )
+        })
+        .collect();
+    std::fs::write(trajectory_path.with_extension("work"), lines.join("\n"))?;
+    Ok(())
+}
+
+/// Every chosen trajectory (`only`, all without) on each of `sizes` under
+/// callgrind, in `work_dir`: every size's table checked against the build
+/// limits first, then per size its table built, and per trajectory a
+/// `--probe` child of `scene_arg` measured and its ticks' work read back.
+fn measure_sizes(
+    scene: &mut Scene,
+    scene_arg: &str,
+    work_dir: &Path,
+    only: &[String],
+    sizes: Vec<MeshSource>,
+) -> anyhow::Result<Vec<BudgetRow>> {
     std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
     let exe = std::env::current_exe()?;
-    let chosen = chosen_trajectories(&scene, only)?;
+    let chosen = chosen_trajectories(scene, only)?;
     // Every size's table is checked against the build limits before the
     // first is built (the coarse one can take a while).
     for source in &sizes {
@@ -131,7 +191,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
     for (s, source) in sizes.into_iter().enumerate() {
         scene.mesh = source;
         let (mesh, report) = scene.load_mesh()?;
-        let (tables, bound) = budget_table(&scene, &mesh, &report, &HOST_IR, None)?;
+        let (tables, bound) = budget_table(scene, &mesh, &report, &HOST_IR, None)?;
         let table_path = work_dir.join(format!("table-{s}.bin"));
         tables.write(&table_path)?;
         for (name, trajectory) in &chosen {
@@ -164,7 +224,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             let total_ir = irs.iter().sum::<u64>();
             let mean_ir = total_ir as f64 / irs.len().max(1) as f64;
             // The host's time per instruction in the ticks, run natively.
-            let native = probe(&tables, &scene, trajectory)?;
+            let native = probe(&tables, scene, trajectory)?;
             let host_ns_per_ir = native.ticks_s * 1e9 / total_ir.max(1) as f64;
             rows.push(BudgetRow {
                 mesh: format!(
@@ -182,10 +242,11 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
             });
         }
     }
-    if *json {
-        stdout::println(&serde_json::to_string(&rows)?)?;
-        return Ok(());
-    }
+    Ok(rows)
+}
+
+/// Prints the measured rows as a table, one line a trajectory and size.
+fn print_rows(rows: &[BudgetRow]) -> anyhow::Result<()> {
     let mut text = format!(
         "{:<26} {:<11} {:>6} {:>9} {:>9} {:>9} {:>6} {:>11} {:>11} {:>12}",
         "mesh",
@@ -200,7 +261,7 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         "tests/walk/solves"
     );
     text.push('\n');
-    for r in &rows {
+    for r in rows {
         let _ = writeln!(
             text,
             "{:<26} {:<11} {:>6} {:>9.0} {:>9} {:>9} {:>6.3} {:>8.1} µs {:>8.2} µs {:>5}/{}/{}",
@@ -219,15 +280,6 @@ pub fn run(args: &BudgetArgs) -> anyhow::Result<()> {
         );
     }
     stdout::print(&text)?;
-    if let Some(r) = rows.iter().find(|r| r.max_ir > r.bound_ir) {
-        bail!(
-            "{} on {}: {} instructions exceed the bound {}",
-            r.trajectory,
-            r.mesh,
-            r.max_ir,
-            r.bound_ir
-        );
-    }
     Ok(())
 }
 

@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 
 use super::volume_bend::{PaperLoads, Scene};
 use crate::fem::material::Material;
+use crate::fem::penalty::penalty_n;
 use crate::mesh::TetMesh;
 use crate::mesh::boundary_surface;
 use crate::mesh::generate::{
@@ -35,24 +36,6 @@ pub const TILTS_DEG: [f64; 3] = [30.0, 60.0, 75.0];
 /// Mean lift of the loaded lobe tip on the St Venant-Kirchhoff organ, mm:
 /// a fifth of the organ's 0.2 m length, a large partial rotation of the lobe.
 pub const ORGAN_LIFT_MM: f64 = 40.0;
-
-/// `γ = PENALTY_SCALE · μ · V̄^(2/3)` (N), with `V̄` the mean rest tet volume:
-/// the penalty on a corner, `γ (ΔV/V₀)²`, then equals the elastic force
-/// scale `μ V̄^(2/3) |ΔV/V₀|` of the tet at a `1/PENALTY_SCALE` volume
-/// change and dominates beyond it. Picinbono gives no value for γ. A larger
-/// γ keeps the volume better but also stiffens bending, which moves the
-/// stage forces (measured on the default cylinder at 30° tilt: scale 10,
-/// 0.10 N, ΔV/V₀ = −0.49 %; scale 30, 0.12 N, −0.30 %; scale 100, 0.20 N,
-/// −0.21 %; plain St Venant-Kirchhoff needs 0.09 N). 10 keeps the stage
-/// forces closest to plain St Venant-Kirchhoff's.
-pub const PENALTY_SCALE: f64 = 10.0;
-
-/// The penalty γ (N) of [`PENALTY_SCALE`] for `mesh` and `material`.
-pub fn penalty_n(mesh: &TetMesh, material: &Material) -> f64 {
-    let total: f64 = (0..mesh.tets.len()).map(|t| mesh.tet_volume(t)).sum();
-    let mean = total / mesh.tets.len() as f64;
-    PENALTY_SCALE * material.lame().1 * mean.powf(2.0 / 3.0)
-}
 
 /// The cylinder of [`cylinder_mesh`] (`radial_cells`, `height_cells`),
 /// bottom face fixed, a lateral force (+x) shared by the top-face vertices,

@@ -1,6 +1,7 @@
 //! Finite elements on the host: the linear P1 element, global assembly and
 //! the direct solves; the St Venant-Kirchhoff element and its Newton static
-//! reference ([`stvk`], [`newton`]).
+//! reference ([`stvk`], [`newton`]); the incompressibility penalty of the
+//! tensor-mass models ([`penalty`]).
 //!
 //! Everything here follows `MODELS.md` §1 (the linear P1 tetrahedron) and
 //! Cotin et al., INRIA RR-3510 §4. SI units throughout (m, N, Pa).
@@ -9,6 +10,7 @@ pub mod assembly;
 pub mod element;
 pub mod material;
 pub mod newton;
+pub mod penalty;
 pub mod static_solve;
 pub mod stvk;
 

@@ -114,105 +114,196 @@ pub const ENERGY_ROUNDING: f64 = 1e-12;
 /// load's size): converged. Above it, a stagnating line search is an error.
 const STAGNATION: f64 = 1e-6;
 
-/// Solves `problem` (module documentation).
+/// Solves `problem` (module documentation): the load in
+/// [`NewtonOptions::load_steps`] increments ([`Discrete::increment`]), the
+/// stability of the end state in descent, and the reactions of the
+/// prescribed vertices.
 pub fn solve_stvk(
     problem: &StaticProblem<'_>,
     options: &NewtonOptions,
 ) -> anyhow::Result<Equilibrium> {
-    let n = problem.positions.len();
-    ensure!(
-        problem.fixed.len() == n,
-        "fixed has {} flags for {n} vertices",
-        problem.fixed.len()
-    );
-    ensure!(
-        problem.loads_n.is_empty() || problem.loads_n.len() == n,
-        "loads has {} entries for {n} vertices",
-        problem.loads_n.len()
-    );
-    ensure!(options.load_steps >= 1, "at least one load step");
-    problem.materials.check_tet_count(problem.tets.len())?;
-    let mut known = problem.fixed.to_vec();
-    for &(v, _) in problem.prescribed {
-        let vi = v as usize;
-        ensure!(
-            vi < n && !known[vi],
-            "prescribed vertex {v} is out of range, fixed or repeated"
-        );
-        known[vi] = true;
-    }
-    let elements: Vec<StvkTet> = problem
-        .tets
-        .iter()
-        .zip(problem.materials.per_tet())
-        .map(|(t, m)| StvkTet::new(&t.map(|v| problem.positions[v as usize]), m))
-        .collect();
-    let mut slot = vec![None; n];
-    let mut unknown = Vec::new();
-    for v in 0..n {
-        if !known[v] {
-            slot[v] = Some(unknown.len() as u32);
-            unknown.push(v);
-        }
-    }
-    let load = |v: usize| problem.loads_n.get(v).copied().unwrap_or([0.0; 3]);
-    let internal = |u: &[[f64; 3]]| -> Vec<Vector3<f64>> {
-        let mut f = vec![Vector3::zeros(); n];
-        for (t, e) in problem.tets.iter().zip(&elements) {
-            let x = t.map(|v| {
-                let (p, d) = (problem.positions[v as usize], u[v as usize]);
-                [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
-            });
-            for (v, fv) in t.iter().zip(e.forces_n(&x)) {
-                f[*v as usize] += fv;
-            }
-        }
-        f
-    };
-
-    let mut u = vec![[0.0; 3]; n];
+    let model = Discrete::new(problem, options)?;
+    let mut u = vec![[0.0; 3]; problem.positions.len()];
     let mut iterations = 0;
     let mut residual_n = 0.0;
     let mut tolerance_met = true;
     for step in 1..=options.load_steps {
+        let increment = model.increment(&mut u, step, options)?;
+        iterations += increment.iterations;
+        residual_n = increment.residual_n;
+        tolerance_met &= increment.tolerance_met;
+    }
+    if options.descent {
+        SparseLlt::new(model.tangent(&u).as_ref()).context(
+            "the equilibrium reached is not stable (its tangent is not positive definite)",
+        )?;
+    }
+    let reactions_n = model.reactions_n(&u);
+    Ok(Equilibrium {
+        u,
+        iterations,
+        residual_n,
+        tolerance_met,
+        reactions_n,
+    })
+}
+
+/// How one load increment ended.
+struct Increment {
+    /// Newton iterations it took.
+    iterations: usize,
+    /// Largest residual force on an unknown DOF at its end, N.
+    residual_n: f64,
+    /// `false` when it stopped at rounding level above the tolerance.
+    tolerance_met: bool,
+}
+
+/// A checked [`StaticProblem`] discretized: one St Venant-Kirchhoff element
+/// per tet and the numbering of the unknown DOFs (the vertices neither
+/// fixed nor prescribed).
+struct Discrete<'p, 'a> {
+    problem: &'p StaticProblem<'a>,
+    /// One element per tet, at the rest positions.
+    elements: Vec<StvkTet>,
+    /// Mesh vertex → unknown index, `None` for a fixed or prescribed vertex.
+    slot: Vec<Option<u32>>,
+    /// Unknown index → mesh vertex.
+    unknown: Vec<usize>,
+}
+
+impl<'p, 'a> Discrete<'p, 'a> {
+    /// Checks that `problem`'s flags, loads, materials and prescribed
+    /// vertices fit its mesh and that `options` has a load step, then builds
+    /// the elements and numbers the unknowns.
+    fn new(problem: &'p StaticProblem<'a>, options: &NewtonOptions) -> anyhow::Result<Self> {
+        let n = problem.positions.len();
+        ensure!(
+            problem.fixed.len() == n,
+            "fixed has {} flags for {n} vertices",
+            problem.fixed.len()
+        );
+        ensure!(
+            problem.loads_n.is_empty() || problem.loads_n.len() == n,
+            "loads has {} entries for {n} vertices",
+            problem.loads_n.len()
+        );
+        ensure!(options.load_steps >= 1, "at least one load step");
+        problem.materials.check_tet_count(problem.tets.len())?;
+        let mut known = problem.fixed.to_vec();
+        for &(v, _) in problem.prescribed {
+            let vi = v as usize;
+            ensure!(
+                vi < n && !known[vi],
+                "prescribed vertex {v} is out of range, fixed or repeated"
+            );
+            known[vi] = true;
+        }
+        let elements: Vec<StvkTet> = problem
+            .tets
+            .iter()
+            .zip(problem.materials.per_tet())
+            .map(|(t, m)| StvkTet::new(&t.map(|v| problem.positions[v as usize]), m))
+            .collect();
+        let mut slot = vec![None; n];
+        let mut unknown = Vec::new();
+        for v in 0..n {
+            if !known[v] {
+                slot[v] = Some(unknown.len() as u32);
+                unknown.push(v);
+            }
+        }
+        Ok(Self {
+            problem,
+            elements,
+            slot,
+            unknown,
+        })
+    }
+
+    /// Dead load on vertex `v`, N (zero without loads).
+    fn load(&self, v: usize) -> [f64; 3] {
+        self.problem.loads_n.get(v).copied().unwrap_or([0.0; 3])
+    }
+
+    /// Deformed corners of tet `t` at displacement `u`, m: rest position
+    /// plus displacement.
+    fn corners(&self, t: &[u32; 4], u: &[[f64; 3]]) -> [[f64; 3]; 4] {
+        t.map(|v| {
+            let (p, d) = (self.problem.positions[v as usize], u[v as usize]);
+            [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+        })
+    }
+
+    /// Internal force `f_int(u)` on every vertex, N.
+    fn internal(&self, u: &[[f64; 3]]) -> Vec<Vector3<f64>> {
+        let mut f = vec![Vector3::zeros(); self.problem.positions.len()];
+        for (t, e) in self.problem.tets.iter().zip(&self.elements) {
+            for (v, fv) in t.iter().zip(e.forces_n(&self.corners(t, u))) {
+                f[*v as usize] += fv;
+            }
+        }
+        f
+    }
+
+    /// Residual `f_int(u) + s f_ext` on the unknown vertices, N.
+    fn residual(&self, u: &[[f64; 3]], s: f64) -> Vec<Vector3<f64>> {
+        let f = self.internal(u);
+        self.unknown
+            .iter()
+            .map(|&v| f[v] + Vector3::from(self.load(v)) * s)
+            .collect()
+    }
+
+    /// `Π(u) = Σ W_e(u) − s f·u` and the scale of its rounding,
+    /// `Σ|W_e| + |s f·u|`, J.
+    fn energy(&self, u: &[[f64; 3]], s: f64) -> (f64, f64) {
+        let elastic: f64 = self
+            .problem
+            .tets
+            .iter()
+            .zip(&self.elements)
+            .map(|(t, e)| e.energy_j(&self.corners(t, u)))
+            .sum();
+        let work: f64 = self
+            .unknown
+            .iter()
+            .map(|&v| s * Vector3::from(self.load(v)).dot(&Vector3::from(u[v])))
+            .sum();
+        (elastic - work, elastic.abs() + work.abs())
+    }
+
+    /// Tangent stiffness `K_t(u)` on the unknown DOFs, N/m.
+    fn tangent(&self, u: &[[f64; 3]]) -> SparseColMat<usize, f64> {
+        let tets = self.problem.tets;
+        let n = self.problem.positions.len();
+        assemble_restricted_with(n, tets, &self.slot, self.unknown.len(), |t| {
+            self.elements[t].tangent(&self.corners(&tets[t], u))
+        })
+    }
+
+    /// Load increment `step` of [`NewtonOptions::load_steps`]: the
+    /// prescribed displacements and the loads scaled to `step / load_steps`,
+    /// then Newton iterations ([`Self::direction`], [`Self::line_search`])
+    /// from `u` until the largest residual force is within the tolerance of
+    /// the load scale. In descent, the tangent's shift is raised where no
+    /// step was taken and lowered after a full step.
+    fn increment(
+        &self,
+        u: &mut Vec<[f64; 3]>,
+        step: usize,
+        options: &NewtonOptions,
+    ) -> anyhow::Result<Increment> {
         let s = step as f64 / options.load_steps as f64;
-        for &(v, d) in problem.prescribed {
+        for &(v, d) in self.problem.prescribed {
             u[v as usize] = d.map(|x| s * x);
         }
-        let residual = |u: &[[f64; 3]]| -> Vec<Vector3<f64>> {
-            let f = internal(u);
-            unknown
-                .iter()
-                .map(|&v| f[v] + Vector3::from(load(v)) * s)
-                .collect()
-        };
-        let norm = |r: &[Vector3<f64>]| r.iter().map(|x| x.norm_squared()).sum::<f64>().sqrt();
-        let largest = |r: &[Vector3<f64>]| r.iter().map(|x| x.amax()).fold(0.0, f64::max);
-        let mut r = residual(&u);
-        let scale = (0..n)
-            .map(|v| Vector3::from(load(v)).amax() * s)
+        let mut r = self.residual(u, s);
+        let scale = (0..self.problem.positions.len())
+            .map(|v| Vector3::from(self.load(v)).amax() * s)
             .fold(largest(&r), f64::max);
         let tolerance_n = options.tolerance * scale;
-        // Π(u) and the scale of its rounding, Σ|W_e| + |s f·u|, J.
-        let energy = |u: &[[f64; 3]]| -> (f64, f64) {
-            let elastic: f64 = problem
-                .tets
-                .iter()
-                .zip(&elements)
-                .map(|(t, e)| {
-                    e.energy_j(&t.map(|v| {
-                        let (p, d) = (problem.positions[v as usize], u[v as usize]);
-                        [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
-                    }))
-                })
-                .sum();
-            let work: f64 = unknown
-                .iter()
-                .map(|&v| s * Vector3::from(load(v)).dot(&Vector3::from(u[v])))
-                .sum();
-            (elastic - work, elastic.abs() + work.abs())
-        };
         let mut shift = 0.0;
+        let mut tolerance_met = true;
         let mut converged = largest(&r) <= tolerance_n;
         let mut k = 0;
         while !converged {
@@ -224,118 +315,145 @@ pub fn solve_stvk(
                 largest(&r)
             );
             k += 1;
-            let tangent = assemble_restricted_with(n, problem.tets, &slot, unknown.len(), |t| {
-                let x = problem.tets[t].map(|v| {
-                    let (p, d) = (problem.positions[v as usize], u[v as usize]);
-                    [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
-                });
-                elements[t].tangent(&x)
-            });
-            let factorized = if options.descent {
-                factor_shifted(&tangent, &mut shift)
-            } else {
-                SparseLlt::new(tangent.as_ref())
-            };
-            let llt = factorized.with_context(|| {
-                format!(
-                    "load step {step}/{}: the tangent stiffness is not positive definite \
-                     (the equilibrium lost stability: buckling or collapse)",
-                    options.load_steps
-                )
-            })?;
-            let mut delta = Mat::<f64>::zeros(3 * unknown.len(), 1);
-            for (i, ri) in r.iter().enumerate() {
-                for c in 0..3 {
-                    delta[(3 * i + c, 0)] = ri[c];
-                }
-            }
-            llt.solve_in_place(delta.as_mut());
-            let before = norm(&r);
-            let (energy_before, energy_scale) = if options.descent {
-                energy(&u)
-            } else {
-                (0.0, 0.0)
-            };
-            let mut alpha = 1.0;
-            let mut accepted = false;
-            for _ in 0..=MAX_HALVINGS {
-                let mut trial = u.clone();
-                for (i, &v) in unknown.iter().enumerate() {
-                    for c in 0..3 {
-                        trial[v][c] += alpha * delta[(3 * i + c, 0)];
-                    }
-                }
-                let r_trial = residual(&trial);
-                let lower = norm(&r_trial) < before || largest(&r_trial) <= tolerance_n;
-                let take = if options.descent {
-                    let (e, _) = energy(&trial);
-                    e < energy_before
-                        || (lower && e <= energy_before + ENERGY_ROUNDING * energy_scale)
-                } else {
-                    lower
-                };
-                if take {
-                    (u, r) = (trial, r_trial);
-                    accepted = true;
-                    break;
-                }
-                alpha *= 0.5;
-            }
+            let delta = self.direction(u, &r, &mut shift, step, options)?;
+            let taken = self.line_search(u, &mut r, &delta, s, tolerance_n, options.descent);
             if options.descent {
-                if accepted && alpha == 1.0 {
+                if taken == Some(1.0) {
                     shift = if shift / 10.0 < MIN_SHIFT {
                         0.0
                     } else {
                         shift / 10.0
                     };
-                } else if !accepted && largest(&r) > STAGNATION * scale {
+                } else if taken.is_none() && largest(&r) > STAGNATION * scale {
                     // Trust the tangent less: a shorter, steeper step.
                     shift = (10.0 * shift).max(MIN_SHIFT);
                     continue;
                 }
             }
-            if !accepted && largest(&r) <= STAGNATION * scale {
+            if taken.is_none() && largest(&r) <= STAGNATION * scale {
                 // At rounding level: no step can decrease the residual.
                 tolerance_met = false;
                 break;
             }
-            if !accepted {
+            if taken.is_none() {
+                // `r` is the one the line search started from.
                 bail!(
                     "load step {step}/{}: the line search found no decrease of the residual \
-                     ({before:.3e} N)",
-                    options.load_steps
+                     ({:.3e} N)",
+                    options.load_steps,
+                    norm(&r)
                 );
             }
             converged = largest(&r) <= tolerance_n;
         }
-        iterations += k;
-        residual_n = largest(&r);
+        Ok(Increment {
+            iterations: k,
+            residual_n: largest(&r),
+            tolerance_met,
+        })
     }
-    if options.descent {
-        let tangent = assemble_restricted_with(n, problem.tets, &slot, unknown.len(), |t| {
-            let x = problem.tets[t].map(|v| {
-                let (p, d) = (problem.positions[v as usize], u[v as usize]);
-                [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
-            });
-            elements[t].tangent(&x)
-        });
-        SparseLlt::new(tangent.as_ref()).context(
-            "the equilibrium reached is not stable (its tangent is not positive definite)",
-        )?;
+
+    /// The Newton step `Δu = K_t⁻¹ r` at `u` (`3 × unknowns` rows), the
+    /// tangent shifted by `shift` in descent ([`factor_shifted`]). Errors,
+    /// naming load increment `step`, where the tangent does not factorize.
+    fn direction(
+        &self,
+        u: &[[f64; 3]],
+        r: &[Vector3<f64>],
+        shift: &mut f64,
+        step: usize,
+        options: &NewtonOptions,
+    ) -> anyhow::Result<Mat<f64>> {
+        let tangent = self.tangent(u);
+        let factorized = if options.descent {
+            factor_shifted(&tangent, shift)
+        } else {
+            SparseLlt::new(tangent.as_ref())
+        };
+        let llt = factorized.with_context(|| {
+            format!(
+                "load step {step}/{}: the tangent stiffness is not positive definite \
+                 (the equilibrium lost stability: buckling or collapse)",
+                options.load_steps
+            )
+        })?;
+        let mut delta = Mat::<f64>::zeros(3 * self.unknown.len(), 1);
+        for (i, ri) in r.iter().enumerate() {
+            for c in 0..3 {
+                delta[(3 * i + c, 0)] = ri[c];
+            }
+        }
+        llt.solve_in_place(delta.as_mut());
+        Ok(delta)
     }
-    let f = internal(&u);
-    let reactions_n = problem
-        .prescribed
-        .iter()
-        .map(|&(v, _)| (-(f[v as usize] + Vector3::from(load(v as usize)))).into())
-        .collect();
-    Ok(Equilibrium {
-        u,
-        iterations,
-        residual_n,
-        tolerance_met,
-        reactions_n,
-    })
+
+    /// Backtracking line search along `delta` from `u`, halving the step
+    /// fraction at most [`MAX_HALVINGS`] times: takes the first trial whose
+    /// residual norm is below that of `r` (or whose largest residual force is
+    /// within `tolerance_n`), in descent the first that lowers `Π` or lowers
+    /// the residual while `Π` grows by less than its rounding
+    /// ([`ENERGY_ROUNDING`]). On a take, `u` and `r` become the trial's and
+    /// the step fraction is returned; `None` leaves them as they were.
+    fn line_search(
+        &self,
+        u: &mut Vec<[f64; 3]>,
+        r: &mut Vec<Vector3<f64>>,
+        delta: &Mat<f64>,
+        s: f64,
+        tolerance_n: f64,
+        descent: bool,
+    ) -> Option<f64> {
+        let before = norm(r);
+        let (energy_before, energy_scale) = if descent {
+            self.energy(u, s)
+        } else {
+            (0.0, 0.0)
+        };
+        let mut alpha = 1.0;
+        for _ in 0..=MAX_HALVINGS {
+            let mut trial = u.clone();
+            for (i, &v) in self.unknown.iter().enumerate() {
+                for c in 0..3 {
+                    trial[v][c] += alpha * delta[(3 * i + c, 0)];
+                }
+            }
+            let r_trial = self.residual(&trial, s);
+            let lower = norm(&r_trial) < before || largest(&r_trial) <= tolerance_n;
+            let take = if descent {
+                let (e, _) = self.energy(&trial, s);
+                e < energy_before || (lower && e <= energy_before + ENERGY_ROUNDING * energy_scale)
+            } else {
+                lower
+            };
+            if take {
+                (*u, *r) = (trial, r_trial);
+                return Some(alpha);
+            }
+            alpha *= 0.5;
+        }
+        None
+    }
+
+    /// For each prescribed vertex, in order, the force the constraint
+    /// applies to the body at `u`, `−f_int − f_ext`, N.
+    fn reactions_n(&self, u: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let f = self.internal(u);
+        self.problem
+            .prescribed
+            .iter()
+            .map(|&(v, _)| (-(f[v as usize] + Vector3::from(self.load(v as usize)))).into())
+            .collect()
+    }
+}
+
+/// Euclidean norm of a residual, N.
+fn norm(r: &[Vector3<f64>]) -> f64 {
+    r.iter().map(|x| x.norm_squared()).sum::<f64>().sqrt()
+}
+
+/// Largest force component of a residual, N.
+fn largest(r: &[Vector3<f64>]) -> f64 {
+    r.iter().map(|x| x.amax()).fold(0.0, f64::max)
 }
 
 /// Factorizes `k + shift d̄ I` (`d̄` the mean absolute diagonal of `k`),

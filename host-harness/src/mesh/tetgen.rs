@@ -60,26 +60,42 @@ pub fn read_tetgen(
 ) -> Result<(TetMesh, MeshReport), MeshError> {
     let nf = format!("{source}.node");
     let ef = format!("{source}.ele");
+    let (positions, base) = read_node(node, &nf)?;
+    let Ele { tets, tet_regions } = read_ele(ele, &ef)?;
+    let raw = RawMesh {
+        positions,
+        node_ids: None,
+        tets,
+        elem_ids: None,
+        numbering: Numbering::Base(base),
+        skipped: 0,
+        tet_regions,
+    };
+    validate(raw, &nf, &ef, &nf)
+}
 
-    // .node
+/// The `.node` file `node` (named `nf` in messages): the header `N dim
+/// [nattr [nbnd]]` (3 dimensions), then `N` vertices with consecutive
+/// indices from 0 or 1. Returns the positions and the numbering base.
+fn read_node(node: &[u8], nf: &str) -> Result<(Vec<[f64; 3]>, i64), MeshError> {
     let mut it = lines(node);
     let (hl, h) = it.next().ok_or_else(|| MeshError::Parse {
-        file: nf.clone(),
+        file: nf.to_string(),
         msg: "empty file: missing header `N dim nattr nbnd`".into(),
     })?;
-    let n: usize = num(&nf, hl, &h, 0, "number of nodes")?;
-    let dim: usize = num(&nf, hl, &h, 1, "dimension")?;
+    let n: usize = num(nf, hl, &h, 0, "number of nodes")?;
+    let dim: usize = num(nf, hl, &h, 1, "dimension")?;
     if dim != 3 {
-        return Err(perr(&nf, hl, format_args!("dimension {dim}, expected 3")));
+        return Err(perr(nf, hl, format_args!("dimension {dim}, expected 3")));
     }
     // Attributes and boundary markers are ignored, but the header must be numeric.
     let _nattr: usize = if h.len() > 2 {
-        num(&nf, hl, &h, 2, "attribute count")?
+        num(nf, hl, &h, 2, "attribute count")?
     } else {
         0
     };
     let _nbnd: usize = if h.len() > 3 {
-        num(&nf, hl, &h, 3, "boundary marker flag")?
+        num(nf, hl, &h, 3, "boundary marker flag")?
     } else {
         0
     };
@@ -87,22 +103,22 @@ pub fn read_tetgen(
     let mut base = 0i64;
     for i in 0..n {
         let (l, t) = it.next().ok_or_else(|| MeshError::Parse {
-            file: nf.clone(),
+            file: nf.to_string(),
             msg: format!("unexpected end of file (truncated?) at vertex {i} of {n}"),
         })?;
-        let idx: i64 = num(&nf, l, &t, 0, &format!("vertex {i}: node index"))?;
+        let idx: i64 = num(nf, l, &t, 0, &format!("vertex {i}: node index"))?;
         if i == 0 {
             base = idx;
             if base != 0 && base != 1 {
                 return Err(perr(
-                    &nf,
+                    nf,
                     l,
                     format_args!("first node index {idx}, expected 0 or 1"),
                 ));
             }
         } else if i128::from(idx) != i128::from(base) + i as i128 {
             return Err(perr(
-                &nf,
+                nf,
                 l,
                 format_args!(
                     "vertex {i}: node index {idx}, expected {}",
@@ -112,32 +128,45 @@ pub fn read_tetgen(
         }
         let mut p = [0.0; 3];
         for (c, x) in p.iter_mut().enumerate() {
-            *x = num(&nf, l, &t, 1 + c, &format!("vertex {i}: coordinate {c}"))?;
+            *x = num(nf, l, &t, 1 + c, &format!("vertex {i}: coordinate {c}"))?;
         }
         positions.push(p);
     }
+    Ok((positions, base))
+}
 
-    // .ele
+/// An `.ele` file as read.
+struct Ele {
+    /// Each tet's first 4 node indices, as written.
+    tets: Vec<[i64; 4]>,
+    /// Where the tets have attributes, the first of each as its region id.
+    tet_regions: Option<Vec<u32>>,
+}
+
+/// The `.ele` file `ele` (named `ef` in messages): the header `M
+/// [nodes_per_tet [nattr]]` (4 or 10 nodes), then `M` tets, read by their
+/// first 4 nodes (the corners).
+fn read_ele(ele: &[u8], ef: &str) -> Result<Ele, MeshError> {
     let mut it = lines(ele);
     let (hl, h) = it.next().ok_or_else(|| MeshError::Parse {
-        file: ef.clone(),
+        file: ef.to_string(),
         msg: "empty file: missing header `M nodes_per_tet nattr`".into(),
     })?;
-    let m: usize = num(&ef, hl, &h, 0, "number of tets")?;
+    let m: usize = num(ef, hl, &h, 0, "number of tets")?;
     let npt: usize = if h.len() > 1 {
-        num(&ef, hl, &h, 1, "nodes per tet")?
+        num(ef, hl, &h, 1, "nodes per tet")?
     } else {
         4
     };
     if npt != 4 && npt != 10 {
         return Err(perr(
-            &ef,
+            ef,
             hl,
             format_args!("{npt} nodes per tet, expected 4 or 10"),
         ));
     }
     let nattr: usize = if h.len() > 2 {
-        num(&ef, hl, &h, 2, "attribute count")?
+        num(ef, hl, &h, 2, "attribute count")?
     } else {
         0
     };
@@ -145,12 +174,12 @@ pub fn read_tetgen(
     let mut regions = Vec::with_capacity(if nattr > 0 { cap(m, ele.len()) } else { 0 });
     for i in 0..m {
         let (l, t) = it.next().ok_or_else(|| MeshError::Parse {
-            file: ef.clone(),
+            file: ef.to_string(),
             msg: format!("unexpected end of file (truncated?) at tet {i} of {m}"),
         })?;
         if t.len() < 1 + npt {
             return Err(perr(
-                &ef,
+                ef,
                 l,
                 format_args!(
                     "tet {i}: {} vertex indices, expected {npt}",
@@ -160,14 +189,14 @@ pub fn read_tetgen(
         }
         let mut tet = [0i64; 4];
         for (c, v) in tet.iter_mut().enumerate() {
-            *v = num(&ef, l, &t, 1 + c, &format!("tet {i}: vertex index"))?;
+            *v = num(ef, l, &t, 1 + c, &format!("tet {i}: vertex index"))?;
         }
         tets.push(tet);
         if nattr > 0 {
-            let attribute: f64 = num(&ef, l, &t, 1 + npt, &format!("tet {i}: region attribute"))?;
+            let attribute: f64 = num(ef, l, &t, 1 + npt, &format!("tet {i}: region attribute"))?;
             let region = region_id(attribute).ok_or_else(|| {
                 perr(
-                    &ef,
+                    ef,
                     l,
                     format_args!("tet {i}: region attribute {attribute} {NOT_A_REGION}"),
                 )
@@ -175,14 +204,8 @@ pub fn read_tetgen(
             regions.push(region);
         }
     }
-    let raw = RawMesh {
-        positions,
-        node_ids: None,
+    Ok(Ele {
         tets,
-        elem_ids: None,
-        numbering: Numbering::Base(base),
-        skipped: 0,
         tet_regions: (nattr > 0).then_some(regions),
-    };
-    validate(raw, &nf, &ef, &nf)
+    })
 }

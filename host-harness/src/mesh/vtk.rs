@@ -60,7 +60,31 @@ fn int_size(ty: &[u8]) -> Option<usize> {
 }
 
 /// Parse a VTK legacy file into unvalidated arrays.
+///
+/// Stages: the header ([`header`]), the geometry ([`geometry`]), the cells'
+/// region ids ([`regions`]), the tet cells kept ([`keep_tets`]).
 pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
+    let mut r = header(bytes, file)?;
+    let geometry = geometry(&mut r, file)?;
+    let cell_regions = regions(&mut r, geometry.attributes, geometry.cells.len())?;
+    keep_tets(geometry, cell_regions, file)
+}
+
+/// The dataset as read up to its attribute data.
+struct Geometry<'a> {
+    /// Point coordinates.
+    positions: Vec<[f64; 3]>,
+    /// Per cell: (npts, first 4 point ids).
+    cells: Vec<(usize, [i64; 4])>,
+    /// VTK cell type per cell.
+    types: Vec<i64>,
+    /// The attribute keyword that ended the geometry, if any.
+    attributes: Option<&'a [u8]>,
+}
+
+/// The three header lines: the `# vtk DataFile Version` line, the title and
+/// `ASCII` or `BINARY`; a reader placed after them.
+fn header<'a>(bytes: &'a [u8], file: &'a str) -> Result<Reader<'a>, MeshError> {
     let mut cur = Cursor::new(bytes, file);
     let l1 = cur
         .line()
@@ -85,13 +109,18 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
             )));
         }
     };
-    let mut r = Reader { cur, binary };
+    Ok(Reader { cur, binary })
+}
+
+/// The `DATASET UNSTRUCTURED_GRID` with its `POINTS`, `CELLS` and
+/// `CELL_TYPES`, in any order, up to the first attribute keyword
+/// (`POINT_DATA`, `CELL_DATA`) or once all three are read: each present,
+/// one type per cell.
+fn geometry<'a>(r: &mut Reader<'a>, file: &str) -> Result<Geometry<'a>, MeshError> {
     let mut positions: Option<Vec<[f64; 3]>> = None;
-    // Per cell: (npts, first 4 point ids).
     let mut cells: Option<Vec<(usize, [i64; 4])>> = None;
     let mut types: Option<Vec<i64>> = None;
     let mut have_dataset = false;
-    // The attribute keyword that ended the geometry, if any.
     let mut attributes: Option<&[u8]> = None;
     while let Some(tok) = r.cur.token() {
         match tok.to_ascii_uppercase().as_slice() {
@@ -108,47 +137,18 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
             }
             b"POINTS" => {
                 r.cur.section = "POINTS";
-                let n = r.count("number of points")?;
-                let ty = r.cur.expect_token(&"point data type")?;
-                let double = match ty.to_ascii_lowercase().as_slice() {
-                    b"double" => true,
-                    b"float" => false,
-                    _ if !binary => true,
-                    _ => {
-                        return Err(r.cur.err(format_args!(
-                            "point type {:?} (expected float or double)",
-                            show(ty)
-                        )));
-                    }
-                };
-                r.start_data();
-                let mut pts = Vec::with_capacity(cap(n, r.cur.len()));
-                for i in 0..n {
-                    let what = format_args!("point {i}");
-                    let mut p = [0.0; 3];
-                    for x in &mut p {
-                        *x = r.float(double, &what)?;
-                    }
-                    pts.push(p);
-                }
-                positions = Some(pts);
+                positions = Some(read_points(r)?);
             }
             b"CELLS" => {
                 r.cur.section = "CELLS";
                 let n = r.count("number of cells")?;
                 let size = r.count("cell list size")?;
                 r.start_data();
-                cells = Some(read_cells(&mut r, n, size)?);
+                cells = Some(read_cells(r, n, size)?);
             }
             b"CELL_TYPES" => {
                 r.cur.section = "CELL_TYPES";
-                let n = r.count("number of cell types")?;
-                r.start_data();
-                let mut ts = Vec::with_capacity(cap(n, r.cur.len()));
-                for i in 0..n {
-                    ts.push(r.int(4, &format_args!("cell type {i}"))?);
-                }
-                types = Some(ts);
+                types = Some(read_cell_types(r)?);
             }
             b"POINT_DATA" | b"CELL_DATA" => {
                 attributes = Some(tok);
@@ -184,7 +184,68 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
             types.len()
         )));
     }
-    let cell_regions = regions(&mut r, attributes, cells.len())?;
+    Ok(Geometry {
+        positions,
+        cells,
+        types,
+        attributes,
+    })
+}
+
+/// The `POINTS n type` block after its keyword: `n` points of `float` or
+/// `double` (any number in ASCII).
+fn read_points(r: &mut Reader<'_>) -> Result<Vec<[f64; 3]>, MeshError> {
+    let n = r.count("number of points")?;
+    let ty = r.cur.expect_token(&"point data type")?;
+    let double = match ty.to_ascii_lowercase().as_slice() {
+        b"double" => true,
+        b"float" => false,
+        _ if !r.binary => true,
+        _ => {
+            return Err(r.cur.err(format_args!(
+                "point type {:?} (expected float or double)",
+                show(ty)
+            )));
+        }
+    };
+    r.start_data();
+    let mut pts = Vec::with_capacity(cap(n, r.cur.len()));
+    for i in 0..n {
+        let what = format_args!("point {i}");
+        let mut p = [0.0; 3];
+        for x in &mut p {
+            *x = r.float(double, &what)?;
+        }
+        pts.push(p);
+    }
+    Ok(pts)
+}
+
+/// The `CELL_TYPES n` block after its keyword: `n` cell types.
+fn read_cell_types(r: &mut Reader<'_>) -> Result<Vec<i64>, MeshError> {
+    let n = r.count("number of cell types")?;
+    r.start_data();
+    let mut ts = Vec::with_capacity(cap(n, r.cur.len()));
+    for i in 0..n {
+        ts.push(r.int(4, &format_args!("cell type {i}"))?);
+    }
+    Ok(ts)
+}
+
+/// The tet cells of `geometry` (linear, or the corners of a quadratic tet),
+/// each with its point count checked, and their regions from
+/// `cell_regions`; other cells are counted as skipped.
+fn keep_tets(
+    geometry: Geometry<'_>,
+    cell_regions: Option<Vec<u32>>,
+    file: &str,
+) -> Result<RawMesh, MeshError> {
+    let Geometry {
+        positions,
+        cells,
+        types,
+        ..
+    } = geometry;
     let mut tets = Vec::new();
     let mut tet_regions = Vec::new();
     let mut skipped = 0;
@@ -311,6 +372,10 @@ struct Array {
 /// that starts at `keyword` (`POINT_DATA` or `CELL_DATA`, already read), `None` without one.
 /// Errors only on the `region` array itself: not one value per cell, not one component, or a
 /// value that is not a region id.
+///
+/// Each array's header is read by [`Reader::scalars_header`] or
+/// [`Reader::field_region`], the arrays that are not the region read past,
+/// the region's values by [`Reader::region_ids`].
 fn regions(
     r: &mut Reader<'_>,
     mut keyword: Option<&[u8]>,
@@ -319,8 +384,6 @@ fn regions(
     r.cur.section = "CELL_DATA";
     let mut on_cells = false;
     let mut count = 0usize;
-    let number = |w: Option<&&[u8]>| w.and_then(|w| parse_tok::<usize>(w));
-    let data_type = |w: Option<&&[u8]>| w.and_then(|w| DataType::of(w));
     loop {
         let Some(tok) = keyword.take().or_else(|| r.cur.token()) else {
             return Ok(None);
@@ -334,65 +397,17 @@ fn regions(
                 count = n;
                 continue;
             }
-            // SCALARS name type [components], then an optional LOOKUP_TABLE line.
             b"SCALARS" => {
-                let words = r.words();
-                let components = if words.len() > 2 {
-                    number(words.get(2))
-                } else {
-                    Some(1)
-                };
-                if matches!(r.cur.peek_token(), Some(t) if t.eq_ignore_ascii_case(b"LOOKUP_TABLE"))
-                {
-                    r.cur.line();
-                }
-                let (Some(&name), Some(ty), Some(components)) =
-                    (words.first(), data_type(words.get(1)), components)
-                else {
+                let Some(array) = r.scalars_header(on_cells, count) else {
                     return Ok(None);
                 };
-                Array {
-                    is_region: on_cells && name == b"region",
-                    ty,
-                    components,
-                    tuples: count,
-                }
+                array
             }
-            // FIELD name arrays, then per array: name components tuples type, values.
-            b"FIELD" => {
-                let Some(arrays) = number(r.words().get(1)) else {
-                    return Ok(None);
-                };
-                let mut region = None;
-                for _ in 0..arrays {
-                    let words = r.words();
-                    let (Some(&name), Some(components), Some(tuples), Some(ty)) = (
-                        words.first(),
-                        number(words.get(1)),
-                        number(words.get(2)),
-                        data_type(words.get(3)),
-                    ) else {
-                        return Ok(None);
-                    };
-                    let array = Array {
-                        is_region: on_cells && name == b"region",
-                        ty,
-                        components,
-                        tuples,
-                    };
-                    if array.is_region {
-                        region = Some(array);
-                        break;
-                    }
-                    if r.skip_values(ty, components.checked_mul(tuples)).is_none() {
-                        return Ok(None);
-                    }
-                }
-                let Some(region) = region else {
-                    continue;
-                };
-                region
-            }
+            b"FIELD" => match r.field_region(on_cells) {
+                None => return Ok(None),
+                Some(None) => continue,
+                Some(Some(region)) => region,
+            },
             b"VECTORS" | b"NORMALS" | b"TENSORS" => {
                 let per = if tok.eq_ignore_ascii_case(b"TENSORS") {
                     9
@@ -417,6 +432,81 @@ fn regions(
             }
             continue;
         }
+        return r.region_ids(array, cells).map(Some);
+    }
+}
+
+/// A count word of an array header, if it is one.
+fn number(w: Option<&&[u8]>) -> Option<usize> {
+    w.and_then(|w| parse_tok::<usize>(w))
+}
+
+/// A data type word of an array header, if it is one.
+fn data_type(w: Option<&&[u8]>) -> Option<DataType> {
+    w.and_then(|w| DataType::of(w))
+}
+
+impl Reader<'_> {
+    /// After `SCALARS`: `name type [components]`, then an optional
+    /// `LOOKUP_TABLE` line; the array of `count` tuples, the region if it is
+    /// `region` on the cells. `None` if the header is not one.
+    fn scalars_header(&mut self, on_cells: bool, count: usize) -> Option<Array> {
+        let words = self.words();
+        let components = if words.len() > 2 {
+            number(words.get(2))
+        } else {
+            Some(1)
+        };
+        if matches!(self.cur.peek_token(), Some(t) if t.eq_ignore_ascii_case(b"LOOKUP_TABLE")) {
+            self.cur.line();
+        }
+        let (Some(&name), Some(ty), Some(components)) =
+            (words.first(), data_type(words.get(1)), components)
+        else {
+            return None;
+        };
+        Some(Array {
+            is_region: on_cells && name == b"region",
+            ty,
+            components,
+            tuples: count,
+        })
+    }
+
+    /// After `FIELD`: `name arrays`, then per array `name components tuples
+    /// type` and its values. Reads past the arrays up to the region array
+    /// on the cells, whose header it returns (`Some(None)` when the field
+    /// has none, its arrays all read past); `None` if a header is not one or
+    /// values are missing.
+    fn field_region(&mut self, on_cells: bool) -> Option<Option<Array>> {
+        let arrays = number(self.words().get(1))?;
+        for _ in 0..arrays {
+            let words = self.words();
+            let (Some(&name), Some(components), Some(tuples), Some(ty)) = (
+                words.first(),
+                number(words.get(1)),
+                number(words.get(2)),
+                data_type(words.get(3)),
+            ) else {
+                return None;
+            };
+            let array = Array {
+                is_region: on_cells && name == b"region",
+                ty,
+                components,
+                tuples,
+            };
+            if array.is_region {
+                return Some(Some(array));
+            }
+            self.skip_values(ty, components.checked_mul(tuples))?;
+        }
+        Some(None)
+    }
+
+    /// The values of the region `array`: one component per cell of
+    /// `cells`, each a region id.
+    fn region_ids(&mut self, array: Array, cells: usize) -> Result<Vec<u32>, MeshError> {
         let Array {
             ty,
             components,
@@ -424,20 +514,20 @@ fn regions(
             ..
         } = array;
         if components != 1 || tuples != cells {
-            return Err(r.cur.err(format_args!(
+            return Err(self.cur.err(format_args!(
                 "the region array has {tuples} values of {components} components for {cells} cells (expected one integer per cell)"
             )));
         }
-        let mut ids = Vec::with_capacity(cap(cells, r.cur.len()));
+        let mut ids = Vec::with_capacity(cap(cells, self.cur.len()));
         for i in 0..cells {
-            let v = r.value(ty, &format_args!("region of cell {i}"))?;
+            let v = self.value(ty, &format_args!("region of cell {i}"))?;
             let id = region_id(v).ok_or_else(|| {
-                r.cur
+                self.cur
                     .err(format_args!("cell {i}: region {v} {NOT_A_REGION}"))
             })?;
             ids.push(id);
         }
-        return Ok(Some(ids));
+        Ok(ids)
     }
 }
 

@@ -85,7 +85,7 @@ pub struct CostOptions {
     /// Their mass-proportional damping, 1/s.
     pub damping_per_s: f64,
     /// Their incompressibility penalty `γ`, N, where they take it (`None`: the
-    /// experiments' default, `crate::experiment::scenes::penalty_n` of the region).
+    /// experiments' default, `crate::fem::penalty::penalty_n` of the region).
     pub incompressibility_n: Option<f64>,
 }
 
@@ -212,7 +212,7 @@ pub fn costs(
                 let gamma = incompressibility.then(|| {
                     options
                         .incompressibility_n
-                        .unwrap_or_else(|| crate::experiment::scenes::penalty_n(&sub, &default))
+                        .unwrap_or_else(|| crate::fem::penalty::penalty_n(&sub, &default))
                 });
                 let critical_dt_s = stable_step_s(&sub, &surface.triangles, &arrays, options)
                     .with_context(|| format!("the stable step of dynamic region {}", region.id))?;

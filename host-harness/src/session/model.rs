@@ -11,7 +11,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 
 use super::run::{precomputed_options, tensor_mass_options};
 use super::{DynamicSpec, ModelSpec, Scene};
-use crate::experiment::scenes::penalty_n;
+use crate::fem::penalty::penalty_n;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;

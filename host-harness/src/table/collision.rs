@@ -9,7 +9,7 @@ use palpate_kernel::Real;
 use palpate_kernel::contact::grid::{self, BinBuffers, Binned};
 use palpate_kernel::table::{Grid, candidate_radius_m, list_subdivision};
 
-use super::file::Precision;
+use super::precision::Precision;
 use palpate_kernel::table::Plane;
 use palpate_kernel::table::format::{GRID_LEN, PLANE_LEN};
 

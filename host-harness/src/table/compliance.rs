@@ -3,6 +3,7 @@
 
 use anyhow::{Context, ensure};
 use faer::Mat;
+use faer::sparse::SparseColMat;
 use indicatif::{ProgressBar, ProgressStyle};
 use palpate_kernel::table::format::surface_block_index;
 
@@ -65,6 +66,10 @@ const CG_REL_TOL: f64 = 1e-10;
 /// Errors if the ordering or the materials do not match the mesh, a tet
 /// references a missing vertex, `A` is not positive definite (nothing
 /// fixed), or CG does not converge.
+///
+/// Stages: the inputs checked ([`check_inputs`]), `A` assembled, the
+/// columns solved by [`solve_cholesky`] or [`solve_cg`] and scattered into
+/// the blocks ([`Compliance::store`]).
 pub fn compute_compliance(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
@@ -73,6 +78,37 @@ pub fn compute_compliance(
     solver: Solver,
     progress: bool,
 ) -> anyhow::Result<Compliance> {
+    check_inputs(positions, tets, m, ordering)?;
+    let f = ordering.free_count();
+    let s = ordering.touchable_count;
+    let interior_count = f - s;
+    let mut out = Compliance {
+        surface: vec![[0.0; 9]; s * (s + 1) / 2],
+        interior: vec![[0.0; 9]; interior_count * s],
+    };
+    if s == 0 {
+        return Ok(out);
+    }
+    let a = assemble_restricted(positions, tets, m, &ordering.vertex_slot, f);
+    let bar = progress_bar(progress, s);
+    let store = |k0: usize, x: &Mat<f64>| out.store(s, interior_count, k0, x);
+    match solver {
+        Solver::Cholesky => solve_cholesky(&a, s, &bar, store)?,
+        Solver::Cg => solve_cg(&a, s, &bar, store)?,
+    }
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// The ordering is of the mesh's vertices and consistent (free index ↔
+/// vertex both ways, no more touchable than free vertices), the materials
+/// one per tet, every tet's vertices in range.
+fn check_inputs(
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    m: &TetMaterials,
+    ordering: &FreeOrdering,
+) -> anyhow::Result<()> {
     let nv = positions.len();
     ensure!(
         ordering.vertex_slot.len() == nv,
@@ -99,18 +135,13 @@ pub fn compute_compliance(
             "tet {t} references a vertex out of range"
         );
     }
-    let interior_count = f - s;
-    let mut out = Compliance {
-        surface: vec![[0.0; 9]; s * (s + 1) / 2],
-        interior: vec![[0.0; 9]; interior_count * s],
-    };
-    if s == 0 {
-        return Ok(out);
-    }
-    let a = assemble_restricted(positions, tets, m, &ordering.vertex_slot, f);
-    let dof = 3 * f;
+    Ok(())
+}
 
-    let bar = if progress {
+/// A progress bar over the `s` touchable vertices on stderr, or a hidden
+/// one without `progress`.
+fn progress_bar(progress: bool, s: usize) -> ProgressBar {
+    if progress {
         let bar = ProgressBar::new(s as u64);
         if let Ok(style) = ProgressStyle::with_template(
             "compliance {bar:40} {pos}/{len} touchable vertices ({eta})",
@@ -120,10 +151,14 @@ pub fn compute_compliance(
         bar
     } else {
         ProgressBar::hidden()
-    };
+    }
+}
 
-    // Scatter the solved columns of touchable vertices k0..k0+nb.
-    let mut store = |k0: usize, x: &Mat<f64>| {
+impl Compliance {
+    /// Scatters the solved columns `x` (3 per vertex) of touchable vertices
+    /// `k0..k0 + x.ncols()/3` into the blocks, of `s` touchable and
+    /// `interior_count` interior vertices.
+    fn store(&mut self, s: usize, interior_count: usize, k0: usize, x: &Mat<f64>) {
         let nb = x.ncols() / 3;
         for kk in 0..nb {
             let k = k0 + kk;
@@ -137,66 +172,83 @@ pub fn compute_compliance(
                 blk
             };
             for n in 0..=k {
-                out.surface[surface_block_index(n, k)] = block(n);
+                self.surface[surface_block_index(n, k)] = block(n);
             }
             for i in 0..interior_count {
-                out.interior[k * interior_count + i] = block(s + i);
-            }
-        }
-    };
-
-    match solver {
-        Solver::Cholesky => {
-            let llt = SparseLlt::new(a.as_ref()).context("compliance: factorizing A")?;
-            log::debug!(
-                "compliance: {dof} free DOFs, {} non-zeros in A, {} in L",
-                a.compute_nnz(),
-                llt.factor_len()
-            );
-            let mut k0 = 0;
-            while k0 < s {
-                let nb = BATCH_VERTICES.min(s - k0);
-                let mut x = Mat::<f64>::zeros(dof, 3 * nb);
-                for c in 0..3 * nb {
-                    x[(3 * k0 + c, c)] = 1.0;
-                }
-                llt.solve_in_place(x.as_mut());
-                store(k0, &x);
-                k0 += nb;
-                bar.inc(nb as u64);
-            }
-        }
-        Solver::Cg => {
-            check_cg_work(s as u64, dof as u64, a.compute_nnz() as u64)?;
-            let cg = JacobiCg::new(a.as_ref());
-            let inv_diag = cg.inv_diag();
-            ensure!(
-                inv_diag.iter().all(|d| d.is_finite() && *d > 0.0),
-                "A has a non-positive diagonal entry (a free vertex in no tet?)"
-            );
-            let max_iter = 10 * dof;
-            let mut e = vec![0.0f64; dof];
-            for k in 0..s {
-                let mut x = Mat::<f64>::zeros(dof, 3);
-                for b in 0..3 {
-                    e[3 * k + b] = 1.0;
-                    let (col, _) =
-                        cg.solve(&e, &inv_diag, CG_REL_TOL, max_iter)
-                            .with_context(|| {
-                                format!("compliance: CG for touchable vertex {k}, component {b}")
-                            })?;
-                    e[3 * k + b] = 0.0;
-                    for (r, v) in col.into_iter().enumerate() {
-                        x[(r, b)] = v;
-                    }
-                }
-                store(k, &x);
-                bar.inc(1);
+                self.interior[k * interior_count + i] = block(s + i);
             }
         }
     }
-    bar.finish_and_clear();
-    Ok(out)
+}
+
+/// The columns of `A⁻¹` of the `s` touchable vertices by one sparse
+/// Cholesky factorization, solved [`BATCH_VERTICES`] vertices at a time and
+/// handed to `store(first vertex, columns)`.
+fn solve_cholesky(
+    a: &SparseColMat<usize, f64>,
+    s: usize,
+    bar: &ProgressBar,
+    mut store: impl FnMut(usize, &Mat<f64>),
+) -> anyhow::Result<()> {
+    let dof = a.ncols();
+    let llt = SparseLlt::new(a.as_ref()).context("compliance: factorizing A")?;
+    log::debug!(
+        "compliance: {dof} free DOFs, {} non-zeros in A, {} in L",
+        a.compute_nnz(),
+        llt.factor_len()
+    );
+    let mut k0 = 0;
+    while k0 < s {
+        let nb = BATCH_VERTICES.min(s - k0);
+        let mut x = Mat::<f64>::zeros(dof, 3 * nb);
+        for c in 0..3 * nb {
+            x[(3 * k0 + c, c)] = 1.0;
+        }
+        llt.solve_in_place(x.as_mut());
+        store(k0, &x);
+        k0 += nb;
+        bar.inc(nb as u64);
+    }
+    Ok(())
+}
+
+/// The columns of `A⁻¹` of the `s` touchable vertices by Jacobi-preconditioned
+/// CG, one right-hand side at a time ([`CG_REL_TOL`], at most `10·dof`
+/// iterations), handed to `store(vertex, its 3 columns)`.
+fn solve_cg(
+    a: &SparseColMat<usize, f64>,
+    s: usize,
+    bar: &ProgressBar,
+    mut store: impl FnMut(usize, &Mat<f64>),
+) -> anyhow::Result<()> {
+    let dof = a.ncols();
+    check_cg_work(s as u64, dof as u64, a.compute_nnz() as u64)?;
+    let cg = JacobiCg::new(a.as_ref());
+    let inv_diag = cg.inv_diag();
+    ensure!(
+        inv_diag.iter().all(|d| d.is_finite() && *d > 0.0),
+        "A has a non-positive diagonal entry (a free vertex in no tet?)"
+    );
+    let max_iter = 10 * dof;
+    let mut e = vec![0.0f64; dof];
+    for k in 0..s {
+        let mut x = Mat::<f64>::zeros(dof, 3);
+        for b in 0..3 {
+            e[3 * k + b] = 1.0;
+            let (col, _) = cg
+                .solve(&e, &inv_diag, CG_REL_TOL, max_iter)
+                .with_context(|| {
+                    format!("compliance: CG for touchable vertex {k}, component {b}")
+                })?;
+            e[3 * k + b] = 0.0;
+            for (r, v) in col.into_iter().enumerate() {
+                x[(r, b)] = v;
+            }
+        }
+        store(k, &x);
+        bar.inc(1);
+    }
+    Ok(())
 }
 
 /// Checks the estimated work of the CG compliance, `3S` solves of about `sqrt(dof)` iterations

@@ -32,9 +32,9 @@
 use bytemuck::Zeroable;
 use palpate_kernel::table::format::{RawHeader, SectionKind, TableKind};
 
-use super::build::{BuildOptions, TableKindOptions};
 use super::collision::{CELLS_PER_SURFACE_VERTEX, collision_index};
 use super::file::{Precision, layout};
+use super::options::{BuildOptions, TableKindOptions};
 use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
 use crate::mesh::{MeshReport, Surface, TetMesh};
 

@@ -9,15 +9,9 @@ use palpate_kernel::table::format::{
     SectionEntry, SectionKind, TableKind,
 };
 
-/// Float width of the stored tables: `f32` for firmware (the default), `f64`
-/// for verification against reference data.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Precision {
-    /// 4-byte floats.
-    F32,
-    /// 8-byte floats.
-    F64,
-}
+/// The stored float width, defined in [`super::precision`] and named here
+/// too, beside the writer that takes it.
+pub use super::precision::Precision;
 
 /// Everything a pre-computed table holds, in `f64` before rounding.
 pub struct TableContents<'a> {
@@ -199,16 +193,6 @@ impl Section {
             kind,
             count: items.len() as u64,
             bytes,
-        }
-    }
-}
-
-impl Precision {
-    /// Bytes of one stored scalar (the header's `scalar_bytes`).
-    pub fn scalar_bytes(self) -> u32 {
-        match self {
-            Precision::F32 => 4,
-            Precision::F64 => 8,
         }
     }
 }
