@@ -398,8 +398,14 @@ fn the_scanner_follows_re_exports_and_finds_circles() {
     let module = |m: &[&str]| m.iter().map(|s| (*s).to_owned()).collect::<ModulePath>();
     let krate = Crate {
         files: BTreeMap::from([
-            (module(&[]), file("pub mod a; pub mod b; pub use a::x::Thing;")),
-            (module(&["a"]), file("pub mod x; pub mod y; pub use x::Thing;")),
+            (
+                module(&[]),
+                file("pub mod a; pub mod b; pub use a::x::Thing;"),
+            ),
+            (
+                module(&["a"]),
+                file("pub mod x; pub mod y; pub use x::Thing;"),
+            ),
             (
                 module(&["a", "x"]),
                 file("use super::y::{Other, self as why};\npub struct Thing;"),
