@@ -263,6 +263,9 @@ fn dynamic_sessions_run_with_every_law() {
     assert!(forms < 1e-5, "per tet {} vs tensors {}", peaks[1], peaks[2]);
 }
 
+/// Tool samples `(t, position)`, s and m.
+type Samples = Vec<(f64, [f64; 3])>;
+
 /// A tool deeper than the penetration test looks (its centre 5 mm below the
 /// block's top, 2.5 radii), reached without the sweep seeing it cross the
 /// surface, on the built-in block with both models: the first sample
@@ -278,7 +281,7 @@ fn a_tool_deeper_than_its_radius_is_reported_inside() {
     // (t, x, y, z) samples: sample-and-hold between them; the tool rises to
     // 1 mm below the top from t = 0.3 s to 0.35 s.
     let deep = [0.06, 0.06, 0.055];
-    let cases: [(&str, Vec<(f64, [f64; 3])>); 3] = [
+    let cases: [(&str, Samples); 3] = [
         ("first sample inside", vec![(0.0, deep)]),
         (
             "after a far sample",

@@ -88,13 +88,16 @@ fn with_loop<const P: usize, R>(
     body(&mut haptic)
 }
 
+/// Held vertices: index, displacement (m) and share.
+type HeldVertices = Vec<(u32, Vector3<f64>, f64)>;
+
 /// The held vertices of `held` at the static truth's displacements (module
 /// docs) for the tool at `tip_m`, with their shares.
 fn truth_vertices<const P: usize>(
     haptic: &DynamicLoop<'_, '_, f64, P, P>,
     held: &HeldContact<f64>,
     tip_m: Vector3<f64>,
-) -> Vec<(u32, Vector3<f64>, f64)> {
+) -> HeldVertices {
     let c = &held.contact;
     let n = c.normal;
     let rest = haptic.tissue().model().table().rest_positions();
@@ -119,7 +122,7 @@ fn truth_vertices<const P: usize>(
 /// cantilever with every contact's vertices held at `held` (as
 /// [`truth_vertices`]), the reaction at each contact the shares' sum of its
 /// vertices' reactions.
-fn static_forces(held: &[(Vec<(u32, Vector3<f64>, f64)>, Vector3<f64>)]) -> Vec<f64> {
+fn static_forces(held: &[(HeldVertices, Vector3<f64>)]) -> Vec<f64> {
     let options = BuildOptions::precomputed(
         material(),
         vec![FIX.parse().expect("fix")],
