@@ -48,6 +48,7 @@ mod kernel {
     mod candidates;
     mod haptic;
     mod haptic_dynamic;
+    mod haptic_settle;
     mod haptic_tools;
     mod hybrid;
     mod layers;

@@ -155,14 +155,14 @@
 /*
  Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 368
+#define PALPATE_DYNAMIC_LOOP_WORDS 369
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 624
+#define PALPATE_HYBRID_LOOP_WORDS 625
 #endif
 
 #if !defined(PALPATE_POINTER_64)
@@ -557,6 +557,14 @@ enum palpate_output_status
    contact set or diverged.
    */
   PALPATE_OUTPUT_STATUS_FAULT_MODEL = 4,
+  /*
+   Not latched: a tool point's centre is inside the body with no
+   contact (it got deeper than the contact test looks without crossing
+   the surface where the test saw it: a first position inside, a jump,
+   a contact let go inside). It adds no force: the force is the other
+   contacts', slew-limited (with none, it ramps to zero).
+   */
+  PALPATE_OUTPUT_STATUS_TOOL_INSIDE = 5,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -892,7 +900,7 @@ typedef struct palpate_force {
    */
   float force_n[3];
   /*
-   Ok, clamped, or the latched fault.
+   Ok, clamped, the latched fault, or a tool point inside the body.
    */
   palpate_output_status status;
   /*

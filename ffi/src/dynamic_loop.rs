@@ -33,7 +33,7 @@ use crate::table::{self, Table};
 pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 456;
 /// Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
-pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 368;
+pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 369;
 
 /// A haptic loop over a tensor-mass table (opaque). Its memory block must
 /// outlive it, in place and untouched (the table's bytes too). Do not copy

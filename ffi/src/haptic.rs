@@ -141,6 +141,12 @@ pub enum OutputStatus {
     /// Latched fault, zero force until reset: the model refused the
     /// contact set or diverged.
     FaultModel = 4,
+    /// Not latched: a tool point's centre is inside the body with no
+    /// contact (it got deeper than the contact test looks without crossing
+    /// the surface where the test saw it: a first position inside, a jump,
+    /// a contact let go inside). It adds no force: the force is the other
+    /// contacts', slew-limited (with none, it ramps to zero).
+    ToolInside = 5,
 }
 
 /// What the device receives each tick.
@@ -149,7 +155,7 @@ pub enum OutputStatus {
 pub struct Force {
     /// Force on the hand, N (after the supervisor).
     pub force_n: [f32; 3],
-    /// Ok, clamped, or the latched fault.
+    /// Ok, clamped, the latched fault, or a tool point inside the body.
     pub status: OutputStatus,
     /// Tool points in contact.
     pub contacts: u8,
@@ -174,6 +180,7 @@ impl From<&ForceOutput<f32>> for Force {
                     OutputStatus::FaultNonFiniteForce
                 }
                 KernelStatus::Faulted(SafetyFault::ModelFault) => OutputStatus::FaultModel,
+                KernelStatus::ToolInside => OutputStatus::ToolInside,
             },
             contacts: out.contacts,
             refused: out.refused,

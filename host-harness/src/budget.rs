@@ -15,7 +15,9 @@
 //! test's second pass and up to 7 more cells along the sweep; without, `3
 //! · max_query_triangles`, two point queries, the sweep's and the
 //! penetration test's sharing the one at the tool, and the second pass;
-//! both table-declared maxima over all grid cells, computed at load), `P` tool
+//! plus one `max_query_triangles` for the deep check that may follow a
+//! detection that made no contact; all table-declared maxima over all grid
+//! cells, computed at load), `P` tool
 //! points, `M` the contact capacity and `P + 1` the most solves a tick can
 //! do. The unit costs are the largest per-unit costs callgrind measured on
 //! this build (x86-64, `cargo build`, the workspace's opt-level 2 for our
@@ -26,10 +28,11 @@
 //! included (`palpate budget built-in`).
 //!
 //! The dynamic model's tick (between physics updates, which run outside the
-//! measured function) has the bound `BASE + P · (TRIANGLE · 6T + WALK ·
+//! measured function) has the bound `BASE + P · (TRIANGLE · 9T + WALK ·
 //! MAX_WALK_STEPS + DYNAMIC_TRACK) + (P + 1) · DYNAMIC_SOLVE · M`: a
 //! detection on the re-binned grid tests at most every triangle reference
-//! twice (`3F` references for the `F` faces a cut can expose), since compression can crowd a bucket, and
+//! twice, and the deep check that may follow it once more (`3F` references
+//! for the `F` faces a cut can expose), since compression can crowd a bucket, and
 //! a solve is linear in the contacts (no factorization). The tick is the
 //! same with grips and blades (a held contact skips the walk; a blade cuts
 //! at the physics update, outside the tick). Measured on
@@ -147,7 +150,8 @@ pub fn tick_bound(
 /// The static per-tick bound (in the unit of `costs`) of the dynamic
 /// model's tick, between physics updates, for `points` tool points and
 /// capacity `capacity` over `table`. A detection tests at most every
-/// triangle reference of the surface twice (`2 × 3F`, `F` the mesh's
+/// triangle reference of the surface twice, and the deep check that may
+/// follow it once more (`3 × 3F`, `F` the mesh's
 /// faces, every one of which a cut may expose): the re-binned grid's
 /// buckets depend on the deformation, so no tighter bound holds for any
 /// state.
@@ -157,7 +161,7 @@ pub fn dynamic_tick_bound(
     points: u64,
     capacity: u64,
 ) -> u64 {
-    let detection = 2 * 3 * table.mesh_triangles().len() as u64;
+    let detection = 3 * 3 * table.mesh_triangles().len() as u64;
     costs.base
         + points
             * (costs.triangle * detection
@@ -168,8 +172,9 @@ pub fn dynamic_tick_bound(
 
 /// The static per-tick bound (in the unit of `costs`) of the hybrid
 /// model's tick (RR-3510 §6.2), between physics updates, for `points` tool
-/// points and capacity `capacity`: a detection tests at most every triangle
-/// reference of the whole surface twice (`2 × 3 (B + F)`, the pre-computed
+/// points and capacity `capacity`: a detection and its deep check test at
+/// most every triangle reference of the whole surface three times
+/// (`3 × 3 (B + F)`, the pre-computed
 /// region's `B` boundary triangles and the tensor-mass region's `F` faces),
 /// and each solve is the pre-computed one (`O(M³)`) and the tensor-mass one
 /// (linear) together.
@@ -181,7 +186,7 @@ pub fn hybrid_tick_bound(
     capacity: u64,
 ) -> u64 {
     let slots = precomputed.surface_triangles().len() + dynamic.mesh_triangles().len();
-    let detection = 2 * 3 * slots as u64;
+    let detection = 3 * 3 * slots as u64;
     costs.base
         + points
             * (costs.triangle * detection

@@ -299,3 +299,45 @@ fn an_msh_node_id_of_zero_is_named_as_written() {
         &["zero-node.msh", "element id 7", "node id 0 is not defined"],
     );
 }
+
+/// A probe whose first sample is 5 mm inside the built-in block's top
+/// (2.5 radii: deeper than the penetration test looks) and stays there
+/// for 0.4 s once ran 401 ticks with 0 contacts, zero force and every
+/// status `ok`: the tool was inside, silently. Now every tick says
+/// `tool-inside` (zero force: the probe adds none) and the run's summary
+/// counts them.
+#[test]
+fn a_probe_starting_inside_the_block_is_reported_not_silent() {
+    let trajectory = temp("inside.csv");
+    std::fs::write(
+        &trajectory,
+        "t,tool,x,y,z\n0,0,0.06,0.06,0.055\n0.4,0,0.06,0.06,0.055\n",
+    )
+    .unwrap();
+    let forces = temp("inside-forces.csv");
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        trajectory.to_str().unwrap(),
+        "--out",
+        forces.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("401 ticks with a tool point inside the body"),
+        "{stderr}"
+    );
+    let csv = std::fs::read_to_string(&forces).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 401);
+    for r in &rows {
+        assert_eq!(r[1..6], ["0", "0", "0", "0", "tool-inside"], "{r:?}");
+    }
+}

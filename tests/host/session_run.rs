@@ -5,6 +5,7 @@
 
 use palpate::session::run::run_session;
 use palpate::session::{Generator, Poke, Scene, Slide, Strike, Trajectory};
+use palpate_tests::traj;
 
 fn run(scene: &Scene, trajectory: &Trajectory) -> (String, palpate::session::run::SessionSummary) {
     let mut out = Vec::new();
@@ -260,4 +261,69 @@ fn dynamic_sessions_run_with_every_law() {
     }
     let forms = (peaks[1] - peaks[2]).abs() / peaks[1];
     assert!(forms < 1e-5, "per tet {} vs tensors {}", peaks[1], peaks[2]);
+}
+
+/// Tool samples `(t, position)`, s and m.
+type Samples = Vec<(f64, [f64; 3])>;
+
+/// A tool deeper than the penetration test looks (its centre 5 mm below the
+/// block's top, 2.5 radii), reached without the sweep seeing it cross the
+/// surface, on the built-in block with both models: the first sample
+/// there; a first sample far beside the block (at x = 1 m, beyond the
+/// grid) then there; and a fast sideways entry (3 cm inside the side face x = 0 in
+/// one tick, beyond a grid cell from the face). Each run's ticks with the
+/// tool inside are reported `tool-inside` (never a silent `ok` with no
+/// contact and zero force), with zero force, until the tool comes back up
+/// to 1 mm below the top, where the penetration test finds it: a contact,
+/// pushing the tool out (+z).
+#[test]
+fn a_tool_deeper_than_its_radius_is_reported_inside() {
+    // (t, x, y, z) samples: sample-and-hold between them; the tool rises to
+    // 1 mm below the top from t = 0.3 s to 0.35 s.
+    let deep = [0.06, 0.06, 0.055];
+    let cases: [(&str, Samples); 3] = [
+        ("first sample inside", vec![(0.0, deep)]),
+        (
+            "after a far sample",
+            vec![(0.0, [1.0, 0.06, 0.055]), (0.001, deep)],
+        ),
+        (
+            "fast sideways entry",
+            vec![(0.0, [-0.02, 0.06, 0.055]), (0.001, [0.03, 0.06, 0.055])],
+        ),
+    ];
+    for scene in [Scene::built_in(), Scene::built_in_dynamic()] {
+        for (name, samples) in &cases {
+            let at = samples.last().map(|(_, p)| *p).expect("samples");
+            let mut text = String::from("t,tool,x,y,z\n");
+            for (t, [x, y, z]) in samples {
+                text += &format!("{t},0,{x},{y},{z}\n");
+            }
+            text += &format!("0.3,0,{},{},{}\n", at[0], at[1], at[2]);
+            text += &format!("0.35,0,{},{},0.059\n", at[0], at[1]);
+            text += &format!("0.4,0,{},{},0.059\n", at[0], at[1]);
+            let (csv, summary) = run(&scene, &traj(&text, 1));
+            let rows: Vec<Vec<&str>> = csv
+                .lines()
+                .skip(1)
+                .map(|l| l.split(',').collect())
+                .collect();
+            let label = format!("{}: {name}", scene.source);
+            println!("{label}: {summary:?}");
+            // Every tick from the one at the deep point to t = 0.3 s.
+            let first = samples.len() - 1;
+            for (k, r) in rows.iter().enumerate().take(300).skip(first) {
+                assert_eq!(r[5], "tool-inside", "{label}: tick {k}: {r:?}");
+                assert_eq!(r[4], "0", "{label}: tick {k}");
+                let f: f64 = r[3].parse().expect("fz");
+                assert_eq!(f, 0.0, "{label}: tick {k}");
+            }
+            assert!(summary.tool_inside >= 300 - first, "{label}");
+            let last = rows.last().expect("rows");
+            assert_eq!(last[4], "1", "{label}: found again near the top: {last:?}");
+            assert_ne!(last[5], "tool-inside", "{label}");
+            let fz: f64 = last[3].parse().expect("fz");
+            assert!(fz > 0.0, "{label}: pushes out: {last:?}");
+        }
+    }
 }

@@ -140,6 +140,12 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                     summary.cut_refused
                 );
             }
+            if summary.tool_inside > 0 {
+                eprintln!(
+                    "{} ticks with a tool point inside the body and no contact: it adds no force (status tool-inside)",
+                    summary.tool_inside
+                );
+            }
             if let Some(e) = summary.physics_error {
                 eprintln!("physics update failed at {e}; the force was zero from the next tick on");
             }

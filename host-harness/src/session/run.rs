@@ -3,7 +3,9 @@
 //! trajectory and writes one CSV line per tick, `t,fx,fy,fz,contacts,status`
 //! (s, N, N, N, count, `ok` | `clamped` | `faulted:<reason>` |
 //! `cut-refused`: an enabled blade touched tissue the model cannot cut, the
-//! pre-computed model; the force is the probe's, unclamped).
+//! pre-computed model; the force is the probe's, unclamped |
+//! `tool-inside`: a tool point's centre is inside the body with no contact,
+//! it adds no force, [`OutputStatus::ToolInside`]).
 //!
 //! The scene's tools ([`super::tools`]): probes, graspers (two jaws that
 //! hold what they touch once closed) and cutters (a blade that removes the
@@ -243,6 +245,9 @@ pub struct SessionSummary {
     pub removed_tets: usize,
     /// Ticks whose blade touched tissue that cannot be cut.
     pub cut_refused: usize,
+    /// Ticks with a tool point inside the body and no contact (status
+    /// `tool-inside`: it adds no force).
+    pub tool_inside: usize,
 }
 
 /// [`run_session`] into files, as `palpate session run` does: the CSV to the
@@ -694,6 +699,10 @@ impl Session<'_, '_> {
             OutputStatus::Clamped => {
                 summary.clamped += 1;
                 "clamped".to_string()
+            }
+            OutputStatus::ToolInside => {
+                summary.tool_inside += 1;
+                "tool-inside".to_string()
             }
             OutputStatus::Faulted(reason) => {
                 summary.faulted += 1;

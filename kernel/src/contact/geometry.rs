@@ -125,6 +125,9 @@ enum Pass<T> {
     Tool,
     /// Around the motion's start: the sweep only.
     Start,
+    /// Around the tool, for [`SurfaceGeometry::centre_inside`]: the nearest
+    /// plane over the centre at any distance (no sweep, no depth bound).
+    Deep,
     /// Around the tool again, when more unreached planes came than
     /// [`Unreached`] keeps: is one over the centre nearer than `bound_m`,
     /// or as near and tested before the `order`-th? Then it, not the
@@ -669,6 +672,53 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         Some((triangle, weights, true))
     }
 
+    /// Whether the centre `to_m` (m) of a tool sphere of radius `radius_m`
+    /// lies inside the body: the deep check a detection that made no
+    /// contact is followed by when the tool may have got deeper than the
+    /// penetration test looks ([`PENETRATION_DEPTH_RADII`] radii behind a
+    /// plane) without the sweep seeing it cross the surface (the haptic
+    /// loop's first tick, a motion longer than a grid cell, a contact let
+    /// go or refused: `HapticLoop::tick_tools`).
+    ///
+    /// Among the surface triangles around the surface vertices in the 27
+    /// grid cells around `to_m` (the walk of [`Self::detect`], bounded by
+    /// [`SurfaceIndex::max_query_triangles`]; the grid's cell is at least
+    /// the longest surface edge, so a centre within a cell of the surface
+    /// sees the faces over it), the one with the nearest plane over the
+    /// centre (its projection inside the triangle) decides:
+    /// `Some(true)` when the centre lies behind it (inside the body),
+    /// `Some(false)` in front of it, or for a centre beyond the grid's
+    /// reach (outside every face's box by more than a cell); `None` when no
+    /// plane there lies over the centre (deeper in a body than a grid cell,
+    /// or in a cavity wider than one): the surface near the tool does not
+    /// say.
+    pub fn centre_inside(
+        &self,
+        to_m: &Vector3<T>,
+        radius_m: T,
+        work: &mut ContactWork,
+    ) -> Option<bool> {
+        if !within(to_m, &self.index.reach(radius_m)) {
+            return Some(false);
+        }
+        let mut planes = UnreachedPlanes::new();
+        let mut scan = Scan {
+            sphere: Sphere {
+                to_m: *to_m,
+                radius_m,
+                depth_m: T::zero(),
+            },
+            segment: None,
+            hit: None,
+            reached: None,
+            unreached: Unreached::new(&mut planes),
+            order: 0,
+            covered: false,
+        };
+        self.visit(to_m, &mut Visited::new(), work, Pass::Deep, &mut scan);
+        scan.reached.map(|nearest| nearest.distance_m < T::zero())
+    }
+
     /// Runs `pass` of `scan` once for each surface triangle around the
     /// surface vertices in the 27 grid cells around `around` (m) that
     /// `visited` has not met; a triangle is around up to three of the
@@ -776,6 +826,12 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
                     }
                 }
                 scan.order = scan.order.wrapping_add(1);
+            }
+            Pass::Deep => {
+                if normal != Vector3::zeros() {
+                    let distance = normal.dot(&to_m) - offset;
+                    self.nearest_test(t, distance, &to_m, scan.order, &mut scan.reached);
+                }
             }
             Pass::Covered { bound_m, order } => {
                 let distance = normal.dot(&to_m) - offset;

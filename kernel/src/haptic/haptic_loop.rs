@@ -31,7 +31,8 @@ use crate::{MAX_CONTACTS, Real};
 pub struct ForceOutput<T> {
     /// Force on the hand, N (after the supervisor).
     pub force_n: Vector3<T>,
-    /// Ok, clamped, or faulted with the reason.
+    /// Ok, clamped, faulted with the reason, or a tool point inside the
+    /// body with no contact ([`OutputStatus::ToolInside`]).
     pub status: OutputStatus,
     /// Tool points in contact.
     pub contacts: u8,
@@ -92,6 +93,13 @@ pub struct HapticLoop<T: Real, B, const P: usize, const M: usize> {
     previous_m: Option<[Vector3<T>; P]>,
     actions: [ToolAction<T>; P],
     contacts: [Option<Contact<T>>; P],
+    /// Bit `p`: tool point `p`'s centre was inside the body with no
+    /// contact at the last tick ([`OutputStatus::ToolInside`]). Bits, not
+    /// an array: the C interface's loop handles have a fixed size.
+    inside: u8,
+    /// Bit `p`: look for tool point `p` inside the body at the next tick if
+    /// no contact is made (it lost its contact).
+    recheck: u8,
     counters: TickCounters,
 }
 
@@ -128,6 +136,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             previous_m: None,
             actions: [ToolAction::Touch; P],
             contacts: [None; P],
+            inside: 0,
+            recheck: 0,
             counters: TickCounters::default(),
         })
     }
@@ -155,6 +165,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         self.contacts = [None; P];
         self.previous_m = None;
         self.actions = [ToolAction::Touch; P];
+        self.inside = 0;
+        self.recheck = 0;
         self.tissue.reset();
     }
 
@@ -182,6 +194,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             self.contacts = [None; P];
             self.previous_m = None;
             self.actions = [ToolAction::Touch; P];
+            self.inside = 0;
+            self.recheck = 0;
             self.tissue.forget();
             return self.output(Err(SafetyFault::NonFiniteInput), dt, 0);
         }
@@ -191,6 +205,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             self.tissue.forget();
             self.previous_m = Some(tool_m);
             self.actions = [ToolAction::Touch; P];
+            self.inside = 0;
+            self.recheck = 0;
             return self.output(Err(SafetyFault::ModelFault), dt, 0);
         }
         let mut refused = self.track_and_detect(tools);
@@ -231,9 +247,10 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         // The loan ends here (the set's drop would hold it to the end).
         drop(set);
         if let Some(device_force_n) = solved {
-            for (slot, &d) in self.contacts.iter_mut().zip(&dropped) {
+            for (p, (slot, &d)) in self.contacts.iter_mut().zip(&dropped).enumerate() {
                 if d {
                     *slot = None;
+                    self.recheck |= bit(p);
                 }
             }
             return self.output(Ok(device_force_n), dt, refused);
@@ -247,6 +264,18 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
     /// opening lets it go) and detects new ones from the motion segment or
     /// the penetration where the tool stands; returns how many new
     /// contacts the capacity `M` refused.
+    ///
+    /// A tool point left with no contact is then looked for inside the body
+    /// ([`crate::contact::SurfaceGeometry::centre_inside`], one more walk
+    /// of the 27 grid cells around it) when it may have got deeper than the
+    /// penetration test looks without the sweep seeing it cross the
+    /// surface: at its first tick (no earlier position), after a motion of
+    /// more than a grid cell on an axis (the sweep tests only the
+    /// triangles around the motion's two ends), and at the tick after it
+    /// lost a contact or was inside. Where the surface near it does not say
+    /// (no face over the centre within the walk), a point inside stays
+    /// inside and any other is outside. A point inside adds no force and
+    /// the output says so ([`OutputStatus::ToolInside`]).
     fn track_and_detect(&mut self, tools: &[ToolInput<T>; P]) -> u8 {
         let radius = self.config.radius_m;
         let Self {
@@ -255,6 +284,8 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             counters,
             previous_m,
             actions,
+            inside,
+            recheck,
             ..
         } = self;
         let refused = tissue.with_geometry(|surface| {
@@ -268,6 +299,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                 let gripping = tool.action == ToolAction::Grip;
                 let closing = gripping && *was != ToolAction::Grip;
                 let work = &mut counters.contact;
+                let mut lost = false;
                 match slot {
                     Some(c) => {
                         // Tracked in place (no copy of the contact record).
@@ -278,6 +310,7 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                             && (c.grip_offset_m.is_some() || tissue.keeps(c.gap_m));
                         if !kept {
                             *slot = None;
+                            lost = true;
                         } else if closing {
                             c.grip();
                         }
@@ -287,13 +320,33 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
                         surface.detect_into(p, from, tip, radius, work, slot);
                     }
                 }
+                let mask = bit(p);
+                let (was_inside, again) = (*inside & mask != 0, *recheck & mask != 0);
+                *inside &= !mask;
+                *recheck &= !mask;
                 if slot.is_some() {
                     if active < M {
                         active += 1;
                     } else {
                         *slot = None;
                         refused = refused.saturating_add(1);
+                        *recheck |= mask;
                     }
+                    continue;
+                }
+                let from = previous_m.as_ref().and_then(|prev| prev.get(p));
+                let cell_m = surface.index().cell_m();
+                let jumped = from.is_none_or(|from| (tip - from).amax() > cell_m);
+                let now_inside = if jumped || lost || again || was_inside {
+                    let work = &mut counters.contact;
+                    surface
+                        .centre_inside(tip, radius, work)
+                        .unwrap_or(was_inside)
+                } else {
+                    false
+                };
+                if now_inside {
+                    *inside |= mask;
                 }
             }
             refused
@@ -319,7 +372,10 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
         dt: T,
         refused: u8,
     ) -> ForceOutput<T> {
-        let (force_n, status) = self.supervisor.output(requested, dt);
+        let (force_n, mut status) = self.supervisor.output(requested, dt);
+        if !matches!(status, OutputStatus::Faulted(_)) && self.inside != 0 {
+            status = OutputStatus::ToolInside;
+        }
         let cutting = self
             .actions
             .iter()
@@ -333,6 +389,13 @@ impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, 
             cut_refused: cutting && !self.tissue.can_cut(),
         }
     }
+}
+
+/// Tool point `p`'s bit in the loop's per-point masks (`p < P ≤
+/// MAX_CONTACTS ≤ 8`).
+fn bit(p: usize) -> u8 {
+    const { assert!(MAX_CONTACTS <= 8, "one bit per tool point in a u8") };
+    1u8.checked_shl(p as u32).unwrap_or(0)
 }
 
 impl<'a, T: Real, const P: usize, const M: usize> PrecomputedLoop<'a, T, P, M> {

@@ -48,6 +48,19 @@ pub enum OutputStatus {
     Ok,
     /// The force was reduced by the magnitude clamp or the slew limit.
     Clamped,
+    /// A tool point's centre lies inside the body and it has no contact
+    /// (not latched; the haptic loop says so, the supervisor never does):
+    /// it went deeper than the penetration test looks without the sweep
+    /// seeing it cross the surface (the first sample inside, a jump of more
+    /// than a grid cell, a contact let go or refused while inside). It adds
+    /// no force (it is not pushed out: from deep inside, the nearest face is
+    /// not necessarily the one it entered by, and a push through the wrong
+    /// one is the pop-through a device must never give), so the force is
+    /// the other contacts', slew-limited as always: with no other contact
+    /// it ramps down to zero. The point is found again as usual once it
+    /// reaches within the penetration test's depth of the surface, and the
+    /// status clears once it is found or outside.
+    ToolInside,
     /// Latched fault: the force is zero until [`Supervisor::reset`].
     Faulted(SafetyFault),
 }

@@ -220,14 +220,18 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// short motion, the tool's cell twice (the test, and the penetration
     /// test's second pass) and up to `2³ − 1` more cells along the sweep;
     /// a longer motion, or a tool the lists do not serve, walks: `3 ×
-    /// max_query_triangles`. The larger of the two when the lists serve.
+    /// max_query_triangles`. The larger of the two when the lists serve;
+    /// plus one walk, `max_query_triangles`, for the deep check a
+    /// detection that made no contact may be followed by
+    /// (`SurfaceGeometry::centre_inside`).
     pub fn max_detection_tests(&self, radius_m: T) -> u32 {
         let walk = self.max_query_triangles.saturating_mul(3);
-        if self.serves(radius_m) {
+        let detection = if self.serves(radius_m) {
             walk.max(self.max_cell_triangles.saturating_mul(9))
         } else {
             walk
-        }
+        };
+        detection.saturating_add(self.max_query_triangles)
     }
 
     /// The most candidate triangles one point query

@@ -451,6 +451,7 @@ fn publish_tick(out: &ForceOutput<f32>, solves: u32) {
         OutputStatus::Ok => 0,
         OutputStatus::Clamped => 1,
         OutputStatus::Faulted(_) => 2,
+        OutputStatus::ToolInside => 3,
     };
     let o = addr_of_mut!(HAPTIC_OUTPUTS);
     // SAFETY: single-threaded; plain-old-data fields of a live static.
