@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
+use palpate::output::stderr;
 
 mod commands;
 
@@ -76,7 +77,7 @@ fn main() -> ExitCode {
         // The reader of standard output went away (`… | head -1`): a normal end.
         Err(e) if commands::stdout::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            stderr::line(&format!("error: {e:#}"));
             ExitCode::from(2)
         }
     }

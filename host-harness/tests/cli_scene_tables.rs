@@ -137,7 +137,10 @@ fn an_output_that_is_an_input_is_refused_before_any_work() {
         "--out-dir",
         &dir.display().to_string(),
     ]);
-    assert_one_line_error(&out, &["refusing to overwrite an input"]);
+    assert_one_line_error(
+        &out,
+        &["interface.bin is inside --out-dir", "replaced as a whole"],
+    );
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), toml);
     assert!(!dir.join("precomputed.bin").exists());
 }

@@ -17,6 +17,7 @@ use crate::fem::material::Material;
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_BENCH_ESTIMATE_S, MAX_BENCH_SAMPLE_S, MAX_BENCH_SAMPLES};
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::stderr;
 use crate::table::build::BuildOptions;
 use crate::table::compliance::Solver;
 use crate::table::estimate::SizeLimits;
@@ -432,7 +433,7 @@ pub fn run(
             Item::Tick(m) => match pre()?.time_tick(m, precision, sampling) {
                 Ok(timing) => (timing, None, None),
                 Err(e) => {
-                    eprintln!("warning: {}: {e:#}", what.label());
+                    stderr::line(&format!("warning: {}: {e:#}", what.label()));
                     continue;
                 }
             },

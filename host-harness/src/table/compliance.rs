@@ -3,13 +3,13 @@
 
 use anyhow::{Context, ensure};
 use faer::Mat;
-use indicatif::{ProgressBar, ProgressStyle};
 use palpate_kernel::table::format::surface_block_index;
 
 use super::cg::JacobiCg;
 use crate::fem::assembly::{FreeOrdering, assemble_restricted};
 use crate::fem::llt::SparseLlt;
 use crate::fem::material::TetMaterials;
+use crate::output::stderr;
 
 /// How [`compute_compliance`] solves `A x = e`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,17 +110,11 @@ pub fn compute_compliance(
     let a = assemble_restricted(positions, tets, m, &ordering.vertex_slot, f);
     let dof = 3 * f;
 
-    let bar = if progress {
-        let bar = ProgressBar::new(s as u64);
-        if let Ok(style) = ProgressStyle::with_template(
-            "compliance {bar:40} {pos}/{len} touchable vertices ({eta})",
-        ) {
-            bar.set_style(style);
-        }
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    let bar = stderr::progress_bar(
+        s as u64,
+        "compliance {bar:40} {pos}/{len} touchable vertices ({eta})",
+        progress,
+    );
 
     // Scatter the solved columns of touchable vertices k0..k0+nb.
     let mut store = |k0: usize, x: &Mat<f64>| {
