@@ -279,7 +279,7 @@ fn negative_material_values_get_the_physics_message() {
     ]);
     assert_one_line_error(
         &out,
-        &["Poisson ratio must satisfy 0 <= nu < 0.5, got -0.1"],
+        &["Poisson ratio must satisfy 0 <= nu <= 0.4999", "got -0.1"],
     );
 }
 

@@ -17,6 +17,7 @@ use crate::fem::material::Material;
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_BENCH_ESTIMATE_S, MAX_BENCH_SAMPLE_S, MAX_BENCH_SAMPLES};
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::number::shown;
 use crate::output::stderr;
 use crate::table::build::BuildOptions;
 use crate::table::compliance::Solver;
@@ -337,7 +338,7 @@ pub fn check(mesh: &TetMesh, options: &BenchOptions) -> anyhow::Result<RunEstima
         bail!(
             "--sample-ms must be > 0 and at most {} ms (MAX_BENCH_SAMPLE_S), got {}",
             MAX_BENCH_SAMPLE_S * 1e3,
-            s.sample_s * 1e3
+            shown(s.sample_s * 1e3)
         );
     }
     let items = plan(options, 0.0);

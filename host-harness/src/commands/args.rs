@@ -16,7 +16,7 @@ pub struct MaterialArgs {
     /// Young's modulus, Pa.
     #[arg(long, allow_negative_numbers = true)]
     pub young: f64,
-    /// Poisson ratio, in [0, 0.5).
+    /// Poisson ratio, in [0, 0.4999].
     #[arg(long, allow_negative_numbers = true)]
     pub poisson: f64,
 }

@@ -46,7 +46,7 @@ pub struct ChartArgs {
     /// Young's modulus of `--mesh`, Pa.
     #[arg(long, requires = "mesh", allow_negative_numbers = true)]
     young: Option<f64>,
-    /// Poisson ratio of `--mesh`, in [0, 0.5).
+    /// Poisson ratio of `--mesh`, in [0, 0.4999].
     #[arg(long, requires = "mesh", allow_negative_numbers = true)]
     poisson: Option<f64>,
     /// Fixed vertices of `--mesh`: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).

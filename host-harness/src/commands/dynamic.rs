@@ -84,7 +84,7 @@ pub struct DynamicModelArgs {
     /// Young's modulus, Pa.
     #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
     young: Option<f64>,
-    /// Poisson ratio, in [0, 0.5).
+    /// Poisson ratio, in [0, 0.4999].
     #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
     poisson: Option<f64>,
     /// Mass density, kg/m3.
@@ -183,7 +183,10 @@ impl ModelArg {
                 Ok((stvk, Some(gamma)))
             }
             (ModelArg::StvkIncompressible, Some(gamma)) => {
-                bail!("--incompressibility must be finite and >= 0 N, got {gamma}")
+                bail!(
+                    "--incompressibility must be finite and >= 0 N, got {}",
+                    palpate::output::number::shown(gamma)
+                )
             }
             (ModelArg::StvkIncompressible, None) => {
                 bail!("--model stvk-incompressible needs --incompressibility <gamma> (N)")

@@ -45,7 +45,12 @@ impl SceneModel {
     pub fn of(scene: &Scene, mesh: &TetMesh, report: &MeshReport) -> anyhow::Result<Self> {
         if scene.zones.is_empty() {
             return Ok(match scene.model {
-                ModelSpec::Precomputed => Self::Precomputed,
+                ModelSpec::Precomputed => {
+                    // A piece held by no fixed vertex makes the stiffness
+                    // singular: said as `scene plan` says it, before the build.
+                    Partition::of_scene(scene, mesh, report).map_err(|e| anyhow!("{e}"))?;
+                    Self::Precomputed
+                }
                 ModelSpec::Dynamic(spec) => Self::Dynamic(spec),
             });
         }
