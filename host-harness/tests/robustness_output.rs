@@ -530,8 +530,17 @@ fn a_full_or_closed_standard_error_never_stops_a_run() {
         let runs: Vec<(Vec<&str>, i32)> = vec![
             (
                 vec![
-                    "tables", "build", &mesh, "--young", "5000", "--poisson", "0.45", "--fix",
-                    "z<0.001", "-o", s(&table),
+                    "tables",
+                    "build",
+                    &mesh,
+                    "--young",
+                    "5000",
+                    "--poisson",
+                    "0.45",
+                    "--fix",
+                    "z<0.001",
+                    "-o",
+                    s(&table),
                 ],
                 0,
             ),
@@ -579,8 +588,17 @@ fn a_full_or_closed_standard_error_never_stops_a_run() {
             // An error: its one line cannot be shown, its status can.
             (
                 vec![
-                    "tables", "build", "missing.msh", "--young", "5000", "--poisson", "0.45",
-                    "--fix", "z<0.001", "-o", s(&table),
+                    "tables",
+                    "build",
+                    "missing.msh",
+                    "--young",
+                    "5000",
+                    "--poisson",
+                    "0.45",
+                    "--fix",
+                    "z<0.001",
+                    "-o",
+                    s(&table),
                 ],
                 2,
             ),
@@ -641,7 +659,13 @@ fn chart_and_scene_tables_refuse_a_folder_palpate_did_not_write() {
         std::fs::write(tables.join(file), "old").expect("file");
     }
     for _ in 0..2 {
-        let out = palpate(&["scene", "tables", "built-in-hybrid", "--out-dir", s(&tables)]);
+        let out = palpate(&[
+            "scene",
+            "tables",
+            "built-in-hybrid",
+            "--out-dir",
+            s(&tables),
+        ]);
         assert!(out.status.success(), "{}", stderr(&out));
         for file in ["precomputed.bin", "dynamic.bin", "interface.bin"] {
             let bytes = std::fs::read(tables.join(file)).expect("table");
