@@ -1,7 +1,7 @@
 //! Values in messages, bounded in length: Rust's `{}` writes an `f64`
 //! without an exponent, so `1e300` is 301 digits and `5e-324` 326
 //! characters. [`shown`] writes the shortest form that reads back the same
-//! value, with an exponent outside `[1e-4, 1e7)`: at most 24 characters.
+//! value, with an exponent outside `[1e-4, 1e15)` (integers of up to 15 digits stay plain): at most 24 characters.
 //! [`time_s`] writes a time with nine significant digits (`2.264`, not the
 //! accumulated `2.2640000000000002`).
 
@@ -19,7 +19,7 @@ pub fn shown(x: f64) -> Shown {
 impl fmt::Display for Shown {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let x = self.0;
-        let plain = x == 0.0 || !x.is_finite() || (1e-4..1e7).contains(&x.abs());
+        let plain = x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs());
         if plain {
             write!(f, "{x}")
         } else {

@@ -79,7 +79,7 @@ pub fn check_regions(
                      most {} times stiffer or softer (beyond, the table build's stiffness is \
                      singular)",
                     shown(young_pa),
-                    shown(MAX_STIFFNESS_CONTRAST)
+                    format_args!("{MAX_STIFFNESS_CONTRAST:e}")
                 ),
             ));
         }
