@@ -2,7 +2,9 @@
 //! sessions, experiments, demo. This file parses, dispatches to the command
 //! groups of [`commands`] and applies the error policy: any error is one
 //! line `error: …` on stderr and exit status 2, except a closed standard
-//! output (a broken pipe), which ends the run normally (exit 0).
+//! output (a broken pipe), which ends the run normally (exit 0). Standard
+//! error is written through `palpate::output::stderr` only: a full or
+//! closed one loses the lines, never the run (its outputs, its status).
 
 use std::process::ExitCode;
 
