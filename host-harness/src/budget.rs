@@ -57,7 +57,7 @@ use palpate_kernel::table::TensorMassTable;
 use palpate_script::ticks::{Header, Settings, tool_words, write_tick};
 
 use crate::mesh::{MeshReport, TetMesh};
-use crate::output::atomic::AtomicFile;
+use crate::output::atomic::{AtomicFile, work_folder};
 use crate::session::generate::{
     GenerateError, Generator, Keyframe, Pinch, Poke, Press, PressHold, Slide, Strike, hepatectomy,
     sample_keyframes, surgery,
@@ -396,7 +396,7 @@ pub fn record(
     let (mesh, report) = scene.load_mesh()?;
     check_scene_table(scene, &mesh, &report)?;
     check_stable_step(scene, &mesh, &report)?;
-    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    work_folder("--record", dir)?;
     let (tables, bound) = budget_table(scene, &mesh, &report, &M4F_CYCLES, compression)?;
     tables.write(&dir.join(RECORD_TABLE))?;
     let load = |e| anyhow::anyhow!("table: {e}");

@@ -82,7 +82,7 @@ pub fn check_tet_steps(what: &str, tets: u64, steps: u64, instead: &str) -> anyh
         );
     }
     if seconds > PRINT_ESTIMATE_ABOVE_S {
-        eprintln!("{what}: estimate: {figures}");
+        crate::output::stderr::line(&format!("{what}: estimate: {figures}"));
     }
     Ok(())
 }

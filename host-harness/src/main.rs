@@ -2,12 +2,15 @@
 //! sessions, experiments, demo. This file parses, dispatches to the command
 //! groups of [`commands`] and applies the error policy: any error is one
 //! line `error: …` on stderr and exit status 2, except a closed standard
-//! output (a broken pipe), which ends the run normally (exit 0).
+//! output (a broken pipe), which ends the run normally (exit 0). Standard
+//! error is written through `palpate::output::stderr` only: a full or
+//! closed one loses the lines, never the run (its outputs, its status).
 
 use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
+use palpate::output::stderr;
 
 mod commands;
 
@@ -76,7 +79,7 @@ fn main() -> ExitCode {
         // The reader of standard output went away (`… | head -1`): a normal end.
         Err(e) if commands::stdout::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            stderr::line(&format!("error: {e:#}"));
             ExitCode::from(2)
         }
     }

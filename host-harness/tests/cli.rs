@@ -176,7 +176,7 @@ fn build_compressed_table_and_report_it() {
     );
     assert_one_line_error(
         &out(&["--compress", "q16", "--drop-below", "1.5"]),
-        &["--drop-below 1.5", "[0, 1)"],
+        &["'1.5' for '--drop-below <REL>'", "[0, 1)"],
     );
     assert_one_line_error(
         &out(&["--compress", "f16", "--precision", "f64"]),

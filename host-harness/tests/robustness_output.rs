@@ -459,3 +459,305 @@ fn a_csv_that_cannot_be_written_keeps_the_previous_series() {
     assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// How a probe's standard error is broken.
+#[derive(Clone, Copy, Debug)]
+enum BrokenStderr {
+    /// `2>/dev/full`: every write fails with "No space left on device".
+    Full,
+    /// A pipe whose reader has gone: every write fails with a broken pipe.
+    Closed,
+}
+
+/// Starts `palpate args` with its standard error broken as `how`, standard
+/// output captured; `None` where `/dev/full` is missing.
+fn spawn_with_broken_stderr(args: &[&str], how: BrokenStderr) -> Option<Child> {
+    let mut command = palpate_command(args);
+    command.stdout(Stdio::piped());
+    match how {
+        BrokenStderr::Full => {
+            let full = std::fs::OpenOptions::new()
+                .write(true)
+                .open("/dev/full")
+                .ok()?;
+            command.stderr(full);
+        }
+        BrokenStderr::Closed => {
+            command.stderr(Stdio::piped());
+        }
+    }
+    let mut child = command.spawn().expect("spawn palpate");
+    drop(child.stderr.take());
+    Some(child)
+}
+
+/// A full or closed standard error never stops a run (the release build
+/// aborted, exit 134, at the first progress line, leaving a 0-byte
+/// temporary file): `tables build` (with its progress bar), `session run
+/// --vtk`, `bench`, `chart --quick` and an error path each end with their
+/// own status, write their outputs complete (the table loads, the CSV has
+/// a line per tick, the series and the chart are in place) and leave no
+/// temporary file.
+#[test]
+fn a_full_or_closed_standard_error_never_stops_a_run() {
+    if !Path::new("/dev/full").exists() {
+        return; // not on this system
+    }
+    let dir = fresh_dir("broken-stderr");
+    let mesh = reference("meshes/cube.msh");
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let ticks = std::fs::read_to_string(&trajectory)
+        .expect("trajectory")
+        .lines()
+        .count();
+    for how in [BrokenStderr::Full, BrokenStderr::Closed] {
+        let sub = dir.join(format!("{how:?}"));
+        std::fs::create_dir_all(&sub).expect("folder");
+        let (table, csv, series, chart) = (
+            sub.join("cube.tbl"),
+            sub.join("forces.csv"),
+            sub.join("series"),
+            sub.join("chart"),
+        );
+        // The longest first: the chart runs while the others do.
+        let Some(chart_run) =
+            spawn_with_broken_stderr(&["chart", "--quick", "--out", s(&chart)], how)
+        else {
+            return;
+        };
+        let runs: Vec<(Vec<&str>, i32)> = vec![
+            (
+                vec![
+                    "tables",
+                    "build",
+                    &mesh,
+                    "--young",
+                    "5000",
+                    "--poisson",
+                    "0.45",
+                    "--fix",
+                    "z<0.001",
+                    "-o",
+                    s(&table),
+                ],
+                0,
+            ),
+            (
+                vec![
+                    "session",
+                    "run",
+                    "built-in",
+                    "--trajectory",
+                    s(&trajectory),
+                    "--out",
+                    s(&csv),
+                    "--vtk",
+                    s(&series),
+                ],
+                0,
+            ),
+            (
+                vec![
+                    "bench",
+                    &mesh,
+                    "--young",
+                    "5000",
+                    "--poisson",
+                    "0.45",
+                    "--density",
+                    "1000",
+                    "--fix",
+                    "z<0.001",
+                    "--models",
+                    "linear",
+                    "--integrators",
+                    "symplectic",
+                    "--precision",
+                    "f32",
+                    "--samples",
+                    "1",
+                    "--warmup",
+                    "0",
+                    "--sample-ms",
+                    "1",
+                ],
+                0,
+            ),
+            // An error: its one line cannot be shown, its status can.
+            (
+                vec![
+                    "tables",
+                    "build",
+                    "missing.msh",
+                    "--young",
+                    "5000",
+                    "--poisson",
+                    "0.45",
+                    "--fix",
+                    "z<0.001",
+                    "-o",
+                    s(&table),
+                ],
+                2,
+            ),
+        ];
+        for (args, code) in runs {
+            let child = spawn_with_broken_stderr(&args, how).expect("/dev/full");
+            let out = child.wait_with_output().expect("wait");
+            assert_eq!(out.status.code(), Some(code), "{how:?} {args:?}");
+            if args[0] == "bench" {
+                let rows = String::from_utf8_lossy(&out.stdout);
+                assert!(rows.contains("step linear/symplectic"), "{rows}");
+            }
+        }
+        let info = palpate(&["tables", "info", s(&table)]);
+        assert!(info.status.success(), "{how:?}: {}", stderr(&info));
+        let lines = std::fs::read_to_string(&csv).expect("csv").lines().count();
+        assert_eq!(lines, ticks, "{how:?}: a header and a line per tick");
+        assert!(series.join("session.pvd").is_file(), "{how:?}");
+        let out = chart_run.wait_with_output().expect("wait");
+        assert_eq!(out.status.code(), Some(0), "{how:?} chart");
+        for file in ["study.json", "report.md", "index.html"] {
+            assert!(chart.join(file).is_file(), "{how:?}: chart {file}");
+        }
+        assert_eq!(temporaries(&sub), Vec::<PathBuf>::new(), "{how:?}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `chart --out` onto a folder palpate did not write (a person's
+/// `report.md` and `index.html`) is refused before any work, the files
+/// untouched; `scene tables --out-dir` likewise. A folder holding only an
+/// earlier `scene tables`' three files is replaced as a whole (the marker
+/// written), as is one the previous run marked.
+#[test]
+fn chart_and_scene_tables_refuse_a_folder_palpate_did_not_write() {
+    let dir = fresh_dir("foreign-folders");
+    let mine = dir.join("mine");
+    std::fs::create_dir(&mine).expect("folder");
+    for file in ["report.md", "index.html"] {
+        std::fs::write(mine.join(file), "keep\n").expect("file");
+    }
+    let out = palpate(&["chart", "--quick", "--out", s(&mine)]);
+    assert_one_line_error(&out, &["palpate did not write", "choose a new folder"]);
+    let out = palpate(&["scene", "tables", "built-in-hybrid", "--out-dir", s(&mine)]);
+    assert_one_line_error(&out, &["palpate did not write"]);
+    for file in ["report.md", "index.html"] {
+        assert_eq!(
+            std::fs::read_to_string(mine.join(file)).expect("kept"),
+            "keep\n"
+        );
+    }
+    assert_eq!(std::fs::read_dir(&mine).expect("folder").count(), 2);
+
+    // An earlier version's set (no marker): replaced whole, then marked.
+    let tables = dir.join("tables");
+    std::fs::create_dir(&tables).expect("folder");
+    for file in ["precomputed.bin", "dynamic.bin", "interface.bin"] {
+        std::fs::write(tables.join(file), "old").expect("file");
+    }
+    for _ in 0..2 {
+        let out = palpate(&[
+            "scene",
+            "tables",
+            "built-in-hybrid",
+            "--out-dir",
+            s(&tables),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        for file in ["precomputed.bin", "dynamic.bin", "interface.bin"] {
+            let bytes = std::fs::read(tables.join(file)).expect("table");
+            assert!(bytes.len() > 3, "{file} replaced");
+        }
+        assert!(tables.join(".palpate-series").is_file());
+    }
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `session run --out /dev/null` (and a pipe) works, as the README says:
+/// an output that is not a regular file is written in place, never synced
+/// (`fsync` of a device fails with EINVAL).
+#[test]
+fn a_session_run_to_dev_null_or_a_pipe_succeeds() {
+    let dir = fresh_dir("dev-null");
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        s(&trajectory),
+        "--out",
+        "/dev/null",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        s(&trajectory),
+        "--out",
+        "/dev/stdout",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = String::from_utf8_lossy(&out.stdout);
+    assert!(csv.starts_with("t,fx,fy,fz,contacts,status\n"), "{csv}");
+    assert_eq!(csv.lines().count(), 1002, "a header and 1001 ticks");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The temporaries a killed run leaves (a process that no longer runs) are
+/// removed by the next run into the same place, which says so on stderr;
+/// those of a process that still runs (this test's) are left.
+#[test]
+fn the_next_run_sweeps_what_killed_runs_left() {
+    let dir = fresh_dir("sweep");
+    let trajectory = dir.join("poke.csv");
+    let out = palpate(&["session", "generate", "poke", "-o", s(&trajectory)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // A process that has ended: its ID names no running process.
+    let mut ended = palpate_command(&["--version"])
+        .stdout(Stdio::null())
+        .spawn()
+        .expect("spawn");
+    let dead = ended.id();
+    ended.wait().expect("wait");
+    let live = std::process::id();
+    let stale_csv = dir.join(format!(".forces.csv.palpate-tmp.{dead}.0"));
+    let stale_series = dir.join(format!(".series.palpate-tmp.{dead}.3"));
+    let running = dir.join(format!(".series.palpate-tmp.{live}.0"));
+    std::fs::write(&stale_csv, "t,fx\n").expect("stale file");
+    std::fs::create_dir(&stale_series).expect("stale folder");
+    std::fs::write(stale_series.join("frame_0.vtk"), vec![b'x'; 4096]).expect("frame");
+    std::fs::create_dir(&running).expect("live folder");
+    let out = palpate(&[
+        "session",
+        "run",
+        "built-in",
+        "--trajectory",
+        s(&trajectory),
+        "--out",
+        s(&dir.join("forces.csv")),
+        "--vtk",
+        s(&dir.join("series")),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    for name in [&stale_csv, &stale_series] {
+        let name = name.file_name().expect("name").to_string_lossy();
+        assert!(
+            err.contains(&format!("removed {name} (")) && err.contains("was killed"),
+            "{err}"
+        );
+    }
+    assert!(err.contains("4.1 kB"), "the folder's size: {err}");
+    assert!(!stale_csv.exists() && !stale_series.exists());
+    assert!(running.is_dir(), "a running process's folder is kept");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -36,6 +36,7 @@ fn built_in_hybrid_cuts_its_tensor_mass_region_and_grasps_its_precomputed_one() 
             csv: &mut csv,
             removed: Some(&mut removed),
             vtk_dir: None,
+            vtk_name: None,
         },
     )
     .expect("session");

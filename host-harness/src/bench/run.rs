@@ -17,6 +17,8 @@ use crate::fem::penalty::penalty_n;
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_BENCH_ESTIMATE_S, MAX_BENCH_SAMPLE_S, MAX_BENCH_SAMPLES};
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::number::shown;
+use crate::output::stderr;
 use crate::table::build::BuildOptions;
 use crate::table::compliance::Solver;
 use crate::table::estimate::SizeLimits;
@@ -336,7 +338,7 @@ pub fn check(mesh: &TetMesh, options: &BenchOptions) -> anyhow::Result<RunEstima
         bail!(
             "--sample-ms must be > 0 and at most {} ms (MAX_BENCH_SAMPLE_S), got {}",
             MAX_BENCH_SAMPLE_S * 1e3,
-            s.sample_s * 1e3
+            shown(s.sample_s * 1e3)
         );
     }
     let items = plan(options, 0.0);
@@ -432,7 +434,7 @@ pub fn run(
             Item::Tick(m) => match pre()?.time_tick(m, precision, sampling) {
                 Ok(timing) => (timing, None, None),
                 Err(e) => {
-                    eprintln!("warning: {}: {e:#}", what.label());
+                    stderr::line(&format!("warning: {}: {e:#}", what.label()));
                     continue;
                 }
             },

@@ -16,7 +16,7 @@ pub struct MaterialArgs {
     /// Young's modulus, Pa.
     #[arg(long, allow_negative_numbers = true)]
     pub young: f64,
-    /// Poisson ratio, in [0, 0.5).
+    /// Poisson ratio, in [0, 0.4999].
     #[arg(long, allow_negative_numbers = true)]
     pub poisson: f64,
 }
@@ -85,5 +85,47 @@ impl From<FormArg> for StvkForm {
             FormArg::PerTet => StvkForm::PerTet,
             FormArg::Tensors => StvkForm::Tensors,
         }
+    }
+}
+
+/// A real argument: parsed, and refused by clap in one line (`error:
+/// invalid value '-1' for '--dt <DT>': must be finite and > 0`) when it is
+/// not finite or `check` refuses it. Declare the argument with
+/// `allow_negative_numbers = true`, so that a negative value reaches the
+/// parser instead of clap's usage error.
+fn real(s: &str, check: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("not a number; expected {range}"))?;
+    if x.is_finite() && check(x) {
+        Ok(x)
+    } else {
+        Err(format!("must be {range}"))
+    }
+}
+
+/// Value parser of a real `> 0` (`--dt`).
+pub fn positive(s: &str) -> Result<f64, String> {
+    real(s, |x| x > 0.0, "finite and > 0")
+}
+
+/// Value parser of a real `>= 0` (`--damping`).
+pub fn non_negative(s: &str) -> Result<f64, String> {
+    real(s, |x| x >= 0.0, "finite and >= 0")
+}
+
+/// Value parser of a fraction in `[0, 1)` (`--drop-below`).
+pub fn fraction(s: &str) -> Result<f64, String> {
+    real(s, |x| (0.0..1.0).contains(&x), "a fraction in [0, 1)")
+}
+
+/// Value parser of a vector `x,y,z` of finite reals (`--gravity`).
+pub fn finite_vector(s: &str) -> Result<[f64; 3], String> {
+    let v: [f64; 3] = palpate_script::parse_vector(s).map_err(|e| e.to_string())?;
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(v)
+    } else {
+        Err("each of the three components must be a finite number".into())
     }
 }

@@ -4,11 +4,11 @@
 
 use std::path::PathBuf;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use palpate::bench::measure::Sampling;
 use palpate::bench::run::{BenchModel, BenchOptions, Record, check, run};
 use palpate::dispatch::HostDispatch;
 use palpate::mesh::read_mesh;
+use palpate::output::stderr;
 use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
 
@@ -78,7 +78,7 @@ enum DispatchChoice {
 pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
     let (mesh, report) = read_mesh(&args.mesh)?;
     for w in &report.warnings {
-        eprintln!("warning: {w}");
+        stderr::line(&format!("warning: {w}"));
     }
     let detected = HostDispatch::detect();
     let dispatches = match args.dispatch {
@@ -108,7 +108,7 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
     };
     let name = args.mesh.display().to_string();
     let estimate = check(&mesh, &options)?;
-    eprintln!(
+    stderr::line(&format!(
         "bench {name}: {} vertices, {} tets; {} measurements, estimated {:.0} s \
          (at most {} s); this CPU runs the dispatched passes as {}",
         mesh.positions.len(),
@@ -117,11 +117,12 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
         estimate.seconds.ceil(),
         palpate::limits::MAX_BENCH_ESTIMATE_S,
         detected.name(),
+    ));
+    let bar = stderr::progress_bar(
+        estimate.measurements as u64,
+        "bench {bar:30} {pos}/{len} {wide_msg}",
+        true,
     );
-    let bar = ProgressBar::new(estimate.measurements as u64);
-    if let Ok(style) = ProgressStyle::with_template("bench {bar:30} {pos}/{len} {wide_msg}") {
-        bar.set_style(style);
-    }
     let limits = SizeLimits {
         print_estimate: true,
         ..SizeLimits::system()

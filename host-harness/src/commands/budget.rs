@@ -9,6 +9,7 @@ use anyhow::{Context, bail};
 use palpate::budget::{
     BudgetRow, HOST_IR, M4F_IPS, budget_table, chosen_trajectories, measure, probe, record,
 };
+use palpate::output::atomic::work_folder;
 use palpate::session::model::{SceneModel, SceneTables};
 use palpate::session::run::check_scene_table;
 use palpate::session::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
@@ -175,7 +176,7 @@ fn measure_sizes(
     only: &[String],
     sizes: Vec<MeshSource>,
 ) -> anyhow::Result<Vec<BudgetRow>> {
-    std::fs::create_dir_all(work_dir).with_context(|| work_dir.display().to_string())?;
+    work_folder("--work-dir", work_dir)?;
     let exe = std::env::current_exe()?;
     let chosen = chosen_trajectories(scene, only)?;
     // Every size's table is checked against the build limits before the

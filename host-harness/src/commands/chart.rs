@@ -1,20 +1,22 @@
 //! `palpate chart`: the speed/accuracy study ([`palpate::chart`]): runs the
 //! matrix with a progress bar, writes the charts, `report.md`,
-//! `index.html` and `study.json` into `--out`, prints the summary (or the
-//! JSON).
+//! `index.html` and `study.json` into `--out` (built in a hidden sibling
+//! folder and renamed into place whole: `palpate::output::atomic`'s
+//! `SeriesDir`, which refuses a folder palpate did not write), prints the
+//! summary (or the JSON).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use palpate::chart::{self, GivenMesh, Matrix, plot, report, ticks};
 use palpate::experiment::scenes;
 use palpate::experiment::volume_bend::{self, Protocol};
 use palpate::fix::FixPredicate;
 use palpate::limits::MAX_CHART_TET_STEPS;
 use palpate::mesh::read_mesh;
-use palpate::output::atomic::write_file;
+use palpate::output::atomic::{self, FolderKind, SeriesDir, write_file};
+use palpate::output::stderr;
 
 use super::args::{MaterialArgs, parse_fix};
 use super::stdout;
@@ -26,7 +28,8 @@ pub struct ChartArgs {
     /// small stability grid, the small volume cylinder): under a minute.
     #[arg(long)]
     quick: bool,
-    /// Output folder (created; files in it replaced atomically).
+    /// Output folder: created, or replaced as a whole if a previous run
+    /// wrote it (anything else is refused).
     #[arg(long, default_value = "chart-out")]
     out: PathBuf,
     /// Count the haptic tick's instructions under callgrind in `--quick`
@@ -43,7 +46,7 @@ pub struct ChartArgs {
     /// Young's modulus of `--mesh`, Pa.
     #[arg(long, requires = "mesh", allow_negative_numbers = true)]
     young: Option<f64>,
-    /// Poisson ratio of `--mesh`, in [0, 0.5).
+    /// Poisson ratio of `--mesh`, in [0, 0.4999].
     #[arg(long, requires = "mesh", allow_negative_numbers = true)]
     poisson: Option<f64>,
     /// Fixed vertices of `--mesh`: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
@@ -98,6 +101,13 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     } else {
         Matrix::full()
     };
+    // The folder: one a previous run wrote (or new), checked before any
+    // work; the files go to a hidden sibling put in place when complete.
+    if let Some(mesh) = &args.mesh {
+        atomic::refuse_inside(("--out", &args.out), &[("--mesh", mesh)])?;
+    }
+    let folder = SeriesDir::of_kind(&args.out, FolderKind::Chart)?;
+    let dir = folder.dir();
     let mut matrix = match args.given()? {
         Some(given) => matrix.on(given),
         None => matrix,
@@ -128,7 +138,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         0
     };
     let total = matrix.static_runs() + trials + matrix.trajectories() + protocols.len() + tick_runs;
-    eprintln!(
+    stderr::line(&format!(
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
          references), {} stability trials, {} trajectories (each against its Δt/{}), {} volume \
          experiments, {tick_runs} callgrind runs: {total} steps of progress",
@@ -142,7 +152,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         matrix.trajectories(),
         chart::trajectory::REFINEMENT,
         protocols.len(),
-    );
+    ));
     // The work bound, checked before anything runs, and its time here.
     let bodies = matrix.bodies()?;
     chart::preflight(&bodies, &args.out)?;
@@ -158,7 +168,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     );
     let finest = bodies.last().context("no mesh")?;
     let per_tet_step_s = chart::seconds_per_tet_step(finest)?;
-    eprintln!(
+    stderr::line(&format!(
         "chart: at most {bound:.2e} tet-steps (every relaxation at its {}-step cap; limit \
          {MAX_CHART_TET_STEPS:.0e}), at most {:.0} s at {:.0} ns per tet-step measured here \
          (St Venant-Kirchhoff + penalty on {}), plus the Newton references and the timing; \
@@ -167,11 +177,12 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         bound as f64 * per_tet_step_s,
         1e9 * per_tet_step_s,
         finest.label,
+    ));
+    let bar = stderr::progress_bar(
+        total as u64,
+        "chart {bar:40} {pos}/{len} ({eta}) {msg}",
+        true,
     );
-    let bar = ProgressBar::new(total as u64);
-    if let Ok(style) = ProgressStyle::with_template("chart {bar:40} {pos}/{len} ({eta}) {msg}") {
-        bar.set_style(style);
-    }
     // Without a terminal (CI, a redirected run) the bar is hidden: one line
     // per step instead, with the time since the start.
     let lines = bar.is_hidden();
@@ -179,11 +190,11 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     let mut tick = |message: &str| {
         bar.inc(1);
         if lines {
-            eprintln!(
+            stderr::line(&format!(
                 "chart {}/{total} {:7.1} s {message}",
                 bar.position(),
                 start.elapsed().as_secs_f64()
-            );
+            ));
         } else {
             bar.set_message(message.to_string());
         }
@@ -210,7 +221,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
             ]
         };
         let quasi = study.remap.kernel::<f64>()?;
-        ticks::measure_ticks(&exe, child, &args.out.join("ticks"), &quasi, &mut tick)?
+        ticks::measure_ticks(&exe, child, &dir.join("ticks"), &quasi, &mut tick)?
     };
     let mut volume = Vec::new();
     for &protocol in protocols {
@@ -219,8 +230,7 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
 
-    std::fs::create_dir_all(&args.out)?;
-    let charts = plot::draw_all(&study, &volume, &args.out, &matrix.loads, &matrix.levels)?;
+    let charts = plot::draw_all(&study, &volume, dir, &matrix.loads, &matrix.levels)?;
     let volume_table: String = volume
         .iter()
         .map(|r| volume_bend::table(core::slice::from_ref(r)))
@@ -233,9 +243,9 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         &charts,
         &volume_table,
     );
-    write_file(&args.out.join("report.md"), markdown.as_bytes())?;
+    write_file(&dir.join("report.md"), markdown.as_bytes())?;
     write_file(
-        &args.out.join("index.html"),
+        &dir.join("index.html"),
         report::html(&markdown, &charts).as_bytes(),
     )?;
     let mut summary = serde_json::Map::new();
@@ -266,7 +276,8 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         "volume": volume,
         "charts": charts,
     });
-    write_file(&args.out.join("study.json"), json.to_string().as_bytes())?;
+    write_file(&dir.join("study.json"), json.to_string().as_bytes())?;
+    folder.commit()?;
     if args.json {
         stdout::println(&json.to_string())?;
     } else {

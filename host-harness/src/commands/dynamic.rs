@@ -17,7 +17,9 @@ use palpate::table::file::Precision;
 use palpate::tensor_mass::run::RunOptions;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
 
-use super::args::{FixArgs, FormArg, JsonArgs, MaterialArgs, optional_fix};
+use super::args::{
+    FixArgs, FormArg, JsonArgs, MaterialArgs, finite_vector, non_negative, optional_fix, positive,
+};
 use super::stdout;
 
 #[derive(Subcommand)]
@@ -30,10 +32,10 @@ pub enum DynamicCommand {
         #[arg(long = "load", value_parser = parse_load, allow_hyphen_values = true)]
         load: Vec<(u32, [f64; 3])>,
         /// Gravity <gx>,<gy>,<gz> (m/s2).
-        #[arg(long, value_parser = parse_gravity, allow_hyphen_values = true, default_value = "0,0,0")]
+        #[arg(long, value_parser = finite_vector, allow_hyphen_values = true, default_value = "0,0,0")]
         gravity: [f64; 3],
         /// Time step, s.
-        #[arg(long)]
+        #[arg(long, value_parser = positive, allow_negative_numbers = true)]
         dt: f64,
         /// Number of steps.
         #[arg(long)]
@@ -82,14 +84,14 @@ pub struct DynamicModelArgs {
     /// Young's modulus, Pa.
     #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
     young: Option<f64>,
-    /// Poisson ratio, in [0, 0.5).
+    /// Poisson ratio, in [0, 0.4999].
     #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
     poisson: Option<f64>,
     /// Mass density, kg/m3.
     #[arg(long, required_unless_present = "scene")]
     density: Option<f64>,
     /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative, allow_negative_numbers = true)]
     damping: f64,
     #[command(flatten)]
     fix: FixArgs,
@@ -181,7 +183,10 @@ impl ModelArg {
                 Ok((stvk, Some(gamma)))
             }
             (ModelArg::StvkIncompressible, Some(gamma)) => {
-                bail!("--incompressibility must be finite and >= 0 N, got {gamma}")
+                bail!(
+                    "--incompressibility must be finite and >= 0 N, got {}",
+                    palpate::output::number::shown(gamma)
+                )
             }
             (ModelArg::StvkIncompressible, None) => {
                 bail!("--model stvk-incompressible needs --incompressibility <gamma> (N)")
@@ -225,10 +230,6 @@ impl From<IntegratorArg> for Integrator {
 
 fn parse_load(s: &str) -> Result<(u32, [f64; 3]), String> {
     palpate_script::parse_vertex_vector(s).map_err(|e| e.to_string())
-}
-
-fn parse_gravity(s: &str) -> Result<[f64; 3], String> {
-    palpate_script::parse_vector(s).map_err(|e| e.to_string())
 }
 
 /// Runs a `dynamic` command: prints its JSON object.

@@ -4,6 +4,7 @@
 use clap::{Subcommand, ValueEnum};
 use palpate::experiment::volume_bend::Protocol;
 use palpate::experiment::{scenes, volume_bend};
+use palpate::output::stderr;
 
 use super::stdout;
 
@@ -59,7 +60,7 @@ pub fn run(command: ExperimentCommand) -> anyhow::Result<()> {
                         &scene,
                         protocol,
                         &controls,
-                        |line| eprintln!("{line}"),
+                        stderr::line,
                     )?);
                 }
                 tables.push(results);

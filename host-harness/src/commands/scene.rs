@@ -11,7 +11,7 @@ use anyhow::{Context, bail};
 use clap::Subcommand;
 use palpate::hybrid::owned::with_hybrid_files;
 use palpate::limits::{MAX_SEQUENCE_FILE_BYTES, read_bounded};
-use palpate::output::atomic;
+use palpate::output::atomic::{self, FolderKind, SeriesDir};
 use palpate::output::vtk::write_regions;
 use palpate::partition::{Partition, PlanReport};
 use palpate::session::model::{SceneModel, hybrid_tables};
@@ -41,7 +41,8 @@ pub enum SceneCommand {
     Tables {
         /// Scene file (TOML), or a built-in scene name as `session run` takes.
         scene: String,
-        /// Output folder (created if missing); each table is written atomically.
+        /// Output folder: created, or replaced as a whole (the three tables
+        /// together) if a previous run wrote it; anything else is refused.
         #[arg(long)]
         out_dir: PathBuf,
         /// Stored float width: f32 (firmware) or f64 (verification).
@@ -130,14 +131,15 @@ fn plan(name: &str, json: bool, vtk: Option<&Path>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `scene tables`: the three tables of a hybrid scene, built in memory, then each written
-/// atomically into `out_dir` (none is written if the build fails).
+/// `scene tables`: the three tables of a hybrid scene, built in memory, written into a fresh
+/// hidden folder and renamed into place as `out_dir` ([`SeriesDir`]): `out_dir` holds the old
+/// set or the new one, never a mix; nothing changes if the build fails. Refused before any
+/// work: an `out_dir` palpate did not write, or one holding an input.
 fn tables(name: &str, out_dir: &Path, precision: Precision) -> anyhow::Result<()> {
     let (scene, inputs) = scene_and_inputs(name)?;
-    let outputs = TABLE_FILES.map(|f| out_dir.join(f));
-    for out in &outputs {
-        refuse_input("--out-dir", out, &inputs)?;
-    }
+    let labelled: Vec<(&str, &Path)> = inputs.iter().map(|(l, p)| (*l, p.as_path())).collect();
+    atomic::refuse_inside(("--out-dir", out_dir), &labelled)?;
+    let folder = SeriesDir::of_kind(out_dir, FolderKind::HybridTables)?;
     let (mesh, report) = scene.load_mesh()?;
     let SceneModel::Hybrid { partition, .. } = SceneModel::of(&scene, &mesh, &report)? else {
         bail!(
@@ -145,15 +147,14 @@ fn tables(name: &str, out_dir: &Path, precision: Precision) -> anyhow::Result<()
         );
     };
     let built = hybrid_tables(&scene, &mesh, &report, &partition, precision)?;
-    std::fs::create_dir_all(out_dir)
-        .with_context(|| format!("{}: cannot create the folder", out_dir.display()))?;
-    for (out, table) in outputs
-        .iter()
-        .zip([&built.precomputed, &built.dynamic, &built.interface])
+    for (file, table) in
+        TABLE_FILES
+            .iter()
+            .zip([&built.precomputed, &built.dynamic, &built.interface])
     {
-        atomic::write_file(out, table.bytes())?;
+        atomic::write_file(&folder.dir().join(file), table.bytes())?;
     }
-    Ok(())
+    Ok(folder.commit()?)
 }
 
 /// `scene replay-hybrid`: the three f32 tables of `dir` and the sequence, through

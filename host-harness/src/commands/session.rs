@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
 use palpate::output::atomic::{self, AtomicFile};
+use palpate::output::stderr;
 use palpate::session::generate::{hepatectomy, surgery};
 use palpate::session::run::{removed_path, removes_tets, run_session_to_files};
 use palpate::session::{
@@ -110,14 +111,14 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             let trajectory = if lenient {
                 let (t, findings) = Trajectory::read_unchecked(&trajectory, points)?;
                 for finding in findings {
-                    eprintln!("warning: {finding}");
+                    stderr::line(&format!("warning: {finding}"));
                 }
                 t
             } else {
                 Trajectory::read(&trajectory, points)?
             };
             let summary = run_session_to_files(&scene, &trajectory, &out, vtk.as_deref())?;
-            eprintln!(
+            stderr::line(&format!(
                 "{} ticks ({} in contact, {} clamped, {} faulted); max force {:.3} N, max jump {:.4} N per tick; {} VTK frames",
                 summary.ticks,
                 summary.ticks_in_contact,
@@ -126,28 +127,30 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
                 summary.max_force_n,
                 summary.max_jump_n,
                 summary.frames
-            );
+            ));
             if removes_tets(&scene) {
-                eprintln!(
+                stderr::line(&format!(
                     "{} tets removed (cuts and tears), listed in {}",
                     summary.removed_tets,
                     removed_path(&out).display()
-                );
+                ));
             }
             if summary.cut_refused > 0 {
-                eprintln!(
+                stderr::line(&format!(
                     "{} ticks with an enabled blade on tissue the pre-computed model cannot cut (status cut-refused)",
                     summary.cut_refused
-                );
+                ));
             }
             if summary.tool_inside > 0 {
-                eprintln!(
+                stderr::line(&format!(
                     "{} ticks with a tool point inside the body and no contact: it adds no force (status tool-inside)",
                     summary.tool_inside
-                );
+                ));
             }
             if let Some(e) = summary.physics_error {
-                eprintln!("physics update failed at {e}; the force was zero from the next tick on");
+                stderr::line(&format!(
+                    "physics update failed at {e}; the force was zero from the next tick on"
+                ));
             }
             Ok(())
         }

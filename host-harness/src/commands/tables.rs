@@ -9,6 +9,7 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Subcommand};
 use palpate::mesh::read_mesh;
 use palpate::output::atomic::{self, AtomicFile};
+use palpate::output::stderr;
 use palpate::table::build::{
     BuildOptions, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build_with_limits,
 };
@@ -18,7 +19,7 @@ use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 
-use super::args::{FixArgs, MaterialArgs};
+use super::args::{FixArgs, MaterialArgs, fraction};
 use super::{mesh_files, stdout};
 
 #[derive(Subcommand)]
@@ -47,7 +48,7 @@ pub enum TablesCommand {
         /// With --compress: leave out each interior compliance block whose
         /// largest entry is below REL times the largest of its column
         /// (far-field blocks; they count as zero), REL in [0, 1).
-        #[arg(long, value_name = "REL")]
+        #[arg(long, value_name = "REL", value_parser = fraction, allow_negative_numbers = true)]
         drop_below: Option<f64>,
         /// With --compress: how the touchable-touchable blocks (the contact
         /// solve's) are stored: coded (default), f32, or coded with
@@ -191,7 +192,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             let mut file = AtomicFile::create(&output)?;
             let (mesh_data, report) = read_mesh(&mesh)?;
             for w in &report.warnings {
-                eprintln!("warning: {w}");
+                stderr::line(&format!("warning: {w}"));
             }
             let options = BuildOptions {
                 kind,
@@ -224,19 +225,19 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             );
             let (source, bytes, output) = (&report.source, built.bytes.len(), output.display());
             match kind {
-                TableKindOptions::Precomputed { .. } => eprintln!(
+                TableKindOptions::Precomputed { .. } => stderr::line(&format!(
                     "{source}: {vertices}, {} free, {} touchable; {mesh_notes}; \
                      compliance in {:.3} s; wrote {bytes} bytes to {output}{}",
                     built.free_count,
                     built.touchable_count,
                     built.arrays_time.as_secs_f64(),
                     compression_note(&built.bytes)
-                ),
-                TableKindOptions::TensorMass { density_kg_m3 } => eprintln!(
+                )),
+                TableKindOptions::TensorMass { density_kg_m3 } => stderr::line(&format!(
                     "{source}: tensor-mass table: {vertices}, {} edges, {density_kg_m3} kg/m3; \
                      {mesh_notes}; wrote {bytes} bytes to {output}",
                     built.edge_count
-                ),
+                )),
             }
             Ok(())
         }

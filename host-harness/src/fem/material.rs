@@ -1,13 +1,36 @@
 //! Isotropic linear elastic material (Young's modulus, Poisson ratio).
 
+use crate::output::number::Shown;
+
+/// The largest Poisson ratio accepted. The bulk-to-shear ratio
+/// `λ/μ = 2ν/(1 − 2ν)` is the stiffness's condition number's factor: at
+/// `ν = 0.4999` it is 5 000, and the f32 unit roundoff (6e-8) times it
+/// leaves the stored compliance 3e-4 relative accuracy. Nearer 0.5 the f32
+/// tables stop holding the material (measured on the built-in block with the
+/// poke trajectory: ν = 0.499999 gives 2 N jumps in one tick, ν = 0.4999999
+/// no contact at all, ν = 0.49999999 a singular contact system).
+pub const MAX_POISSON: f64 = 0.4999;
+
+/// The largest ratio between the Young's moduli of two materials of one
+/// body (a scene's `[[region]]` and its `[material]`): the stiffness's
+/// condition number grows with it, and the f64 factorization of the
+/// compliance build fails far beyond (a region of 1e300 Pa in 3 kPa tissue:
+/// a non-positive pivot; 1e-300 Pa: compliance values beyond f32). Tissue
+/// and bone differ by about 1e7.
+pub const MAX_STIFFNESS_CONTRAST: f64 = 1e8;
+
+/// The accepted range of the Poisson ratio, for messages.
+pub const POISSON_RANGE: &str = "0 <= nu <= 0.4999 (nearer 0.5 the material is too \
+     nearly incompressible for the f32 tables: λ/μ above 5000)";
+
 /// Why a [`Material`] was rejected.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum MaterialError {
     /// Young's modulus must be finite and strictly positive (Pa).
-    #[error("Young's modulus must be finite and > 0 Pa, got {0}")]
+    #[error("Young's modulus must be finite and > 0 Pa, got {}", Shown(*.0))]
     YoungModulus(f64),
-    /// Poisson ratio must satisfy `0 <= nu < 0.5`.
-    #[error("Poisson ratio must satisfy 0 <= nu < 0.5, got {0}")]
+    /// Poisson ratio must satisfy `0 <= nu <= MAX_POISSON`.
+    #[error("Poisson ratio must satisfy {POISSON_RANGE}, got {}", Shown(*.0))]
     PoissonRatio(f64),
 }
 
@@ -16,18 +39,19 @@ pub enum MaterialError {
 pub struct Material {
     /// Young's modulus `E`, Pa.
     pub young_pa: f64,
-    /// Poisson ratio `nu`, dimensionless, `0 <= nu < 0.5`.
+    /// Poisson ratio `nu`, dimensionless, `0 <= nu <= MAX_POISSON`.
     pub poisson: f64,
 }
 
 impl Material {
     /// A material with Young's modulus `young_pa` (Pa, finite, `> 0`) and Poisson
-    /// ratio `poisson` (`0 <= nu < 0.5`, incompressible `0.5` excluded).
+    /// ratio `poisson` (`0 <= nu <=` [`MAX_POISSON`]: incompressible `0.5`, and a
+    /// margin below it, excluded).
     pub fn new(young_pa: f64, poisson: f64) -> Result<Self, MaterialError> {
         if !(young_pa.is_finite() && young_pa > 0.0) {
             return Err(MaterialError::YoungModulus(young_pa));
         }
-        if !(poisson.is_finite() && (0.0..0.5).contains(&poisson)) {
+        if !(poisson.is_finite() && (0.0..=MAX_POISSON).contains(&poisson)) {
             return Err(MaterialError::PoissonRatio(poisson));
         }
         Ok(Self { young_pa, poisson })

@@ -187,7 +187,7 @@ impl HybridEstimate {
             );
         }
         if limits.print_estimate {
-            eprintln!("{prefix}estimate: {}", self.describe());
+            crate::output::stderr::line(&format!("{prefix}estimate: {}", self.describe()));
         }
         Ok(())
     }

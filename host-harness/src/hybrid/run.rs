@@ -9,6 +9,7 @@ use nalgebra::Vector3;
 use super::build::{HybridOptions, build_hybrid};
 use super::owned::with_hybrid;
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::number::shown;
 use crate::table::file::Precision;
 use crate::tensor_mass::run::{RunOptions, RunOutput, host_params, run_steps, volume_change};
 
@@ -26,7 +27,7 @@ pub fn run(
 ) -> anyhow::Result<RunOutput> {
     crate::tensor_mass::run::check_run_steps(mesh, options)?;
     if !(options.dt_s.is_finite() && options.dt_s > 0.0) {
-        bail!("--dt must be finite and > 0 s, got {}", options.dt_s);
+        bail!("--dt must be finite and > 0 s, got {}", shown(options.dt_s));
     }
     let mut in_dynamic = vec![false; mesh.positions.len()];
     for (tet, _) in mesh.tets.iter().zip(dynamic_tet).filter(|(_, d)| **d) {

@@ -21,13 +21,16 @@
 //!   stays).
 //! - An existing output that is not a regular file (`/dev/null`,
 //!   `/dev/full`, a named pipe) cannot be replaced by a rename: it is
-//!   written in place, and nothing above holds for it.
+//!   written in place (no temporary file, no sync: such files cannot be
+//!   synced), and nothing above holds for it.
 //! - Every error names the output as given on the command line and keeps
 //!   the I/O error's kind (`{output}: cannot write: No space left on
 //!   device (os error 28)`).
 //!
-//! Guarantees of [`SeriesDir`] (a folder of files written together, the VTK
-//! series of `demo --out` and `session run --vtk`):
+//! Guarantees of [`SeriesDir`] (a folder of files written together: the VTK
+//! series of `demo --out` and `session run --vtk`, the three tables of
+//! `scene tables --out-dir`, the charts and report of `chart --out`; see
+//! [`FolderKind`]):
 //!
 //! - The files are written into a fresh temporary sibling folder
 //!   (`.NAME.palpate-tmp.PID.N`); `commit` writes the marker file
@@ -36,13 +39,26 @@
 //!   complete new one, never old and new frames mixed.
 //! - An existing folder is replaced only if a previous palpate run wrote it
 //!   (it holds [`SERIES_MARKER`]), if it is empty, or if it holds only files
-//!   named as a series palpate writes (`frame_*.vtk`, `*.pvd`: the folders
-//!   of palpate versions before the marker). Anything else is refused before
-//!   any work starts, as is an output path that is an existing file.
+//!   named as palpate versions before the marker wrote them into such a
+//!   folder ([`FolderKind::is_legacy_file`]: `frame_*.vtk` and `*.pvd` of a
+//!   series, the three `.bin` of hybrid tables; none for a chart, whose
+//!   `report.md` and `index.html` are names a person's folder holds too).
+//!   Anything else is refused before any work starts, as is an output path
+//!   that is an existing file.
 //! - Replacing renames the old folder aside (`.NAME.palpate-old.PID.N`),
 //!   renames the new one in and removes the old one. A crash between those
 //!   two renames leaves both folders whole under their hidden names.
 //! - Dropped without `commit`, the temporary folder is removed.
+//!
+//! Stale temporary files and folders ([`sweep_stale`]): a run killed
+//! outright leaves its `.NAME.palpate-tmp.PID.N` (a VTK series of a long
+//! run can be hundreds of MB). The next [`AtomicFile`] or [`SeriesDir`]
+//! for the same output removes those of its own name whose process `PID`
+//! no longer runs on this machine (Linux: no `/proc/PID`; elsewhere nothing
+//! is swept), and the `.NAME.palpate-old.PID.N` of a replaced folder when
+//! the folder itself is in place (else that old copy may be the only whole
+//! one, and stays), and says so on standard error. A folder shared between
+//! machines is not supported (a process ID names a process of one machine).
 //!
 //! And [`refuse_input`], [`refuse_inside`]: an output that is one of the
 //! command's inputs (same file by canonical path, and on unix by device and
@@ -54,9 +70,16 @@ use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Component, Path, PathBuf};
 
+use super::stderr;
+use crate::limits::human_bytes;
+
 /// The part of the name of every temporary file or folder: a temporary
 /// output `NAME` is `.NAME.palpate-tmp.PID.N` in the output's folder.
 pub const TEMP_TAG: &str = ".palpate-tmp.";
+
+/// The part of the name of a replaced folder between the two renames of
+/// [`SeriesDir::commit`]: `.NAME.palpate-old.PID.N`.
+pub const OLD_TAG: &str = ".palpate-old.";
 
 /// The marker file in a folder written by [`SeriesDir`]: such a folder may
 /// be replaced by the next run.
@@ -167,6 +190,7 @@ impl AtomicFile {
                 });
             }
         }
+        sweep_stale(&target, &shown);
         let temp = sibling(&target, TEMP_TAG);
         let file = OpenOptions::new()
             .write(true)
@@ -199,13 +223,21 @@ impl AtomicFile {
     /// Flushes and syncs what was written, so that only the rename of
     /// [`Self::commit`] is left to fail: call it before committing another
     /// output that must not be replaced if this one fails (a session's VTK
-    /// series before its CSV).
+    /// series before its CSV). An output written in place (`/dev/null`, a
+    /// pipe) is flushed only: such a file cannot be synced (`EINVAL`).
     pub fn prepare(&mut self) -> io::Result<()> {
+        let in_place = self.temp.is_none();
         let writer = self
             .writer
             .as_mut()
             .ok_or_else(|| io::Error::other("internal: output already committed"))?;
-        let synced = writer.flush().and_then(|()| writer.get_ref().sync_all());
+        let synced = writer.flush().and_then(|()| {
+            if in_place {
+                Ok(())
+            } else {
+                writer.get_ref().sync_all()
+            }
+        });
         synced.map_err(|e| named(&self.shown, "cannot write", &e))
     }
 
@@ -277,13 +309,52 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> io::Result<()> {
     file.commit()
 }
 
-/// A folder of files written together (a VTK series), built in a temporary
-/// sibling folder and renamed into place by [`SeriesDir::commit`] (see the
-/// module's guarantees).
+/// What a [`SeriesDir`] holds: how messages name it and which files of a
+/// folder without [`SERIES_MARKER`] an earlier palpate wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FolderKind {
+    /// A VTK series (`demo --out`, `session run --vtk`).
+    VtkSeries,
+    /// A hybrid scene's three tables (`scene tables --out-dir`).
+    HybridTables,
+    /// The speed/accuracy study's charts, report and JSON (`chart --out`).
+    Chart,
+}
+
+impl FolderKind {
+    /// What the folder holds, for messages: `the VTK series`.
+    pub fn what(self) -> &'static str {
+        match self {
+            Self::VtkSeries => "the VTK series",
+            Self::HybridTables => "the hybrid tables",
+            Self::Chart => "the chart",
+        }
+    }
+
+    /// Whether a file `name` is one palpate versions before the marker wrote
+    /// into such a folder: a folder holding only these may be replaced.
+    pub fn is_legacy_file(self, name: &str) -> bool {
+        match self {
+            Self::VtkSeries => {
+                (name.starts_with("frame_") && name.ends_with(".vtk")) || name.ends_with(".pvd")
+            }
+            Self::HybridTables => {
+                matches!(name, "precomputed.bin" | "dynamic.bin" | "interface.bin")
+            }
+            Self::Chart => false,
+        }
+    }
+}
+
+/// A folder of files written together (a VTK series, hybrid tables, a
+/// chart), built in a temporary sibling folder and renamed into place by
+/// [`SeriesDir::commit`] (see the module's guarantees).
 #[derive(Debug)]
 pub struct SeriesDir {
     /// The output folder as given, for messages.
     shown: PathBuf,
+    /// What it holds.
+    kind: FolderKind,
     /// The path the folder is renamed to.
     target: PathBuf,
     /// The temporary folder; `None` once committed.
@@ -291,19 +362,27 @@ pub struct SeriesDir {
 }
 
 impl SeriesDir {
-    /// Checks that `path` is absent or a folder palpate may replace, and
+    /// [`Self::of_kind`] for a VTK series.
+    pub fn create(path: &Path) -> io::Result<Self> {
+        Self::of_kind(path, FolderKind::VtkSeries)
+    }
+
+    /// Checks that `path` is absent or a folder palpate may replace (for
+    /// `kind`), sweeps stale temporaries of it ([`sweep_stale`]) and
     /// creates the temporary folder beside it (and `path`'s missing parent
     /// folders). Nothing under `path` changes before [`Self::commit`].
-    pub fn create(path: &Path) -> io::Result<Self> {
+    pub fn of_kind(path: &Path, kind: FolderKind) -> io::Result<Self> {
         let shown = path.to_path_buf();
         let target = real_target(path, &shown)?;
-        check_replaceable(&target, &shown)?;
+        check_replaceable(&target, &shown, kind)?;
         let parent = parent_of(&target);
         fs::create_dir_all(parent).map_err(|e| named(&shown, "cannot create", &e))?;
+        sweep_stale(&target, &shown);
         let temp = sibling(&target, TEMP_TAG);
         fs::create_dir(&temp).map_err(|e| named(&shown, "cannot create", &e))?;
         Ok(Self {
             shown,
+            kind,
             target,
             temp: Some(temp),
         })
@@ -340,8 +419,8 @@ impl SeriesDir {
             }
         }
         sync_folder(&temp);
-        check_replaceable(&self.target, &self.shown)?;
-        let old = sibling(&self.target, ".palpate-old.");
+        check_replaceable(&self.target, &self.shown, self.kind)?;
+        let old = sibling(&self.target, OLD_TAG);
         let replacing = match fs::rename(&self.target, &old) {
             Ok(()) => true,
             Err(e) if e.kind() == io::ErrorKind::NotFound => false,
@@ -370,15 +449,10 @@ impl Drop for SeriesDir {
     }
 }
 
-/// Whether a file name is one of a series palpate writes.
-fn is_series_file(name: &str) -> bool {
-    (name.starts_with("frame_") && name.ends_with(".vtk")) || name.ends_with(".pvd")
-}
-
 /// `Ok` when `target` is absent, or a folder palpate may replace: it holds
-/// the marker, nothing, or only series files. Refuses a file and any other
-/// folder.
-fn check_replaceable(target: &Path, shown: &Path) -> io::Result<()> {
+/// the marker, nothing, or only `kind`'s legacy files. Refuses a file and
+/// any other folder.
+fn check_replaceable(target: &Path, shown: &Path, kind: FolderKind) -> io::Result<()> {
     let meta = match fs::metadata(target) {
         Ok(meta) => meta,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
@@ -388,8 +462,9 @@ fn check_replaceable(target: &Path, shown: &Path) -> io::Result<()> {
         return Err(refusal(
             io::ErrorKind::AlreadyExists,
             format!(
-                "{}: exists and is not a folder: the VTK series needs a folder (a new one, or one palpate wrote)",
-                shown.display()
+                "{}: exists and is not a folder: {} needs a folder (a new one, or one palpate wrote)",
+                shown.display(),
+                kind.what()
             ),
         ));
     }
@@ -400,7 +475,7 @@ fn check_replaceable(target: &Path, shown: &Path) -> io::Result<()> {
     for entry in entries {
         let entry = entry.map_err(|e| named(shown, "cannot read", &e))?;
         let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-        if !(is_file && is_series_file(&entry.file_name().to_string_lossy())) {
+        if !(is_file && kind.is_legacy_file(&entry.file_name().to_string_lossy())) {
             return Err(refusal(
                 io::ErrorKind::AlreadyExists,
                 format!(
@@ -414,6 +489,103 @@ fn check_replaceable(target: &Path, shown: &Path) -> io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Creates the working folder `path` (and its missing parents), named
+/// `label` in messages (`--work-dir`): a path that is a file is refused in
+/// one line, not with the system's "File exists".
+pub fn work_folder(label: &str, path: &Path) -> io::Result<()> {
+    if fs::metadata(path).is_ok_and(|m| !m.is_dir()) {
+        return Err(refusal(
+            io::ErrorKind::AlreadyExists,
+            format!(
+                "{label} {}: is a file, not a folder: give a folder (created if missing)",
+                path.display()
+            ),
+        ));
+    }
+    fs::create_dir_all(path).map_err(|e| named(path, &format!("{label}: cannot create"), &e))
+}
+
+/// Whether process `pid` runs on this machine: `None` where that cannot be
+/// told (no `/proc`).
+fn process_runs(pid: u32) -> Option<bool> {
+    let proc = Path::new("/proc");
+    proc.join("self")
+        .exists()
+        .then(|| proc.join(pid.to_string()).exists())
+}
+
+/// The bytes under `path` (a file, or a folder's files), for messages.
+fn bytes_under(path: &Path) -> u64 {
+    match fs::symlink_metadata(path) {
+        Ok(meta) if meta.is_dir() => fs::read_dir(path)
+            .map(|entries| entries.flatten().map(|e| bytes_under(&e.path())).sum())
+            .unwrap_or(0),
+        Ok(meta) => meta.len(),
+        Err(_) => 0,
+    }
+}
+
+/// The stale temporaries of `target` (module docs): in its folder, each
+/// `.NAME.palpate-tmp.PID.N`, and each `.NAME.palpate-old.PID.N` when
+/// `target` exists, whose `PID` is not this process and runs no more.
+pub fn stale_temporaries(target: &Path) -> Vec<PathBuf> {
+    let Some(name) = target.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return Vec::new();
+    };
+    let Ok(entries) = fs::read_dir(parent_of(target)) else {
+        return Vec::new();
+    };
+    let in_place = fs::symlink_metadata(target).is_ok();
+    let own = std::process::id();
+    let mut stale: Vec<PathBuf> = entries
+        .flatten()
+        .filter(|entry| {
+            let entry_name = entry.file_name().to_string_lossy().into_owned();
+            let rest = entry_name
+                .strip_prefix(&format!(".{name}{TEMP_TAG}"))
+                .or_else(|| {
+                    in_place
+                        .then(|| entry_name.strip_prefix(&format!(".{name}{OLD_TAG}")))
+                        .flatten()
+                });
+            let pid = rest
+                .and_then(|r| r.split_once('.'))
+                .and_then(|(pid, n)| n.parse::<u64>().is_ok().then_some(pid))
+                .and_then(|pid| pid.parse::<u32>().ok());
+            pid.is_some_and(|pid| pid != own && process_runs(pid) == Some(false))
+        })
+        .map(|entry| entry.path())
+        .collect();
+    stale.sort();
+    stale
+}
+
+/// Removes [`stale_temporaries`] of `target` and says so on standard
+/// error, naming the output as `shown`; one that cannot be removed is
+/// named and left.
+pub fn sweep_stale(target: &Path, shown: &Path) {
+    for path in stale_temporaries(target) {
+        let bytes = bytes_under(&path);
+        let removed = if path.is_dir() {
+            fs::remove_dir_all(&path)
+        } else {
+            fs::remove_file(&path)
+        };
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        stderr::line(&match removed {
+            Ok(()) => format!(
+                "note: {}: removed {name} ({}), left by a palpate run that was killed",
+                shown.display(),
+                human_bytes(bytes)
+            ),
+            Err(e) => format!(
+                "note: {}: cannot remove {name}, left by a palpate run that was killed: {e}",
+                shown.display()
+            ),
+        });
+    }
 }
 
 /// Whether `a` and `b` name the same existing file: the same device and

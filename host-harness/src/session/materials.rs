@@ -4,7 +4,7 @@
 //! [[region]]                   # per-region materials; tets of other regions take [material]
 //! id = 2                       # MSH physical tag (first tag, 2.2 and 4.1), VTK cell field
 //! young_pa = 30000.0           # "region" (integer), TetGen region attribute
-//! poisson = 0.45               # 0 <= nu < 0.5, as [material]
+//! poisson = 0.45               # 0 <= nu <= 0.4999, as [material]
 //! density_kg_m3 = 1000.0       # optional; a table has one density: [material]'s (only that
 //!                              # value is accepted)
 //! ```
@@ -17,8 +17,11 @@
 use serde::Deserialize;
 
 use super::scene::{Scene, SceneError};
-use crate::fem::material::{Material, MaterialError, TetMaterials};
+use crate::fem::material::{
+    MAX_STIFFNESS_CONTRAST, Material, MaterialError, POISSON_RANGE, TetMaterials,
+};
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::number::shown;
 
 /// One `[[region]]` of a scene: the material of the tets whose region id is `id`.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
@@ -41,26 +44,44 @@ impl RegionSpec {
     }
 }
 
-/// The checks of `regions` that need no mesh, given the `[material]` density (kg/m³): each
-/// region's `E` and `ν` in [`Material::new`]'s ranges, its density absent or the
-/// `[material]`'s, and no id twice. Errors are `(key, message)`.
-pub fn check_regions(regions: &[RegionSpec], density_kg_m3: f64) -> Result<(), (String, String)> {
+/// The checks of `regions` that need no mesh, given the `[material]` Young's modulus (Pa) and
+/// density (kg/m³): each region's `E` and `ν` in [`Material::new`]'s ranges, its `E` within
+/// [`MAX_STIFFNESS_CONTRAST`] of the `[material]`'s, its density absent or the `[material]`'s,
+/// and no id twice. Errors are `(key, message)`.
+pub fn check_regions(
+    regions: &[RegionSpec],
+    young_pa: f64,
+    density_kg_m3: f64,
+) -> Result<(), (String, String)> {
     for (k, region) in regions.iter().enumerate() {
         let key = region.key();
         match Material::new(region.young_pa, region.poisson) {
             Err(MaterialError::YoungModulus(e)) => {
                 return Err((
-                    format!("{key}: young_pa = {e}"),
+                    format!("{key}: young_pa = {}", shown(e)),
                     "must be finite and > 0 Pa".into(),
                 ));
             }
             Err(MaterialError::PoissonRatio(nu)) => {
                 return Err((
-                    format!("{key}: poisson = {nu}"),
-                    "must satisfy 0 <= nu < 0.5".into(),
+                    format!("{key}: poisson = {}", shown(nu)),
+                    format!("must satisfy {POISSON_RANGE}"),
                 ));
             }
             Ok(_) => {}
+        }
+        let contrast = region.young_pa / young_pa;
+        if !(1.0 / MAX_STIFFNESS_CONTRAST..=MAX_STIFFNESS_CONTRAST).contains(&contrast) {
+            return Err((
+                format!("{key}: young_pa = {}", shown(region.young_pa)),
+                format!(
+                    "is {contrast:.1e} times [material] young_pa = {}: a [[region]] may be at \
+                     most {} times stiffer or softer (beyond, the table build's stiffness is \
+                     singular)",
+                    shown(young_pa),
+                    format_args!("{MAX_STIFFNESS_CONTRAST:e}")
+                ),
+            ));
         }
         if let Some(density) = region.density_kg_m3
             && density != density_kg_m3

@@ -12,6 +12,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use super::run::{precomputed_options, tensor_mass_options};
 use super::{DynamicSpec, ModelSpec, Scene};
 use crate::fem::penalty::penalty_n;
+use crate::fix::fixed_vertices;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
@@ -47,7 +48,17 @@ impl SceneModel {
         scene.check_on_mesh(mesh)?;
         if scene.zones.is_empty() {
             return Ok(match scene.model {
-                ModelSpec::Precomputed => Self::Precomputed,
+                ModelSpec::Precomputed => {
+                    // A piece held by no fixed vertex makes the stiffness
+                    // singular: said as `scene plan` says it, before the
+                    // build (which names a `fix` that matches nothing).
+                    let (fixed, _) =
+                        fixed_vertices(&mesh.positions, &scene.fix, &report.unreferenced_vertices);
+                    if fixed.contains(&true) {
+                        Partition::of_scene(scene, mesh, report).map_err(|e| anyhow!("{e}"))?;
+                    }
+                    Self::Precomputed
+                }
                 ModelSpec::Dynamic(spec) => Self::Dynamic(spec),
             });
         }

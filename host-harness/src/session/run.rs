@@ -57,6 +57,7 @@ use crate::limits::{
 };
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::output::atomic::{self, AtomicFile, SeriesDir};
+use crate::output::number::time_s;
 use crate::output::vtk;
 use crate::table::build::BuildOptions;
 use crate::table::compliance::Solver;
@@ -278,6 +279,7 @@ pub fn run_session_to_files(
             csv: &mut csv,
             removed: removed.as_mut().map(|f| f as &mut dyn Write),
             vtk_dir: series.as_ref().map(SeriesDir::dir),
+            vtk_name: series.as_ref().map(SeriesDir::path),
         },
     )?;
     // The CSVs are complete and synced before the series replaces the old
@@ -338,6 +340,7 @@ pub fn run_session(
             csv: out,
             removed: None,
             vtk_dir,
+            vtk_name: None,
         },
     )
 }
@@ -350,6 +353,9 @@ pub struct SessionOutputs<'o> {
     pub removed: Option<&'o mut dyn Write>,
     /// The VTK series folder (see [`run_session`]), if wanted.
     pub vtk_dir: Option<&'o Path>,
+    /// The VTK folder as the user named it, for messages, when `vtk_dir`
+    /// is a hidden temporary one ([`SeriesDir::dir`]); `None`: `vtk_dir`.
+    pub vtk_name: Option<&'o Path>,
 }
 
 /// [`run_session`] into `outputs`. Before any work: the tick count, the
@@ -364,6 +370,7 @@ pub fn run_session_into(
         csv: out,
         mut removed,
         vtk_dir,
+        vtk_name,
     } = outputs;
     // Bounded before any work: the table build can take minutes.
     let tick_total =
@@ -372,7 +379,7 @@ pub fn run_session_into(
     let (mesh, report) = scene.load_mesh()?;
     check_stable_step(scene, &mesh, &report)?;
     if let Some(dir) = vtk_dir {
-        check_series_size(scene, tick_total, &mesh, dir)?;
+        check_series_size(scene, tick_total, &mesh, vtk_name.unwrap_or(dir))?;
     }
     if let Some(removed) = removed.as_mut() {
         writeln!(removed, "t,tet")?;
@@ -635,7 +642,7 @@ impl Ticks<'_> {
             if let Err(e) = haptic.physics_update()
                 && session.summary.physics_error.is_none()
             {
-                session.summary.physics_error = Some(format!("t = {t} s: {e}"));
+                session.summary.physics_error = Some(format!("t = {} s: {e}", time_s(t)));
             }
             session.removed(t, &view.removed(haptic.tissue()))?;
             if session.dir.is_some() {

@@ -9,7 +9,7 @@
 //!
 //! [material]
 //! young_pa = 3000.0            # required
-//! poisson = 0.45               # required, 0 <= nu < 0.5
+//! poisson = 0.45               # required, 0 <= nu <= 0.4999 (fem::material::MAX_POISSON)
 //! density_kg_m3 = 1000.0       # default 1000 (used by the dynamic model)
 //!
 //! [model]                      # default: kind = "precomputed"
@@ -84,11 +84,12 @@ use serde::Deserialize;
 
 use super::materials::{RegionSpec, check_regions};
 use super::zones::{PartitionFile, PartitionSpec, Zone, ZoneFile, ZoneKind, ZoneShape, zones_spec};
-use crate::fem::material::{Material, MaterialError};
+use crate::fem::material::{Material, MaterialError, POISSON_RANGE};
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_HAPTIC_HZ, MAX_SCENE_FILE_BYTES, read_bounded};
 use crate::mesh::generate::{ORGAN_CUBE_M, box_mesh, organ_mesh};
 use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh, top_height};
+use crate::output::number::shown;
 
 /// Largest number of tool points of a scene, both the trajectory's tool points (`[tool] points`)
 /// and the kernel tool points their kinds need ([`ToolSpec::kernel_points`]: a grasper's two jaws
@@ -1043,18 +1044,18 @@ impl Scene {
         if let Err(err) = Material::new(m.young_pa, m.poisson) {
             return match err {
                 MaterialError::YoungModulus(e) => invalid(
-                    format!("[material] young_pa = {e}"),
+                    format!("[material] young_pa = {}", shown(e)),
                     "must be finite and > 0 Pa",
                 ),
                 MaterialError::PoissonRatio(nu) => invalid(
-                    format!("[material] poisson = {nu}"),
-                    "must satisfy 0 <= nu < 0.5",
+                    format!("[material] poisson = {}", shown(nu)),
+                    &format!("must satisfy {POISSON_RANGE}"),
                 ),
             };
         }
         if !positive(m.density_kg_m3) {
             return invalid(
-                format!("[material] density_kg_m3 = {}", m.density_kg_m3),
+                format!("[material] density_kg_m3 = {}", shown(m.density_kg_m3)),
                 "must be finite and > 0 kg/m3",
             );
         }
@@ -1066,7 +1067,7 @@ impl Scene {
         }
         if !positive(self.tool.radius_m) {
             return invalid(
-                format!("[tool] radius_m = {}", self.tool.radius_m),
+                format!("[tool] radius_m = {}", shown(self.tool.radius_m)),
                 "must be finite and > 0 m",
             );
         }
@@ -1075,18 +1076,18 @@ impl Scene {
             key,
             msg,
         };
-        check_regions(&self.regions, m.density_kg_m3).map_err(in_file)?;
+        check_regions(&self.regions, m.young_pa, m.density_kg_m3).map_err(in_file)?;
         check_tool(&self.tool).map_err(in_file)?;
         check_removal(&self.cutting, self.tearing.as_ref(), &self.model).map_err(in_file)?;
         if !positive(self.rates.haptic_hz) {
             return invalid(
-                format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
+                format!("[rates] haptic_hz = {}", shown(self.rates.haptic_hz)),
                 "must be finite and > 0 Hz",
             );
         }
         if self.rates.haptic_hz > MAX_HAPTIC_HZ {
             return invalid(
-                format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
+                format!("[rates] haptic_hz = {}", shown(self.rates.haptic_hz)),
                 &format!(
                     "above {MAX_HAPTIC_HZ} Hz (MAX_HAPTIC_HZ): haptic devices servo at 1 to 10 kHz"
                 ),
@@ -1100,13 +1101,13 @@ impl Scene {
         }
         if !(positive(self.tick_s()) && positive(self.physics_period_s())) {
             return invalid(
-                format!("[rates] haptic_hz = {}", self.rates.haptic_hz),
+                format!("[rates] haptic_hz = {}", shown(self.rates.haptic_hz)),
                 "too small: 1/haptic_hz and physics_every/haptic_hz must be finite seconds",
             );
         }
         if !positive(self.safety.max_force_n) {
             return invalid(
-                format!("[safety] max_force_n = {}", self.safety.max_force_n),
+                format!("[safety] max_force_n = {}", shown(self.safety.max_force_n)),
                 "must be finite and > 0 N",
             );
         }
@@ -1114,7 +1115,7 @@ impl Scene {
             return invalid(
                 format!(
                     "[safety] max_slew_n_per_s = {}",
-                    self.safety.max_slew_n_per_s
+                    shown(self.safety.max_slew_n_per_s)
                 ),
                 "must be finite and > 0 N/s",
             );
@@ -1505,19 +1506,19 @@ fn check_dynamic(d: &DynamicSpec, physics_period_s: f64) -> Result<(), (String, 
     }
     if !(d.damping_per_s.is_finite() && d.damping_per_s >= 0.0) {
         return Err((
-            format!("[model] damping_per_s = {}", d.damping_per_s),
+            format!("[model] damping_per_s = {}", shown(d.damping_per_s)),
             "must be finite and >= 0 1/s".into(),
         ));
     }
     if !(d.dt_s.is_finite() && d.dt_s > 0.0) {
         return Err((
-            format!("[model] dt_s = {}", d.dt_s),
+            format!("[model] dt_s = {}", shown(d.dt_s)),
             "must be finite and > 0 s".into(),
         ));
     }
     if substeps(physics_period_s, d.dt_s).is_none() {
         return Err((
-            format!("[model] dt_s = {}", d.dt_s),
+            format!("[model] dt_s = {}", shown(d.dt_s)),
             format!(
                 "the physics period ({physics_period_s} s = physics_every / haptic_hz) must be a whole number of steps, 1 to {MAX_SUBSTEPS}"
             ),

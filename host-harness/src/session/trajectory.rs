@@ -70,6 +70,7 @@ use crate::limits::{
     MAX_TOOL_COORDINATE_M, MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S,
     read_bounded,
 };
+use crate::output::number::time_s;
 
 /// The header line's fields, in order, of a file without the tool columns.
 pub const HEADER: [&str; 5] = ["t", "tool", "x", "y", "z"];
@@ -197,7 +198,7 @@ pub enum LineProblem {
         count: usize,
     },
     /// A time before the previous line's.
-    #[error("time {t_s} s goes backwards: line {previous_line} is at {previous_s} s")]
+    #[error("time {} s goes backwards: line {previous_line} is at {} s", time_s(*.t_s), time_s(*.previous_s))]
     TimeBackwards {
         /// This line's time, s.
         t_s: f64,
@@ -219,7 +220,8 @@ pub enum LineProblem {
     },
     /// A time further than [`MAX_TRAJECTORY_SPAN_S`] from the earliest or latest so far.
     #[error(
-        "time {t_s} s is {span_s} s from line {other_line} at {other_s} s: a trajectory spans at most {MAX_TRAJECTORY_SPAN_S} s (MAX_TRAJECTORY_SPAN_S); split a longer one"
+        "time {} s is {} s from line {other_line} at {} s: a trajectory spans at most {MAX_TRAJECTORY_SPAN_S} s (MAX_TRAJECTORY_SPAN_S); split a longer one",
+        time_s(*.t_s), time_s(*.span_s), time_s(*.other_s)
     )]
     SpanTooLong {
         /// This line's time, s.

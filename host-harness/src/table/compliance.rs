@@ -4,13 +4,14 @@
 use anyhow::{Context, ensure};
 use faer::Mat;
 use faer::sparse::SparseColMat;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use palpate_kernel::table::format::surface_block_index;
 
 use super::cg::JacobiCg;
 use crate::fem::assembly::{FreeOrdering, assemble_restricted};
 use crate::fem::llt::SparseLlt;
 use crate::fem::material::TetMaterials;
+use crate::output::stderr;
 
 /// How [`compute_compliance`] solves `A x = e`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,17 +142,11 @@ fn check_inputs(
 /// A progress bar over the `s` touchable vertices on stderr, or a hidden
 /// one without `progress`.
 fn progress_bar(progress: bool, s: usize) -> ProgressBar {
-    if progress {
-        let bar = ProgressBar::new(s as u64);
-        if let Ok(style) = ProgressStyle::with_template(
-            "compliance {bar:40} {pos}/{len} touchable vertices ({eta})",
-        ) {
-            bar.set_style(style);
-        }
-        bar
-    } else {
-        ProgressBar::hidden()
-    }
+    stderr::progress_bar(
+        s as u64,
+        "compliance {bar:40} {pos}/{len} touchable vertices ({eta})",
+        progress,
+    )
 }
 
 impl Compliance {
@@ -280,7 +275,7 @@ pub fn check_cg_work(touchable: u64, dof: u64, nnz: u64) -> anyhow::Result<()> {
         );
     }
     if seconds > PRINT_ESTIMATE_ABOVE_S {
-        eprintln!("compliance by CG: estimate: {figures}");
+        crate::output::stderr::line(&format!("compliance by CG: estimate: {figures}"));
     }
     Ok(())
 }

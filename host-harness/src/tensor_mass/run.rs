@@ -17,6 +17,7 @@ use super::OwnedState;
 use crate::dispatch::HostDispatch;
 use crate::fem::element::shape_gradients;
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::number::shown;
 use crate::table::build::{BuildOptions, build};
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
@@ -117,7 +118,7 @@ fn run_in<T: Real>(
             .with_context(|| format!("--load {vertex}"))?;
     }
     if !(options.dt_s.is_finite() && options.dt_s > 0.0) {
-        bail!("--dt must be finite and > 0 s, got {}", options.dt_s);
+        bail!("--dt must be finite and > 0 s, got {}", shown(options.dt_s));
     }
     let dt_s = T::of_f64(options.dt_s);
     let first = model.displacements_m()?.to_vec();

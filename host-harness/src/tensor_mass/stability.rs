@@ -11,6 +11,7 @@ use serde::Serialize;
 use super::OwnedState;
 use super::run::{diagonal, f64_table, host_params};
 use crate::mesh::{MeshReport, TetMesh};
+use crate::output::number::shown;
 use crate::table::build::BuildOptions;
 
 /// Steps of the loading scenario per trial.
@@ -387,7 +388,10 @@ pub fn stable_step_limit(
     integrator: Integrator,
 ) -> anyhow::Result<StableStep> {
     if !(damping_per_s.is_finite() && damping_per_s >= 0.0) {
-        bail!("the damping must be finite and >= 0 1/s, got {damping_per_s}");
+        bail!(
+            "the damping must be finite and >= 0 1/s, got {}",
+            shown(damping_per_s)
+        );
     }
     with_moving_model(mesh, report, options, damping_per_s, |model| {
         stable_step_of_model(model, options.material.young_pa, damping_per_s, integrator)

@@ -372,3 +372,113 @@ fn atomic_files_replace_whole_and_name_the_output_in_errors() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The ID of a process that has ended (a child that exited): no process
+/// runs under it (until the system reuses it, far later).
+fn ended_process_id() -> u32 {
+    let mut child = std::process::Command::new("true")
+        .spawn()
+        .expect("spawn true");
+    let id = child.id();
+    child.wait().expect("wait");
+    id
+}
+
+/// The sweep's rule: a temporary of this output whose process has ended is
+/// stale; one of this process, of another output's name, or of a name not
+/// of palpate's pattern is not; a replaced folder's old copy is stale only
+/// while the folder is in place (else it may be the only whole copy).
+#[test]
+fn only_temporaries_of_ended_runs_of_this_output_are_stale() {
+    if !Path::new("/proc/self").exists() {
+        return; // no process table to ask: nothing is swept
+    }
+    let dir = fresh_dir("stale");
+    let target = dir.join("series");
+    let dead = ended_process_id();
+    let live = std::process::id();
+    let names = [
+        format!(".series{TEMP_TAG}{dead}.0"),
+        format!(".series{TEMP_TAG}{live}.0"),
+        format!(".other{TEMP_TAG}{dead}.0"),
+        format!(".series{TEMP_TAG}{dead}.x"),
+        format!(".series{TEMP_TAG}notapid.0"),
+        format!(".series{}{dead}.1", atomic::OLD_TAG),
+    ];
+    for name in &names {
+        std::fs::create_dir(dir.join(name)).expect("folder");
+    }
+    let stale = |expected: &[&String]| {
+        let expected: Vec<PathBuf> = expected.iter().map(|n| dir.join(n)).collect();
+        assert_eq!(atomic::stale_temporaries(&target), expected);
+    };
+    // The folder absent: its old copy is kept.
+    stale(&[&names[0]]);
+    std::fs::create_dir(&target).expect("folder");
+    stale(&[&names[5], &names[0]]);
+    atomic::sweep_stale(&target, &target);
+    stale(&[]);
+    for (i, name) in names.iter().enumerate() {
+        assert_eq!(dir.join(name).exists(), ![0, 5].contains(&i), "{name}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `scene tables`' and `chart`'s folders: a folder holding only the hybrid
+/// tables of an earlier palpate is replaced whole; a chart's names in a
+/// folder without the marker are a person's (refused); a file in the
+/// folder's place is named with what needs the folder.
+#[test]
+fn folder_kinds_accept_their_own_earlier_folders_only() {
+    use palpate::output::atomic::FolderKind;
+    let dir = fresh_dir("kinds");
+    let tables = dir.join("tables");
+    std::fs::create_dir(&tables).expect("folder");
+    for name in ["precomputed.bin", "dynamic.bin", "interface.bin"] {
+        std::fs::write(tables.join(name), "old").expect("file");
+    }
+    let folder = SeriesDir::of_kind(&tables, FolderKind::HybridTables).expect("earlier tables");
+    std::fs::write(folder.dir().join("precomputed.bin"), "new").expect("file");
+    folder.commit().expect("commit");
+    let mut names: Vec<String> = std::fs::read_dir(&tables)
+        .expect("folder")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [SERIES_MARKER, "precomputed.bin"],
+        "the set replaced whole"
+    );
+    assert!(SeriesDir::of_kind(&tables, FolderKind::VtkSeries).is_ok());
+
+    let report = dir.join("report");
+    std::fs::create_dir(&report).expect("folder");
+    std::fs::write(report.join("report.md"), "mine").expect("file");
+    let err = SeriesDir::of_kind(&report, FolderKind::Chart).expect_err("a person's folder");
+    assert!(err.to_string().contains("palpate did not write"), "{err}");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "mine").expect("file");
+    let err = SeriesDir::of_kind(&file, FolderKind::HybridTables).expect_err("a file");
+    assert!(
+        err.to_string().contains("the hybrid tables needs a folder"),
+        "{err}"
+    );
+    assert_eq!(leftovers(&dir), Vec::<String>::new());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// An output that is not a regular file is written in place and `prepare`
+/// does not sync it (a device's `fsync` fails with EINVAL).
+#[test]
+fn an_output_written_in_place_prepares_and_commits() {
+    let null = Path::new("/dev/null");
+    if !null.exists() {
+        return;
+    }
+    let mut file = AtomicFile::create(null).expect("/dev/null");
+    assert_eq!(file.temp_path(), None);
+    file.write_all(b"t,fx\n").expect("write");
+    file.prepare().expect("prepare in place");
+    file.commit().expect("commit in place");
+}
