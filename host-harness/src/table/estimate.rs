@@ -37,7 +37,6 @@ use super::file::{Precision, layout};
 use super::options::{BuildOptions, TableKindOptions};
 use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
 use crate::mesh::{MeshReport, Surface, TetMesh};
-use crate::output::stderr;
 
 /// Working memory of a build per mesh vertex besides its arrays, bytes: the mesh (24 bytes of
 /// position, ~6 tets of 16), the stiffness matrix's pattern and values (~15 blocks of 9 values
