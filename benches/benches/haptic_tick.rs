@@ -4,7 +4,7 @@
 //! a tissue cube (0.1 m, base fixed) of 6³ and 12³ cells; and the collision
 //! query alone (detection of a crossing by a swept sphere).
 //!
-//! Target (issue 6): a full tick with up to 4 contacts in ≤ 2 µs on the
+//! Target (the haptic loop's speed target): a full tick with up to 4 contacts in ≤ 2 µs on the
 //! host, independent of the mesh size. Printed after the group: the RAM of
 //! the loop state, `size_of::<PrecomputedLoop<f32, P, P>>()`.
 //!

@@ -3,9 +3,9 @@
 //!
 //! - `force_path`: `contact_forces::<4>` for m = 1..=4 vertex contacts and one
 //!   barycentric contact, on two mesh sizes (its cost depends on m only).
-//!   Target (issue 3): at most 1 µs for up to 4 contacts.
+//!   Target (the pre-computed model's speed target): at most 1 µs for up to 4 contacts.
 //! - `displacement_update`: `free_displacements` (free-index order) and
-//!   `displacements` (vertex order, the call the issue names) for m = 1 and 4
+//!   `displacements` (vertex order, the call a renderer makes) for m = 1 and 4
 //!   vertex contacts on three mesh sizes, each next to a `copy_from_slice` of
 //!   the bytes it reads and writes, measured in the same run. Bytes, f32
 //!   tables (`add_column_rows` in `kernel/src/precomputed/model.rs`):

@@ -7,7 +7,7 @@
 //! each fixed at its base, deformed by a 20 % shear first so that every
 //! tet is strained.
 //!
-//! Targets (issue 5): a St Venant-Kirchhoff step on ~6000 tets in ≤ 200 µs
+//! Targets (the non-linear model's speed targets): a St Venant-Kirchhoff step on ~6000 tets in ≤ 200 µs
 //! (5 kHz) on one core; non-linear/linear cost ratio ≤ 2.5 (Picinbono 2001
 //! §3.3: 5×, 9 Hz for 6342 tets on a 600 MHz PIII). Printed after the group:
 //! steps per second and the ratio to the linear step, per mesh.

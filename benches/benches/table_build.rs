@@ -2,7 +2,7 @@
 //! ordering) vs the paper's conjugate-gradient baseline, on tissue cubes of
 //! 6³, 12³ and 20³ cells (343, 2197 and 9261 vertices).
 //!
-//! Target (issue 3): the 12³ cube in at most 2 s on one core, at least 5×
+//! Target (the table build's speed target): the 12³ cube in at most 2 s on one core, at least 5×
 //! faster than scipy's SuperLU computing the same blocks
 //! (`tools/reference/scipy_compliance.py`). CG is run on the two smaller
 //! sizes only: it already takes seconds at 6³ and grows about as N².

@@ -3,7 +3,7 @@
 //! 5³, 10³ and 20³ cells (750, 6000 and 48 000 tets), base fixed, after a
 //! perturbation so every vertex moves.
 //!
-//! Target (issue 4): a symplectic-Euler step on ~6000 tets in ≤ 50 µs on one
+//! Target (the dynamic model's speed target): a symplectic-Euler step on ~6000 tets in ≤ 50 µs on one
 //! core (20 kHz), cost linear in the mesh size. Printed after the group:
 //! steps per second per mesh and the ratio of a step to a memcpy of the bytes
 //! one force pass touches (`40·(N+E)` bytes of tensors and CSR, `12·N` each

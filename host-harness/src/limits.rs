@@ -1,4 +1,4 @@
-//! The harness's bounds on its inputs and runs (issue 12), each in one place: every one is
+//! The harness's bounds on its inputs and runs (nothing unbounded: every input-sized allocation and run is checked first), each in one place: every one is
 //! checked before the work it bounds starts, so that a typo or a hostile file gives a one-line
 //! error instead of filling the disk or the memory. README.md lists them ("Limits").
 //!

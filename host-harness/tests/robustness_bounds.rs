@@ -1,4 +1,4 @@
-//! Issue 12, bounded runs and inputs: the probes that need the `palpate`
+//! Robustness, bounded runs and inputs: the probes that need the `palpate`
 //! binary (the in-process ones are `tests/host/robustness/bounds.rs`). Each
 //! once grew without bound or aborted; each now exits 2 with one line, fast.
 

@@ -1,4 +1,4 @@
-//! Issue 12, output safety, through the binary: a run killed while writing
+//! Robustness, output safety, through the binary: a run killed while writing
 //! leaves the previous output byte-identical; a failed run leaves it too;
 //! an output that is an input is refused; a closed standard output is a
 //! normal end (exit 0, nothing on stderr) and a full one a one-line error
@@ -99,7 +99,7 @@ fn a_killed_session_run_leaves_the_previous_csv() {
 }
 
 /// A failed run keeps the previous output, through the binary:
-/// `session run` whose scene's mesh is missing (issue 12's first probe),
+/// `session run` whose scene's mesh is missing (the first robustness probe),
 /// and `tables build` over a good table whose `--fix` matches no vertex
 /// (the output was opened before the mesh was read). Nothing is left
 /// beside them.

@@ -1,4 +1,4 @@
-//! Issue 12, "wrong or unusable results with exit 0" and "messages", at the
+//! Robustness, "wrong or unusable results with exit 0" and "messages", at the
 //! process level: each probe that once printed a wrong or unusable result
 //! with exit status 0, or an error naming nothing, now exits 2 with one line
 //! `error: …` naming the file, line, key or element (or gives the correct

@@ -46,7 +46,7 @@ fn refusal(scene: &Scene, mesh: &TetMesh) -> String {
     }
 }
 
-/// The case: a finely meshed cylinder (6144 tets, 7.6 cm high, radius 1.52 cm, E =
+/// A user's case: a finely meshed cylinder (6144 tets, 7.6 cm high, radius 1.52 cm, E =
 /// 3 kPa, ν = 0.45, symplectic Euler) at dt_s = 0.5 ms faulted on the first press; its limit
 /// is 0.458 ms. Refused at load, with the limit and a dt_s that validates and passes.
 #[test]

@@ -174,7 +174,7 @@ fn a_blade_on_the_precomputed_model_says_cut_refused() {
     assert_eq!(forces(&csv), forces(&probe_csv));
 }
 
-/// The stable-step check at load: the built-in dynamic block with
+/// The stable-step check at load: the built-in dynamic block with
 /// `dt_s = 5 ms` (two steps per 10 ms physics period; its symplectic
 /// limit is 1.9 ms) is refused before the table build, with the limit and
 /// a step that works.

@@ -210,7 +210,7 @@ proptest! {
     }
 }
 
-/// Issue 12: a tool sample far away (1e10 m on every axis, then a return to
+/// A hostile probe: a tool sample far away (1e10 m on every axis, then a return to
 /// 5 mm inside the top face) is detected again on the way back. The swept
 /// segment from 1e10 m is clipped to the grid's reach before the
 /// intersection, so in f32 the part near the surface keeps its precision

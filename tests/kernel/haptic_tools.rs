@@ -68,7 +68,7 @@ fn with_loop<const P: usize, R>(
     body(&mut haptic)
 }
 
-/// The cantilever: 0.1 × 0.02 × 0.02 m, fixed at x = 0, 1 cm cells.
+/// A user's cantilever: 0.1 × 0.02 × 0.02 m, fixed at x = 0, 1 cm cells.
 fn cantilever() -> TableFile {
     table_of(&box_mesh([10, 2, 2], [0.1, 0.02, 0.02]), "x<0.001")
 }
@@ -103,7 +103,7 @@ fn top_height(
     panic!("({x}, {y}) is not over the top face");
 }
 
-/// The defect (pop-through): the cantilever, E = 3 kPa, ν = 0.45,
+/// A defect a user reported (pop-through): the cantilever, E = 3 kPa, ν = 0.45,
 /// damping 30/s, symplectic Euler (0.5 ms, a physics update every 10
 /// ticks), pressed 0.5 mm deep near its free end within one physics period,
 /// then held still for 3 s. The beam overshoots and the contact is let go

@@ -662,7 +662,7 @@ fn tearing_removes_overstretched_tets_only() {
     }
 }
 
-/// The model's edge layout (`kernel/src/tensor_mass/edges.rs`) on issue 15's
+/// The model's edge layout (`kernel/src/tensor_mass/edges.rs`) on `palpate bench`'s
 /// cylinder (`cylinder_mesh(0.1, 4, 16)`: 1377 vertices, 6144 tets, 8160
 /// edges) and the reference cube: every table edge is stored exactly once,
 /// as `K_ij` in row `i` or as `K_ij`ᵀ in row `j`, bit for bit (the layout

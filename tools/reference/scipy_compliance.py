@@ -1,4 +1,4 @@
-"""Baseline for the table-build bench (issue 3): scipy's SuperLU computing the
+"""Baseline for the table-build bench (its speed target): scipy's SuperLU computing the
 same compliance blocks as `palpate tables build` on the same mesh.
 
 Mesh: the benches' tissue cube (`benches/src/lib.rs`): 12x12x12 Kuhn cells,

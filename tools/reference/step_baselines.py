@@ -1,11 +1,11 @@
-"""Baselines of `palpate bench` (issue 15): what a tensor-mass step costs next
+"""Baselines of `palpate bench`: what a tensor-mass step costs next
 to the sparse matrix-vector product and the force evaluations of Python
 libraries, on the same mesh.
 
 Mesh: the generated cylinder of `palpate::mesh::generate::cylinder_mesh`
 (H = 0.1 m, R = H/5), ported below construction for construction, at
 `radial_cells` = 4 and `height_cells` = 16: 1377 vertices, 6144 tets (the
-"about 6000 tets" of issue 15). `--write-mesh PREFIX` writes it as TetGen
+"about 6000 tets" of the speed targets). `--write-mesh PREFIX` writes it as TetGen
 `PREFIX.node` / `PREFIX.ele` (0-based), which `palpate bench` reads.
 Material: E = 5000 Pa, nu = 0.4 (the St Venant-Kirchhoff benches'), base
 z = 0 fixed; the deformed state is the benches' 20 % shear

@@ -26,7 +26,7 @@ pub fn tissue() -> Material {
 /// Cylinder height, m (radius `H/5`).
 pub const CYLINDER_HEIGHT_M: f64 = 0.1;
 
-/// Top-face tilts of the three stages, degrees. The issue asks for about
+/// Top-face tilts of the three stages, degrees. The experiment asks for about
 /// 30°, 60°, 90°; under a dead (fixed-direction) lateral load the tilt only
 /// approaches 90° as the force grows without bound (the cantilever elastica),
 /// and the measured tilt of the default cylinder levels off near 78°, so the

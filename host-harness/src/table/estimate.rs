@@ -1,5 +1,5 @@
 //! A table's size and its build's peak memory, estimated from the mesh's counts before any
-//! array is computed (issue 12), and the limits a build checks them against.
+//! array is computed (nothing unbounded), and the limits a build checks them against.
 //!
 //! A pre-computed table stores `B = S(S+1)/2 + (F−S)·S` compliance blocks of 3×3 scalars
 //! (`F` free, `S` touchable vertices; `kernel/src/table/format/mod.rs`): quadratic in the mesh. A

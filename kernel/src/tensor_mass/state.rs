@@ -108,7 +108,7 @@ impl core::error::Error for StateError {}
 impl<T: Real> StateBuffers<'_, T> {
     /// `G`, the length of [`Self::edge_groups`] for `table`: at most
     /// `⌈(E + 3 k) / 4⌉` groups of 4 edges, `k` the vertices with at most 2
-    /// table edges to higher vertices (on issue 15's 6144-tet cylinder, 2083
+    /// table edges to higher vertices (on `palpate bench`'s 6144-tet cylinder, 2083
     /// groups for 8160 edges, of which the layout fills 2051). Cost: one
     /// pass over the `N` rows.
     pub fn edge_group_count(table: &TensorMassTable<'_, T>) -> usize {

@@ -135,7 +135,7 @@ fn an_injected_write_failure_leaves_the_old_file_and_no_temporary() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Issue 12's first probe: `session run --out` over previous results with a
+/// The first robustness probe: `session run --out` over previous results with a
 /// missing mesh, or a `fix` that matches no vertex (an error after the mesh
 /// is read), once truncated the CSV at the start. Now both the CSV and the
 /// VTK folder of the previous run keep every byte, and nothing is left
