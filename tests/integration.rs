@@ -21,14 +21,17 @@ mod ffi {
 
 mod host {
     mod bench;
+    mod chart;
     mod compliance;
     mod dispatch;
     mod experiment;
     mod fem;
+    mod fix;
     mod materials;
     mod mesh;
     mod mesh_regions;
     mod newton;
+    mod output;
     mod partition;
     mod remap;
     mod robustness;

@@ -134,7 +134,7 @@ pub fn remap_word(remap: Option<&QuasiNonLinear<f64>>) -> String {
 }
 
 /// The inverse of [`remap_word`], in f32 (the haptic tick's precision).
-fn parse_remap(word: &str) -> anyhow::Result<Option<QuasiNonLinear<f32>>> {
+pub fn parse_remap(word: &str) -> anyhow::Result<Option<QuasiNonLinear<f32>>> {
     if word == "linear" {
         return Ok(None);
     }
@@ -268,27 +268,4 @@ pub fn measure_ticks(
         }
     }
     Ok(TickCounts::Measured { counts })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The command-line word carries the remap exactly (f64 → text → f64,
-    /// then f32, as the tick runs it).
-    #[test]
-    fn remap_word_round_trips() {
-        let c = [0.9, 0.5, -0.1, 0.0, 0.0];
-        let q = QuasiNonLinear {
-            radial: Remap::new(c, 0.01).unwrap(),
-            force: Remap::new([1.2, 3.0, 0.0, 0.0, 0.0], 2.5).unwrap(),
-        };
-        let back = parse_remap(&remap_word(Some(&q))).unwrap().unwrap();
-        assert_eq!(back.radial.coefficients(), &c.map(|x| x as f32));
-        assert_eq!(back.radial.x_max(), 0.01f32);
-        assert_eq!(back.force.coefficients()[1], 3.0f32);
-        assert_eq!(back.force.x_max(), 2.5f32);
-        assert!(parse_remap("linear").unwrap().is_none());
-        assert!(parse_remap("1,2").is_err());
-    }
 }

@@ -1,0 +1,141 @@
+//! The chart's pieces with an independent truth: the remap's command-line word round trip
+//! (`chart::ticks`), the Pareto front and "cheapest within" on hand-made points
+//! (`chart::select`), and the SVG text outlines against the font's own tables (`chart::svg_text`).
+
+use palpate::chart::select::{cheapest_within, pareto_front};
+use palpate::chart::svg_text::outline_text;
+use palpate::chart::ticks::{parse_remap, remap_word};
+use palpate_kernel::precomputed::{QuasiNonLinear, Remap};
+
+/// The command-line word carries the remap exactly (f64 → text → f64,
+/// then f32, as the tick runs it).
+#[test]
+fn remap_word_round_trips() {
+    let c = [0.9, 0.5, -0.1, 0.0, 0.0];
+    let q = QuasiNonLinear {
+        radial: Remap::new(c, 0.01).unwrap(),
+        force: Remap::new([1.2, 3.0, 0.0, 0.0, 0.0], 2.5).unwrap(),
+    };
+    let back = parse_remap(&remap_word(Some(&q))).unwrap().unwrap();
+    assert_eq!(back.radial.coefficients(), &c.map(|x| x as f32));
+    assert_eq!(back.radial.x_max(), 0.01f32);
+    assert_eq!(back.force.coefficients()[1], 3.0f32);
+    assert_eq!(back.force.x_max(), 2.5f32);
+    assert!(parse_remap("linear").unwrap().is_none());
+    assert!(parse_remap("1,2").is_err());
+}
+
+/// Hand-made points: (1, 0.5) and (2, 0.1) and (4, 0.01) are each
+/// best at their cost; (3, 0.2) is dominated by (2, 0.1); (5, 0.01)
+/// by (4, 0.01) (costlier, no better); (0.5, NaN) has no error and is
+/// off the front without dominating anything; the duplicate of (2, 0.1)
+/// stays on it.
+#[test]
+fn pareto_front_of_hand_made_points() {
+    let points = [
+        (1.0, 0.5),
+        (3.0, 0.2),
+        (2.0, 0.1),
+        (4.0, 0.01),
+        (5.0, 0.01),
+        (0.5, f64::NAN),
+        (2.0, 0.1),
+    ];
+    assert_eq!(
+        pareto_front(&points),
+        [true, false, true, true, false, false, true]
+    );
+}
+
+/// Within 20 %: (1, 0.15) is cheapest; within 5 %: (2, 0.04) beats the
+/// costlier (4, 0.001); within 0.05 %: none; the bound is inclusive;
+/// equal costs give the first.
+#[test]
+fn cheapest_within_bounds() {
+    let points = [(4.0, 0.001), (1.0, 0.15), (2.0, 0.04), (2.0, 0.03)];
+    assert_eq!(cheapest_within(&points, 0.20), Some(1));
+    assert_eq!(cheapest_within(&points, 0.05), Some(2));
+    assert_eq!(cheapest_within(&points, 0.15), Some(1));
+    assert_eq!(cheapest_within(&points, 0.002), Some(0));
+    assert_eq!(cheapest_within(&points, 0.0005), None);
+    assert_eq!(cheapest_within(&[(1.0, f64::NAN)], 1.0), None);
+}
+
+static FONT: &[u8] = include_bytes!("../../host-harness/assets/fonts/DejaVuSans.ttf");
+
+/// The x extent (min, max) of the coordinates of a path's `d`.
+fn x_extent(svg: &str) -> (f64, f64) {
+    let d = svg
+        .split_once(" d=\"")
+        .and_then(|(_, rest)| rest.split_once('"'))
+        .map(|(d, _)| d)
+        .unwrap();
+    let numbers: Vec<f64> = d
+        .split(|c: char| c.is_ascii_alphabetic() || c == ' ')
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    numbers
+        .chunks_exact(2)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p[0]), hi.max(p[0]))
+        })
+}
+
+/// A plotters `<text>` becomes one `<path>` with the same fill,
+/// opacity and rotation and no font reference; the rest of the SVG is
+/// kept. DejaVu Sans' `H` (2048 units per em; advance 1540, outline
+/// x 201…1339: its `hmtx` and `glyf` entries, read from the TTF's tables
+/// by a separate parser) at font size 20.48 (0.01 px per unit) spans
+/// x = 10 + 2.01 … 10 + 13.39 anchored at its start, and 7.70 (half
+/// its advance) less anchored in the middle.
+#[test]
+fn text_becomes_outlines() {
+    let svg = "<svg>\n<rect/>\n<text x=\"10\" y=\"40\" dy=\"0.76em\" text-anchor=\"start\" \
+               font-family=\"sans-serif\" font-size=\"20.48\" opacity=\"0.5\" \
+               fill=\"#FF0000\" transform=\"rotate(270, 10, 40)\">\nH\n</text>\n</svg>\n";
+    let out = outline_text(svg, FONT).unwrap();
+    assert!(
+        !out.contains("<text") && !out.contains("font-family"),
+        "{out}"
+    );
+    assert!(out.starts_with("<svg>\n<rect/>\n<path d=\"M"), "{out}");
+    assert!(out.ends_with("/>\n</svg>\n"), "{out}");
+    assert!(out.contains("fill=\"#FF0000\" opacity=\"0.5\" transform=\"rotate(270, 10, 40)\""));
+    let (lo, hi) = x_extent(&out);
+    assert!(
+        (lo - 12.01).abs() < 0.006 && (hi - 23.39).abs() < 0.006,
+        "{lo} {hi}"
+    );
+    let middle = outline_text(&svg.replace("\"start\"", "\"middle\""), FONT).unwrap();
+    let (lo, hi) = x_extent(&middle);
+    assert!(
+        (lo - 4.31).abs() < 0.006 && (hi - 15.69).abs() < 0.006,
+        "{lo} {hi}"
+    );
+}
+
+/// Escaped text is unescaped before layout: `&lt;` is one `<` glyph
+/// (outline x 217…1499 units, the font's `glyf` entry) and a space has
+/// no outline but advances 651 units (`hmtx`); at font size 10.24
+/// (0.005 px per unit) that is x 1.085…7.495, then 3.255 further right
+/// behind a space.
+#[test]
+fn escaped_text_and_spaces() {
+    let text = |s: &str| {
+        format!(
+            "<text x=\"0\" y=\"0\" dy=\"0.5ex\" text-anchor=\"start\" font-family=\"a\" \
+             font-size=\"10.24\" opacity=\"1\" fill=\"#000000\">\n{s}\n</text>\n"
+        )
+    };
+    let (lo, hi) = x_extent(&outline_text(&text("&lt;"), FONT).unwrap());
+    assert!(
+        (lo - 1.085).abs() < 0.006 && (hi - 7.495).abs() < 0.006,
+        "{lo} {hi}"
+    );
+    let (lo, hi) = x_extent(&outline_text(&text(" &lt;"), FONT).unwrap());
+    assert!(
+        (lo - 4.34).abs() < 0.006 && (hi - 10.75).abs() < 0.006,
+        "{lo} {hi}"
+    );
+}
