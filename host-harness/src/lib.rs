@@ -24,6 +24,7 @@ pub mod partition;
 pub mod precomputed;
 pub mod remap;
 pub mod replay;
+pub mod scene;
 pub mod session;
 pub mod table;
 pub mod tensor_mass;

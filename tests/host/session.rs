@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use palpate::session::generate::MAX_GENERATED_SAMPLES;
-use palpate::session::{
+use palpate::scene::generate::MAX_GENERATED_SAMPLES;
+use palpate::scene::{
     DynamicSpec, GenerateError, Generator, Keyframe, MaterialSpec, MeshSource, ModelSpec, Pinch,
     Poke, Press, PressHold, Rates, Sample, Scene, Slide, Strike, ToolSpec, Trajectory,
     TrajectoryError, sample_keyframes,

@@ -10,7 +10,7 @@ use palpate::fem::material::Material;
 use palpate::mesh::generate::{box_mesh, cylinder_mesh};
 use palpate::mesh::{MeshReport, TetMesh};
 use palpate::session::stability::{STABLE_STEP_SAFETY, check_stable_step};
-use palpate::session::{ModelSpec, Scene};
+use palpate::scene::{ModelSpec, Scene};
 use palpate::table::build::BuildOptions;
 use palpate::table::file::Precision;
 use palpate::tensor_mass::stability::{critical_dt_of_mesh, integrator_limit, stable_step_limit};

@@ -14,7 +14,7 @@ use palpate::fix::fixed_vertices;
 use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
 use palpate::session::run::{loop_config, precomputed_options, ticks};
 use palpate::session::tool_points::{ForToolPoints, with_tool_points};
-use palpate::session::{ModelSpec, Scene, Trajectory};
+use palpate::scene::{ModelSpec, Scene, Trajectory};
 use palpate::table::build::{BuildOptions, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build};
 use palpate::table::compliance::{Compliance, Solver, compute_compliance};
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks, f16_bits, measure};

@@ -38,9 +38,9 @@ use crate::budget::{HOST_IR, budget_table, chosen_trajectories, measure, probe_r
 use crate::fem::material::Material;
 use crate::fem::penalty::penalty_n;
 use crate::session::model::{SceneModel, SceneTables};
-use crate::session::scene::ModelSpec;
-use crate::session::scene::{MAX_TOOL_POINTS, ToolSpec};
-use crate::session::{Scene, Trajectory};
+use crate::scene::ModelSpec;
+use crate::scene::{MAX_TOOL_POINTS, ToolSpec};
+use crate::scene::{Scene, Trajectory};
 use palpate_kernel::tensor_mass::ElasticLaw;
 
 /// The trajectory of the counts: every probe pressed and held.

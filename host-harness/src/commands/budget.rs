@@ -12,9 +12,9 @@ use palpate::budget::{
 use palpate::output::atomic::work_folder;
 use palpate::session::model::{SceneModel, SceneTables};
 use palpate::session::run::check_scene_table;
-use palpate::session::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
+use palpate::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
 use palpate::session::stability::check_stable_step;
-use palpate::session::{MeshSource, Scene, Trajectory};
+use palpate::scene::{MeshSource, Scene, Trajectory};
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 
 use super::stdout;

@@ -10,7 +10,7 @@ use palpate::hybrid::HybridOptions;
 use palpate::hybrid::stability::critical_dt_of_hybrid;
 use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::partition::Partition;
-use palpate::session::Scene;
+use palpate::scene::Scene;
 use palpate::session::run::tensor_mass_options;
 use palpate::table::build::BuildOptions;
 use palpate::table::file::Precision;

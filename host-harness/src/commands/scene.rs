@@ -15,7 +15,7 @@ use palpate::output::atomic::{self, FolderKind, SeriesDir};
 use palpate::output::vtk::write_regions;
 use palpate::partition::{Partition, PlanReport};
 use palpate::session::model::{SceneModel, hybrid_tables};
-use palpate::session::{MeshSource, Scene, ZoneShape};
+use palpate::scene::{MeshSource, Scene, ZoneShape};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 

@@ -10,7 +10,7 @@ use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 
 use super::model::HybridFiles;
 use super::run::{DynamicSetup, PhysicsView};
-use super::{DynamicSpec, Scene};
+use crate::scene::{DynamicSpec, Scene};
 use crate::hybrid::owned::OwnedHybridBuffers;
 
 /// A hybrid scene's tables and settings: everything to build its loop.

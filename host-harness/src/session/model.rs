@@ -10,7 +10,7 @@ use anyhow::{Context, anyhow, bail};
 use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 
 use super::run::{precomputed_options, tensor_mass_options};
-use super::{DynamicSpec, ModelSpec, Scene};
+use crate::scene::{DynamicSpec, ModelSpec, Scene};
 use crate::fem::penalty::penalty_n;
 use crate::fix::fixed_vertices;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};

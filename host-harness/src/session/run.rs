@@ -44,12 +44,12 @@ use palpate_kernel::tensor_mass::{
 
 use super::hybrid::HybridSetup;
 use super::model::{SceneModel, SceneTables};
-use super::scene::{ToolKind, ToolSpec};
+use crate::scene::{ToolKind, ToolSpec};
 use super::stability::check_stable_step;
 use super::tool_points::{ForToolPoints, with_tool_points};
 use super::tools::kernel_tools;
-use super::trajectory::ToolState;
-use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
+use crate::scene::trajectory::ToolState;
+use crate::scene::{DynamicSpec, ModelSpec, Scene, Trajectory};
 use crate::dispatch::HostDispatch;
 use crate::fix::fixed_vertices;
 use crate::limits::{

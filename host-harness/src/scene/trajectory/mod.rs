@@ -65,7 +65,7 @@
 use std::io;
 use std::path::Path;
 
-use super::scene::MAX_TOOL_POINTS;
+use super::spec::MAX_TOOL_POINTS;
 use crate::limits::{
     MAX_TOOL_COORDINATE_M, MAX_TRAJECTORY_FILE_BYTES, MAX_TRAJECTORY_SPAN_S, MAX_TRAJECTORY_TIME_S,
     read_bounded,

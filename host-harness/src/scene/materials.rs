@@ -16,7 +16,7 @@
 
 use serde::Deserialize;
 
-use super::scene::{Scene, SceneError};
+use super::spec::{Scene, SceneError};
 use crate::fem::material::{
     MAX_STIFFNESS_CONTRAST, Material, MaterialError, POISSON_RANGE, TetMaterials,
 };

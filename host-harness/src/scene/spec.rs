@@ -62,7 +62,7 @@
 //! id = 2                       # the mesh's region id; tets of other regions take [material]
 //! young_pa = 30000.0
 //! poisson = 0.45
-//! # [[zone]] and [partition]: where the hybrid model must be dynamic (crate::session::zones)
+//! # [[zone]] and [partition]: where the hybrid model must be dynamic (crate::scene::zones)
 //! ```
 //!
 //! Unknown keys are refused, so a typo is an error, not a silently ignored setting. TOML integers
@@ -361,7 +361,7 @@ pub struct Scene {
     /// Limits of the safety supervisor on the device force (N, N/s), each finite and > 0;
     /// the loop takes them in f32 ([`crate::session::run::loop_config`]).
     pub safety: SafetyLimits<f64>,
-    /// Where the tissue must be dynamic (`[[zone]]`, [`crate::session::zones`]).
+    /// Where the tissue must be dynamic (`[[zone]]`, [`crate::scene::zones`]).
     pub zones: Vec<Zone>,
     /// How the zones become tets (`[partition]`).
     pub partition: PartitionSpec,

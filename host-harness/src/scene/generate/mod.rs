@@ -15,7 +15,7 @@
 //! the surface and a depth below it, and the approach and withdraw speeds. Defaults are on the
 //! built-in scene's block (top face `z = 0.06` m, centre `(0.06, 0.06)`), at 1 kHz.
 
-use super::scene::MAX_TOOL_POINTS;
+use super::spec::MAX_TOOL_POINTS;
 use super::trajectory::{Sample, ToolState, Trajectory, state_on};
 
 /// Largest number of samples a generator produces, so a typo (a speed of 1e-9 m/s) is an error
@@ -983,8 +983,8 @@ impl Generator for CutLine {
 /// a grasper's [`GraspPull`], a cutter's [`CutLine`] (with the scene's
 /// blade), a probe's [`PressHold`]; all sampled at 1 kHz with the tool
 /// columns (`session generate surgery` writes it for `built-in-tools`).
-pub fn surgery(tool: &super::scene::ToolSpec) -> Result<Trajectory, GenerateError> {
-    use super::scene::ToolKind;
+pub fn surgery(tool: &super::spec::ToolSpec) -> Result<Trajectory, GenerateError> {
+    use super::spec::ToolKind;
     let mut keyframes = Vec::new();
     for (i, kind) in tool.kinds.iter().enumerate() {
         let y = 0.03 + 0.025 * i as f64;
@@ -1018,12 +1018,12 @@ pub fn surgery(tool: &super::scene::ToolSpec) -> Result<Trajectory, GenerateErro
 }
 
 /// The built-in hybrid scene's tools at work on the organ
-/// ([`super::scene::Scene::built_in_hybrid`], sites [`super::scene::HepatectomySites`]): the
+/// ([`super::spec::Scene::built_in_hybrid`], sites [`super::spec::HepatectomySites`]): the
 /// grasper (tool 0) grasps the right lobe's terrace and pulls it up, the cutter (tool 1, the
 /// scene's blade) cuts along the cut line at the same time; 1 kHz with the tool columns
 /// (`session generate hepatectomy`).
-pub fn hepatectomy(tool: &super::scene::ToolSpec) -> Result<Trajectory, GenerateError> {
-    let sites = super::scene::HepatectomySites::on_the_organ();
+pub fn hepatectomy(tool: &super::spec::ToolSpec) -> Result<Trajectory, GenerateError> {
+    let sites = super::spec::HepatectomySites::on_the_organ();
     let mut keyframes = GraspPull {
         tool: 0,
         surface_m: sites.grasp_m,
