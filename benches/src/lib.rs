@@ -7,7 +7,7 @@ use palpate::fem::material::Material;
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
 use palpate::scene::Scene;
-use palpate::session::run::precomputed_options;
+use palpate::session::options::precomputed_options;
 use palpate::table::build::{
     BuildOptions, BuiltTable, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build,
 };

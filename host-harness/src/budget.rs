@@ -62,14 +62,15 @@ use crate::scene::generate::{
     GenerateError, Generator, Keyframe, Pinch, Poke, Press, PressHold, Slide, Strike, hepatectomy,
     sample_keyframes, surgery,
 };
+use crate::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, ToolKind};
+use crate::scene::{Scene, Trajectory};
 use crate::session::hybrid::HybridSetup;
 use crate::session::model::{SceneModel, SceneTables};
-use crate::session::run::check_scene_table;
-use crate::session::run::{DynamicSetup, loop_config, ticks};
-use crate::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, ToolKind};
+use crate::session::options::check_scene_table;
+use crate::session::run::ticks;
+use crate::session::setup::{DynamicSetup, loop_config};
 use crate::session::stability::check_stable_step;
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
-use crate::scene::{Scene, Trajectory};
 use crate::table::compress::Compression;
 
 /// The unit costs of the static tick bound, in one unit: x86-64

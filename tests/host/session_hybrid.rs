@@ -7,8 +7,8 @@
 
 use palpate::partition::Partition;
 use palpate::scene::generate::hepatectomy;
-use palpate::session::run::{SessionOutputs, run_session, run_session_into};
 use palpate::scene::{Generator, PressHold, Scene};
+use palpate::session::run::{SessionOutputs, run_session, run_session_into};
 use palpate_tests::scene;
 
 /// `built-in-hybrid` over `session generate hepatectomy`: the cuts and

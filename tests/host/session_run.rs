@@ -3,8 +3,8 @@
 //! bounded force changes, and non-finite input turned into a latched fault
 //! with zero force.
 
-use palpate::session::run::run_session;
 use palpate::scene::{Generator, Poke, Scene, Slide, Strike, Trajectory};
+use palpate::session::run::run_session;
 use palpate_tests::traj;
 
 fn run(scene: &Scene, trajectory: &Trajectory) -> (String, palpate::session::run::SessionSummary) {

@@ -7,12 +7,12 @@
 //! and a cutter's blade tip as kernel tool points.
 
 use nalgebra::Vector3;
+use palpate::scene::ToolKind;
 use palpate::scene::ToolSpec;
 use palpate::scene::generate::surgery;
-use palpate::session::run::{SessionSummary, removed_path, run_session, run_session_to_files};
-use palpate::scene::ToolKind;
-use palpate::session::tools::kernel_tools;
 use palpate::scene::{DynamicSpec, Generator, ModelSpec, Poke, Scene};
+use palpate::session::run::{SessionSummary, removed_path, run_session, run_session_to_files};
+use palpate::session::tools::kernel_tools;
 use palpate_kernel::haptic::{ToolAction, ToolInput};
 use palpate_tests::tool_state;
 

@@ -37,10 +37,10 @@ use super::{HYBRID_LAW, Model, Progress};
 use crate::budget::{HOST_IR, budget_table, chosen_trajectories, measure, probe_remapped};
 use crate::fem::material::Material;
 use crate::fem::penalty::penalty_n;
-use crate::session::model::{SceneModel, SceneTables};
 use crate::scene::ModelSpec;
 use crate::scene::{MAX_TOOL_POINTS, ToolSpec};
 use crate::scene::{Scene, Trajectory};
+use crate::session::model::{SceneModel, SceneTables};
 use palpate_kernel::tensor_mass::ElasticLaw;
 
 /// The trajectory of the counts: every probe pressed and held.

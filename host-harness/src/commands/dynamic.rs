@@ -11,7 +11,7 @@ use palpate::hybrid::stability::critical_dt_of_hybrid;
 use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::partition::Partition;
 use palpate::scene::Scene;
-use palpate::session::run::tensor_mass_options;
+use palpate::session::options::tensor_mass_options;
 use palpate::table::build::BuildOptions;
 use palpate::table::file::Precision;
 use palpate::tensor_mass::run::RunOptions;

@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::spec::exact;
+use super::exact;
 use super::trajectory::Trajectory;
 use crate::limits::MAX_ZONE_PATH_SEGMENTS;
 

@@ -1,5 +1,6 @@
 //! Haptic sessions on a scene ([`crate::scene`]): the scene's model resolved and its tables
-//! built ([`model`]), the stable step checked ([`stability`]), and `session run` ([`run`],
+//! built ([`model`], with the build options of [`options`]), the stable step checked
+//! ([`stability`]), what the loop is built from ([`setup`]), and `session run` ([`run`],
 //! [`hybrid`] for the hybrid model).
 //!
 //! Data flow: [`crate::scene::Scene`] + [`crate::scene::Trajectory`] → [`model::SceneModel`] →
@@ -9,7 +10,9 @@
 
 pub mod hybrid;
 pub mod model;
+pub mod options;
 pub mod run;
+pub mod setup;
 pub mod stability;
 pub mod tool_points;
 pub mod tools;

@@ -18,8 +18,8 @@
 use nalgebra::Vector3;
 use palpate_kernel::haptic::{ToolAction, ToolInput};
 
-use crate::scene::{ToolKind, ToolSpec};
 use crate::scene::trajectory::ToolState;
+use crate::scene::{ToolKind, ToolSpec};
 
 /// The `P` kernel tool points of `spec`'s tools in `states` (one per
 /// trajectory tool point), f32 as the loop runs; a point with no state (a
