@@ -67,7 +67,7 @@ fuzz_target!(|data: &[u8]| {
         period.is_finite() && period >= tick,
         "physics period {period} s"
     );
-    assert!(scene.elastic_material().is_ok());
+    assert!(scene.material.elastic.check().is_ok());
     match scene.model {
         ModelSpec::Precomputed => {
             assert!(scene.dynamic_substeps().is_none());

@@ -170,7 +170,7 @@ impl Partition {
             fixed: &fixed,
             zones: &scene.zones,
             margin_rings: scene.partition.margin_rings,
-            poisson: scene.material.poisson,
+            poisson: scene.material.elastic.poisson,
             scene: &scene.source,
             mesh_name: &report.source,
         })

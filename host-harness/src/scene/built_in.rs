@@ -16,6 +16,7 @@ use super::spec::{
 };
 use super::tool::{DEFAULT_TOOL_POINTS, DEFAULT_TOOL_RADIUS_M, ToolKind, ToolSpec};
 use super::zones::{PartitionSpec, Zone, ZoneKind, ZoneShape};
+use crate::fem::material::Material;
 use crate::fix::FixPredicate;
 use crate::mesh::generate::{ORGAN_CUBE_M, organ_mesh};
 use crate::mesh::top_height;
@@ -79,8 +80,10 @@ impl Scene {
             // Parses (a fixed literal); the base is the face z = 0 of the generated box.
             fix: "z<0.0001".parse::<FixPredicate>().into_iter().collect(),
             material: MaterialSpec {
-                young_pa: 3000.0,
-                poisson: 0.45,
+                elastic: Material {
+                    young_pa: 3000.0,
+                    poisson: 0.45,
+                },
                 density_kg_m3: DEFAULT_DENSITY_KG_M3,
             },
             regions: Vec::new(),
@@ -168,8 +171,10 @@ impl Scene {
                 .into_iter()
                 .collect(),
             material: MaterialSpec {
-                young_pa: 5000.0,
-                poisson: 0.4,
+                elastic: Material {
+                    young_pa: 5000.0,
+                    poisson: 0.4,
+                },
                 density_kg_m3: DEFAULT_DENSITY_KG_M3,
             },
             zones: vec![Zone {

@@ -94,6 +94,7 @@ use super::tool::{
     DEFAULT_TOOL_RADIUS_M, MAX_TOOL_POINTS, ToolKind, ToolSpec, normalized,
 };
 use super::zones::{PartitionFile, ZoneFile, zones_spec};
+use crate::fem::material::Material;
 use crate::fix::FixPredicate;
 use crate::limits::{MAX_SCENE_FILE_BYTES, read_bounded};
 
@@ -108,7 +109,7 @@ struct SceneFile {
     fix: Vec<String>,
     material: MaterialFile,
     #[serde(default)]
-    region: Vec<RegionSpec>,
+    region: Vec<RegionFile>,
     #[serde(default)]
     model: ModelFile,
     #[serde(default)]
@@ -132,6 +133,16 @@ struct GeneratedFile {
     box_m: [f64; 3],
     #[serde(deserialize_with = "exact::three")]
     cells: [usize; 3],
+}
+
+/// A `[[region]]` table as written ([`RegionSpec`]).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RegionFile {
+    id: u32,
+    young_pa: f64,
+    poisson: f64,
+    density_kg_m3: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -445,12 +456,26 @@ impl Scene {
             source: source.to_owned(),
             mesh,
             fix,
+            // Checked by `validate` below, with the key that names them.
             material: MaterialSpec {
-                young_pa: raw.material.young_pa,
-                poisson: raw.material.poisson,
+                elastic: Material {
+                    young_pa: raw.material.young_pa,
+                    poisson: raw.material.poisson,
+                },
                 density_kg_m3: raw.material.density_kg_m3,
             },
-            regions: raw.region,
+            regions: raw
+                .region
+                .iter()
+                .map(|r| RegionSpec {
+                    id: r.id,
+                    elastic: Material {
+                        young_pa: r.young_pa,
+                        poisson: r.poisson,
+                    },
+                    density_kg_m3: r.density_kg_m3,
+                })
+                .collect(),
             model,
             tool,
             cutting: CuttingSpec {

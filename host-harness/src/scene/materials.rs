@@ -14,8 +14,6 @@
 //! [`tet_materials`] (`Scene::tet_materials`) gives every consumer the material of each tet, refusing a region id
 //! no tet has.
 
-use serde::Deserialize;
-
 use super::error::SceneError;
 use crate::fem::material::{
     MAX_STIFFNESS_CONTRAST, Material, MaterialError, POISSON_RANGE, TetMaterials,
@@ -29,24 +27,22 @@ pub const DEFAULT_DENSITY_KG_M3: f64 = 1000.0;
 /// The tissue material.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaterialSpec {
-    /// Young's modulus `E`, Pa, finite and > 0.
-    pub young_pa: f64,
-    /// Poisson ratio `ν`, `0 ≤ ν < 0.5`.
-    pub poisson: f64,
+    /// The elastic material (Young's modulus `E`, Pa, finite and > 0; Poisson ratio `ν`,
+    /// `0 ≤ ν ≤ MAX_POISSON`), built once when the scene is and checked by its validation: the
+    /// one every table build and model takes.
+    pub elastic: Material,
     /// Mass density, kg/m³, finite and > 0 (the dynamic model's lumped masses).
     pub density_kg_m3: f64,
 }
 
 /// One `[[region]]` of a scene: the material of the tets whose region id is `id`.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RegionSpec {
     /// The region id (MSH physical tag, VTK `region` cell value, TetGen region attribute).
     pub id: u32,
-    /// Young's modulus `E`, Pa, finite and > 0.
-    pub young_pa: f64,
-    /// Poisson ratio `ν`, `0 ≤ ν < 0.5`.
-    pub poisson: f64,
+    /// The region's elastic material (the ranges of [`MaterialSpec::elastic`]), built once
+    /// when the scene is and checked by [`check_regions`].
+    pub elastic: Material,
     /// Mass density, kg/m³: `None`, or the `[material]`'s (a table has one density).
     pub density_kg_m3: Option<f64>,
 }
@@ -69,7 +65,7 @@ pub fn check_regions(
 ) -> Result<(), (String, String)> {
     for (k, region) in regions.iter().enumerate() {
         let key = region.key();
-        match Material::new(region.young_pa, region.poisson) {
+        match region.elastic.check() {
             Err(MaterialError::YoungModulus(e)) => {
                 return Err((
                     format!("{key}: young_pa = {}", shown(e)),
@@ -82,12 +78,12 @@ pub fn check_regions(
                     format!("must satisfy {POISSON_RANGE}"),
                 ));
             }
-            Ok(_) => {}
+            Ok(()) => {}
         }
-        let contrast = region.young_pa / young_pa;
+        let contrast = region.elastic.young_pa / young_pa;
         if !(1.0 / MAX_STIFFNESS_CONTRAST..=MAX_STIFFNESS_CONTRAST).contains(&contrast) {
             return Err((
-                format!("{key}: young_pa = {}", shown(region.young_pa)),
+                format!("{key}: young_pa = {}", shown(region.elastic.young_pa)),
                 format!(
                     "is {contrast:.1e} times [material] young_pa = {}: a [[region]] may be at \
                      most {} times stiffer or softer (beyond, the table build's stiffness is \
@@ -133,8 +129,7 @@ pub fn tet_materials(
         key,
         msg,
     };
-    let default = Material::new(material.young_pa, material.poisson)
-        .map_err(|err| invalid("[material]".into(), err.to_string()))?;
+    let default = material.elastic;
     let Some(first) = regions.first() else {
         return Ok(TetMaterials::uniform(default, mesh.tets.len()));
     };
@@ -165,9 +160,7 @@ pub fn tet_materials(
                 ),
             ));
         }
-        let material = Material::new(region.young_pa, region.poisson)
-            .map_err(|err| invalid(region.key(), err.to_string()))?;
-        by_id.push((region.id, material));
+        by_id.push((region.id, region.elastic));
     }
     Ok(TetMaterials::from_regions(default, tet_regions, &by_id))
 }

@@ -10,7 +10,7 @@ use super::materials::{MaterialSpec, RegionSpec, tet_materials};
 use super::mesh::MeshSource;
 use super::tool::ToolSpec;
 use super::zones::{PartitionSpec, Zone};
-use crate::fem::material::{Material, MaterialError, TetMaterials};
+use crate::fem::material::TetMaterials;
 use crate::fix::FixPredicate;
 use crate::mesh::{MeshError, MeshReport, TetMesh};
 
@@ -141,11 +141,6 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// The validated elastic material (E, ν) for the table builders.
-    pub fn elastic_material(&self) -> Result<Material, MaterialError> {
-        Material::new(self.material.young_pa, self.material.poisson)
-    }
-
     /// The tick period, s: `1 / haptic_hz`.
     pub fn tick_s(&self) -> f64 {
         1.0 / self.rates.haptic_hz

@@ -8,7 +8,7 @@ use super::spec::{
     substeps,
 };
 use super::tool::{MAX_TOOL_POINTS, MAX_TOOL_RADIUS_FRACTION, check_tool, length};
-use crate::fem::material::{Material, MaterialError, POISSON_RANGE};
+use crate::fem::material::{MaterialError, POISSON_RANGE};
 use crate::limits::MAX_HAPTIC_HZ;
 use crate::mesh::TetMesh;
 use crate::output::number::shown;
@@ -57,7 +57,7 @@ impl Scene {
         self.check_material().map_err(in_file)?;
         self.check_tool_size().map_err(in_file)?;
         let m = &self.material;
-        check_regions(&self.regions, m.young_pa, m.density_kg_m3).map_err(in_file)?;
+        check_regions(&self.regions, m.elastic.young_pa, m.density_kg_m3).map_err(in_file)?;
         check_tool(&self.tool).map_err(in_file)?;
         check_removal(&self.cutting, self.tearing.as_ref(), &self.model).map_err(in_file)?;
         self.check_rates().map_err(in_file)?;
@@ -80,11 +80,11 @@ impl Scene {
         Ok(())
     }
 
-    /// `[material]`: `E` and `ν` in [`Material::new`]'s ranges, the density finite and > 0;
-    /// errors are `(key, message)`.
+    /// `[material]`: `E` and `ν` in [`crate::fem::material::Material::new`]'s ranges, the
+    /// density finite and > 0; errors are `(key, message)`.
     fn check_material(&self) -> Result<(), (String, String)> {
         let m = &self.material;
-        if let Err(err) = Material::new(m.young_pa, m.poisson) {
+        if let Err(err) = m.elastic.check() {
             return match err {
                 MaterialError::YoungModulus(e) => invalid(
                     format!("[material] young_pa = {}", shown(e)),

@@ -101,7 +101,7 @@ impl SceneModel {
         let incompressibility_n = match (spec.incompressibility_n, penalty) {
             (None, true) => {
                 let (region, _) = sub_mesh(mesh, &dynamic);
-                Some(penalty_n(&region, &scene.elastic_material()?))
+                Some(penalty_n(&region, &scene.material.elastic))
             }
             (given, _) => given,
         };
