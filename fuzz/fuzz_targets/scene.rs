@@ -9,8 +9,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use palpate::scene::{MAX_BLADE_M, MAX_CAPACITY_TETS};
-use palpate::scene::{MAX_TOOL_POINTS, ModelSpec, Scene};
+use palpate::scene::{MAX_BLADE_M, MAX_CAPACITY_TETS, MAX_TOOL_POINTS, ModelSpec, Scene};
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
