@@ -20,7 +20,7 @@ use core::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use palpate::session::Scene;
+use palpate::scene::Scene;
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::load::{AnyModel, TableFile};
 use palpate_benches::scene_table;

@@ -6,8 +6,8 @@ use nalgebra::Vector3;
 use palpate::fem::material::Material;
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
-use palpate::session::Scene;
-use palpate::session::run::precomputed_options;
+use palpate::scene::Scene;
+use palpate::session::options::precomputed_options;
 use palpate::table::build::{
     BuildOptions, BuiltTable, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build,
 };

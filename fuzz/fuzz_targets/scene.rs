@@ -9,8 +9,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use palpate::session::scene::{MAX_BLADE_M, MAX_CAPACITY_TETS};
-use palpate::session::{MAX_TOOL_POINTS, ModelSpec, Scene};
+use palpate::scene::{MAX_BLADE_M, MAX_CAPACITY_TETS, MAX_TOOL_POINTS, ModelSpec, Scene};
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
@@ -67,7 +66,7 @@ fuzz_target!(|data: &[u8]| {
         period.is_finite() && period >= tick,
         "physics period {period} s"
     );
-    assert!(scene.elastic_material().is_ok());
+    assert!(scene.material.elastic.check().is_ok());
     match scene.model {
         ModelSpec::Precomputed => {
             assert!(scene.dynamic_substeps().is_none());

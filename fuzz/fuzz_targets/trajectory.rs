@@ -12,7 +12,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use palpate::session::{Sample, ToolState, Trajectory, TrajectoryError};
+use palpate::scene::{Sample, ToolState, Trajectory, TrajectoryError};
 
 const SOURCE: &str = "fuzz-input";
 

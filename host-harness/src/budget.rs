@@ -58,18 +58,19 @@ use palpate_script::ticks::{Header, Settings, tool_words, write_tick};
 
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::{AtomicFile, work_folder};
-use crate::session::generate::{
+use crate::scene::generate::{
     GenerateError, Generator, Keyframe, Pinch, Poke, Press, PressHold, Slide, Strike, hepatectomy,
     sample_keyframes, surgery,
 };
+use crate::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, ToolKind};
+use crate::scene::{Scene, Trajectory};
 use crate::session::hybrid::HybridSetup;
 use crate::session::model::{SceneModel, SceneTables};
-use crate::session::run::check_scene_table;
-use crate::session::run::{DynamicSetup, loop_config, ticks};
-use crate::session::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, ToolKind};
+use crate::session::options::check_scene_table;
+use crate::session::run::ticks;
+use crate::session::setup::{DynamicSetup, loop_config};
 use crate::session::stability::check_stable_step;
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
-use crate::session::{Scene, Trajectory};
 use crate::table::compress::Compression;
 
 /// The unit costs of the static tick bound, in one unit: x86-64
@@ -637,7 +638,7 @@ fn probe_site(k: usize, press: Press) -> Press {
 /// with a grasper or a cutter, [`surgery`] (on the built-in block's top),
 /// or [`hepatectomy`] on the generated organ.
 pub fn trajectories(scene: &Scene) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
-    let err = |e: crate::session::GenerateError| anyhow::anyhow!("{e}");
+    let err = |e: crate::scene::GenerateError| anyhow::anyhow!("{e}");
     let tool = &scene.tool;
     if tool.kinds.iter().any(|k| *k != ToolKind::Probe) {
         return Ok(match scene.mesh {

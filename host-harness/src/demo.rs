@@ -18,8 +18,8 @@ use palpate_kernel::{Constraint, MAX_CONTACTS};
 
 use crate::output::atomic::SeriesDir;
 use crate::output::vtk;
-use crate::session::run::table_options;
-use crate::session::{MeshSource, Scene};
+use crate::scene::{MeshSource, Scene};
+use crate::session::options::table_options;
 use crate::table::build::build;
 use crate::table::load::{AnyModel, TableFile};
 

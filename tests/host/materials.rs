@@ -1,5 +1,5 @@
 //! Heterogeneous tissue: per-tet materials (`palpate::fem::material::TetMaterials`, the scene's
-//! `[[region]]` in `palpate::session::materials`, the table's `tet-material` section).
+//! `[[region]]` in `palpate::scene::materials`, the table's `tet-material` section).
 //!
 //! Independent truth: a dense global linear FEM written here from MODELS.md §1 alone (own shape
 //! gradients, own element blocks, nalgebra's dense Cholesky on the Dirichlet-reduced system),
@@ -19,8 +19,8 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use palpate::fem::material::{Material, TetMaterials};
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh};
+use palpate::scene::{Generator, Press, Scene, Slide};
 use palpate::session::run::run_session;
-use palpate::session::{Generator, Press, Scene, Slide};
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::compliance::Solver;
 use palpate::table::file::Precision;

@@ -9,8 +9,8 @@ use palpate::fem::static_solve::solve_prescribed;
 use palpate::mesh::TetMesh;
 use palpate::mesh::generate::box_mesh;
 use palpate::partition::{Partition, PlanError, PlanInput, RegionModel, plan};
-use palpate::session::zones::DEFAULT_MARGIN_RINGS;
-use palpate::session::{GraspPull, Zone, ZoneKind, ZoneShape};
+use palpate::scene::zones::DEFAULT_MARGIN_RINGS;
+use palpate::scene::{GraspPull, Zone, ZoneKind, ZoneShape};
 use palpate_kernel::tensor_mass::ElasticLaw;
 
 /// A 4 × 4 × 4-cell box of 1 cm cells (384 tets, 125 vertices).

@@ -4,8 +4,9 @@
 
 use std::path::PathBuf;
 
-use palpate::session::generate::MAX_GENERATED_SAMPLES;
-use palpate::session::{
+use palpate::fem::material::Material;
+use palpate::scene::generate::MAX_GENERATED_SAMPLES;
+use palpate::scene::{
     DynamicSpec, GenerateError, Generator, Keyframe, MaterialSpec, MeshSource, ModelSpec, Pinch,
     Poke, Press, PressHold, Rates, Sample, Scene, Slide, Strike, ToolSpec, Trajectory,
     TrajectoryError, sample_keyframes,
@@ -74,8 +75,10 @@ fn hand_written_scene_with_every_field() {
     assert_eq!(
         s.material,
         MaterialSpec {
-            young_pa: 5000.0,
-            poisson: 0.4,
+            elastic: Material {
+                young_pa: 5000.0,
+                poisson: 0.4
+            },
             density_kg_m3: 1050.0
         }
     );
@@ -108,7 +111,7 @@ fn hand_written_scene_with_every_field() {
     assert_eq!(s.tick_s(), 0.001);
     assert_eq!(s.physics_period_s(), 0.002);
     assert_eq!(s.dynamic_substeps(), Some(4));
-    let material = s.elastic_material().unwrap();
+    let material = s.material.elastic;
     assert_eq!((material.young_pa, material.poisson), (5000.0, 0.4));
 }
 
@@ -232,8 +235,10 @@ fn built_in_scene_is_the_demo_block() {
     assert_eq!(
         s.material,
         MaterialSpec {
-            young_pa: 3000.0,
-            poisson: 0.45,
+            elastic: Material {
+                young_pa: 3000.0,
+                poisson: 0.45
+            },
             density_kg_m3: 1000.0
         }
     );

@@ -1,10 +1,10 @@
-//! The generators of the tool columns (`palpate::session::generate`): the
+//! The generators of the tool columns (`palpate::scene::generate`): the
 //! probe generators unchanged by them, grasp-and-pull and cut-line keyframes
 //! and trajectories, the jaw and cut of sampled keyframes, and every bad
 //! grasp or cut parameter (the probe generators themselves are tested in
 //! `host::session`).
 
-use palpate::session::{
+use palpate::scene::{
     CutLine, Generator, GraspPull, Keyframe, MAX_TOOL_POINTS, Pinch, Poke, Press, PressHold, Slide,
     Strike, Trajectory, sample_keyframes, sample_keyframes_with_tool_columns,
 };

@@ -6,9 +6,9 @@
 //! model's step.
 
 use palpate::partition::Partition;
-use palpate::session::generate::hepatectomy;
+use palpate::scene::generate::hepatectomy;
+use palpate::scene::{Generator, PressHold, Scene};
 use palpate::session::run::{SessionOutputs, run_session, run_session_into};
-use palpate::session::{Generator, PressHold, Scene};
 use palpate_tests::scene;
 
 /// `built-in-hybrid` over `session generate hepatectomy`: the cuts and
@@ -94,7 +94,7 @@ fn a_zone_over_the_whole_mesh_is_the_tensor_mass_model() {
     let base = "fix = [\"z<0.0001\"]\n[generated]\nbox_m = [0.04, 0.04, 0.02]\ncells = [4, 4, 2]\n[material]\nyoung_pa = 3000.0\npoisson = 0.3\n[model]\nkind = \"dynamic\"\ndt_s = 0.0005\ndamping_per_s = 30.0\n[rates]\nphysics_every = 10\n";
     let zone = "[[zone]]\nkind = \"cut\"\nshape = \"box\"\nmin_m = [-1.0, -1.0, -1.0]\nmax_m = [1.0, 1.0, 1.0]\n";
     let press = PressHold {
-        press: palpate::session::Press {
+        press: palpate::scene::Press {
             surface_m: [0.02, 0.02, 0.02],
             ..PressHold::default().press
         },

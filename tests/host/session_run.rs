@@ -3,8 +3,8 @@
 //! bounded force changes, and non-finite input turned into a latched fault
 //! with zero force.
 
+use palpate::scene::{Generator, Poke, Scene, Slide, Strike, Trajectory};
 use palpate::session::run::run_session;
-use palpate::session::{Generator, Poke, Scene, Slide, Strike, Trajectory};
 use palpate_tests::traj;
 
 fn run(scene: &Scene, trajectory: &Trajectory) -> (String, palpate::session::run::SessionSummary) {
@@ -226,7 +226,7 @@ fn dynamic_slide_crosses_triangles_and_writes_frames() {
 /// f32 rounding (measured 9e-8 relative; bound 1e-5).
 #[test]
 fn dynamic_sessions_run_with_every_law() {
-    use palpate::session::{DynamicSpec, MeshSource, ModelSpec};
+    use palpate::scene::{DynamicSpec, MeshSource, ModelSpec};
     use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
     let base = Scene::built_in_dynamic();
     let ModelSpec::Dynamic(spec) = base.model else {

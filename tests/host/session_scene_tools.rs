@@ -1,8 +1,8 @@
 //! Scene files' tool kinds, `[cutting]` and `[tearing]`
-//! (`palpate::session::scene`; the rest of the format is tested in
+//! (`palpate::scene`; the rest of the format is tested in
 //! `host::session`).
 
-use palpate::session::scene::{
+use palpate::scene::{
     CuttingSpec, DEFAULT_CUT_FORCE_N, MAX_TOOL_POINTS, Scene, TearingSpec, ToolKind, ToolSpec,
 };
 use palpate_tests::{BASE_SCENE, assert_scene_errors, scene, scene_err};

@@ -7,12 +7,12 @@
 //! and a cutter's blade tip as kernel tool points.
 
 use nalgebra::Vector3;
-use palpate::session::ToolSpec;
-use palpate::session::generate::surgery;
+use palpate::scene::ToolKind;
+use palpate::scene::ToolSpec;
+use palpate::scene::generate::surgery;
+use palpate::scene::{DynamicSpec, Generator, ModelSpec, Poke, Scene};
 use palpate::session::run::{SessionSummary, removed_path, run_session, run_session_to_files};
-use palpate::session::scene::ToolKind;
 use palpate::session::tools::kernel_tools;
-use palpate::session::{DynamicSpec, Generator, ModelSpec, Poke, Scene};
 use palpate_kernel::haptic::{ToolAction, ToolInput};
 use palpate_tests::tool_state;
 
@@ -140,7 +140,7 @@ fn a_grasper_without_jaw_columns_is_refused() {
 fn a_blade_on_the_precomputed_model_says_cut_refused() {
     let mut scene = Scene::built_in();
     scene.tool.kinds = vec![ToolKind::Cutter];
-    let trajectory = palpate::session::CutLine::default()
+    let trajectory = palpate::scene::CutLine::default()
         .trajectory()
         .expect("cut line");
     let mut out = Vec::new();
@@ -160,7 +160,7 @@ fn a_blade_on_the_precomputed_model_says_cut_refused() {
             s.position_m[2] -= 0.01;
             s.cut = false;
         }
-        palpate::session::Trajectory::from_samples(samples, 1).expect("trajectory")
+        palpate::scene::Trajectory::from_samples(samples, 1).expect("trajectory")
     };
     let mut out = Vec::new();
     run_session(&probe, &shifted, &mut out, None).expect("probe session");

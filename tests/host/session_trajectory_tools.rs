@@ -1,10 +1,10 @@
-//! Trajectory files' tool columns `jaw_m,cut` (`palpate::session::trajectory`):
+//! Trajectory files' tool columns `jaw_m,cut` (`palpate::scene::trajectory`):
 //! the 5-column format read as no jaw and no cut, the jaw interpolated and the
 //! cut held, the round trip bit for bit, when the columns are written, every
 //! error and the lenient reader (the 5-column format itself is tested in
 //! `host::session`).
 
-use palpate::session::{Sample, ToolState, Trajectory};
+use palpate::scene::{Sample, ToolState, Trajectory};
 use palpate_tests::{csv, tool_state, traj, traj_err};
 
 /// Two tool points with the tool columns; tool 0 jumps at t = 3 (jaw and cut too).

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 pub mod source;
 
-use palpate::session::{Keyframe, Scene, ToolState, Trajectory};
+use palpate::scene::{Keyframe, Scene, ToolState, Trajectory};
 
 /// The independent reference data committed with the tests
 /// (`tests/reference/`, see its README for how each file was computed).

@@ -8,8 +8,8 @@
 
 use nalgebra::Vector3;
 use palpate::budget::{RECORD_RUNS, RECORD_TABLE, record};
-use palpate::session::Scene;
-use palpate::session::scene::{DEFAULT_TOOL_RADIUS_M, ToolSpec};
+use palpate::scene::Scene;
+use palpate::scene::{DEFAULT_TOOL_RADIUS_M, ToolSpec};
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{LoopConfig, PrecomputedLoop, SafetyLimits, ToolAction, ToolInput};

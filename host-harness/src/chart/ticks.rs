@@ -35,12 +35,11 @@ use serde::Serialize;
 
 use super::{HYBRID_LAW, Model, Progress};
 use crate::budget::{HOST_IR, budget_table, chosen_trajectories, measure, probe_remapped};
-use crate::fem::material::Material;
 use crate::fem::penalty::penalty_n;
+use crate::scene::ModelSpec;
+use crate::scene::{MAX_TOOL_POINTS, ToolSpec};
+use crate::scene::{Scene, Trajectory};
 use crate::session::model::{SceneModel, SceneTables};
-use crate::session::scene::ModelSpec;
-use crate::session::scene::{MAX_TOOL_POINTS, ToolSpec};
-use crate::session::{Scene, Trajectory};
 use palpate_kernel::tensor_mass::ElasticLaw;
 
 /// The trajectory of the counts: every probe pressed and held.
@@ -60,11 +59,7 @@ pub fn tick_scene(model: Model, points: usize) -> anyhow::Result<Scene> {
         Model::TensorMassLinear => (ElasticLaw::Linear, None),
         Model::StvkPenalty => {
             let (mesh, _) = scene.load_mesh()?;
-            let material = Material {
-                young_pa: scene.material.young_pa,
-                poisson: scene.material.poisson,
-            };
-            (HYBRID_LAW, Some(penalty_n(&mesh, &material)))
+            (HYBRID_LAW, Some(penalty_n(&mesh, &scene.material.elastic)))
         }
         _ => (HYBRID_LAW, None),
     };

@@ -10,11 +10,11 @@ use palpate::budget::{
     BudgetRow, HOST_IR, M4F_IPS, budget_table, chosen_trajectories, measure, probe, record,
 };
 use palpate::output::atomic::work_folder;
+use palpate::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
+use palpate::scene::{MeshSource, Scene, Trajectory};
 use palpate::session::model::{SceneModel, SceneTables};
-use palpate::session::run::check_scene_table;
-use palpate::session::scene::{MAX_TOOL_POINTS, ToolKind, ToolSpec};
+use palpate::session::options::check_scene_table;
 use palpate::session::stability::check_stable_step;
-use palpate::session::{MeshSource, Scene, Trajectory};
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 
 use super::stdout;

@@ -14,8 +14,8 @@ use palpate::limits::{MAX_SEQUENCE_FILE_BYTES, read_bounded};
 use palpate::output::atomic::{self, FolderKind, SeriesDir};
 use palpate::output::vtk::write_regions;
 use palpate::partition::{Partition, PlanReport};
+use palpate::scene::{MeshSource, Scene, ZoneShape};
 use palpate::session::model::{SceneModel, hybrid_tables};
-use palpate::session::{MeshSource, Scene, ZoneShape};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 

@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 use clap::Subcommand;
 use palpate::output::atomic::{self, AtomicFile};
 use palpate::output::stderr;
-use palpate::session::generate::{hepatectomy, surgery};
-use palpate::session::run::{removed_path, removes_tets, run_session_to_files};
-use palpate::session::{
+use palpate::scene::generate::{hepatectomy, surgery};
+use palpate::scene::{
     CutLine, Generator, GraspPull, MeshSource, Pinch, Poke, PressHold, Scene, Slide, Strike,
     Trajectory,
 };
+use palpate::session::run::{removed_path, removes_tets, run_session_to_files};
 
 use super::mesh_files;
 

@@ -48,13 +48,22 @@ impl Material {
     /// ratio `poisson` (`0 <= nu <=` [`MAX_POISSON`]: incompressible `0.5`, and a
     /// margin below it, excluded).
     pub fn new(young_pa: f64, poisson: f64) -> Result<Self, MaterialError> {
+        let material = Self { young_pa, poisson };
+        material.check()?;
+        Ok(material)
+    }
+
+    /// Whether the fields are in [`Material::new`]'s ranges (for a material built from its
+    /// public fields, as a scene's is before [`crate::scene::Scene::validate`] checks it).
+    pub fn check(&self) -> Result<(), MaterialError> {
+        let Self { young_pa, poisson } = *self;
         if !(young_pa.is_finite() && young_pa > 0.0) {
             return Err(MaterialError::YoungModulus(young_pa));
         }
         if !(poisson.is_finite() && (0.0..=MAX_POISSON).contains(&poisson)) {
             return Err(MaterialError::PoissonRatio(poisson));
         }
-        Ok(Self { young_pa, poisson })
+        Ok(())
     }
 
     /// Lamé coefficients `(lambda, mu)` in Pa (`MODELS.md` §1):

@@ -20,7 +20,7 @@
 use nalgebra::Vector3;
 
 use crate::mesh::TetMesh;
-use crate::session::ZoneShape;
+use crate::scene::ZoneShape;
 
 /// Golden-section steps of the segment-to-tet distance (interval `0.618⁶⁰ ≈ 3·10⁻¹³` of the
 /// segment).

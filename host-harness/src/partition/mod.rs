@@ -1,5 +1,5 @@
 //! The hybrid model's partition (MODELS.md §5, RR-3510 §6), chosen from a scene's intent: the
-//! zones where cutting or large deformation may happen ([`crate::session::zones`]) become
+//! zones where cutting or large deformation may happen ([`crate::scene::zones`]) become
 //! tensor-mass regions with a margin of element rings, the rest is pre-computed.
 //!
 //! Data flow: scene zones + mesh → [`geometry`] (which tets each zone takes) → [`mod@plan`]

@@ -25,7 +25,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use super::geometry::TetGrid;
 use crate::fix::fixed_vertices;
 use crate::mesh::{MeshReport, TetMesh};
-use crate::session::{Scene, Zone, ZoneKind};
+use crate::scene::{Scene, Zone, ZoneKind};
 
 /// Poisson ratio from which a St Venant-Kirchhoff region gets the incompressibility penalty
 /// (Picinbono 2001 §3.2: nearly incompressible soft tissue; the built-in block's ν = 0.45).
@@ -170,7 +170,7 @@ impl Partition {
             fixed: &fixed,
             zones: &scene.zones,
             margin_rings: scene.partition.margin_rings,
-            poisson: scene.material.poisson,
+            poisson: scene.material.elastic.poisson,
             scene: &scene.source,
             mesh_name: &report.source,
         })

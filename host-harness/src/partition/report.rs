@@ -13,7 +13,7 @@ use crate::fix::fixed_vertices;
 use crate::limits::human_bytes;
 use crate::limits::{MAX_TABLE_FILE_BYTES, mem_available_bytes};
 use crate::mesh::{MeshReport, TetMesh};
-use crate::session::{ModelSpec, Scene};
+use crate::scene::{ModelSpec, Scene};
 
 /// One region of the JSON report.
 #[derive(Clone, Debug, Serialize)]

@@ -9,9 +9,9 @@ use palpate_kernel::hybrid::HybridTissue;
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 
 use super::model::HybridFiles;
-use super::run::{DynamicSetup, PhysicsView};
-use super::{DynamicSpec, Scene};
+use super::setup::{DynamicSetup, PhysicsView};
 use crate::hybrid::owned::OwnedHybridBuffers;
+use crate::scene::{DynamicSpec, Scene};
 
 /// A hybrid scene's tables and settings: everything to build its loop.
 pub struct HybridSetup<'t> {

@@ -9,14 +9,14 @@
 use anyhow::{Context, anyhow, bail};
 use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 
-use super::run::{precomputed_options, tensor_mass_options};
-use super::{DynamicSpec, ModelSpec, Scene};
+use super::options::{precomputed_options, tensor_mass_options};
 use crate::fem::penalty::penalty_n;
 use crate::fix::fixed_vertices;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
+use crate::scene::{DynamicSpec, ModelSpec, Scene};
 use crate::table::build::build;
 use crate::table::compress::Compression;
 use crate::table::estimate::SizeLimits;
@@ -101,7 +101,7 @@ impl SceneModel {
         let incompressibility_n = match (spec.incompressibility_n, penalty) {
             (None, true) => {
                 let (region, _) = sub_mesh(mesh, &dynamic);
-                Some(penalty_n(&region, &scene.elastic_material()?))
+                Some(penalty_n(&region, &scene.material.elastic))
             }
             (given, _) => given,
         };

@@ -31,118 +31,28 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{
-    DynamicLoop, ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop,
-    SafetyLimits, ToolInput,
+    ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop, ToolInput,
 };
 use palpate_kernel::math::Dispatch;
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{
-    DynamicParams, DynamicTissue, ElasticLaw, PhysicsConfig, StvkForm, SurfaceBuffers,
-    TearThresholds, Tearing, TensorMassModel,
-};
+use palpate_kernel::tensor_mass::DynamicTissue;
 
 use super::hybrid::HybridSetup;
 use super::model::{SceneModel, SceneTables};
-use super::scene::{ToolKind, ToolSpec};
+use super::setup::{DynamicSetup, PhysicsView, loop_config};
 use super::stability::check_stable_step;
 use super::tool_points::{ForToolPoints, with_tool_points};
 use super::tools::kernel_tools;
-use super::trajectory::ToolState;
-use super::{DynamicSpec, ModelSpec, Scene, Trajectory};
 use crate::dispatch::HostDispatch;
-use crate::fix::fixed_vertices;
 use crate::limits::{
     MAX_HAPTIC_HZ, MAX_SESSION_TICKS, MAX_TRAJECTORY_SPAN_S, MAX_VTK_SERIES_BYTES, vtk_frame_bytes,
 };
-use crate::mesh::{MeshReport, TetMesh, boundary_surface};
+use crate::mesh::TetMesh;
 use crate::output::atomic::{self, AtomicFile, SeriesDir};
 use crate::output::number::time_s;
 use crate::output::vtk;
-use crate::table::build::BuildOptions;
-use crate::table::compliance::Solver;
-use crate::table::estimate::{SizeLimits, TableEstimate};
-use crate::table::file::Precision;
-use crate::tensor_mass::run::diagonal;
-use crate::tensor_mass::{OwnedState, OwnedSurface};
-
-/// The build options of `scene`'s table on `mesh` (read with `report`), by
-/// its model: its materials per tet ([`Scene::tet_materials`]) and
-/// supports, f32 (the firmware precision), quiet; a pre-computed table
-/// solved by sparse Cholesky, a tensor-mass table of the scene's density.
-pub fn table_options(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<BuildOptions> {
-    match scene.model {
-        ModelSpec::Precomputed => precomputed_options(scene, mesh, report),
-        ModelSpec::Dynamic(_) => tensor_mass_options(scene, mesh, report),
-    }
-}
-
-/// The pre-computed table options of `scene` on `mesh` (see [`table_options`]).
-pub fn precomputed_options(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<BuildOptions> {
-    let materials = scene.tet_materials(mesh, report)?;
-    let options = BuildOptions::precomputed(
-        materials.default_material(),
-        scene.fix.clone(),
-        Solver::Cholesky,
-        Precision::F32,
-    )
-    .with_tool_radius(scene.tool.radius_m);
-    Ok(options.with_tet_materials(materials))
-}
-
-/// The tensor-mass table options of `scene` on `mesh` (see [`table_options`]).
-pub fn tensor_mass_options(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<BuildOptions> {
-    let materials = scene.tet_materials(mesh, report)?;
-    let options = BuildOptions::tensor_mass(
-        materials.default_material(),
-        scene.material.density_kg_m3,
-        scene.fix.clone(),
-        Precision::F32,
-    );
-    Ok(options.with_tet_materials(materials))
-}
-
-/// Checks that `scene`'s table on `mesh` fits the limits every build
-/// applies ([`SizeLimits::system`]: the largest table file, the memory
-/// available), from the estimate of its size, without building it (linear
-/// in the mesh): for a command that builds several tables, before the
-/// first. Returns the estimate.
-pub fn check_scene_table(
-    scene: &Scene,
-    mesh: &TetMesh,
-    report: &MeshReport,
-) -> anyhow::Result<TableEstimate> {
-    let options = table_options(scene, mesh, report)?;
-    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
-    let surface = boundary_surface(mesh);
-    let estimate = TableEstimate::of_build(mesh, report, &options, &fixed, &surface);
-    SizeLimits::system().check(&estimate, &report.source)?;
-    Ok(estimate)
-}
-
-/// The haptic loop configuration of `scene` (f32).
-pub fn loop_config(scene: &Scene) -> LoopConfig<f32> {
-    LoopConfig {
-        radius_m: scene.tool.radius_m as f32,
-        dt_s: scene.tick_s() as f32,
-        limits: SafetyLimits {
-            max_force_n: scene.safety.max_force_n as f32,
-            max_slew_n_per_s: scene.safety.max_slew_n_per_s as f32,
-        },
-    }
-}
+use crate::scene::{ModelSpec, Scene, ToolKind, ToolSpec, ToolState, Trajectory};
 
 /// The number of ticks of `trajectory` at period `tick_s` (s): one at its
 /// start, then one every `tick_s` up to its end,
@@ -456,122 +366,6 @@ impl ForToolPoints for SessionTicks<'_, '_, '_, '_> {
     }
 }
 
-/// A dynamic scene's table and settings: everything to build its loop.
-pub struct DynamicSetup<'t> {
-    table: TensorMassTable<'t, f32>,
-    params: DynamicParams<f32>,
-    physics: PhysicsConfig<f32>,
-    config: LoopConfig<f32>,
-}
-
-impl<'t> DynamicSetup<'t> {
-    /// The settings of dynamic `scene` (model `spec`) over `table`: its law,
-    /// penalty and damping, no gravity (the tissue rests in its meshed
-    /// shape), divergence when a displacement exceeds the mesh's
-    /// bounding-box diagonal; the physics period in steps of `dt_s`; the
-    /// scene's cut capacity and tearing.
-    pub fn of(
-        scene: &Scene,
-        spec: &DynamicSpec,
-        table: TensorMassTable<'t, f32>,
-    ) -> anyhow::Result<Self> {
-        let rest: Vec<[f64; 3]> = table
-            .rest_positions()
-            .iter()
-            .map(|p| p.map(f64::from))
-            .collect();
-        Ok(Self {
-            table,
-            params: DynamicParams::linear(spec.damping_per_s as f32, diagonal(&rest) as f32)
-                .with_law(spec.law)
-                .with_incompressibility(spec.incompressibility_n.map(|g| g as f32)),
-            physics: PhysicsConfig {
-                extrapolation: spec.extrapolation,
-                integrator: spec.integrator,
-                dt_s: spec.dt_s as f32,
-                substeps: scene
-                    .dynamic_substeps()
-                    .context("physics period is not a whole number of dt_s")?,
-                cut_capacity_tets: scene.cutting.capacity_tets,
-                cut_force_n: scene.cutting.force_n as f32,
-                tearing: scene.tearing.map(|t| Tearing {
-                    thresholds: TearThresholds {
-                        volume_change: t.volume_change.map(|x| x as f32),
-                        mean_elongation: t.mean_elongation.map(|x| x as f32),
-                        max_elongation: t.max_elongation.map(|x| x as f32),
-                    },
-                    capacity_tets: t.capacity_tets,
-                }),
-            },
-            config: loop_config(scene),
-        })
-    }
-
-    /// Builds the model, its surface and the loop at rest on heap buffers
-    /// and runs `body` on the loop, the model's steps through `dispatch`
-    /// (`session run`: [`crate::dispatch::HostDispatch::detect`]; `budget`:
-    /// portable).
-    pub fn with_loop<const P: usize, R, D: Dispatch>(
-        &self,
-        dispatch: D,
-        body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P, D>) -> anyhow::Result<R>,
-    ) -> anyhow::Result<R> {
-        self.with_parts(|model, buffers, forces| {
-            let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, self.physics)
-                .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?
-                .with_dispatch(dispatch);
-            let mut haptic = DynamicLoop::<f32, P, P, D>::new(tissue, self.config)
-                .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
-            body(&mut haptic)
-        })
-    }
-
-    /// Builds the model at rest and its surface buffers and force scratch
-    /// on the heap (the split-term buffers only for the form that reads
-    /// them), and runs `body` on them: what a dynamic or hybrid tissue is
-    /// built from.
-    pub fn with_parts<R>(
-        &self,
-        body: impl FnOnce(
-            TensorMassModel<'_, '_, f32>,
-            SurfaceBuffers<'_, f32>,
-            &mut [[f32; 3]],
-        ) -> anyhow::Result<R>,
-    ) -> anyhow::Result<R> {
-        let state = OwnedState::for_table(&self.table);
-        let mut state = if self.params.law == ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) {
-            state
-        } else {
-            state.without_split_terms()
-        };
-        let model = TensorMassModel::new(self.table, state.buffers(), self.params)
-            .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
-        let mut surface = OwnedSurface::for_model(&model);
-        let (buffers, forces) = surface.buffers();
-        body(model, buffers, forces)
-    }
-
-    /// The tensor-mass table.
-    pub fn table(&self) -> TensorMassTable<'t, f32> {
-        self.table
-    }
-
-    /// The tensor-mass model's parameters.
-    pub fn params(&self) -> DynamicParams<f32> {
-        self.params
-    }
-
-    /// The physics settings.
-    pub fn physics(&self) -> PhysicsConfig<f32> {
-        self.physics
-    }
-
-    /// The haptic loop settings.
-    pub fn config(&self) -> LoopConfig<f32> {
-        self.config
-    }
-}
-
 /// The trajectory's ticks, the tools and the physics period in ticks.
 struct Ticks<'r> {
     trajectory: &'r Trajectory,
@@ -652,15 +446,6 @@ impl Ticks<'_> {
         }
         Ok(())
     }
-}
-
-/// What a session reads of a tissue stepped at the physics rate, in the
-/// mesh's numbering.
-pub trait PhysicsView<B> {
-    /// The mesh tets the last physics update removed, in removal order.
-    fn removed(&self, tissue: &B) -> Vec<u32>;
-    /// The displacement of every mesh vertex (m) and which tets live.
-    fn frame(&self, tissue: &B) -> anyhow::Result<(Vec<[f32; 3]>, Vec<bool>)>;
 }
 
 /// The tensor-mass tissue is the whole mesh.

@@ -10,7 +10,7 @@ use anyhow::Context;
 use palpate_kernel::tensor_mass::Integrator;
 
 use crate::mesh::{MeshReport, TetMesh};
-use crate::session::scene::{MAX_SUBSTEPS, ModelSpec, Scene, SceneError};
+use crate::scene::{MAX_SUBSTEPS, ModelSpec, Scene, SceneError};
 use crate::table::build::BuildOptions;
 use crate::table::file::Precision;
 use crate::tensor_mass::stability::{StableStep, stable_step_limit};

@@ -2,7 +2,7 @@
 //! of the kernel's haptic loop (its tool points and contact capacity): the
 //! one place that turns the one into the other.
 
-use super::MAX_TOOL_POINTS;
+use crate::scene::MAX_TOOL_POINTS;
 
 /// Work generic over the tool-point count, run by [`with_tool_points`]
 /// with the count of a scene.

@@ -18,8 +18,8 @@
 use nalgebra::Vector3;
 use palpate_kernel::haptic::{ToolAction, ToolInput};
 
-use super::scene::{ToolKind, ToolSpec};
-use super::trajectory::ToolState;
+use crate::scene::trajectory::ToolState;
+use crate::scene::{ToolKind, ToolSpec};
 
 /// The `P` kernel tool points of `spec`'s tools in `states` (one per
 /// trajectory tool point), f32 as the loop runs; a point with no state (a

@@ -11,7 +11,7 @@ use crate::fix::FixPredicate;
 
 /// The tool radius (m) a pre-computed table's candidate lists serve unless
 /// told otherwise: the default tool's.
-pub const DEFAULT_LIST_TOOL_RADIUS_M: f64 = crate::session::scene::DEFAULT_TOOL_RADIUS_M;
+pub const DEFAULT_LIST_TOOL_RADIUS_M: f64 = crate::scene::DEFAULT_TOOL_RADIUS_M;
 
 /// Everything a table build needs besides the mesh.
 #[derive(Clone, Debug)]

@@ -23,9 +23,10 @@ use palpate::limits::{
 use palpate::limits::{MAX_POSITION_LINE_BYTES, MAX_RUN_TET_STEPS, MAX_ZONE_PATH_SEGMENTS};
 use palpate::mesh::generate::box_mesh;
 use palpate::mesh::{MeshReport, TetMesh, boundary_surface, read_mesh};
-use palpate::session::run::{check_scene_table, run_session, tick_count};
-use palpate::session::zones::merge_collinear;
-use palpate::session::{MeshSource, Scene, Trajectory};
+use palpate::scene::zones::merge_collinear;
+use palpate::scene::{MeshSource, Scene, Trajectory};
+use palpate::session::options::check_scene_table;
+use palpate::session::run::{run_session, tick_count};
 use palpate::table::build::{BuildOptions, build_with_limits};
 use palpate::table::compliance::{Solver, check_cg_work};
 use palpate::table::estimate::{SizeLimits, TableEstimate};

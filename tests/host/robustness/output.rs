@@ -12,8 +12,8 @@ use palpate::fix::FixPredicate;
 use palpate::output::atomic::{
     self, AtomicFile, SERIES_MARKER, SeriesDir, TEMP_TAG, refuse_input, refuse_inside,
 };
+use palpate::scene::{Generator, MeshSource, Poke, Scene};
 use palpate::session::run::{run_session, run_session_to_files};
-use palpate::session::{Generator, MeshSource, Poke, Scene};
 
 /// An empty folder of its own for test `name`.
 fn fresh_dir(name: &str) -> PathBuf {

@@ -14,9 +14,9 @@ use palpate::mesh::{MeshFormat, MeshReport, TetMesh, read_mesh, read_mesh_bytes}
 use palpate::partition::cost::{CostOptions, costs};
 use palpate::partition::geometry::TetGrid;
 use palpate::partition::{Partition, PlanInput, PlanReport, plan};
-use palpate::session::Scene;
+use palpate::scene::Scene;
+use palpate::scene::{Trajectory, Zone, ZoneKind, ZoneShape};
 use palpate::session::model::hybrid_tables;
-use palpate::session::{Trajectory, Zone, ZoneKind, ZoneShape};
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::compliance::Solver;
 use palpate::table::file::Precision;

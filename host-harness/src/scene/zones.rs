@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::scene::exact;
+use super::exact;
 use super::trajectory::Trajectory;
 use crate::limits::MAX_ZONE_PATH_SEGMENTS;
 
@@ -236,6 +236,14 @@ fn zone(
             ));
         }
     };
+    check_shape_keys(z, &key)?;
+    let shape = shape(z, &key, base_dir, tool_points)?;
+    Ok(Zone { kind, shape })
+}
+
+/// The keys `z`'s shape takes are given, and no other: errors are `(key, message)`, the key
+/// named by `key`.
+fn check_shape_keys(z: &ZoneFile, key: &dyn Fn(&str) -> String) -> Result<(), (String, String)> {
     // The keys each shape takes; any other given key is refused.
     let wanted: &[&str] = match z.shape.as_str() {
         "box" => &["min_m", "max_m"],
@@ -276,6 +284,17 @@ fn zone(
             ));
         }
     }
+    Ok(())
+}
+
+/// The shape of `z` (its keys checked by [`check_shape_keys`]), a `path`'s trajectory read
+/// relative to `base_dir` with `tool_points` tool points; errors are `(key, message)`.
+fn shape(
+    z: &ZoneFile,
+    key: &dyn Fn(&str) -> String,
+    base_dir: &Path,
+    tool_points: usize,
+) -> Result<ZoneShape, (String, String)> {
     let point = |name: &str, p: Option<[f64; 3]>| {
         let p = p.unwrap_or_default();
         if p.iter().all(|x| x.is_finite()) {
@@ -349,7 +368,7 @@ fn zone(
             }
         }
     };
-    Ok(Zone { kind, shape })
+    Ok(shape)
 }
 
 /// Per tool point, its samples' positions in file order without consecutive repeats, each run
