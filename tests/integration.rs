@@ -22,6 +22,7 @@ mod ffi {
 mod host {
     mod bench;
     mod compliance;
+    mod demo;
     mod dispatch;
     mod experiment;
     mod fem;
