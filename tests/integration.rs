@@ -23,6 +23,7 @@ mod host {
     mod bench;
     mod chart;
     mod compliance;
+    mod demo;
     mod dispatch;
     mod experiment;
     mod fem;

@@ -65,7 +65,8 @@ enum Command {
     /// The speed/accuracy study: every model against the Newton St
     /// Venant-Kirchhoff reference, timed; charts and a report.
     Chart(chart::ChartArgs),
-    /// Built-in scene: two-probe press and release, forces, timings, VTK series.
+    /// Built-in scenes: the block pressed by two probes, the hybrid organ
+    /// grasped and cut; forces, tick costs, VTK series.
     Demo(demo::DemoArgs),
 }
 

@@ -1,5 +1,5 @@
-//! `palpate demo`: the built-in scene (two probes pressed and released),
-//! run by [`palpate::demo`].
+//! `palpate demo`: the pre-computed block pressed by two probes, then the
+//! hybrid organ grasped and cut, run by [`palpate::demo`].
 
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -9,8 +9,9 @@ use super::stdout::Stdout;
 /// `palpate demo`'s arguments.
 #[derive(clap::Args)]
 pub struct DemoArgs {
-    /// Folder for the VTK series: created, or replaced if a previous run
-    /// wrote it (anything else is refused).
+    /// Folder for the VTK series (the block's `demo.pvd`, the organ's
+    /// `organ.pvd`): created, or replaced if a previous run wrote it
+    /// (anything else is refused).
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
 }
