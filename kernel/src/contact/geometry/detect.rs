@@ -64,7 +64,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// (a rigid support, no compliance) are not touchable.
     ///
     /// Candidates, when the table's per-cell lists serve `radius_m`
-    /// ([`SurfaceIndex::candidates`]): the list of `to_m`'s cell of the
+    /// ([`SurfaceIndex::candidates`](crate::table::SurfaceIndex::candidates)): the list of `to_m`'s cell of the
     /// lists' grid (every triangle the tests below can find from a centre
     /// there) and, for the sweep, the lists of the cells from `from_m`'s
     /// towards `to_m`'s (`SurfaceIndex::for_each_candidate_list_between`;
@@ -76,11 +76,11 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// corners the cells hold. In both, none around `from_m` when both
     /// points are in the same cell, and none for a point more than a cell
     /// plus the radius outside the grid. Bounded by
-    /// [`SurfaceIndex::max_detection_tests`] triangle tests (with the
+    /// [`SurfaceIndex::max_detection_tests`](crate::table::SurfaceIndex::max_detection_tests) triangle tests (with the
     /// penetration test's second pass), most rejected by two dot products
     /// with the stored plane; the sweep and the penetration test share the
     /// visit at `to_m`. A candidate's barycentric weights are two more dot
-    /// products, with its stored frame ([`SurfaceIndex::weights`]).
+    /// products, with its stored frame ([`SurfaceIndex::weights`](crate::table::SurfaceIndex::weights)).
     ///
     /// Sweep: an end outside that reach is first moved along the segment to
     /// where the segment leaves it (`clip_towards`, computed from the end
@@ -209,7 +209,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     }
 
     /// The sweep of a motion between `ends` (the earlier position and the
-    /// tool, m, each with its cell of [`SurfaceIndex::detection_cell_of`];
+    /// tool, m, each with its cell of [`SurfaceIndex::detection_cell_of`](crate::table::SurfaceIndex::detection_cell_of);
     /// the tool within `reach` when `to_in`): writes the swept segment
     /// into `segment`, clipped to the grid's `reach` when exactly one end
     /// lies outside it (written where it is found: each copy of the segment
@@ -343,7 +343,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     ///
     /// Among the surface triangles around the surface vertices in the 27
     /// grid cells around `to_m` (the walk of [`Self::detect`], bounded by
-    /// [`SurfaceIndex::max_query_triangles`]; the grid's cell is at least
+    /// [`SurfaceIndex::max_query_triangles`](crate::table::SurfaceIndex::max_query_triangles); the grid's cell is at least
     /// the longest surface edge, so a centre within a cell of the surface
     /// sees the faces over it), the one with the nearest plane over the
     /// centre (its projection inside the triangle) decides:
