@@ -280,6 +280,18 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         self.lists.cell_of(p)
     }
 
+    /// The cell a detection files `p` (m) in: of the candidate lists' grid
+    /// when `lists` (the lists serve the tool, [`Self::serves`]), else of
+    /// the grid ([`Self::list_cell_of`], [`Self::cell_of`]).
+    #[inline(always)]
+    pub fn detection_cell_of(&self, p: &Vector3<T>, lists: bool) -> [u32; 3] {
+        if lists {
+            self.list_cell_of(p)
+        } else {
+            self.cell_of(p)
+        }
+    }
+
     /// The candidate lists' grid: the grid's box in cells `k` times finer
     /// ([`super::format::SectionKind::GridDims`]).
     pub fn list_grid(&self) -> &Grid<T> {

@@ -14,6 +14,7 @@ use super::format::{
     kept_rank, surface_block_index,
 };
 use crate::Real;
+use crate::math::block;
 
 /// The 16-bit code of a coded part (a [`BlockEncoding`] other than
 /// [`BlockEncoding::Scalar`]).
@@ -285,14 +286,11 @@ fn add_products<T: Real>(blocks: &[[T; 9]], w: &Vector3<T>, out: &mut [[T; 3]]) 
     }
 }
 
-/// Transpose of a row-major 3×3 block times a vector.
+/// Transpose of a row-major 3×3 block times a vector
+/// (`math::block::mul_transposed`, the same products in the same order).
 #[inline(always)]
 fn mul_transposed<T: Real>(c: &[T; 9], w: &Vector3<T>) -> [T; 3] {
-    [
-        c[0] * w.x + c[3] * w.y + c[6] * w.z,
-        c[1] * w.x + c[4] * w.y + c[7] * w.z,
-        c[2] * w.x + c[5] * w.y + c[8] * w.z,
-    ]
+    block::mul_transposed(c, &[w.x, w.y, w.z])
 }
 
 /// The sections of one compliance part.

@@ -24,11 +24,11 @@ mod plane;
 mod precomputed;
 mod tensor_mass;
 
-pub(crate) use candidates::for_each_candidate_filing;
 pub use candidates::{
     CANDIDATE_MARGIN_CELLS, CANDIDATE_MARGIN_RADII, candidate_cells, candidate_margin_m,
     candidate_radius_m, list_subdivision,
 };
+pub(crate) use candidates::{corners_of, for_each_candidate_filing};
 pub(crate) use collision::BuiltLists;
 pub use collision::{CandidateList, DEAD_TRIANGLE, SurfaceIndex};
 pub use compressed::{CodedBlocks, ComplianceBlocks};
