@@ -13,10 +13,12 @@ use plotters::prelude::*;
 
 use palpate_kernel::tensor_mass::Integrator;
 
+use super::body::Load;
+use super::model::Model;
+use super::results::Study;
 use super::select::pareto_front;
 use super::series::{cost_series, log_slope, trajectory_points};
 use super::stability::{Map, Outcome};
-use super::{Load, Model, Study};
 use crate::experiment::volume_bend::{Protocol, SceneResult};
 use crate::output::atomic::write_file;
 
@@ -135,7 +137,7 @@ pub fn draw_all(
     names.push("cost-mesh".into());
     for map in &study.stability {
         let name = match map.model {
-            super::Model::Hybrid => format!("stability-hybrid-{}", map.integrator),
+            Model::Hybrid => format!("stability-hybrid-{}", map.integrator),
             _ => format!("stability-{}", map.integrator),
         };
         render!(dir, name, |root: &DrawingArea<_, Shift>| stability(

@@ -2,12 +2,14 @@
 
 use core::fmt::Write;
 
+use super::body::{HYBRID_DYNAMIC_FRACTION, Load};
+use super::model::Model;
+use super::results::{Run, Study};
 use super::select::{cheapest_within, pareto_front};
 use super::series::{cost_series, log_slope, trajectory_points};
 use super::stability::Outcome;
 use super::ticks::TickCounts;
 use super::trajectory::REFINEMENT;
-use super::{Load, Model, Run, Study};
 
 /// Error bounds of the report's "cheapest within" columns.
 pub const BOUNDS: [f64; 3] = [0.01, 0.05, 0.20];
@@ -128,7 +130,7 @@ pub fn markdown(
          condensed onto the connection nodes. The bend's and twist's rotations grow towards the \
          loaded end, where a tool would also touch and cut; the largest strains of the bend are at \
          the supports, in the linear region.\n",
-        100.0 * super::HYBRID_DYNAMIC_FRACTION,
+        100.0 * HYBRID_DYNAMIC_FRACTION,
         regions.join(", ")
     );
     let _ = writeln!(out, "## Cheapest model within an error bound\n");

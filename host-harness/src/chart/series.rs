@@ -2,8 +2,10 @@
 //! ([`super::report`]) draw from a study: the trajectories' (cost, error)
 //! points, each model's cost against mesh size and its log-log slope.
 
+use super::body::Load;
+use super::model::Model;
+use super::results::Study;
 use super::trajectory::Trajectory;
-use super::{Load, Model, Study};
 
 /// The trajectories of one load with an error, as (cost, error) points:
 /// compute time per simulated second (s) and trajectory error.

@@ -21,7 +21,10 @@ use palpate_kernel::tensor_mass::{
 };
 use serde::Serialize;
 
-use super::{Body, Load, Model, Progress, hybrid_field, hybrid_tables, region_loads, set_loads};
+use super::body::{Body, Load, tip_m};
+use super::model::Model;
+use super::progress::Progress;
+use super::tables::{hybrid_field, hybrid_tables, region_loads, set_loads};
 use crate::dispatch::HostDispatch;
 use crate::fem::material::{Material, TetMaterials};
 use crate::fem::static_solve::solve_loaded;
@@ -279,7 +282,7 @@ impl<'a, 's> System<'a, 's> for HybridModel<'a, 's, f64> {
 }
 
 /// Builds `model` of `body` (a tensor-mass model, or [`Model::Hybrid`]:
-/// its tables with `material`, [`super::hybrid_tables`]) with `material`
+/// its tables with `material`, [`hybrid_tables`]) with `material`
 /// and `params`, sets the nodal `loads` (on the hybrid's region, in its
 /// numbering), and runs `f` on it with the loads as set.
 pub(crate) fn with_system<R>(
@@ -325,7 +328,7 @@ fn trial(
         &[],
         &unit,
     )?;
-    let scale = 0.05 * body.length_m / super::tip_m(&unit, &u_unit);
+    let scale = 0.05 * body.length_m / tip_m(&unit, &u_unit);
     let loads: Vec<[f64; 3]> = unit.iter().map(|f| f.map(|x| x * scale)).collect();
     let work: f64 = loads
         .iter()

@@ -18,7 +18,7 @@
 //!   ([`crate::fem::penalty::penalty_n`] of the block);
 //! - the hybrid on the built-in hybrid organ (`built-in-hybrid`, probes in
 //!   place of its grasper and cutter), its tensor-mass region St
-//!   Venant-Kirchhoff as the chart's ([`super::HYBRID_LAW`]).
+//!   Venant-Kirchhoff as the chart's ([`HYBRID_LAW`]).
 //!
 //! The dynamic scenes' physics updates (the law's force evaluations) run
 //! every 10th tick outside the measured function, as in `palpate budget`:
@@ -33,7 +33,8 @@ use anyhow::Context;
 use palpate_kernel::precomputed::{QuasiNonLinear, REMAP_DEGREE, Remap};
 use serde::Serialize;
 
-use super::{HYBRID_LAW, Model, Progress};
+use super::model::{HYBRID_LAW, Model};
+use super::progress::Progress;
 use crate::budget::{HOST_IR, budget_table, chosen_trajectories, measure, probe_remapped};
 use crate::fem::penalty::penalty_n;
 use crate::scene::ModelSpec;

@@ -20,8 +20,11 @@ use nalgebra::Vector3;
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator};
 use serde::Serialize;
 
+use super::body::{Body, Load};
+use super::measure::median_s;
+use super::model::Model;
+use super::progress::Progress;
 use super::stability::{DAMPING_PER_S, with_params, with_system};
-use super::{Body, Load, Model, Progress, median_s};
 use crate::dispatch::HostDispatch;
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::stability::omega_max;

@@ -5,13 +5,15 @@
 //! `SeriesDir`, which refuses a folder palpate did not write), prints the
 //! summary (or the JSON).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use palpate::chart::{self, GivenMesh, Matrix, plot, report, ticks};
+use indicatif::ProgressBar;
+use palpate::chart::{self, GivenMesh, Matrix, Progress as _, plot, report, ticks};
 use palpate::experiment::scenes;
-use palpate::experiment::volume_bend::{self, Protocol};
+use palpate::experiment::volume_bend::{self, Protocol, SceneResult};
 use palpate::fix::FixPredicate;
 use palpate::limits::MAX_CHART_TET_STEPS;
 use palpate::mesh::read_mesh;
@@ -113,31 +115,97 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         None => matrix,
     };
     matrix.tick_counts |= args.tick_counts;
-    // Picinbono's table 2 is the cylinder's experiment: not run on a given mesh.
-    let protocols: &[Protocol] = if matrix.given.is_some() {
-        &[]
+    let volume_runs = VolumeRuns::of(&matrix, args.quick);
+    let total = announce(&matrix, volume_runs.protocols.len());
+    check_bound(&matrix, &args.out, &volume_runs)?;
+    let mut progress = Bar::new(total);
+    let mut study = chart::run(&matrix, &mut progress)?;
+    study.ticks = tick_counts(&matrix, &study, dir, &mut progress)?;
+    let volume = volume_runs.run(&mut progress)?;
+    progress.bar.finish_and_clear();
+
+    let (json, markdown) = write_outputs(&matrix, &study, &volume, dir)?;
+    folder.commit()?;
+    if args.json {
+        stdout::println(&json.to_string())?;
     } else {
-        &[Protocol::PaperLoads, Protocol::Tilt]
-    };
-    // Picinbono's table 2 on the bent cylinder: the small one in --quick;
-    // its relaxations capped as the study's.
-    let scene = if args.quick {
-        scenes::cylinder(2, 8)
-    } else {
-        scenes::default_cylinder()
-    };
-    let controls = volume_bend::Controls {
-        max_steps: matrix.max_relax_steps,
-        ..volume_bend::Controls::default()
-    };
+        stdout::print(&markdown)?;
+    }
+    Ok(())
+}
+
+/// The study's volume experiments: Picinbono's table 2 on the bent
+/// cylinder (the small one in `--quick`), its relaxations capped as the
+/// study's; none on a given mesh (table 2 is the cylinder's experiment).
+struct VolumeRuns {
+    protocols: &'static [Protocol],
+    scene: volume_bend::Scene,
+    controls: volume_bend::Controls,
+}
+
+impl VolumeRuns {
+    /// The experiments of `matrix` (`quick`: the small cylinder).
+    fn of(matrix: &Matrix, quick: bool) -> Self {
+        let protocols: &[Protocol] = if matrix.given.is_some() {
+            &[]
+        } else {
+            &[Protocol::PaperLoads, Protocol::Tilt]
+        };
+        let scene = if quick {
+            scenes::cylinder(2, 8)
+        } else {
+            scenes::default_cylinder()
+        };
+        let controls = volume_bend::Controls {
+            max_steps: matrix.max_relax_steps,
+            ..volume_bend::Controls::default()
+        };
+        Self {
+            protocols,
+            scene,
+            controls,
+        }
+    }
+
+    /// Upper bound on their tet-steps: every relaxation at its step cap.
+    fn tet_step_bound(&self) -> u64 {
+        let relaxations: usize = self
+            .protocols
+            .iter()
+            .map(|&p| volume_bend::relaxations_bound(&self.scene, p, &self.controls))
+            .sum();
+        (relaxations * self.controls.max_steps * self.scene.mesh.tets.len()) as u64
+    }
+
+    /// Runs them, one step of `progress` each.
+    fn run(&self, progress: &mut Bar) -> anyhow::Result<Vec<SceneResult>> {
+        let mut volume = Vec::new();
+        for &protocol in self.protocols {
+            volume.push(volume_bend::run_scene(
+                &self.scene,
+                protocol,
+                &self.controls,
+                |_| {},
+            )?);
+            progress.tick(&format!("volume {protocol:?}"));
+        }
+        Ok(volume)
+    }
+}
+
+/// Prints the study's extent on standard error and returns its steps of
+/// progress: the static runs, the stability trials, the trajectories, the
+/// `volume_experiments` and the callgrind runs (none without valgrind:
+/// the tick counts are then skipped, said in the report).
+fn announce(matrix: &Matrix, volume_experiments: usize) -> usize {
     let trials = chart::stability::map_count() * matrix.stability.trials();
-    // The tick counts need valgrind: without it, skipped (said in the report).
     let tick_runs = if matrix.tick_counts && ticks::valgrind_available() {
         ticks::TICK_RUNS
     } else {
         0
     };
-    let total = matrix.static_runs() + trials + matrix.trajectories() + protocols.len() + tick_runs;
+    let total =
+        matrix.static_runs() + trials + matrix.trajectories() + volume_experiments + tick_runs;
     stderr::line(&format!(
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
          references), {} stability trials, {} trajectories (each against its Δt/{}), {} volume \
@@ -151,17 +219,20 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         trials,
         matrix.trajectories(),
         chart::trajectory::REFINEMENT,
-        protocols.len(),
+        volume_experiments,
     ));
-    // The work bound, checked before anything runs, and its time here.
+    total
+}
+
+/// The study's checks before anything runs: its preflight
+/// ([`chart::preflight`] of `out` and the bodies) and its work bound (the
+/// matrix's and the volume experiments') against [`MAX_CHART_TET_STEPS`],
+/// the bound's time at the tet-step measured here printed on standard
+/// error.
+fn check_bound(matrix: &Matrix, out: &Path, volume_runs: &VolumeRuns) -> anyhow::Result<()> {
     let bodies = matrix.bodies()?;
-    chart::preflight(&bodies, &args.out)?;
-    let volume_relaxations: usize = protocols
-        .iter()
-        .map(|&p| volume_bend::relaxations_bound(&scene, p, &controls))
-        .sum();
-    let bound = matrix.tet_step_bound(&bodies)?
-        + (volume_relaxations * controls.max_steps * scene.mesh.tets.len()) as u64;
+    chart::preflight(&bodies, out)?;
+    let bound = matrix.tet_step_bound(&bodies)? + volume_runs.tet_step_bound();
     anyhow::ensure!(
         bound <= MAX_CHART_TET_STEPS,
         "the study's work bound, {bound:.3e} tet-steps, exceeds the limit of {MAX_CHART_TET_STEPS:.0e}"
@@ -178,76 +249,121 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
         1e9 * per_tet_step_s,
         finest.label,
     ));
-    let bar = stderr::progress_bar(
-        total as u64,
-        "chart {bar:40} {pos}/{len} ({eta}) {msg}",
-        true,
-    );
-    // Without a terminal (CI, a redirected run) the bar is hidden: one line
-    // per step instead, with the time since the start.
-    let lines = bar.is_hidden();
-    let start = std::time::Instant::now();
-    let mut tick = |message: &str| {
-        bar.inc(1);
-        if lines {
+    Ok(())
+}
+
+/// The study's progress on standard error: a bar on a terminal; without
+/// one (CI, a redirected run) the bar is hidden and each step is one line
+/// with the time since the start.
+struct Bar {
+    bar: ProgressBar,
+    lines: bool,
+    start: Instant,
+    total: usize,
+}
+
+impl Bar {
+    /// A bar of `total` steps, its clock started.
+    fn new(total: usize) -> Self {
+        let bar = stderr::progress_bar(
+            total as u64,
+            "chart {bar:40} {pos}/{len} ({eta}) {msg}",
+            true,
+        );
+        let lines = bar.is_hidden();
+        Self {
+            bar,
+            lines,
+            start: Instant::now(),
+            total,
+        }
+    }
+}
+
+impl chart::Progress for Bar {
+    fn tick(&mut self, message: &str) {
+        self.bar.inc(1);
+        if self.lines {
             stderr::line(&format!(
-                "chart {}/{total} {:7.1} s {message}",
-                bar.position(),
-                start.elapsed().as_secs_f64()
+                "chart {}/{} {:7.1} s {message}",
+                self.bar.position(),
+                self.total,
+                self.start.elapsed().as_secs_f64()
             ));
         } else {
-            bar.set_message(message.to_string());
+            self.bar.set_message(message.to_string());
         }
-    };
-    let mut study = chart::run(&matrix, &mut tick)?;
-    study.ticks = if !matrix.tick_counts {
-        ticks::TickCounts::Skipped {
+    }
+}
+
+/// The haptic tick's instruction counts of the study's pre-computed models
+/// ([`ticks::measure_ticks`]: child processes of this executable under
+/// callgrind, in `dir/ticks`), or why they were not measured.
+fn tick_counts(
+    matrix: &Matrix,
+    study: &chart::Study,
+    dir: &Path,
+    progress: &mut Bar,
+) -> anyhow::Result<ticks::TickCounts> {
+    if !matrix.tick_counts {
+        return Ok(ticks::TickCounts::Skipped {
             reason: format!(
                 "--quick ({} callgrind runs; `--tick-counts` measures them)",
                 ticks::TICK_RUNS
             ),
-        }
-    } else {
-        let exe = std::env::current_exe()?;
-        let child = |a: &ticks::ChildArgs<'_>| {
-            vec![
-                "chart".into(),
-                "--tick-probe".into(),
-                a.model.name().into(),
-                a.table.display().to_string(),
-                a.trajectory.display().to_string(),
-                a.points.to_string(),
-                a.remap.into(),
-            ]
-        };
-        let quasi = study.remap.kernel::<f64>()?;
-        ticks::measure_ticks(&exe, child, &dir.join("ticks"), &quasi, &mut tick)?
-    };
-    let mut volume = Vec::new();
-    for &protocol in protocols {
-        volume.push(volume_bend::run_scene(&scene, protocol, &controls, |_| {})?);
-        tick(&format!("volume {protocol:?}"));
+        });
     }
-    bar.finish_and_clear();
+    let exe = std::env::current_exe()?;
+    let child = |a: &ticks::ChildArgs<'_>| {
+        vec![
+            "chart".into(),
+            "--tick-probe".into(),
+            a.model.name().into(),
+            a.table.display().to_string(),
+            a.trajectory.display().to_string(),
+            a.points.to_string(),
+            a.remap.into(),
+        ]
+    };
+    let quasi = study.remap.kernel::<f64>()?;
+    ticks::measure_ticks(&exe, child, &dir.join("ticks"), &quasi, progress)
+}
 
-    let charts = plot::draw_all(&study, &volume, dir, &matrix.loads, &matrix.levels)?;
+/// Writes the charts, `report.md`, `index.html` and `study.json` (the
+/// [`summary`], the study, the volume experiments and the charts' names)
+/// into `dir`; returns the JSON and the report.
+fn write_outputs(
+    matrix: &Matrix,
+    study: &chart::Study,
+    volume: &[SceneResult],
+    dir: &Path,
+) -> anyhow::Result<(serde_json::Value, String)> {
+    let charts = plot::draw_all(study, volume, dir, &matrix.loads, &matrix.levels)?;
     let volume_table: String = volume
         .iter()
         .map(|r| volume_bend::table(core::slice::from_ref(r)))
         .collect::<Vec<_>>()
         .join("\n");
-    let markdown = report::markdown(
-        &study,
-        &matrix.loads,
-        &matrix.levels,
-        &charts,
-        &volume_table,
-    );
+    let markdown = report::markdown(study, &matrix.loads, &matrix.levels, &charts, &volume_table);
     write_file(&dir.join("report.md"), markdown.as_bytes())?;
     write_file(
         &dir.join("index.html"),
         report::html(&markdown, &charts).as_bytes(),
     )?;
+    let json = serde_json::json!({
+        "summary": summary(matrix, study),
+        "study": study,
+        "volume": volume,
+        "charts": charts,
+    });
+    write_file(&dir.join("study.json"), json.to_string().as_bytes())?;
+    Ok((json, markdown))
+}
+
+/// `study.json`'s summary: per load and level (`press-5`), the Pareto
+/// front's members and the cheapest model within each of
+/// [`report::BOUNDS`] (keyed by the bound in percent).
+fn summary(matrix: &Matrix, study: &chart::Study) -> serde_json::Map<String, serde_json::Value> {
     let mut summary = serde_json::Map::new();
     for &load in &matrix.loads {
         for &level in &matrix.levels {
@@ -257,31 +373,18 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
                 .map(|&b| {
                     (
                         format!("{:.0}", 100.0 * b),
-                        report::cheapest(&study, load, level, b).into(),
+                        report::cheapest(study, load, level, b).into(),
                     )
                 })
                 .collect();
             summary.insert(
                 key,
                 serde_json::json!({
-                    "pareto": report::pareto_members(&study, load, level),
+                    "pareto": report::pareto_members(study, load, level),
                     "cheapest_within_percent": within,
                 }),
             );
         }
     }
-    let json = serde_json::json!({
-        "summary": summary,
-        "study": study,
-        "volume": volume,
-        "charts": charts,
-    });
-    write_file(&dir.join("study.json"), json.to_string().as_bytes())?;
-    folder.commit()?;
-    if args.json {
-        stdout::println(&json.to_string())?;
-    } else {
-        stdout::print(&markdown)?;
-    }
-    Ok(())
+    summary
 }

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use anyhow::bail;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Subcommand};
-use palpate::mesh::read_mesh;
+use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::output::atomic::{self, AtomicFile};
 use palpate::output::stderr;
 use palpate::table::build::{
-    BuildOptions, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build_with_limits,
+    BuildOptions, BuiltTable, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build_with_limits,
 };
 use palpate::table::compliance::Solver;
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
@@ -147,42 +147,15 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 .subcommand_matches("build")
                 .and_then(|m| m.value_source("solver"))
                 == Some(ValueSource::CommandLine);
-            if compress.is_none() {
-                if drop_below.is_some() {
-                    bail!("--drop-below applies to a compressed table: add --compress f16|q16");
-                }
-                if contact_blocks.is_some() {
-                    bail!("--contact-blocks applies to a compressed table: add --compress f16|q16");
-                }
-            }
-            let kind = match (kind, density) {
-                (TableKindArg::TensorMass, None) => {
-                    bail!("--kind tensor-mass needs --density <kg/m3>")
-                }
-                (TableKindArg::Precomputed, Some(_)) => {
-                    bail!(
-                        "--density applies to --kind tensor-mass only (the pre-computed model is quasi-static)"
-                    )
-                }
-                (TableKindArg::TensorMass, Some(_)) if solver_given => {
-                    bail!("--solver applies to --kind precomputed only")
-                }
-                (TableKindArg::TensorMass, Some(_)) if compress.is_some() => {
-                    bail!("--compress applies to --kind precomputed only")
-                }
-                (TableKindArg::TensorMass, Some(density_kg_m3)) => {
-                    TableKindOptions::TensorMass { density_kg_m3 }
-                }
-                (TableKindArg::Precomputed, None) => TableKindOptions::Precomputed {
-                    solver: solver.into(),
-                    compression: compress.map(|code| Compression {
-                        code,
-                        drop_below: drop_below.unwrap_or(0.0),
-                        contact: contact_blocks.unwrap_or_default(),
-                    }),
-                    tool_radius_m: tool_radius,
-                },
-            };
+            let compression = compression(compress, drop_below, contact_blocks)?;
+            let kind = kind_options(
+                kind,
+                density,
+                solver,
+                solver_given,
+                compression,
+                tool_radius,
+            )?;
             // The output: never one of the inputs, and written whole or not at
             // all (opened before the build, so an unwritable path fails fast).
             let inputs = mesh_files(&mesh);
@@ -211,34 +184,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             let built = build_with_limits(&mesh_data, &report, &options, &limits)?;
             file.write_all(&built.bytes)?;
             file.commit()?;
-            // The summary line on stderr: the mesh, then the kind's counts.
-            let vertices = format!(
-                "{} vertices ({} fixed by --fix, {} unreferenced kept fixed), {} tets",
-                mesh_data.positions.len(),
-                built.fixed_by_predicate,
-                built.fixed_unreferenced,
-                mesh_data.tets.len()
-            );
-            let mesh_notes = format!(
-                "{} non-tet elements skipped, {} tets reoriented",
-                report.skipped_elements, report.reoriented_tets
-            );
-            let (source, bytes, output) = (&report.source, built.bytes.len(), output.display());
-            match kind {
-                TableKindOptions::Precomputed { .. } => stderr::line(&format!(
-                    "{source}: {vertices}, {} free, {} touchable; {mesh_notes}; \
-                     compliance in {:.3} s; wrote {bytes} bytes to {output}{}",
-                    built.free_count,
-                    built.touchable_count,
-                    built.arrays_time.as_secs_f64(),
-                    compression_note(&built.bytes)
-                )),
-                TableKindOptions::TensorMass { density_kg_m3 } => stderr::line(&format!(
-                    "{source}: tensor-mass table: {vertices}, {} edges, {density_kg_m3} kg/m3; \
-                     {mesh_notes}; wrote {bytes} bytes to {output}",
-                    built.edge_count
-                )),
-            }
+            summary_line(&mesh_data, &report, &built, &kind, &output);
             Ok(())
         }
         TablesCommand::Info { table } => {
@@ -255,5 +201,101 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 }
             }
         }
+    }
+}
+
+/// The compression of `--compress` with its `--drop-below` and
+/// `--contact-blocks` (refused without `--compress`).
+fn compression(
+    compress: Option<BlockCode>,
+    drop_below: Option<f64>,
+    contact_blocks: Option<ContactBlocks>,
+) -> anyhow::Result<Option<Compression>> {
+    if compress.is_none() {
+        if drop_below.is_some() {
+            bail!("--drop-below applies to a compressed table: add --compress f16|q16");
+        }
+        if contact_blocks.is_some() {
+            bail!("--contact-blocks applies to a compressed table: add --compress f16|q16");
+        }
+    }
+    Ok(compress.map(|code| Compression {
+        code,
+        drop_below: drop_below.unwrap_or(0.0),
+        contact: contact_blocks.unwrap_or_default(),
+    }))
+}
+
+/// The table kind's options of `--kind` with `--density`, `--solver`
+/// (`solver_given`: on the command line), the `compression` and
+/// `--tool-radius`: each option refused where its kind does not take it.
+fn kind_options(
+    kind: TableKindArg,
+    density: Option<f64>,
+    solver: SolverArg,
+    solver_given: bool,
+    compression: Option<Compression>,
+    tool_radius: f64,
+) -> anyhow::Result<TableKindOptions> {
+    Ok(match (kind, density) {
+        (TableKindArg::TensorMass, None) => {
+            bail!("--kind tensor-mass needs --density <kg/m3>")
+        }
+        (TableKindArg::Precomputed, Some(_)) => {
+            bail!(
+                "--density applies to --kind tensor-mass only (the pre-computed model is quasi-static)"
+            )
+        }
+        (TableKindArg::TensorMass, Some(_)) if solver_given => {
+            bail!("--solver applies to --kind precomputed only")
+        }
+        (TableKindArg::TensorMass, Some(_)) if compression.is_some() => {
+            bail!("--compress applies to --kind precomputed only")
+        }
+        (TableKindArg::TensorMass, Some(density_kg_m3)) => {
+            TableKindOptions::TensorMass { density_kg_m3 }
+        }
+        (TableKindArg::Precomputed, None) => TableKindOptions::Precomputed {
+            solver: solver.into(),
+            compression,
+            tool_radius_m: tool_radius,
+        },
+    })
+}
+
+/// The build's summary line on stderr: the mesh, then the kind's counts.
+fn summary_line(
+    mesh_data: &TetMesh,
+    report: &MeshReport,
+    built: &BuiltTable,
+    kind: &TableKindOptions,
+    output: &Path,
+) {
+    let vertices = format!(
+        "{} vertices ({} fixed by --fix, {} unreferenced kept fixed), {} tets",
+        mesh_data.positions.len(),
+        built.fixed_by_predicate,
+        built.fixed_unreferenced,
+        mesh_data.tets.len()
+    );
+    let mesh_notes = format!(
+        "{} non-tet elements skipped, {} tets reoriented",
+        report.skipped_elements, report.reoriented_tets
+    );
+    let (source, bytes, output) = (&report.source, built.bytes.len(), output.display());
+    match kind {
+        TableKindOptions::Precomputed { .. } => stderr::line(&format!(
+            "{source}: {vertices}, {} free, {} touchable; {mesh_notes}; \
+             compliance in {:.3} s; wrote {bytes} bytes to {output}{}",
+            built.free_count,
+            built.touchable_count,
+            built.arrays_time.as_secs_f64(),
+            compression_note(&built.bytes)
+        )),
+        TableKindOptions::TensorMass { density_kg_m3 } => stderr::line(&format!(
+            "{source}: tensor-mass table: {vertices}, {} edges, {density_kg_m3} kg/m3; \
+             {mesh_notes}; wrote {bytes} bytes to {output}",
+            built.edge_count
+        )),
     }
 }

@@ -140,7 +140,6 @@ pub fn build_hybrid(
     options: &HybridOptions,
 ) -> anyhow::Result<HybridTables> {
     let source = &report.source;
-    let n = mesh.positions.len();
     let build = &options.build;
     let materials = build.materials_for(mesh.tets.len())?;
     let Prepared {
@@ -149,69 +148,16 @@ pub fn build_hybrid(
         region,
         ..
     } = prepare(mesh, report, dynamic_tet, options)?;
-    let PrecomputedRegion {
-        mesh: pmesh,
-        fixed: pfixed,
-        surface,
-    } = region;
-    let region_tets = |dynamic: bool| {
-        let flags = &split.dynamic_tet;
-        (0..flags.len()).filter(move |&t| flags[t] == dynamic)
-    };
-    let pmaterials = materials.subset(region_tets(false));
-    let summary = BuiltTable {
-        bytes: Vec::new(),
-        fixed_by_predicate: fixed.iter().filter(|&&f| f).count(),
-        fixed_unreferenced: report.unreferenced_vertices.len(),
-        free_count: pfixed.iter().filter(|&&f| !f).count(),
-        touchable_count: 0,
-        edge_count: 0,
-        arrays_time: core::time::Duration::ZERO,
-    };
-    let preport = MeshReport {
-        source: format!("{source} (pre-computed region)"),
-        ..MeshReport::default()
-    };
-    let stages = Stages {
-        fixed: &pfixed,
-        surface: &surface,
-        materials: &pmaterials,
-    };
-    let precomputed_summary =
-        precomputed(&pmesh, &preport, build, Solver::Cholesky, &stages, summary)?;
-    let ordering = FreeOrdering::new(n, &pfixed, &surface.vertices);
+    let pmaterials = materials.subset(region_tets(&split, false));
+    let (precomputed_summary, ordering) =
+        precomputed_table(mesh, report, &fixed, &region, &pmaterials, build)?;
 
-    // Lumped masses of each region's tets, and the pre-computed load.
-    let mass_of = |dynamic: bool| {
-        let mut m = vec![0.0f64; n];
-        for (tet, &d) in mesh.tets.iter().zip(&split.dynamic_tet) {
-            if d == dynamic {
-                let (_, volume) = shape_gradients(&tet.map(|v| mesh.positions[v as usize]));
-                for &v in tet {
-                    m[v as usize] += options.density_kg_m3 * volume / 4.0;
-                }
-            }
-        }
-        m
-    };
-    let precomputed_mass = mass_of(false);
-    let mut load_n: Vec<[f64; 3]> = precomputed_mass
-        .iter()
-        .map(|&m| options.gravity_m_s2.map(|g| m * g))
-        .collect();
-    for &(v, force) in &options.point_loads {
-        let Some(load) = load_n.get_mut(v as usize).filter(|_| !pfixed[v as usize]) else {
-            bail!(
-                "{source}: point load on vertex {v}, not a free vertex of the pre-computed region"
-            );
-        };
-        for (l, f) in load.iter_mut().zip(force) {
-            *l += f;
-        }
-    }
+    // Lumped masses of the pre-computed region's tets, and its load.
+    let precomputed_mass = lumped_mass(mesh, &split, options.density_kg_m3, false);
+    let load_n = precomputed_load(&precomputed_mass, &region.fixed, options, source)?;
     let mut condensed = condense(
         &mesh.positions,
-        &pmesh.tets,
+        &region.mesh.tets,
         &pmaterials,
         &ordering,
         &split.connection,
@@ -228,24 +174,7 @@ pub fn build_hybrid(
         }
     }
 
-    // The tensor-mass region, the connection nodes carrying both regions' mass.
-    let dmesh = split.dynamic_mesh(mesh);
-    let dfixed: Vec<bool> = split
-        .dynamic_vertex
-        .iter()
-        .map(|&v| fixed[v as usize])
-        .collect();
-    let dmaterials = materials.subset(region_tets(true));
-    let mut arrays = TensorMassArrays::new(&dmesh, &dmaterials, options.density_kg_m3, dfixed);
-    if options.connection_mass == ConnectionMass::AllTets {
-        for &v in &split.connection {
-            if let Some(d) = split.dynamic_index[v as usize] {
-                arrays.masses_kg[d as usize] += precomputed_mass[v as usize];
-            }
-        }
-    }
-    let dsurface = boundary_surface(&dmesh);
-    let dynamic = write_tensor_mass_table(&dmesh, &dsurface.triangles, &arrays, build.precision);
+    let dynamic = dynamic_table(mesh, &split, &fixed, &materials, &precomputed_mass, options);
     let checksums = [&precomputed_summary.bytes, &dynamic].map(|bytes| trailer(bytes));
     let interface = write_interface_table(
         mesh, &split, &ordering, &condensed, &materials, checksums, options,
@@ -268,6 +197,134 @@ pub fn build_hybrid(
         format!("{source}: the built hybrid tables fail Palpate's own load check")
     })?;
     Ok(tables)
+}
+
+/// The tets of the tensor-mass region (`dynamic`) or of the pre-computed one.
+fn region_tets(split: &RegionSplit, dynamic: bool) -> impl Iterator<Item = usize> + '_ {
+    let flags = &split.dynamic_tet;
+    (0..flags.len()).filter(move |&t| flags[t] == dynamic)
+}
+
+/// The pre-computed region's table (its tets with `pmaterials`, the
+/// connection nodes fixed; Cholesky), with its build summary counting the
+/// whole mesh's `fixed` vertices, and the region's free ordering.
+fn precomputed_table(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    fixed: &[bool],
+    region: &PrecomputedRegion,
+    pmaterials: &TetMaterials,
+    build: &BuildOptions,
+) -> anyhow::Result<(BuiltTable, FreeOrdering)> {
+    let summary = BuiltTable {
+        bytes: Vec::new(),
+        fixed_by_predicate: fixed.iter().filter(|&&f| f).count(),
+        fixed_unreferenced: report.unreferenced_vertices.len(),
+        free_count: region.fixed.iter().filter(|&&f| !f).count(),
+        touchable_count: 0,
+        edge_count: 0,
+        arrays_time: core::time::Duration::ZERO,
+    };
+    let preport = MeshReport {
+        source: format!("{} (pre-computed region)", report.source),
+        ..MeshReport::default()
+    };
+    let stages = Stages {
+        fixed: &region.fixed,
+        surface: &region.surface,
+        materials: pmaterials,
+    };
+    let built = precomputed(
+        &region.mesh,
+        &preport,
+        build,
+        Solver::Cholesky,
+        &stages,
+        summary,
+    )?;
+    let ordering = FreeOrdering::new(
+        mesh.positions.len(),
+        &region.fixed,
+        &region.surface.vertices,
+    );
+    Ok((built, ordering))
+}
+
+/// Per vertex, the lumped mass (kg) of the tensor-mass region's tets
+/// (`dynamic`) or of the pre-computed region's: a quarter of each tet's
+/// `density_kg_m3 × volume` on each of its vertices.
+fn lumped_mass(mesh: &TetMesh, split: &RegionSplit, density_kg_m3: f64, dynamic: bool) -> Vec<f64> {
+    let mut m = vec![0.0f64; mesh.positions.len()];
+    for (tet, &d) in mesh.tets.iter().zip(&split.dynamic_tet) {
+        if d == dynamic {
+            let (_, volume) = shape_gradients(&tet.map(|v| mesh.positions[v as usize]));
+            for &v in tet {
+                m[v as usize] += density_kg_m3 * volume / 4.0;
+            }
+        }
+    }
+    m
+}
+
+/// The pre-computed region's load, N per vertex: the gravity of its
+/// `precomputed_mass` and the point loads of `options`, each on a free
+/// vertex of the region (`pfixed` false), else refused.
+fn precomputed_load(
+    precomputed_mass: &[f64],
+    pfixed: &[bool],
+    options: &HybridOptions,
+    source: &str,
+) -> anyhow::Result<Vec<[f64; 3]>> {
+    let mut load_n: Vec<[f64; 3]> = precomputed_mass
+        .iter()
+        .map(|&m| options.gravity_m_s2.map(|g| m * g))
+        .collect();
+    for &(v, force) in &options.point_loads {
+        let Some(load) = load_n.get_mut(v as usize).filter(|_| !pfixed[v as usize]) else {
+            bail!(
+                "{source}: point load on vertex {v}, not a free vertex of the pre-computed region"
+            );
+        };
+        for (l, f) in load.iter_mut().zip(force) {
+            *l += f;
+        }
+    }
+    Ok(load_n)
+}
+
+/// The tensor-mass region's table (its own vertex numbering), the
+/// connection nodes carrying the pre-computed tets' mass too
+/// ([`ConnectionMass::AllTets`]).
+fn dynamic_table(
+    mesh: &TetMesh,
+    split: &RegionSplit,
+    fixed: &[bool],
+    materials: &TetMaterials,
+    precomputed_mass: &[f64],
+    options: &HybridOptions,
+) -> Vec<u8> {
+    let dmesh = split.dynamic_mesh(mesh);
+    let dfixed: Vec<bool> = split
+        .dynamic_vertex
+        .iter()
+        .map(|&v| fixed[v as usize])
+        .collect();
+    let dmaterials = materials.subset(region_tets(split, true));
+    let mut arrays = TensorMassArrays::new(&dmesh, &dmaterials, options.density_kg_m3, dfixed);
+    if options.connection_mass == ConnectionMass::AllTets {
+        for &v in &split.connection {
+            if let Some(d) = split.dynamic_index[v as usize] {
+                arrays.masses_kg[d as usize] += precomputed_mass[v as usize];
+            }
+        }
+    }
+    let dsurface = boundary_surface(&dmesh);
+    write_tensor_mass_table(
+        &dmesh,
+        &dsurface.triangles,
+        &arrays,
+        options.build.precision,
+    )
 }
 
 impl HybridTables {

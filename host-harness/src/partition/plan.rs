@@ -222,9 +222,48 @@ impl VertexTets {
 /// Chooses the partition (module doc).
 pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
     let mesh = input.mesh;
+    let ZoneTets {
+        taken,
+        mut dynamic,
+        large,
+    } = zone_tets(input)?;
+    let adjacency = VertexTets::new(mesh);
+    grow_rings(mesh, &adjacency, &mut dynamic, input.margin_rings);
+    let connection = connection_vertices(mesh, &dynamic);
+    let connection_nodes: Vec<u32> = (0..connection.len() as u32)
+        .filter(|&v| connection[v as usize])
+        .collect();
+    let builder = RegionBuilder {
+        input,
+        adjacency: &adjacency,
+        connection: &connection,
+    };
+    let mut regions = Vec::new();
+    regions.extend(builder.precomputed(&dynamic)?);
+    regions.extend(builder.dynamic(&dynamic, &taken, &large)?);
+    Ok(Partition {
+        dynamic,
+        connection_nodes,
+        regions,
+    })
+}
+
+/// The tets the zones take, per tet.
+struct ZoneTets {
+    /// Per zone, per tet: taken by the zone.
+    taken: Vec<Vec<bool>>,
+    /// Taken by any zone (the dynamic set before the margin).
+    dynamic: Vec<bool>,
+    /// Taken by a large-deformation zone.
+    large: Vec<bool>,
+}
+
+/// The tets each zone of `input` takes ([`TetGrid::select`]); a zone that
+/// takes none is refused.
+fn zone_tets(input: &PlanInput<'_>) -> Result<ZoneTets, PlanError> {
+    let mesh = input.mesh;
     let n_tets = mesh.tets.len();
     let grid = TetGrid::new(mesh);
-    // The tets each zone takes, and which are large-deformation tets.
     let mut zone_tets: Vec<Vec<bool>> = Vec::with_capacity(input.zones.len());
     let mut dynamic = vec![false; n_tets];
     let mut large = vec![false; n_tets];
@@ -247,12 +286,19 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
         }
         zone_tets.push(taken);
     }
-    let adjacency = VertexTets::new(mesh);
-    grow_rings(mesh, &adjacency, &mut dynamic, input.margin_rings);
+    Ok(ZoneTets {
+        taken: zone_tets,
+        dynamic,
+        large,
+    })
+}
 
+/// Per vertex, whether it is a connection node: a vertex of both a
+/// `dynamic` tet and a pre-computed one.
+fn connection_vertices(mesh: &TetMesh, dynamic: &[bool]) -> Vec<bool> {
     let mut on_dynamic = vec![false; mesh.positions.len()];
     let mut on_static = vec![false; mesh.positions.len()];
-    for (tet, &d) in mesh.tets.iter().zip(&dynamic) {
+    for (tet, &d) in mesh.tets.iter().zip(dynamic) {
         for &v in tet {
             if d {
                 on_dynamic[v as usize] = true;
@@ -261,39 +307,74 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
             }
         }
     }
-    let connection: Vec<bool> = on_dynamic
+    on_dynamic
         .iter()
         .zip(&on_static)
         .map(|(a, b)| *a && *b)
-        .collect();
-    let connection_nodes: Vec<u32> = (0..connection.len() as u32)
-        .filter(|&v| connection[v as usize])
-        .collect();
-    let held = |tets: &[u32]| {
-        tets.iter()
-            .flat_map(|&t| mesh.tets[t as usize])
-            .any(|v| input.fixed.get(v as usize) == Some(&true) || connection[v as usize])
-    };
-    let floating = |region: String, tets: &[u32]| PlanError::Floating {
-        scene: input.scene.to_owned(),
-        region,
-        tets: tets.len(),
-        at_m: mesh.tet_centroid(tets[0] as usize),
-    };
-    let vertex_count = |tets: &[u32]| distinct_vertices(mesh, tets).len();
-    let connection_count = |tets: &[u32]| {
-        distinct_vertices(mesh, tets)
-            .iter()
-            .filter(|&&v| connection[v as usize])
-            .count()
-    };
+        .collect()
+}
 
-    let mut regions = Vec::new();
-    let static_pieces = components(mesh, &adjacency, &dynamic, false);
-    if !static_pieces.is_empty() {
+/// What the regions are built from: the input, the tets around each
+/// vertex and the connection nodes (per vertex).
+struct RegionBuilder<'a> {
+    input: &'a PlanInput<'a>,
+    adjacency: &'a VertexTets,
+    connection: &'a [bool],
+}
+
+impl RegionBuilder<'_> {
+    /// Whether `tets` hold a fixed vertex or a connection node.
+    fn held(&self, tets: &[u32]) -> bool {
+        tets.iter()
+            .flat_map(|&t| self.input.mesh.tets[t as usize])
+            .any(|v| self.input.fixed.get(v as usize) == Some(&true) || self.connection[v as usize])
+    }
+
+    /// The refusal of `region`, its `tets` floating.
+    fn floating(&self, region: String, tets: &[u32]) -> PlanError {
+        PlanError::Floating {
+            scene: self.input.scene.to_owned(),
+            region,
+            tets: tets.len(),
+            at_m: self.input.mesh.tet_centroid(tets[0] as usize),
+        }
+    }
+
+    /// The region `id` of `tets` (ascending) with its model, pieces and
+    /// reason, its vertices and connection nodes counted.
+    fn region(
+        &self,
+        id: u32,
+        model: RegionModel,
+        pieces: usize,
+        tets: Vec<u32>,
+        why: String,
+    ) -> PlannedRegion {
+        let vertices = distinct_vertices(self.input.mesh, &tets);
+        PlannedRegion {
+            id,
+            model,
+            vertices: vertices.len(),
+            connection_nodes: vertices
+                .iter()
+                .filter(|&&v| self.connection[v as usize])
+                .count(),
+            pieces,
+            tets,
+            why,
+        }
+    }
+
+    /// The pre-computed region (region 0), if any tet is not `dynamic`:
+    /// refused if a piece of it floats.
+    fn precomputed(&self, dynamic: &[bool]) -> Result<Option<PlannedRegion>, PlanError> {
+        let static_pieces = components(self.input.mesh, self.adjacency, dynamic, false);
+        if static_pieces.is_empty() {
+            return Ok(None);
+        }
         let several = static_pieces.len() > 1;
         for (i, piece) in static_pieces.iter().enumerate() {
-            if !held(piece) {
+            if !self.held(piece) {
                 let region = if several {
                     format!(
                         "piece {} of {} of the pre-computed region",
@@ -303,59 +384,60 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
                 } else {
                     "the pre-computed region".to_owned()
                 };
-                return Err(floating(region, piece));
+                return Err(self.floating(region, piece));
             }
         }
         let mut tets: Vec<u32> = static_pieces.concat();
         tets.sort_unstable();
-        let why = precomputed_why(input, static_pieces.len());
-        regions.push(PlannedRegion {
-            id: 0,
-            model: RegionModel::Precomputed,
-            vertices: vertex_count(&tets),
-            connection_nodes: connection_count(&tets),
-            pieces: static_pieces.len(),
+        let why = precomputed_why(self.input, static_pieces.len());
+        Ok(Some(self.region(
+            0,
+            RegionModel::Precomputed,
+            static_pieces.len(),
             tets,
             why,
-        });
+        )))
     }
-    for (i, tets) in components(mesh, &adjacency, &dynamic, true)
-        .into_iter()
-        .enumerate()
-    {
-        let id = i as u32 + 1;
-        if !held(&tets) {
-            return Err(floating(format!("dynamic region {id}"), &tets));
+
+    /// The dynamic regions (1, 2, …), one per connected component of the
+    /// `dynamic` tets, each with its law (St Venant-Kirchhoff when it holds
+    /// a `large`-deformation tet) and the zones (`taken`) it serves:
+    /// refused if one floats.
+    fn dynamic(
+        &self,
+        dynamic: &[bool],
+        taken: &[Vec<bool>],
+        large: &[bool],
+    ) -> Result<Vec<PlannedRegion>, PlanError> {
+        let input = self.input;
+        let mut regions = Vec::new();
+        for (i, tets) in components(input.mesh, self.adjacency, dynamic, true)
+            .into_iter()
+            .enumerate()
+        {
+            let id = i as u32 + 1;
+            if !self.held(&tets) {
+                return Err(self.floating(format!("dynamic region {id}"), &tets));
+            }
+            let stvk = tets.iter().any(|&t| large[t as usize]);
+            let incompressibility = stvk && input.poisson >= INCOMPRESSIBLE_POISSON;
+            let model = RegionModel::TensorMass {
+                law: if stvk {
+                    ElasticLaw::StVenantKirchhoff(StvkForm::PerTet)
+                } else {
+                    ElasticLaw::Linear
+                },
+                incompressibility,
+            };
+            let zones: Vec<usize> = (0..input.zones.len())
+                .filter(|&z| tets.iter().any(|&t| taken[z][t as usize]))
+                .collect();
+            let whole = tets.len() == input.mesh.tets.len();
+            let why = dynamic_why(input, &zones, model, whole);
+            regions.push(self.region(id, model, 1, tets, why));
         }
-        let stvk = tets.iter().any(|&t| large[t as usize]);
-        let incompressibility = stvk && input.poisson >= INCOMPRESSIBLE_POISSON;
-        let model = RegionModel::TensorMass {
-            law: if stvk {
-                ElasticLaw::StVenantKirchhoff(StvkForm::PerTet)
-            } else {
-                ElasticLaw::Linear
-            },
-            incompressibility,
-        };
-        let zones: Vec<usize> = (0..input.zones.len())
-            .filter(|&z| tets.iter().any(|&t| zone_tets[z][t as usize]))
-            .collect();
-        let why = dynamic_why(input, &zones, model, tets.len() == n_tets);
-        regions.push(PlannedRegion {
-            id,
-            model,
-            vertices: vertex_count(&tets),
-            connection_nodes: connection_count(&tets),
-            pieces: 1,
-            tets,
-            why,
-        });
+        Ok(regions)
     }
-    Ok(Partition {
-        dynamic,
-        connection_nodes,
-        regions,
-    })
 }
 
 /// Adds `rings` element rings to `set`: each ring, every tet sharing a vertex with the tets the
