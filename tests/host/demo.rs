@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use palpate::demo::{block, organ, run_with};
-use palpate::session::Scene;
+use palpate::scene::Scene;
 
 /// The first second of the surgery, at 1 kHz.
 const ORGAN_S: f64 = 1.0;

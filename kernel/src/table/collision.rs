@@ -305,6 +305,12 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
         self.grid.reach(margin_m)
     }
 
+    /// The box of the grid's cells, m ([`Grid::bounds`]): it holds every
+    /// filed surface vertex, so a point outside it is outside the body.
+    pub fn bounds(&self) -> [Vector3<T>; 2] {
+        self.grid.bounds()
+    }
+
     /// Calls `f` with each surface vertex filed in the 27 cells around the
     /// cell of `p` (m), cell by cell (`x` fastest), each cell's in filing
     /// order. Bounded by `27 × max_bucket`. A row of up to three cells

@@ -189,14 +189,17 @@ impl<T: Real> Grid<T> {
     /// The box within one cell edge plus `margin_m` (m) of the grid: its
     /// lowest and highest corners, m.
     pub fn reach(&self, margin_m: T) -> [Vector3<T>; 2] {
-        let Grid {
-            origin_m,
-            cell_m,
-            dims,
-        } = self;
-        let margin = Vector3::repeat(*cell_m + margin_m);
-        let extent = Vector3::from(dims.map(|d| *cell_m * T::of_f64(f64::from(d))));
-        [origin_m - margin, origin_m + extent + margin]
+        let margin = Vector3::repeat(self.cell_m + margin_m);
+        let [lo, hi] = self.bounds();
+        [lo - margin, hi + margin]
+    }
+
+    /// The box of the grid's cells: its lowest corner (the origin) and its
+    /// highest, m. A grid built over points ([`Self::covering`] from their
+    /// lowest corner and extent) holds every one of them.
+    pub fn bounds(&self) -> [Vector3<T>; 2] {
+        let extent = Vector3::from(self.dims.map(|d| self.cell_m * T::of_f64(f64::from(d))));
+        [self.origin_m, self.origin_m + extent]
     }
 }
 
