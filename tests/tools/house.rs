@@ -1,4 +1,6 @@
-//! The house's structure, read from the sources: no file circle in any crate of the workspace
+//! The house's structure, read from the sources: files and functions that fit in a head in
+//! `kernel/` and `host-harness/` ([`MAX_FILE_LINES`], [`MAX_FUNCTION_LINES`]), and no file circle
+//! in any crate of the workspace
 //! (two files that import each other, directly or through a cycle of files), so that every
 //! folder reads from its leaves up.
 //!
@@ -434,5 +436,97 @@ fn the_scanner_follows_re_exports_and_finds_circles() {
     assert_eq!(
         circles(&arrows),
         [vec![module(&["a", "x"]), module(&["a", "y"])]]
+    );
+}
+
+/// The largest source file in `kernel/` and `host-harness/`, lines: a file longer than this holds
+/// more than one responsibility (split it by responsibility, not by line count).
+const MAX_FILE_LINES: usize = 800;
+/// The longest function there, lines from its `fn` to its closing brace: longer, its stages
+/// become named functions.
+const MAX_FUNCTION_LINES: usize = 120;
+
+/// Each function's name and length in lines (from the line of `fn` to its closing brace) in code
+/// with comments and literals blanked: a `fn` followed by a body (a declaration ending in `;`, as
+/// in a trait, has none).
+fn function_lengths(code: &str) -> Vec<(String, usize, usize)> {
+    let mut found = Vec::new();
+    for k in path_starts(code, "fn ") {
+        let name = ident_at(&code[k + 3..]);
+        if name.is_empty() {
+            continue; // `fn(` types
+        }
+        let rest = &code[k..];
+        let Some(open) = rest.find(['{', ';']) else {
+            continue;
+        };
+        if rest.as_bytes()[open] == b';' {
+            continue;
+        }
+        let mut depth = 0usize;
+        let mut end = open;
+        for (i, c) in rest[open..].char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        end = open + i;
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        let first_line = code[..k].matches('\n').count() + 1;
+        let lines = rest[..end].matches('\n').count() + 1;
+        found.push((name.to_owned(), first_line, lines));
+    }
+    found
+}
+
+#[test]
+fn files_and_functions_fit_in_a_head() {
+    let root = repository_root();
+    let mut too_long = Vec::new();
+    let mut functions = 0;
+    for src in ["kernel/src", "host-harness/src"] {
+        let mut files = Vec::new();
+        rust_files(&root.join(src), &mut files);
+        for file in files {
+            let source = std::fs::read_to_string(&file).expect("read source");
+            let shown = file
+                .strip_prefix(&root)
+                .unwrap_or(&file)
+                .display()
+                .to_string();
+            let lines = source.lines().count();
+            if lines > MAX_FILE_LINES {
+                too_long.push(format!("{shown}: {lines} lines (at most {MAX_FILE_LINES})"));
+            }
+            for (name, line, length) in function_lengths(&code_only(&source)) {
+                functions += 1;
+                if length > MAX_FUNCTION_LINES {
+                    too_long.push(format!(
+                        "{shown}:{line}: fn {name}: {length} lines (at most {MAX_FUNCTION_LINES})"
+                    ));
+                }
+            }
+        }
+    }
+    // The kernel and the harness hold thousands of functions: a handful means a broken scan.
+    assert!(functions > 1000, "only {functions} functions found");
+    assert!(too_long.is_empty(), "{}", too_long.join("\n"));
+}
+
+/// The length scan on known code: a body's lines counted, a declaration and a `fn` type skipped.
+#[test]
+fn function_lengths_count_bodies_only() {
+    let code = code_only(
+        "trait T { fn declared(&self); }\nfn short() {}\nfn long(f: fn(u8)) {\n    let _ = \"}\";\n    {\n    }\n}\n",
+    );
+    assert_eq!(
+        function_lengths(&code),
+        [("short".to_owned(), 2, 1), ("long".to_owned(), 3, 5)]
     );
 }
