@@ -14,7 +14,7 @@ use crate::fix::FixPredicate;
 use crate::tensor_mass::run::diagonal;
 
 /// The refinements of the full run, (radial, height) cells of
-/// [`cylinder_mesh`]; the last is the reference's.
+/// `cylinder_mesh`; the last is the reference's.
 pub const FULL_MESHES: [(usize, usize); 3] = [(1, 5), (2, 10), (3, 15)];
 /// The refinements of `--quick` (the reference on the last).
 pub const QUICK_MESHES: [(usize, usize); 2] = [(1, 5), (2, 10)];
@@ -48,7 +48,7 @@ pub struct Matrix {
     /// The trajectories' extent.
     pub trajectory: trajectory::TrajectoryExtent,
     /// Whether to count the haptic tick's instructions under callgrind
-    /// ([`ticks`]).
+    /// (`ticks`).
     pub tick_counts: bool,
 }
 

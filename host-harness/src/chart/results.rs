@@ -27,7 +27,7 @@ pub struct Run {
     pub model: Model,
     /// `null`, or why the run has no equilibrium (divergence, refusal).
     pub fault: Option<String>,
-    /// Top-face displacement [`tip_m`], m.
+    /// Top-face displacement `tip_m`, m.
     pub tip_m: f64,
     /// `|tip − tip_ref| / |tip_ref|` against the reference (`null` without one).
     pub tip_error: Option<f64>,

@@ -115,7 +115,7 @@ pub const ENERGY_ROUNDING: f64 = 1e-12;
 const STAGNATION: f64 = 1e-6;
 
 /// Solves `problem` (module documentation): the load in
-/// [`NewtonOptions::load_steps`] increments ([`Discrete::increment`]), the
+/// [`NewtonOptions::load_steps`] increments (`Discrete::increment`), the
 /// stability of the end state in descent, and the reactions of the
 /// prescribed vertices.
 pub fn solve_stvk(

@@ -1,5 +1,5 @@
 //! Standard error: every progress line, warning, summary and the final
-//! `error: …` line goes through [`line`] (or, for a progress bar,
+//! `error: …` line goes through `line` (or, for a progress bar,
 //! [`progress_bar`]), never `eprintln!`, which panics (an abort in the
 //! release build) when standard error is closed or full (`2>/dev/full`,
 //! `2>&-`).
@@ -10,7 +10,7 @@
 //! indicatif's bars draw to standard error too and discard their own write
 //! errors (indicatif 0.18: `BarState` ignores each draw's result); without
 //! a terminal they are hidden and [`progress_bar`]'s callers print lines
-//! through [`line`] instead.
+//! through `line` instead.
 
 use std::io::{self, Write};
 

@@ -1,7 +1,7 @@
 //! Why a scene could not be read: [`SceneError`], whose every message names the file.
 
 /// Why a scene could not be read. Every message starts with the file (or the source name given
-/// to [`Scene::from_toml_str_named`]).
+/// to `Scene::from_toml_str_named`).
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read from disk.

@@ -1,7 +1,7 @@
 //! The input of haptic sessions: what is simulated (a scene file, [`Scene`]), where the tool
 //! goes ([`trajectory`]), and generated tool paths ([`generate`]).
 //!
-//! Data flow: a scene file (TOML, [`file`]) → [`Scene`] ([`spec`]: mesh source, fixed
+//! Data flow: a scene file (TOML, `file`) → [`Scene`] ([`spec`]: mesh source, fixed
 //! vertices, material and [`materials`] per region, model, [`tool`], rates, safety limits,
 //! [`zones`]), checked by [`validate`] → the partition ([`crate::partition`]), the table build
 //! and the session ([`crate::session`]); a trajectory file (CSV) or a [`generate::Generator`] →

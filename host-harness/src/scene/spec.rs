@@ -81,7 +81,7 @@ pub struct TearingSpec {
 /// Loop rates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rates {
-    /// Haptic (tick) rate, Hz, finite, > 0 and at most [`MAX_HAPTIC_HZ`].
+    /// Haptic (tick) rate, Hz, finite, > 0 and at most `MAX_HAPTIC_HZ`.
     pub haptic_hz: f64,
     /// A physics update every this many ticks, ≥ 1 (force extrapolated in between).
     pub physics_every: u32,
@@ -107,7 +107,7 @@ pub const DEFAULT_MAX_SLEW_N_PER_S: f64 = 2000.0;
 /// on each field's type; a pre-computed scene has at least one `fix` predicate (a free body has
 /// no compliance) and no tearing; a dynamic scene's physics period is a whole number
 /// (1..=[`MAX_SUBSTEPS`]) of `dt_s`; the tool has one kind per trajectory tool point and needs
-/// at most [`MAX_TOOL_POINTS`] kernel tool points. Fields are public for reading and for tests; after changing one, call
+/// at most `MAX_TOOL_POINTS` kernel tool points. Fields are public for reading and for tests; after changing one, call
 /// [`Scene::validate`] again.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {

@@ -1,6 +1,6 @@
 //! The scene's tool (`[tool]`): a few trajectory tool points, each a probe, a grasper or a
 //! cutter ([`ToolKind`]), their radius and the grasper's and cutter's settings ([`ToolSpec`]),
-//! with the ranges [`crate::scene::Scene::validate`] checks ([`check_tool`]).
+//! with the ranges [`crate::scene::Scene::validate`] checks (`check_tool`).
 
 use palpate_kernel::MAX_CONTACTS;
 
@@ -21,7 +21,7 @@ pub const DEFAULT_GRIP_OPENING_RADII: f64 = 2.5;
 /// Largest tool radius, as a fraction of the mesh's largest bounding-box extent: 0.5, a tool
 /// sphere as wide as the body. A larger one (`radius_m = 1.0` on a 12 cm block) covers the
 /// whole body from any side: the contact search faulted every tick. Checked once the mesh is
-/// loaded ([`Scene::check_on_mesh`]).
+/// loaded (`Scene::check_on_mesh`).
 pub const MAX_TOOL_RADIUS_FRACTION: f64 = 0.5;
 
 /// Default cutter blade, m: 1 cm straight down from the tool point.

@@ -411,7 +411,7 @@ pub const COLLINEAR_TOLERANCE: f64 = 1e-12;
 const MAX_MERGED_RUN: usize = 1024;
 
 /// `line` with every sample within `tolerance_m` of the segment from the last kept sample to a
-/// later one dropped (greedily, at most [`MAX_MERGED_RUN`] samples a segment): the union of
+/// later one dropped (greedily, at most `MAX_MERGED_RUN` samples a segment): the union of
 /// capsules around it differs from the original's by at most `tolerance_m`.
 pub fn merge_collinear(line: &[[f64; 3]], tolerance_m: f64) -> Vec<[f64; 3]> {
     let Some(&first) = line.first() else {

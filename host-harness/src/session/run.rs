@@ -20,7 +20,7 @@
 //! is computed every tick (see the loop's docs); every `physics_every`
 //! ticks comes the physics update: for the pre-computed model the
 //! deformation field from the last contact solution, for the dynamic model
-//! a [`DynamicLoop::physics_update`] (cuts, steps, tearing, held forces,
+//! a `DynamicLoop::physics_update` (cuts, steps, tearing, held forces,
 //! re-binning). With `--vtk` each update's field is written as a VTK frame
 //! of the live tets (a cut shows as the tets gone, its faces as surface).
 

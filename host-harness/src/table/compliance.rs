@@ -68,9 +68,9 @@ const CG_REL_TOL: f64 = 1e-10;
 /// references a missing vertex, `A` is not positive definite (nothing
 /// fixed), or CG does not converge.
 ///
-/// Stages: the inputs checked ([`check_inputs`]), `A` assembled, the
-/// columns solved by [`solve_cholesky`] or [`solve_cg`] and scattered into
-/// the blocks ([`Compliance::store`]).
+/// Stages: the inputs checked (`check_inputs`), `A` assembled, the
+/// columns solved by `solve_cholesky` or `solve_cg` and scattered into
+/// the blocks (`Compliance::store`).
 pub fn compute_compliance(
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],

@@ -15,8 +15,8 @@
 //! the surface and a depth below it, and the approach and withdraw speeds. Defaults are on the
 //! built-in scene's block (top face `z = 0.06` m, centre `(0.06, 0.06)`), at 1 kHz.
 //!
-//! One file per family: [`press`] (the probes' presses: poke, press-and-hold, slide, pinch,
-//! strike), [`tools`] (a grasper's grasp-and-pull, a cutter's cut line), [`built_in`] (the
+//! One file per family: `press` (the probes' presses: poke, press-and-hold, slide, pinch,
+//! strike), `tools` (a grasper's grasp-and-pull, a cutter's cut line), `built_in` (the
 //! built-in scenes' tools at work).
 
 mod built_in;
