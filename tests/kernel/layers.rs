@@ -14,7 +14,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use palpate_tests::source::{code_only, is_ident};
+use palpate_tests::source::{code_only, is_ident, rust_files};
 
 /// The folders, lowest first, with their rank; equal ranks are peers.
 const LAYERS: [(&str, u32); 7] = [
@@ -139,21 +139,6 @@ fn module_path(src: &Path, file: &Path) -> Vec<String> {
         parts.pop();
     }
     parts
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = std::fs::read_dir(dir)
-        .expect("read kernel source folder")
-        .map(|e| e.expect("entry").path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
 }
 
 /// What each root-level name of `lib.rs` is: a folder's item re-exported

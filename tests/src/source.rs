@@ -1,5 +1,24 @@
 //! Reading Rust sources as text, for the tests that check the house's structure
-//! (`kernel::layers`, `tools::house`): comments and literals blanked out.
+//! (`kernel::layers`, `tools::house`): the `.rs` files of a folder, and their code with comments
+//! and literals blanked out.
+
+use std::path::{Path, PathBuf};
+
+/// Every `.rs` file under `dir`, recursively, in sorted order (folders walked in place).
+pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("folder entry").path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
 
 /// The source with comments (line, doc and nested block comments) and the
 /// contents of string and character literals blanked out, so only code is

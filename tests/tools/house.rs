@@ -14,7 +14,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use palpate_tests::source::{code_only, is_ident};
+use palpate_tests::source::{code_only, is_ident, rust_files};
 
 /// Every crate root of the workspace whose files are checked: the folders holding a `lib.rs`
 /// or `main.rs`, relative to the repository root.
@@ -42,21 +42,6 @@ struct Crate {
 
 fn repository_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("folder entry").path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
 }
 
 /// The module path of `file` under `src` (`mod.rs`, `lib.rs` and `main.rs` name their folder).
