@@ -190,19 +190,8 @@ impl Surgery<'_> {
     /// Writes frame `n`: displacement `u` (m, per mesh vertex; zero where
     /// missing) on the tets `alive` keeps.
     fn frame(&self, n: usize, u: &[[f32; 3]], alive: &[bool]) -> anyhow::Result<PathBuf> {
-        let u: Vec<[f64; 3]> = (0..self.mesh.positions.len())
-            .map(|v| u.get(v).map_or([0.0; 3], |d| d.map(f64::from)))
-            .collect();
-        let live: Vec<[u32; 4]> = self
-            .mesh
-            .tets
-            .iter()
-            .zip(alive)
-            .filter(|(_, a)| **a)
-            .map(|(t, _)| *t)
-            .collect();
         let path = self.dir.join(format!("organ_{n:04}.vtk"));
-        vtk::write_frame(&path, &self.mesh.positions, &live, &u)
+        vtk::write_state_frame(&path, &self.mesh.positions, &self.mesh.tets, u, Some(alive))
             .with_context(|| format!("organ frame {n}"))?;
         Ok(path)
     }

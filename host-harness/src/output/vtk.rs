@@ -12,6 +12,35 @@ use anyhow::Context;
 
 use super::atomic::AtomicFile;
 
+/// Writes one frame of a run's state ([`write_frame`]): the f32 displacement
+/// field `u` (m, per vertex of `rest`; zero where missing) on the tets
+/// `alive` keeps (all of `tets` without it, or when none is removed).
+pub fn write_state_frame(
+    path: &Path,
+    rest: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    u: &[[f32; 3]],
+    alive: Option<&[bool]>,
+) -> anyhow::Result<()> {
+    let u: Vec<[f64; 3]> = (0..rest.len())
+        .map(|v| u.get(v).map_or([0.0; 3], |d| d.map(f64::from)))
+        .collect();
+    let live: Vec<[u32; 4]>;
+    let tets = match alive {
+        Some(alive) if alive.contains(&false) => {
+            live = tets
+                .iter()
+                .zip(alive)
+                .filter(|(_, a)| **a)
+                .map(|(t, _)| *t)
+                .collect();
+            &live
+        }
+        _ => tets,
+    };
+    write_frame(path, rest, tets, &u)
+}
+
 /// Writes one frame: the deformed mesh (`rest + displacement`, m) with the
 /// displacement as point data.
 pub fn write_frame(

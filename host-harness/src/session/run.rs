@@ -530,25 +530,8 @@ impl Session<'_, '_> {
     /// of the tets `alive` keeps (all without it).
     fn frame(&mut self, t: f64, u: &[[f32; 3]], alive: Option<&[bool]>) -> anyhow::Result<()> {
         let Some(dir) = self.dir else { return Ok(()) };
-        let u: Vec<[f64; 3]> = (0..self.rest.len())
-            .map(|v| u.get(v).map_or([0.0; 3], |d| d.map(f64::from)))
-            .collect();
-        let live: Vec<[u32; 4]>;
-        let tets = match alive {
-            Some(alive) if alive.contains(&false) => {
-                live = self
-                    .tets
-                    .iter()
-                    .zip(alive)
-                    .filter(|(_, a)| **a)
-                    .map(|(t, _)| *t)
-                    .collect();
-                &live
-            }
-            _ => self.tets,
-        };
         let path = dir.join(format!("frame_{:06}.vtk", self.frames.len()));
-        vtk::write_frame(&path, self.rest, tets, &u)?;
+        vtk::write_state_frame(&path, self.rest, self.tets, u, alive)?;
         self.frames.push((t, path));
         Ok(())
     }
