@@ -116,15 +116,18 @@ impl<T: Real, const P: usize, D: Dispatch> DynamicTissue<'_, '_, T, P, D> {
             T::zero()
         };
         let mut moves = [[(None, Vector3::zeros(), Vector3::zeros()); 3]; M];
+        if set_now.is_empty() {
+            return Ok(moves); // no contact: the field is not read (nor its fault)
+        }
+        let u = self
+            .model
+            .displacements_m()
+            .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
+        let at = |v: VertexIndex| {
+            u.get(v.get())
+                .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]))
+        };
         for ((t, s), slots) in set_now.iter().zip(shares).zip(moves.iter_mut()) {
-            let u = self
-                .model
-                .displacements_m()
-                .map_err(|f| PhysicsError::Step(StepError::Faulted(f)))?;
-            let at = |v: VertexIndex| {
-                u.get(v.get())
-                    .map_or(Vector3::zeros(), |u| Vector3::new(u[0], u[1], u[2]))
-            };
             let d = t.displacement_m() * measured;
             // A probe's target: its vertices at their shares of the tool's
             // displacement along the rest normal from the contact point at
