@@ -115,14 +115,14 @@
 /*
  Words of a `palpate_table` on 64-bit targets (the host).
  */
-#define PALPATE_TABLE_WORDS 77
+#define PALPATE_TABLE_WORDS 81
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_table` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_TABLE_WORDS 55
+#define PALPATE_TABLE_WORDS 57
 #endif
 
 /*
@@ -134,7 +134,7 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 390
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 394
 #endif
 
 #if !defined(PALPATE_POINTER_64)
@@ -162,7 +162,7 @@
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 625
+#define PALPATE_HYBRID_LOOP_WORDS 629
 #endif
 
 #if !defined(PALPATE_POINTER_64)
@@ -372,6 +372,11 @@ enum palpate_status
    files there (`LoadError::BadCellTriangles`).
    */
   PALPATE_STATUS_TABLE_BAD_CELL_TRIANGLES = 137,
+  /*
+   Hierarchical table: a hierarchy section is inconsistent
+   (`LoadError::BadHierarchy`).
+   */
+  PALPATE_STATUS_TABLE_BAD_HIERARCHY = 138,
   /*
    More contacts than `PALPATE_MAX_CONTACTS`.
    */

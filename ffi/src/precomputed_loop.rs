@@ -16,7 +16,7 @@ use crate::table::{self, Table};
 
 /// Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
 #[cfg(target_pointer_width = "64")]
-pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 390;
+pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 394;
 /// Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
 pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 350;

@@ -126,6 +126,9 @@ pub enum Status {
     /// A grid cell's candidate triangle list is not the triangles the grid
     /// files there (`LoadError::BadCellTriangles`).
     TableBadCellTriangles = 137,
+    /// Hierarchical table: a hierarchy section is inconsistent
+    /// (`LoadError::BadHierarchy`).
+    TableBadHierarchy = 138,
 
     // Contacts (`palpate_precomputed_solve`, `..._displacements`): the
     // kernel's `ContactError` and `DisplacementError`.
@@ -248,6 +251,7 @@ impl Status {
             Self::TableBadScale => c"compressed table: a column scale is not finite and > 0, or too large for the codes",
             Self::TableBadCode => c"compressed table: a fixed-point code is -32768",
             Self::TableBadKeptBlocks => c"compressed table: kept-block bitmap inconsistent",
+            Self::TableBadHierarchy => c"hierarchical table: a hierarchy section is inconsistent",
             Self::TableDroppedDiagonal => {
                 c"compressed table: a diagonal compliance block was dropped"
             }
@@ -328,6 +332,7 @@ impl From<LoadError> for Status {
             LoadError::BadScale { .. } => Self::TableBadScale,
             LoadError::BadCode { .. } => Self::TableBadCode,
             LoadError::BadKeptBlocks { .. } => Self::TableBadKeptBlocks,
+            LoadError::BadHierarchy { .. } => Self::TableBadHierarchy,
             LoadError::DroppedDiagonal { .. } => Self::TableDroppedDiagonal,
             LoadError::BadTetLanes { .. } => Self::TableBadTetLanes,
             LoadError::BadCellTriangles { .. } => Self::TableBadCellTriangles,
@@ -456,7 +461,7 @@ impl From<FieldError> for Status {
 /// raw number, and the tests).
 ///
 /// cbindgen:ignore
-pub const ALL: [Status; 74] = [
+pub const ALL: [Status; 75] = [
     Status::Ok,
     Status::NullPointer,
     Status::Misaligned,
@@ -502,6 +507,7 @@ pub const ALL: [Status; 74] = [
     Status::TableDroppedDiagonal,
     Status::TableBadTetLanes,
     Status::TableBadCellTriangles,
+    Status::TableBadHierarchy,
     Status::ContactTooMany,
     Status::ContactVertexOutOfRange,
     Status::ContactFixedVertex,

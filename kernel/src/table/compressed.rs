@@ -13,6 +13,7 @@ use super::format::{
     self, BlockEncoding, CompressionRecord, KEPT_BITS, SectionKind, is_kept, kept_position,
     kept_rank, surface_block_index,
 };
+use super::hierarchical::HierarchicalBlocks;
 use crate::Real;
 use crate::math::block;
 
@@ -54,6 +55,11 @@ pub enum ComplianceBlocks<'a, T: Real> {
     Dense(&'a [[T; 9]]),
     /// 16-bit codes times a per-column scale; a dropped block is zero.
     Coded(CodedBlocks<'a, T>),
+    /// The surface part as a hierarchical matrix
+    /// ([`BlockEncoding::Hierarchical`]): block `j` of column `k` of the
+    /// packed layout is `C_nk` with `n = j − k(k+1)/2`, or its mirror
+    /// `C_knᵀ` read from column `n` (the same numbers by symmetry).
+    Hierarchical(HierarchicalBlocks<'a, T>),
 }
 
 /// A coded compliance part: codes, per-column scales, and which blocks are
@@ -77,6 +83,10 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
         match self {
             ComplianceBlocks::Dense(blocks) => blocks.len(),
             ComplianceBlocks::Coded(coded) => coded.blocks,
+            ComplianceBlocks::Hierarchical(h) => {
+                let s = h.touchable_count();
+                s * (s + 1) / 2
+            }
         }
     }
 
@@ -86,11 +96,14 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
         self.len() == 0
     }
 
-    /// Blocks stored: [`Self::len`] less the dropped ones.
+    /// Blocks stored: [`Self::len`] less the dropped ones; for a
+    /// hierarchical part, its stored scalars over 9 (near entries and far
+    /// factors, in 3×3-block equivalents).
     pub fn stored_len(&self) -> usize {
         match self {
             ComplianceBlocks::Dense(blocks) => blocks.len(),
             ComplianceBlocks::Coded(coded) => coded.codes.len(),
+            ComplianceBlocks::Hierarchical(h) => h.data_len().div_ceil(9),
         }
     }
 
@@ -104,6 +117,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
             ComplianceBlocks::Coded(CodedBlocks {
                 code: Code::Q16, ..
             }) => BlockEncoding::Q16,
+            ComplianceBlocks::Hierarchical(_) => BlockEncoding::Hierarchical,
         }
     }
 
@@ -111,7 +125,15 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
     pub fn as_dense(&self) -> Option<&'a [[T; 9]]> {
         match self {
             ComplianceBlocks::Dense(blocks) => Some(blocks),
-            ComplianceBlocks::Coded(_) => None,
+            ComplianceBlocks::Coded(_) | ComplianceBlocks::Hierarchical(_) => None,
+        }
+    }
+
+    /// The hierarchical part, `None` for a dense or coded one.
+    pub fn as_hierarchical(&self) -> Option<&HierarchicalBlocks<'a, T>> {
+        match self {
+            ComplianceBlocks::Hierarchical(h) => Some(h),
+            _ => None,
         }
     }
 
@@ -125,6 +147,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
                 None => j < coded.codes.len(),
                 Some(kept) => j < coded.blocks && is_kept(kept, j),
             },
+            ComplianceBlocks::Hierarchical(_) => j < self.len(),
         }
     }
 
@@ -136,6 +159,9 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
         match self {
             ComplianceBlocks::Dense(blocks) => blocks.get(j).copied(),
             ComplianceBlocks::Coded(coded) => coded.block(j, column),
+            ComplianceBlocks::Hierarchical(h) => {
+                h.block(j.checked_sub(surface_block_index(0, column))?, column)
+            }
         }
     }
 
@@ -154,6 +180,11 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
                 }
             }
             ComplianceBlocks::Coded(coded) => coded.add_products(first, column, w, out),
+            ComplianceBlocks::Hierarchical(h) => {
+                if let Some(n) = first.checked_sub(surface_block_index(0, column)) {
+                    h.add_column(column, w, n, out);
+                }
+            }
         }
     }
 
@@ -186,6 +217,8 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
                     }
                 }
             }
+            // `C_knᵀ = C_nk`: column `k`'s rows `first..`.
+            ComplianceBlocks::Hierarchical(h) => h.add_column(k, w, first, out),
         }
     }
 }
@@ -315,6 +348,15 @@ const INTERIOR: Part = Part {
     kept: SectionKind::InteriorKept,
 };
 
+/// The sections of a hierarchical surface part.
+const HIERARCHY: [SectionKind; 5] = [
+    SectionKind::HierarchyRecord,
+    SectionKind::HierarchyLeaves,
+    SectionKind::HierarchyBlocks,
+    SectionKind::HierarchyColumnBlocks,
+    SectionKind::HierarchyData,
+];
+
 /// The compliance of a pre-computed table as loaded: the encoding record
 /// (absent: both parts dense) and the two parts.
 pub(crate) struct Parts<'a, T: Real> {
@@ -337,6 +379,11 @@ pub(crate) fn load_parts<'a, T: Real>(c: &Container<'a>) -> Result<Parts<'a, T>,
             encoding(INTERIOR.dense, r.interior_encoding)?,
         ),
     };
+    if surface != BlockEncoding::Hierarchical
+        && let Some(&kind) = HIERARCHY.iter().find(|&&kind| c.has(kind))
+    {
+        return Err(LoadError::UnexpectedSection { kind });
+    }
     Ok(Parts {
         record,
         surface: load_part(c, &SURFACE, surface)?,
@@ -388,6 +435,25 @@ fn load_part<'a, T: Real>(
         }
         BlockEncoding::F16 => Code::F16,
         BlockEncoding::Q16 => Code::Q16,
+        BlockEncoding::Hierarchical => {
+            // Only the surface part; its dense and coded sections absent.
+            if part.dense != SURFACE.dense {
+                return Err(LoadError::UnknownEncoding {
+                    part: part.dense,
+                    found: encoding as u32,
+                });
+            }
+            if let Some(&kind) = [part.dense, part.scale, part.codes, part.kept]
+                .iter()
+                .find(|&&kind| c.has(kind))
+            {
+                return Err(LoadError::UnexpectedSection { kind });
+            }
+            let s = c.header.touchable_count as usize;
+            return Ok(ComplianceBlocks::Hierarchical(HierarchicalBlocks::load(
+                c, s,
+            )?));
+        }
     };
     if c.has(part.dense) {
         return Err(LoadError::UnexpectedSection { kind: part.dense });

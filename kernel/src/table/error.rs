@@ -226,6 +226,17 @@ pub enum LoadError {
         /// Stored block index within it.
         index: u64,
     },
+    /// A hierarchical compliance section is inconsistent
+    /// ([`crate::table::format::hierarchy`]): which section, which element
+    /// (record 0, leaf, block or leaf column), what is wrong.
+    BadHierarchy {
+        /// The section.
+        kind: SectionKind,
+        /// The element.
+        index: u64,
+        /// What is wrong.
+        what: &'static str,
+    },
     /// A kept-block bitmap is inconsistent: a word's rank is not the number
     /// of bits set before it, or a bit is set past the block count.
     BadKeptBlocks {
@@ -286,6 +297,7 @@ impl fmt::Display for LoadError {
             | LoadError::BadScale { .. }
             | LoadError::BadCode { .. }
             | LoadError::BadKeptBlocks { .. }
+            | LoadError::BadHierarchy { .. }
             | LoadError::DroppedDiagonal { .. } => self.fmt_compliance(f),
         }
     }
@@ -440,6 +452,9 @@ impl LoadError {
                 "section {} block {index}: q16 code -32768 outside -32767..=32767",
                 kind.name()
             ),
+            LoadError::BadHierarchy { kind, index, what } => {
+                write!(f, "section {} element {index}: {what}", kind.name())
+            }
             LoadError::BadKeptBlocks { kind, word } => write!(
                 f,
                 "section {} word {word}: rank not the bits set before it, or a bit past the block count",

@@ -26,14 +26,19 @@ pub enum BlockEncoding {
     /// 16-bit fixed point (`i16` in `−32767..=32767`) times a per-column
     /// scale (the quantum); blocks may be dropped.
     Q16 = 2,
+    /// The surface part as a hierarchical matrix: near blocks entry by
+    /// entry, far blocks as low-rank factors ([`super::hierarchy`]). Not an
+    /// encoding of the interior part.
+    Hierarchical = 3,
 }
 
 impl BlockEncoding {
     /// Every encoding, in value order.
-    pub const ALL: [BlockEncoding; 3] = [
+    pub const ALL: [BlockEncoding; 4] = [
         BlockEncoding::Scalar,
         BlockEncoding::F16,
         BlockEncoding::Q16,
+        BlockEncoding::Hierarchical,
     ];
 
     /// The encoding of a record's value, `None` if unknown.
@@ -48,6 +53,7 @@ impl BlockEncoding {
             BlockEncoding::Scalar => "uncompressed",
             BlockEncoding::F16 => "f16",
             BlockEncoding::Q16 => "q16",
+            BlockEncoding::Hierarchical => "hmatrix",
         }
     }
 }

@@ -87,9 +87,20 @@
 //!   constant time: [`kept_position`]). A dropped block is zero. Bits past
 //!   the block count are zero, the ranks are exact, the bits set are the
 //!   `X-codes` count, and every diagonal block `C_kk` is kept.
+//!
+//! ## Hierarchical compliance (additive)
+//!
+//! The surface part may instead be a hierarchical matrix
+//! ([`BlockEncoding::Hierarchical`], sections
+//! [`SectionKind::HierarchyRecord`] to [`SectionKind::HierarchyData`]): dense
+//! near-field blocks and low-rank far-field blocks over a cluster tree of
+//! the touchable vertices, whose free indices then follow the tree's
+//! leaves. Layout and invariants in [`hierarchy`]. A kernel that predates it
+//! refuses such a table (`unknown block encoding 3`), never misreads it.
 
 mod encoding;
 mod header;
+pub mod hierarchy;
 mod section;
 mod tet;
 
@@ -101,6 +112,10 @@ pub use encoding::{
 pub use header::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
     SectionEntry,
+};
+pub use hierarchy::{
+    HIERARCHY_BLOCK_LEN, HIERARCHY_MAX_RANK, HIERARCHY_MIRRORED, HIERARCHY_RECORD_LEN,
+    HierarchyBlock, HierarchyRecord,
 };
 pub use section::{
     EDGE_TERMS_LEN, FIXED_SLOT, GRID_LEN, MAX_LIST_SUBDIVISION, MAX_LISTS_PER_TRIANGLE,

@@ -5,6 +5,7 @@
 
 use super::encoding::{COMPRESSION_RECORD_LEN, kept_words};
 use super::header::RawHeader;
+use super::hierarchy::{HIERARCHY_BLOCK_LEN, HIERARCHY_MAX_RANK, HIERARCHY_RECORD_LEN};
 
 /// The most list cells per grid cell and axis: the candidate lists' grid
 /// ([`SectionKind::GridDims`]) is the grid in cells 1 to this many times
@@ -277,6 +278,20 @@ pub enum SectionKind {
     /// `[u32; 2]` × ⌈(F−S)·S / 32⌉: the kept-block bitmap of a coded
     /// interior part that dropped blocks.
     InteriorKept = 56,
+    // ---- Hierarchical compliance ([`super::hierarchy`]): 57..=62. ----
+    /// [`super::HierarchyRecord`] × 1: the hierarchy's counts and bounds.
+    HierarchyRecord = 57,
+    /// `[u32; 2]` × (leaves + 1): each leaf cluster's first touchable index
+    /// and the first entry of its column list in
+    /// [`Self::HierarchyColumnBlocks`]; then `S` and the entry count.
+    HierarchyLeaves = 58,
+    /// [`super::HierarchyBlock`] × blocks: the partition of `S × S`.
+    HierarchyBlocks = 59,
+    /// `u32` × entries: the blocks over each leaf column, by row.
+    HierarchyColumnBlocks = 61,
+    /// `scalar` × entries: near blocks' entries and far blocks' factors, m/N
+    /// (a factor's scale is the writer's: only `L Rᵀ` is in m/N).
+    HierarchyData = 62,
 }
 
 /// Marks a boundary face in [`SectionKind::TetNeighbour`].
@@ -317,7 +332,7 @@ pub mod tet_lane_row {
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 46] = [
+    pub const ALL: [SectionKind; 51] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -364,6 +379,11 @@ impl SectionKind {
         SectionKind::InteriorScale,
         SectionKind::InteriorCodes,
         SectionKind::InteriorKept,
+        SectionKind::HierarchyRecord,
+        SectionKind::HierarchyLeaves,
+        SectionKind::HierarchyBlocks,
+        SectionKind::HierarchyColumnBlocks,
+        SectionKind::HierarchyData,
     ];
 
     /// `true` for the sections whose element count the directory declares
@@ -377,6 +397,10 @@ impl SectionKind {
                 | SectionKind::InteriorCodes
                 | SectionKind::CellTriangleStart
                 | SectionKind::CellTriangle
+                | SectionKind::HierarchyLeaves
+                | SectionKind::HierarchyBlocks
+                | SectionKind::HierarchyColumnBlocks
+                | SectionKind::HierarchyData
         )
     }
 
@@ -432,6 +456,11 @@ impl SectionKind {
             SectionKind::SurfaceScale | SectionKind::InteriorScale => scalar_bytes,
             SectionKind::SurfaceCodes | SectionKind::InteriorCodes => 18,
             SectionKind::SurfaceKept | SectionKind::InteriorKept => 8,
+            SectionKind::HierarchyRecord => HIERARCHY_RECORD_LEN as u32,
+            SectionKind::HierarchyBlocks => HIERARCHY_BLOCK_LEN as u32,
+            SectionKind::HierarchyLeaves => 8,
+            SectionKind::HierarchyColumnBlocks => 4,
+            SectionKind::HierarchyData => scalar_bytes,
         }
     }
 
@@ -499,6 +528,16 @@ impl SectionKind {
             SectionKind::InteriorKept => {
                 kept_words(SectionKind::ComplianceInterior.expected_count(h)?)
             }
+            // Declared counts: the most a partition of `S × S` may hold
+            // (every block one vertex pair; its data no more than the
+            // entries of the full matrix and the factors of every block at
+            // the largest rank). The view checks the exact structure.
+            SectionKind::HierarchyRecord => Some(1),
+            SectionKind::HierarchyLeaves => s.checked_add(1),
+            SectionKind::HierarchyBlocks | SectionKind::HierarchyColumnBlocks => s.checked_mul(s),
+            SectionKind::HierarchyData => s
+                .checked_mul(s)?
+                .checked_mul(6 * HIERARCHY_MAX_RANK as u64 + 9),
         }
     }
 
@@ -551,6 +590,11 @@ impl SectionKind {
             SectionKind::InteriorScale => "interior-scale",
             SectionKind::InteriorCodes => "interior-codes",
             SectionKind::InteriorKept => "interior-kept",
+            SectionKind::HierarchyRecord => "hierarchy-record",
+            SectionKind::HierarchyLeaves => "hierarchy-leaves",
+            SectionKind::HierarchyBlocks => "hierarchy-blocks",
+            SectionKind::HierarchyColumnBlocks => "hierarchy-column-blocks",
+            SectionKind::HierarchyData => "hierarchy-data",
         }
     }
 }

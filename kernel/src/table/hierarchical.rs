@@ -1,0 +1,386 @@
+//! The hierarchical surface compliance of a pre-computed table as stored
+//! ([`super::format::hierarchy`]): checked once at load
+//! ([`HierarchicalBlocks::load`]), then read by the step path in bounded
+//! time: a contact block `C_nk` by two binary searches and `9r`
+//! multiply-adds ([`HierarchicalBlocks::block`]), a compliance column by one
+//! pass over the blocks of its leaf column ([`HierarchicalBlocks::add_column`],
+//! a hierarchical matrix–vector product with one non-zero input vertex).
+
+use nalgebra::Vector3;
+
+use super::LoadError;
+use super::container::Container;
+use super::format::{
+    HIERARCHY_MAX_RANK, HIERARCHY_MIRRORED, HierarchyBlock, HierarchyRecord, SectionKind,
+};
+use crate::Real;
+use crate::math::block;
+
+/// A hierarchical surface part, validated at load. Invariants from
+/// [`Self::load`]:
+/// - `leaves` is `0`, strictly ascending, `S` last (`leaf_count + 1`
+///   entries);
+/// - every block spans a non-empty range of rows and of columns within
+///   `0..S`, has a rank `≤ record.max_rank ≤ HIERARCHY_MAX_RANK`, and its
+///   data lie within `data` (every scalar finite);
+/// - each leaf's column list holds at most `record.max_column_blocks`
+///   blocks, each covering the leaf's columns, sorted by row, their rows
+///   tiling `0..S`: every `C_nk` is in exactly one listed block of `k`'s
+///   leaf.
+#[derive(Clone, Copy, Debug)]
+pub struct HierarchicalBlocks<'a, T: Real> {
+    record: &'a HierarchyRecord,
+    /// Per leaf, then one past the last: `[first touchable index, first
+    /// entry of its column list]`.
+    leaves: &'a [[u32; 2]],
+    blocks: &'a [HierarchyBlock],
+    column_blocks: &'a [u32],
+    data: &'a [T],
+}
+
+impl<'a, T: Real> HierarchicalBlocks<'a, T> {
+    /// Reads and checks the hierarchy sections of a table of `s` touchable
+    /// vertices (invariants on the type). Linear in the sections' size.
+    pub(crate) fn load(c: &Container<'a>, s: usize) -> Result<Self, LoadError> {
+        let records: &'a [HierarchyRecord] = c.section(SectionKind::HierarchyRecord)?;
+        let record = records.first().ok_or(LoadError::SectionSize {
+            kind: SectionKind::HierarchyRecord,
+        })?;
+        let h = Self {
+            record,
+            leaves: c.section(SectionKind::HierarchyLeaves)?,
+            blocks: c.section(SectionKind::HierarchyBlocks)?,
+            column_blocks: c.section(SectionKind::HierarchyColumnBlocks)?,
+            data: c.section(SectionKind::HierarchyData)?,
+        };
+        h.check_record(s)?;
+        check_leaves(h.leaves, s)?;
+        for (index, block) in h.blocks.iter().enumerate() {
+            h.check_block(block, s)
+                .map_err(|what| bad(SectionKind::HierarchyBlocks, index, what))?;
+        }
+        for leaf in 0..h.leaf_count() {
+            h.check_column(leaf, s)
+                .map_err(|what| bad(SectionKind::HierarchyColumnBlocks, leaf, what))?;
+        }
+        if let Some(index) = h.data.iter().position(|x| !x.finite()) {
+            return Err(LoadError::NonFinite {
+                kind: SectionKind::HierarchyData,
+                index: index as u64,
+            });
+        }
+        Ok(h)
+    }
+
+    /// The record's counts match the sections, its bounds the kernel's.
+    fn check_record(&self, s: usize) -> Result<(), LoadError> {
+        let r = self.record;
+        let leaves = r.leaf_count as usize;
+        let fail = |what| Err(bad(SectionKind::HierarchyRecord, 0, what));
+        if (s > 0) != (leaves > 0) || leaves > s {
+            return fail("leaf count not in 1..=S");
+        }
+        if self.leaves.len() != leaves + 1 {
+            return fail("leaf count not leaf_count + 1");
+        }
+        if self.blocks.len() != r.block_count as usize {
+            return fail("block count not the blocks section's");
+        }
+        if r.max_rank as usize > HIERARCHY_MAX_RANK {
+            return fail("max rank above the kernel's HIERARCHY_MAX_RANK");
+        }
+        if !(r.tolerance.is_finite() && r.tolerance >= 0.0 && r.eta.is_finite() && r.eta >= 0.0) {
+            return fail("tolerance or eta negative or not finite");
+        }
+        Ok(())
+    }
+
+    /// One block's ranges, rank and data offsets.
+    fn check_block(&self, b: &HierarchyBlock, s: usize) -> Result<(), &'static str> {
+        let range_ok = |start: u32, end: u32| start < end && end as usize <= s;
+        if !range_ok(b.row_start, b.row_end) || !range_ok(b.col_start, b.col_end) {
+            return Err("row or column range empty or beyond S");
+        }
+        if b.rank > self.record.max_rank {
+            return Err("rank above the record's max rank");
+        }
+        let within = |offset: u32, len: u64| {
+            u64::from(offset)
+                .checked_add(len)
+                .is_some_and(|end| end <= self.data.len() as u64)
+        };
+        let (rows, cols, rank) = (b.rows() as u64, b.cols() as u64, u64::from(b.rank));
+        let ok = if b.rank == 0 {
+            b.flags & !HIERARCHY_MIRRORED == 0 && b.right == 0 && within(b.left, 9 * rows * cols)
+        } else {
+            b.flags == 0 && within(b.left, 3 * rows * rank) && within(b.right, 3 * cols * rank)
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err("flags or data offsets invalid")
+        }
+    }
+
+    /// One leaf's column list: bounded, each block covering the leaf's
+    /// columns, rows tiling `0..S` in order.
+    fn check_column(&self, leaf: usize, s: usize) -> Result<(), &'static str> {
+        let (Some(&[lo, first]), Some(&[hi, end])) =
+            (self.leaves.get(leaf), self.leaves.get(leaf + 1))
+        else {
+            return Err("leaf missing");
+        };
+        let list = (first <= end)
+            .then(|| self.column_blocks.get(first as usize..end as usize))
+            .flatten()
+            .ok_or("column starts not ascending or beyond the entries")?;
+        let last = leaf + 1 == self.leaf_count();
+        if (leaf == 0 && first != 0) || (last && end as usize != self.column_blocks.len()) {
+            return Err("column starts do not begin at 0 and end at the entry count");
+        }
+        if list.len() > self.record.max_column_blocks as usize {
+            return Err("column list longer than the record's max_column_blocks");
+        }
+        let mut row = 0u32;
+        for &index in list {
+            let b = self
+                .blocks
+                .get(index as usize)
+                .ok_or("block index beyond the blocks")?;
+            if b.col_start > lo || b.col_end < hi {
+                return Err("a listed block does not cover the leaf's columns");
+            }
+            if b.row_start != row {
+                return Err("the listed blocks' rows do not tile 0..S in order");
+            }
+            row = b.row_end;
+        }
+        if row as usize == s {
+            Ok(())
+        } else {
+            Err("the listed blocks' rows do not reach S")
+        }
+    }
+
+    /// Touchable vertices (`S`): the last leaf's end.
+    pub fn touchable_count(&self) -> usize {
+        self.leaves.last().map_or(0, |&[s, _]| s as usize)
+    }
+
+    /// Leaf clusters.
+    pub fn leaf_count(&self) -> usize {
+        self.record.leaf_count as usize
+    }
+
+    /// The record: counts, bounds, tolerance, admissibility.
+    pub fn record(&self) -> &'a HierarchyRecord {
+        self.record
+    }
+
+    /// Every block of the partition.
+    pub fn blocks(&self) -> &'a [HierarchyBlock] {
+        self.blocks
+    }
+
+    /// Per leaf cluster, then one past the last: its first touchable index
+    /// (`S` last) and the first entry of its column list (their count last).
+    pub fn leaves(&self) -> &'a [[u32; 2]] {
+        self.leaves
+    }
+
+    /// Scalars stored (near entries and far factors).
+    pub fn data_len(&self) -> usize {
+        self.data.len()
+    }
+
+    /// The blocks over touchable column `k`'s leaf, sorted by row: empty
+    /// for `k ≥ S`. Bounded by the record's `max_column_blocks`; the leaf
+    /// found by binary search over the leaves (`log₂` of their count).
+    #[inline]
+    fn column(&self, k: usize) -> &'a [u32] {
+        let leaf = self
+            .leaves
+            .partition_point(|&[start, _]| start as usize <= k)
+            .wrapping_sub(1);
+        match (self.leaves.get(leaf), self.leaves.get(leaf.wrapping_add(1))) {
+            (Some(&[_, a]), Some(&[_, b])) => self
+                .column_blocks
+                .get(a as usize..b as usize)
+                .unwrap_or(&[]),
+            _ => &[],
+        }
+    }
+
+    /// The block `C_nk` (m/N, row-major) of touchable rows `n` and column
+    /// `k`, `None` beyond `0..S`. Two binary searches, then 9 reads (near)
+    /// or `9r` multiply-adds (far).
+    #[inline]
+    pub fn block(&self, n: usize, k: usize) -> Option<[T; 9]> {
+        let list = self.column(k);
+        let at = list.partition_point(|&b| {
+            self.blocks
+                .get(b as usize)
+                .is_some_and(|b| b.row_end as usize <= n)
+        });
+        let b = self.blocks.get(*list.get(at)? as usize)?;
+        if n < b.row_start as usize {
+            return None;
+        }
+        let (i, j) = (
+            n - b.row_start as usize,
+            k.checked_sub(b.col_start as usize)?,
+        );
+        if b.rank == 0 {
+            self.near_entry(b, i, j)
+        } else {
+            let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
+            let left = self.factor_rows(b.left, i, r)?;
+            let right = self.factor_rows(b.right, j, r)?;
+            let mut c = [T::zero(); 9];
+            for (row, l) in c.chunks_exact_mut(3).zip(left.chunks_exact(r)) {
+                for (x, rr) in row.iter_mut().zip(right.chunks_exact(r)) {
+                    *x = dot(l, rr);
+                }
+            }
+            Some(c)
+        }
+    }
+
+    /// Entry `C_ij` of near block `b` (block-relative `i`, `j`), from its
+    /// data or, mirrored, its mirror's transposed.
+    #[inline(always)]
+    fn near_entry(&self, b: &HierarchyBlock, i: usize, j: usize) -> Option<[T; 9]> {
+        let mirrored = b.flags & HIERARCHY_MIRRORED != 0;
+        let at = if mirrored {
+            j * b.rows() + i
+        } else {
+            i * b.cols() + j
+        };
+        let start = b.left as usize + 9 * at;
+        let d: &[T; 9] = self.data.get(start..start + 9)?.try_into().ok()?;
+        Some(if mirrored { transpose(d) } else { *d })
+    }
+
+    /// The three rows (`3r` scalars) of vertex `i` of a factor at `offset`.
+    #[inline(always)]
+    fn factor_rows(&self, offset: u32, i: usize, r: usize) -> Option<&'a [T]> {
+        let start = offset as usize + 3 * i * r;
+        self.data.get(start..start + 3 * r)
+    }
+
+    /// `out[i] += C_{first+i, k} w` (m, for `w` in N) for the touchable rows
+    /// `first .. first + out.len()` (rows `≥ S` add nothing): one pass over
+    /// the blocks of `k`'s leaf column (at most `max_column_blocks`), a far
+    /// block as `L (Rₖᵀ w)` (`3r` then `3r` per row).
+    #[inline]
+    pub fn add_column(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
+        let end = first + out.len();
+        let w = [w.x, w.y, w.z];
+        for &index in self.column(k) {
+            let Some(b) = self.blocks.get(index as usize) else {
+                continue;
+            };
+            let (lo, hi) = (
+                (b.row_start as usize).max(first),
+                (b.row_end as usize).min(end),
+            );
+            let (Some(j), true) = (k.checked_sub(b.col_start as usize), lo < hi) else {
+                continue;
+            };
+            let Some(rows) = out.get_mut(lo - first..hi - first) else {
+                continue;
+            };
+            let i0 = lo - b.row_start as usize;
+            if b.rank == 0 {
+                self.add_near(b, i0, j, &w, rows);
+            } else {
+                self.add_far(b, i0, j, &w, rows);
+            }
+        }
+    }
+
+    /// [`Self::add_column`]'s near block: rows `i0..` of column `j`.
+    #[inline(always)]
+    fn add_near(&self, b: &HierarchyBlock, i0: usize, j: usize, w: &[T; 3], rows: &mut [[T; 3]]) {
+        for (i, u) in (i0..).zip(rows) {
+            if let Some(c) = self.near_entry(b, i, j) {
+                let v = block::mul(&c, w);
+                *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
+            }
+        }
+    }
+
+    /// [`Self::add_column`]'s far block: `t = R_jᵀ w`, then `u_i += L_i t`.
+    #[inline(always)]
+    fn add_far(&self, b: &HierarchyBlock, i0: usize, j: usize, w: &[T; 3], rows: &mut [[T; 3]]) {
+        let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
+        let Some(right) = self.factor_rows(b.right, j, r) else {
+            return;
+        };
+        let mut t = [T::zero(); HIERARCHY_MAX_RANK];
+        let Some(t) = t.get_mut(..r) else {
+            return;
+        };
+        for (row, &wb) in right.chunks_exact(r).zip(w) {
+            for (tl, &x) in t.iter_mut().zip(row) {
+                *tl += x * wb;
+            }
+        }
+        for (i, u) in (i0..).zip(rows) {
+            let Some(left) = self.factor_rows(b.left, i, r) else {
+                continue;
+            };
+            for (x, l) in u.iter_mut().zip(left.chunks_exact(r)) {
+                *x += dot(l, t);
+            }
+        }
+    }
+}
+
+/// `Σ a_l b_l`.
+#[inline(always)]
+fn dot<T: Real>(a: &[T], b: &[T]) -> T {
+    a.iter().zip(b).fold(T::zero(), |s, (&x, &y)| s + x * y)
+}
+
+/// A row-major 3×3 block transposed.
+#[inline(always)]
+fn transpose<T: Real>(c: &[T; 9]) -> [T; 9] {
+    [c[0], c[3], c[6], c[1], c[4], c[7], c[2], c[5], c[8]]
+}
+
+/// The leaves' first touchable indices: `0`, strictly ascending, `S` last.
+fn check_leaves(leaves: &[[u32; 2]], s: usize) -> Result<(), LoadError> {
+    let fail = |index, what| Err(bad(SectionKind::HierarchyLeaves, index, what));
+    if s == 0 {
+        return if leaves == [[0, 0]] {
+            Ok(())
+        } else {
+            fail(
+                0,
+                "a table without touchable vertices has the one leaf [0, 0]",
+            )
+        };
+    }
+    let start = |l: Option<&[u32; 2]>| l.map(|&[start, _]| start as usize);
+    if start(leaves.first()) != Some(0) || start(leaves.last()) != Some(s) {
+        return fail(0, "leaves do not start at 0 and end at S");
+    }
+    match leaves
+        .iter()
+        .zip(leaves.iter().skip(1))
+        .position(|(a, b)| a[0] >= b[0])
+    {
+        Some(index) => fail(index + 1, "leaf starts not strictly ascending"),
+        None => Ok(()),
+    }
+}
+
+/// A [`LoadError::BadHierarchy`].
+fn bad(kind: SectionKind, index: usize, what: &'static str) -> LoadError {
+    LoadError::BadHierarchy {
+        kind,
+        index: index as u64,
+        what,
+    }
+}
