@@ -84,6 +84,12 @@ pub enum TablesCommand {
     Info {
         /// Table file.
         table: PathBuf,
+        /// Print one JSON object instead: at least `{"bytes": N, "encoding":
+        /// "...", "measured": {"force_error": x, "touchable_displacement_error":
+        /// x}}` (a pre-computed table; an uncompressed one measures 0 against
+        /// itself; other kinds have a null encoding).
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -187,9 +193,15 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             summary_line(&mesh_data, &report, &built, &kind, &output);
             Ok(())
         }
-        TablesCommand::Info { table } => {
+        TablesCommand::Info { table, json } => {
             // Read whole when small enough, so a damaged table is reported.
             let file = TableFile::read_for_report(&table)?;
+            if json {
+                return match palpate::table::info_json::info_json(&file) {
+                    Ok(value) => Ok(stdout::print(&format!("{value}\n"))?),
+                    Err(e) => bail!("{}: table failed validation: {e}", table.display()),
+                };
+            }
             match file.info(&table.display().to_string()) {
                 Ok(report) => {
                     stdout::print(&report)?;

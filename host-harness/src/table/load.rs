@@ -12,6 +12,7 @@ use palpate_kernel::table::format::{
 use palpate_kernel::table::{InterfaceTable, LoadError, TensorMassTable};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
+use super::report::describe_hierarchy;
 use crate::limits::{MAX_TABLE_FILE_BYTES, read_bounded};
 
 /// Fills `buf` from `reader` as far as it goes; the bytes read (fewer only
@@ -314,6 +315,25 @@ impl TableFile {
         if kind == Some(TableKind::Precomputed)
             && let Ok(model) = self.model()
         {
+            let hierarchy = match &model {
+                AnyModel::F32(m) => m
+                    .table()
+                    .surface_blocks()
+                    .as_hierarchical()
+                    .map(describe_hierarchy),
+                AnyModel::F64(m) => m
+                    .table()
+                    .surface_blocks()
+                    .as_hierarchical()
+                    .map(describe_hierarchy),
+            };
+            if let Some(hierarchy) = hierarchy {
+                let _ = writeln!(out, "{hierarchy}");
+            }
+        }
+        if kind == Some(TableKind::Precomputed)
+            && let Ok(model) = self.model()
+        {
             let _ = writeln!(out, "{}", describe_candidates(&model));
         }
         let checksum_ok = bytes.len() >= HEADER_LEN + CRC_LEN && {
@@ -412,6 +432,19 @@ fn footprint(out: &mut String, h: &RawHeader, entries: &[SectionEntry]) {
 /// stored, the drop threshold, and the errors measured at build time.
 pub fn describe_compression(r: &CompressionRecord) -> String {
     let name = |value: u32| BlockEncoding::of_u32(value).map_or("unknown", BlockEncoding::name);
+    if r.surface_encoding == BlockEncoding::Hierarchical as u32 {
+        return format!(
+            "contact (surface) blocks {} (no interior rows: the displacements of interior \
+             vertices are not stored), interior blocks {}; measured at build against the exact \
+             compliance columns over {} contact sets: max force error {:.3e}, max touchable \
+             displacement error {:.3e}, relative",
+            name(r.surface_encoding),
+            name(r.interior_encoding),
+            r.probe_count,
+            r.max_force_error,
+            r.max_surface_displacement_error
+        );
+    }
     format!(
         "contact (surface) blocks {}, interior blocks {}, dropped below {} of a column's \
          largest; measured at build against the f32 table over {} contact sets (a 1 mm press \

@@ -6,7 +6,8 @@
 //! 16-bit codes, dropped far-field blocks, the error measured at build time),
 //! the table file writer ([`mod@file`], floats of a [`precision`]) and reader
 //! ([`load`]), the size and memory estimate checked before a build
-//! ([`estimate`]).
+//! ([`estimate`]), and what `tables info` reports beyond the sections
+//! ([`report`], [`info_json`]).
 
 pub mod build;
 pub mod cg;
@@ -15,7 +16,9 @@ pub mod compliance;
 pub mod compress;
 pub mod estimate;
 pub mod file;
+pub mod info_json;
 pub mod load;
 pub mod options;
 pub mod precision;
+pub mod report;
 pub mod tensor_mass;
