@@ -1,7 +1,7 @@
 //! What `tables info` says about a hierarchical compliance part beyond its
 //! sections: its blocks by level and rank ([`describe_hierarchy`]).
 
-use std::fmt::Write as _;
+use core::fmt::Write as _;
 
 use palpate_kernel::Real;
 use palpate_kernel::table::HierarchicalBlocks;
