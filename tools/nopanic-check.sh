@@ -43,7 +43,7 @@ elf="$PWD/target/thumbv7em-none-eabihf/release/palpate-nopanic-check"
 if cargo build --release 2>"$log"; then
     echo "no-panic check: linked; no panic reachable (volatile inputs) from" \
         "PrecomputedTable::load, contact_forces::<MAX_CONTACTS>, free_displacements," \
-        "displacements (f32, f16 and q16 compressed tables); TensorMassTable::load, TensorMassModel::new, reset," \
+        "displacements (f32, f16, q16 and hmatrix tables); TensorMassTable::load, TensorMassModel::new, reset," \
         "set_external_force, set_velocity, impose, release, clear_external_forces," \
         "step (explicit Euler, symplectic Euler, RK4, central difference; linear and" \
         "St Venant-Kirchhoff, incompressibility on and off), remove_tet, cut_with_tool," \

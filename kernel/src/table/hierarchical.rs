@@ -237,9 +237,9 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
             let left = self.factor_rows(b.left, i, r)?;
             let right = self.factor_rows(b.right, j, r)?;
             let mut c = [T::zero(); 9];
-            for (row, l) in c.chunks_exact_mut(3).zip(left.chunks_exact(r)) {
-                for (x, rr) in row.iter_mut().zip(right.chunks_exact(r)) {
-                    *x = dot(l, rr);
+            for (a, row) in c.chunks_exact_mut(3).enumerate() {
+                for (bb, x) in row.iter_mut().enumerate() {
+                    *x = dot(factor_row(left, a, r), factor_row(right, bb, r));
                 }
             }
             Some(c)
@@ -321,8 +321,8 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
         let Some(t) = t.get_mut(..r) else {
             return;
         };
-        for (row, &wb) in right.chunks_exact(r).zip(w) {
-            for (tl, &x) in t.iter_mut().zip(row) {
+        for (bb, &wb) in w.iter().enumerate() {
+            for (tl, &x) in t.iter_mut().zip(factor_row(right, bb, r)) {
                 *tl += x * wb;
             }
         }
@@ -330,11 +330,17 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
             let Some(left) = self.factor_rows(b.left, i, r) else {
                 continue;
             };
-            for (x, l) in u.iter_mut().zip(left.chunks_exact(r)) {
-                *x += dot(l, t);
+            for (a, x) in u.iter_mut().enumerate() {
+                *x += dot(factor_row(left, a, r), t);
             }
         }
     }
+}
+
+/// Row `a` (`r` scalars) of a vertex's three factor rows; empty if beyond.
+#[inline(always)]
+fn factor_row<T>(rows: &[T], a: usize, r: usize) -> &[T] {
+    rows.get(a * r..a * r + r).unwrap_or(&[])
 }
 
 /// `Σ a_l b_l`.
