@@ -31,6 +31,7 @@ mod host {
     mod materials;
     mod mesh;
     mod mesh_regions;
+    mod neo_hookean;
     mod newton;
     mod output;
     mod partition;
