@@ -31,6 +31,8 @@ mod host {
     mod materials;
     mod mesh;
     mod mesh_regions;
+    mod neo_hookean;
+    mod neo_hookean_reference;
     mod newton;
     mod output;
     mod partition;

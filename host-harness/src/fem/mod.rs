@@ -1,14 +1,17 @@
 //! Finite elements on the host: the linear P1 element, global assembly and
-//! the direct solves; the St Venant-Kirchhoff element and its Newton static
-//! reference ([`stvk`], [`newton`]); the incompressibility penalty of the
-//! tensor-mass models ([`penalty`]).
+//! the direct solves; the hyperelastic elements (St Venant-Kirchhoff,
+//! compressible neo-Hookean: [`hyperelastic`], [`stvk`], [`neo_hookean`])
+//! and their Newton static solver ([`newton`]); the incompressibility
+//! penalty of the tensor-mass models ([`penalty`]).
 //!
 //! Everything here follows `MODELS.md` §1 (the linear P1 tetrahedron) and
 //! Cotin et al., INRIA RR-3510 §4. SI units throughout (m, N, Pa).
 
 pub mod assembly;
 pub mod element;
+pub mod hyperelastic;
 pub mod material;
+pub mod neo_hookean;
 pub mod newton;
 pub mod penalty;
 pub mod static_solve;

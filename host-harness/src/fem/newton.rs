@@ -1,13 +1,15 @@
-//! The static equilibrium of St Venant-Kirchhoff by Newton's method with a
-//! direct sparse factorization (faer): the converged reference the
-//! speed/accuracy study measures the kernel's models against, independent
-//! of the kernel ([`super::stvk`] is its own element).
+//! The static equilibrium of a hyperelastic body (St Venant-Kirchhoff,
+//! [`solve_stvk`]; compressible neo-Hookean, [`solve_neo_hookean`]) by
+//! Newton's method with a direct sparse factorization (faer): the converged
+//! references the speed/accuracy study measures the kernel's models
+//! against, independent of the kernel ([`super::stvk`] and
+//! [`super::neo_hookean`] are their own elements).
 //!
 //! Problem: find `u` with `f_int(u) + f_ext = 0` on the unknown DOFs, the
 //! fixed vertices at zero and the prescribed ones at their displacement,
 //! under dead loads `f_ext`. The load (and the prescribed displacement) is
 //! applied in `load_steps` equal increments; at each, Newton iterations
-//! `K_t Δu = f_int + f_ext` (the tangent [`StvkTet::tangent`] assembled on
+//! `K_t Δu = f_int + f_ext` (the tangent [`HyperelasticTet::tangent`] assembled on
 //! the unknown DOFs and factorized by sparse Cholesky) with a backtracking
 //! line search on the residual's norm, until the largest residual force is
 //! at most `tolerance` times the load scale (the largest load, or the
@@ -15,6 +17,12 @@
 //! prescribed). A tangent that is not positive definite means the
 //! equilibrium path has lost stability (buckling, St Venant-Kirchhoff's
 //! collapse under compression): an error naming the increment.
+//!
+//! Inversion: where a law is not defined ([`HyperelasticTet::admissible`]:
+//! neo-Hookean's `J ≤ 0`, its energy `+∞`), a line-search trial that
+//! inverts a tet is rejected and the step halved, as one that does not
+//! lower the merit function; an increment whose prescribed displacements
+//! alone invert a tet is an error (more load steps are needed).
 
 use anyhow::{Context, bail, ensure};
 use faer::Mat;
@@ -22,8 +30,10 @@ use faer::sparse::SparseColMat;
 use nalgebra::Vector3;
 
 use super::assembly::assemble_restricted_with;
+use super::hyperelastic::HyperelasticTet;
 use super::llt::SparseLlt;
 use super::material::TetMaterials;
+use super::neo_hookean::NeoHookeanTet;
 use super::stvk::StvkTet;
 
 /// Newton controls.
@@ -114,15 +124,38 @@ pub const ENERGY_ROUNDING: f64 = 1e-12;
 /// load's size): converged. Above it, a stagnating line search is an error.
 const STAGNATION: f64 = 1e-6;
 
-/// Solves `problem` (module documentation): the load in
-/// [`NewtonOptions::load_steps`] increments (`Discrete::increment`), the
-/// stability of the end state in descent, and the reactions of the
-/// prescribed vertices.
+/// Solves `problem` for St Venant-Kirchhoff ([`solve`]).
 pub fn solve_stvk(
     problem: &StaticProblem<'_>,
     options: &NewtonOptions,
 ) -> anyhow::Result<Equilibrium> {
-    let model = Discrete::new(problem, options)?;
+    solve::<StvkTet>(problem, options)
+}
+
+/// Solves `problem` for the compressible neo-Hookean law
+/// ([`super::neo_hookean`]) with [`NewtonOptions::descent`] always on: the
+/// line search is on the total potential energy (`+∞` where a tet inverts,
+/// so such a trial is halved) and the equilibrium returned is stable.
+pub fn solve_neo_hookean(
+    problem: &StaticProblem<'_>,
+    options: &NewtonOptions,
+) -> anyhow::Result<Equilibrium> {
+    let options = NewtonOptions {
+        descent: true,
+        ..*options
+    };
+    solve::<NeoHookeanTet>(problem, &options)
+}
+
+/// Solves `problem` (module documentation) with the element `E`: the load
+/// in [`NewtonOptions::load_steps`] increments (`Discrete::increment`), the
+/// stability of the end state in descent, and the reactions of the
+/// prescribed vertices.
+pub fn solve<E: HyperelasticTet>(
+    problem: &StaticProblem<'_>,
+    options: &NewtonOptions,
+) -> anyhow::Result<Equilibrium> {
+    let model = Discrete::<E>::new(problem, options)?;
     let mut u = vec![[0.0; 3]; problem.positions.len()];
     let mut iterations = 0;
     let mut residual_n = 0.0;
@@ -158,20 +191,20 @@ struct Increment {
     tolerance_met: bool,
 }
 
-/// A checked [`StaticProblem`] discretized: one St Venant-Kirchhoff element
-/// per tet and the numbering of the unknown DOFs (the vertices neither
-/// fixed nor prescribed).
-struct Discrete<'p, 'a> {
+/// A checked [`StaticProblem`] discretized: one element `E` per tet and
+/// the numbering of the unknown DOFs (the vertices neither fixed nor
+/// prescribed).
+struct Discrete<'p, 'a, E> {
     problem: &'p StaticProblem<'a>,
     /// One element per tet, at the rest positions.
-    elements: Vec<StvkTet>,
+    elements: Vec<E>,
     /// Mesh vertex → unknown index, `None` for a fixed or prescribed vertex.
     slot: Vec<Option<u32>>,
     /// Unknown index → mesh vertex.
     unknown: Vec<usize>,
 }
 
-impl<'p, 'a> Discrete<'p, 'a> {
+impl<'p, 'a, E: HyperelasticTet> Discrete<'p, 'a, E> {
     /// Checks that `problem`'s flags, loads, materials and prescribed
     /// vertices fit its mesh and that `options` has a load step, then builds
     /// the elements and numbers the unknowns.
@@ -198,11 +231,11 @@ impl<'p, 'a> Discrete<'p, 'a> {
             );
             known[vi] = true;
         }
-        let elements: Vec<StvkTet> = problem
+        let elements: Vec<E> = problem
             .tets
             .iter()
             .zip(problem.materials.per_tet())
-            .map(|(t, m)| StvkTet::new(&t.map(|v| problem.positions[v as usize]), m))
+            .map(|(t, m)| E::at_rest(&t.map(|v| problem.positions[v as usize]), m))
             .collect();
         let mut slot = vec![None; n];
         let mut unknown = Vec::new();
@@ -232,6 +265,16 @@ impl<'p, 'a> Discrete<'p, 'a> {
             let (p, d) = (self.problem.positions[v as usize], u[v as usize]);
             [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
         })
+    }
+
+    /// Whether every tet's law is defined at `u`
+    /// ([`HyperelasticTet::admissible`]).
+    fn admissible(&self, u: &[[f64; 3]]) -> bool {
+        self.problem
+            .tets
+            .iter()
+            .zip(&self.elements)
+            .all(|(t, e)| e.admissible(&self.corners(t, u)))
     }
 
     /// Internal force `f_int(u)` on every vertex, N.
@@ -297,6 +340,11 @@ impl<'p, 'a> Discrete<'p, 'a> {
         for &(v, d) in self.problem.prescribed {
             u[v as usize] = d.map(|x| s * x);
         }
+        ensure!(
+            self.admissible(u),
+            "load step {step}/{}: the prescribed displacements invert a tet (more load steps)",
+            options.load_steps
+        );
         let mut r = self.residual(u, s);
         let scale = (0..self.problem.positions.len())
             .map(|v| Vector3::from(self.load(v)).amax() * s)
@@ -388,7 +436,8 @@ impl<'p, 'a> Discrete<'p, 'a> {
     }
 
     /// Backtracking line search along `delta` from `u`, halving the step
-    /// fraction at most [`MAX_HALVINGS`] times: takes the first trial whose
+    /// fraction at most [`MAX_HALVINGS`] times: skips a trial where a tet's
+    /// law is not defined ([`Self::admissible`]), takes the first whose
     /// residual norm is below that of `r` (or whose largest residual force is
     /// within `tolerance_n`), in descent the first that lowers `Π` or lowers
     /// the residual while `Π` grows by less than its rounding
@@ -416,6 +465,10 @@ impl<'p, 'a> Discrete<'p, 'a> {
                 for c in 0..3 {
                     trial[v][c] += alpha * delta[(3 * i + c, 0)];
                 }
+            }
+            if !self.admissible(&trial) {
+                alpha *= 0.5;
+                continue;
             }
             let r_trial = self.residual(&trial, s);
             let lower = norm(&r_trial) < before || largest(&r_trial) <= tolerance_n;
