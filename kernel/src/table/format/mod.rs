@@ -106,8 +106,8 @@ mod tet;
 
 pub use encoding::{
     BlockEncoding, COMPRESSION_RECORD_LEN, CompressionRecord, F16_LARGEST_CODE, KEPT_BITS,
-    PROBE_SET_EVERY_TOUCHABLE, Q16_LARGEST_CODE, f16_to_f32, is_kept, kept_position, kept_rank,
-    kept_words,
+    PROBE_SAMPLE_COUNT, PROBE_SET_EVERY_TOUCHABLE, PROBE_SET_SAMPLED, Q16_LARGEST_CODE, f16_to_f32,
+    is_kept, kept_position, kept_rank, kept_words,
 };
 pub use header::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
