@@ -46,6 +46,7 @@ mod host {
     mod session_trajectory_tools;
     mod stability;
     mod table_compress;
+    mod table_hmatrix;
 }
 
 mod kernel {
