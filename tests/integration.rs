@@ -48,6 +48,7 @@ mod host {
     mod session_trajectory_tools;
     mod stability;
     mod table_compress;
+    mod table_hmatrix;
     mod table_info;
 }
 

@@ -168,6 +168,7 @@ fn update_tables(mesh: &TetMesh, precision: Precision) -> Vec<(String, TableFile
                 code,
                 drop_below,
                 contact,
+                tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
             };
             let options = BuildOptions {
                 kind: TableKindOptions::Precomputed {

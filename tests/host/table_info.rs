@@ -2,12 +2,12 @@
 //! encoding the table's own, and the measured errors those stored at build (an uncompressed
 //! table is its own reference: 0), for the reference liver built uncompressed and q16.
 
-use palpate::mesh::read_mesh;
 use palpate::fem::material::Material;
+use palpate::mesh::read_mesh;
 use palpate::table::build::{BuildOptions, build};
 use palpate::table::compliance::Solver;
-use palpate::table::file::Precision;
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
+use palpate::table::file::Precision;
 use palpate::table::info_json::info_json;
 use palpate::table::load::TableFile;
 use palpate_kernel::PrecomputedTable;
@@ -40,6 +40,7 @@ fn info_json_reports_the_file_bytes_encoding_and_stored_errors() {
         code: BlockCode::Q16,
         drop_below: 0.0,
         contact: ContactBlocks::Coded,
+        tolerance: 0.0,
     }));
     let json = info_json(&q16).expect("valid");
     let record = *PrecomputedTable::<f32>::load(q16.bytes())

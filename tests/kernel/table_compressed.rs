@@ -28,6 +28,7 @@ fn coded(t: &TinyTable, code: BlockCode) -> CompressedCompliance {
         code,
         drop_below: 0.0,
         contact: ContactBlocks::Coded,
+        tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
     };
     encode(&t.compliance(), t.touchable_count, &compression).expect("encode")
 }
@@ -139,6 +140,7 @@ fn decoded_blocks_are_the_codes_times_their_scales() {
         let value = |c: u16| match code {
             BlockCode::F16 => f16_to_f32(c),
             BlockCode::Q16 => f32::from(c.cast_signed()),
+            BlockCode::Hmatrix => unreachable!("16-bit codes only"),
         };
         let expect = |codes: &[u16; 9], scale: f64| codes.map(|c| value(c) * scale as f32);
         let surface = table.surface_blocks();
@@ -332,6 +334,7 @@ fn a_wrong_rank_past_the_first_word_is_refused() {
             code: BlockCode::Q16,
             drop_below: 0.2,
             contact: ContactBlocks::Dropped,
+            tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
         }),
         tool_radius_m: palpate::table::build::DEFAULT_LIST_TOOL_RADIUS_M,
     };

@@ -165,6 +165,7 @@ fn a_recorded_press_with_four_probes_replays_to_the_host_lines() {
         code: BlockCode::Q16,
         drop_below: 0.0,
         contact: ContactBlocks::Coded,
+        tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
     };
     for (name, compression) in [
         ("record-built-in-4", None),
@@ -226,6 +227,7 @@ fn a_compressed_recording_of_a_dynamic_scene_is_refused() {
         code: BlockCode::Q16,
         drop_below: 0.0,
         contact: ContactBlocks::Coded,
+        tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
     };
     let error = record(&scene, &dir, &["poke".to_string()], Some(q16)).unwrap_err();
     assert!(

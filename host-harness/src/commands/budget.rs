@@ -118,6 +118,7 @@ fn record_ticks(
         code,
         drop_below: 0.0,
         contact: ContactBlocks::Coded,
+        tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
     });
     let runs = record(scene, dir, only, compression)?;
     let mut text = format!("recorded in {}:\n", dir.display());

@@ -17,6 +17,7 @@ use palpate::table::compliance::Solver;
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
+use palpate::table::hmatrix::DEFAULT_TOLERANCE;
 use palpate::table::load::TableFile;
 
 use super::args::{FixArgs, MaterialArgs, fraction};
@@ -40,11 +41,17 @@ pub enum TablesCommand {
         #[arg(long, value_enum, default_value = "f32")]
         precision: Precision,
         /// Store the compliance in 16 bits per value with a per-column scale
-        /// (f16: binary16; q16: fixed point), about half the f32 table; its
-        /// force and displacement errors against the f32 table are measured
+        /// (f16: binary16; q16: fixed point), about half the f32 table; or
+        /// (hmatrix) the touchable compliance as a hierarchical matrix,
+        /// far blocks low-rank within --tolerance, no interior
+        /// displacements. The force and displacement errors are measured
         /// and stored in the table (`tables info` prints them).
         #[arg(long, value_enum, value_name = "CODE")]
         compress: Option<BlockCode>,
+        /// With --compress hmatrix: the far blocks' relative truncation
+        /// tolerance (Frobenius norm per block), in (0, 1); default 1e-4.
+        #[arg(long, value_name = "REL")]
+        tolerance: Option<f64>,
         /// With --compress: leave out each interior compliance block whose
         /// largest entry is below REL times the largest of its column
         /// (far-field blocks; they count as zero), REL in [0, 1).
@@ -140,6 +147,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
             solver,
             precision,
             compress,
+            tolerance,
             drop_below,
             contact_blocks,
             quiet,
@@ -153,7 +161,7 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
                 .subcommand_matches("build")
                 .and_then(|m| m.value_source("solver"))
                 == Some(ValueSource::CommandLine);
-            let compression = compression(compress, drop_below, contact_blocks)?;
+            let compression = compression(compress, tolerance, drop_below, contact_blocks)?;
             let kind = kind_options(
                 kind,
                 density,
@@ -216,13 +224,26 @@ pub fn run(command: TablesCommand, matches: &ArgMatches) -> anyhow::Result<()> {
     }
 }
 
-/// The compression of `--compress` with its `--drop-below` and
-/// `--contact-blocks` (refused without `--compress`).
+/// The compression of `--compress` with its `--tolerance` (hmatrix only),
+/// `--drop-below` and `--contact-blocks` (f16 and q16 only; all refused
+/// without `--compress`).
 fn compression(
     compress: Option<BlockCode>,
+    tolerance: Option<f64>,
     drop_below: Option<f64>,
     contact_blocks: Option<ContactBlocks>,
 ) -> anyhow::Result<Option<Compression>> {
+    if compress == Some(BlockCode::Hmatrix) {
+        if drop_below.is_some() || contact_blocks.is_some() {
+            bail!(
+                "--drop-below and --contact-blocks apply to --compress f16|q16: --compress hmatrix \
+                 keeps every touchable block (far ones low-rank within --tolerance) and no \
+                 interior one"
+            );
+        }
+    } else if tolerance.is_some() {
+        bail!("--tolerance applies to --compress hmatrix");
+    }
     if compress.is_none() {
         if drop_below.is_some() {
             bail!("--drop-below applies to a compressed table: add --compress f16|q16");
@@ -235,6 +256,7 @@ fn compression(
         code,
         drop_below: drop_below.unwrap_or(0.0),
         contact: contact_blocks.unwrap_or_default(),
+        tolerance: tolerance.unwrap_or(DEFAULT_TOLERANCE),
     }))
 }
 

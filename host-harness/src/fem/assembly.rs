@@ -132,7 +132,8 @@ pub fn assemble_restricted_with(
 /// (`MODELS.md` §2).
 ///
 /// Free index `0..touchable_count` are the free surface (touchable) vertices
-/// in ascending mesh-vertex order; `touchable_count..free_count()` are the
+/// in ascending mesh-vertex order (or another order:
+/// [`FreeOrdering::with_touchable_order`]); `touchable_count..free_count()` are the
 /// remaining (interior) free vertices in ascending order. Fixed vertices have
 /// no free index.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -185,6 +186,31 @@ impl FreeOrdering {
             free_vertex,
             vertex_slot,
             touchable_count,
+        }
+    }
+
+    /// The same ordering with the touchable vertices renumbered: touchable
+    /// index `i` becomes the vertex that was `order[i]` (a permutation of
+    /// `0..touchable_count`, e.g. a cluster tree's leaf order); the interior
+    /// vertices keep theirs. The kernel reads any touchable order.
+    ///
+    /// # Panics
+    /// If `order` is not a permutation of `0..touchable_count`.
+    pub fn with_touchable_order(self, order: &[usize]) -> Self {
+        let s = self.touchable_count;
+        assert_eq!(order.len(), s, "one entry per touchable vertex");
+        let mut free_vertex = self.free_vertex;
+        let touchable: Vec<u32> = order.iter().map(|&i| free_vertex[i]).collect();
+        free_vertex[..s].copy_from_slice(&touchable);
+        let mut vertex_slot = vec![None; self.vertex_slot.len()];
+        for (i, &v) in free_vertex.iter().enumerate() {
+            assert!(vertex_slot[v as usize].is_none(), "order is a permutation");
+            vertex_slot[v as usize] = Some(i as u32);
+        }
+        Self {
+            free_vertex,
+            vertex_slot,
+            touchable_count: s,
         }
     }
 

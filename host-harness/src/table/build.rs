@@ -17,7 +17,7 @@ use palpate_kernel::{LoadError, PrecomputedTable};
 
 use super::collision::collision_index;
 use super::compliance::{Solver, compute_compliance};
-use super::compress::{encode, measured_record};
+use super::compress::{BlockCode, encode, measured_record};
 use super::estimate::{SizeLimits, TableEstimate};
 use super::file::{Precision, TableContents, write_table};
 use super::load::TableFile;
@@ -268,6 +268,14 @@ pub(crate) fn precomputed(
         surface,
         materials,
     } = *stages;
+    if let TableKindOptions::Precomputed {
+        compression: Some(c),
+        ..
+    } = options.kind
+        && c.code == BlockCode::Hmatrix
+    {
+        return hierarchical(mesh, report, options, solver, stages, summary, c.tolerance);
+    }
     let ordering = FreeOrdering::new(mesh.positions.len(), fixed, &surface.vertices);
     let start = Instant::now();
     let compliance = compute_compliance(
@@ -333,6 +341,53 @@ pub(crate) fn precomputed(
         bytes,
         touchable_count: ordering.touchable_count,
         arrays_time,
+        ..summary
+    })
+}
+
+/// The pre-computed stages of a hierarchical table (`--compress hmatrix`,
+/// [`super::hmatrix::build`]): the collision index, then the clustered
+/// ordering, the compliance by columns and its compression.
+fn hierarchical(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    solver: Solver,
+    stages: &Stages<'_>,
+    summary: BuiltTable,
+    tolerance: f64,
+) -> anyhow::Result<BuiltTable> {
+    if solver != Solver::Cholesky {
+        bail!("--compress hmatrix solves the compliance by sparse Cholesky: drop --solver cg");
+    }
+    let collision = collision_index(
+        &mesh.positions,
+        &stages.surface.triangles,
+        options.list_tool_radius_m(),
+        options.precision,
+    );
+    let tet_lame = stages.materials.lame();
+    let contents = TableContents {
+        tet_lame: &tet_lame,
+        young_pa: options.material.young_pa,
+        poisson: options.material.poisson,
+        mesh_hash: mesh.content_hash(),
+        vertex_slot: &[],
+        free_vertex: &[],
+        touchable_count: 0,
+        positions: &mesh.positions,
+        triangles: &stages.surface.triangles,
+        surface: &[],
+        interior: &[],
+        compressed: None,
+        collision: &collision,
+    };
+    let built = super::hmatrix::build(mesh, stages, contents, tolerance, options.progress)
+        .with_context(|| format!("{}: building the hierarchical compliance", report.source))?;
+    Ok(BuiltTable {
+        bytes: built.bytes,
+        touchable_count: built.touchable_count,
+        arrays_time: built.arrays_time,
         ..summary
     })
 }

@@ -39,6 +39,7 @@ use palpate_kernel::table::format::{
 use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
 use super::compliance::Compliance;
+use super::hmatrix::assemble::Hierarchy;
 use super::load::TableFile;
 
 /// The 16-bit code of a compressed table.
@@ -48,6 +49,10 @@ pub enum BlockCode {
     F16,
     /// 16-bit fixed point: the column's largest entry is ±32767 quanta.
     Q16,
+    /// A hierarchical matrix of the touchable compliance (near blocks in
+    /// f32, far blocks as low-rank factors within `--tolerance`); the
+    /// interior displacements are not stored ([`super::hmatrix`]).
+    Hmatrix,
 }
 
 impl BlockCode {
@@ -56,14 +61,16 @@ impl BlockCode {
         match self {
             BlockCode::F16 => BlockEncoding::F16,
             BlockCode::Q16 => BlockEncoding::Q16,
+            BlockCode::Hmatrix => BlockEncoding::Hierarchical,
         }
     }
 
     /// The column scale (m/N, an `f32` value) for a column whose largest
     /// entry magnitude is `largest` (m/N; a column of zeros gets 1).
     fn scale(self, largest: f64) -> f64 {
+        // `encode` refuses Hmatrix: it never codes a block.
         let scale = match self {
-            BlockCode::F16 => largest,
+            BlockCode::F16 | BlockCode::Hmatrix => largest,
             BlockCode::Q16 => largest / f64::from(format::Q16_LARGEST_CODE),
         };
         if largest > 0.0 {
@@ -76,7 +83,7 @@ impl BlockCode {
     /// The code of `x` (m/N) in a column of scale `scale`.
     fn code(self, x: f64, scale: f64) -> u16 {
         match self {
-            BlockCode::F16 => f16_bits(x / scale),
+            BlockCode::F16 | BlockCode::Hmatrix => f16_bits(x / scale),
             BlockCode::Q16 => q16_code(x / scale),
         }
     }
@@ -105,6 +112,9 @@ pub struct Compression {
     pub drop_below: f64,
     /// How the touchable–touchable blocks are stored.
     pub contact: ContactBlocks,
+    /// [`BlockCode::Hmatrix`]: the far blocks' relative truncation
+    /// tolerance (Frobenius norm per block), in `(0, 1)`; unused otherwise.
+    pub tolerance: f64,
 }
 
 impl Compression {
@@ -115,6 +125,19 @@ impl Compression {
             "--drop-below {}: must be a fraction in [0, 1) of a column's largest compliance",
             self.drop_below
         );
+        if self.code == BlockCode::Hmatrix {
+            ensure!(
+                self.drop_below == 0.0 && self.contact == ContactBlocks::Coded,
+                "--compress hmatrix stores every touchable block (near ones in f32, far ones as \
+                 low-rank factors) and no interior block: --drop-below and --contact-blocks do \
+                 not apply"
+            );
+            ensure!(
+                self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1.0,
+                "--tolerance {}: must be a relative error in (0, 1), e.g. 1e-4",
+                self.tolerance
+            );
+        }
         Ok(())
     }
 }
@@ -173,10 +196,13 @@ pub struct CompressedCompliance {
     /// The encoding record (errors filled in by [`measure`]).
     pub record: CompressionRecord,
     /// The surface part coded, `None` to store it in the table scalar
-    /// ([`ContactBlocks::F32`]).
+    /// ([`ContactBlocks::F32`]) or as [`Self::hierarchy`].
     pub surface: Option<CodedPart>,
     /// The interior part coded.
     pub interior: CodedPart,
+    /// The surface part as a hierarchical matrix (`--compress hmatrix`,
+    /// [`super::hmatrix`]), `None` otherwise.
+    pub hierarchy: Option<Hierarchy>,
 }
 
 /// Largest entry magnitude of a block.
@@ -192,6 +218,11 @@ pub fn encode(
     compression: &Compression,
 ) -> anyhow::Result<CompressedCompliance> {
     compression.check()?;
+    ensure!(
+        compression.code != BlockCode::Hmatrix,
+        "a hierarchical table is built from the compliance columns (table::hmatrix), not coded \
+         from the dense compliance"
+    );
     let surface = &compliance.surface;
     let interior = &compliance.interior;
     ensure!(
@@ -269,6 +300,7 @@ pub fn encode(
         record,
         surface: surface_part,
         interior: interior_part,
+        hierarchy: None,
     })
 }
 
@@ -353,13 +385,26 @@ const PROBE_DEPTH_M: f32 = 1e-3;
 /// The probe set (`PROBE_SET_EVERY_TOUCHABLE`, format docs) of a table:
 /// the contact sets, each one or two vertex contacts.
 pub fn probe_set(table: &PrecomputedTable<'_, f32>) -> Vec<Vec<Constraint<f32>>> {
+    probe_set_at(table, 0..table.touchable_count())
+}
+
+/// The presses of [`probe_set`] at the touchable indices `at` only (each
+/// with its partners among every touchable vertex): five contact sets per
+/// index.
+pub fn probe_set_at(
+    table: &PrecomputedTable<'_, f32>,
+    at: impl IntoIterator<Item = usize>,
+) -> Vec<Vec<Constraint<f32>>> {
     let s = table.touchable_count();
     let touchable = &table.free_vertices()[..s];
     let position = |v: u32| Vector3::from(table.rest_positions()[v as usize]).cast::<f64>();
     let press = |v: u32, d: Vector3<f32>| Constraint::at_vertex(v, d);
     let down = Vector3::new(0.0, 0.0, -PROBE_DEPTH_M);
-    let mut probes = Vec::with_capacity(5 * s);
-    for (k, &v) in touchable.iter().enumerate() {
+    let mut probes = Vec::new();
+    for k in at {
+        let Some(&v) = touchable.get(k) else {
+            continue;
+        };
         for axis in 0..3 {
             let mut d = Vector3::zeros();
             d[axis] = PROBE_DEPTH_M;

@@ -4,6 +4,7 @@ use bytemuck::Zeroable;
 
 use super::collision::CollisionIndex;
 use super::compress::{CodedPart, CompressedCompliance};
+use super::hmatrix::assemble::Hierarchy;
 use palpate_kernel::table::format::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
     SectionEntry, SectionKind, TableKind,
@@ -75,19 +76,24 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
         Section::floats(SectionKind::RestPositions, c.positions, precision),
         Section::ints(SectionKind::SurfaceTriangles, c.triangles),
     ];
-    let (surface, interior) = match c.compressed {
+    let (surface, interior, hierarchy) = match c.compressed {
         Some(compressed) => {
             sections.push(Section {
                 kind: SectionKind::ComplianceEncoding,
                 count: 1,
                 bytes: bytemuck::bytes_of(&compressed.record).to_vec(),
             });
-            (compressed.surface.as_ref(), Some(&compressed.interior))
+            (
+                compressed.surface.as_ref(),
+                Some(&compressed.interior),
+                compressed.hierarchy.as_ref(),
+            )
         }
-        None => (None, None),
+        None => (None, None, None),
     };
-    sections.extend(match surface {
-        Some(part) => part.sections(
+    sections.extend(match (surface, hierarchy) {
+        (_, Some(h)) => h.sections(precision),
+        (Some(part), None) => part.sections(
             [
                 SectionKind::SurfaceScale,
                 SectionKind::SurfaceCodes,
@@ -95,7 +101,7 @@ pub fn write_table(c: &TableContents<'_>, precision: Precision) -> Vec<u8> {
             ],
             precision,
         ),
-        None => vec![Section::floats(
+        (None, None) => vec![Section::floats(
             SectionKind::ComplianceSurface,
             c.surface,
             precision,
@@ -159,6 +165,23 @@ impl CodedPart {
             sections.push(Section::ints(kept, words));
         }
         sections
+    }
+}
+
+impl Hierarchy {
+    /// The five hierarchy sections, the data rounded to `precision`.
+    fn sections(&self, precision: Precision) -> Vec<Section> {
+        vec![
+            Section {
+                kind: SectionKind::HierarchyRecord,
+                count: 1,
+                bytes: bytemuck::bytes_of(&self.record).to_vec(),
+            },
+            Section::ints(SectionKind::HierarchyLeaves, &self.leaves),
+            Section::ints(SectionKind::HierarchyBlocks, &self.blocks),
+            Section::ints(SectionKind::HierarchyColumnBlocks, &self.column_blocks),
+            Section::floats(SectionKind::HierarchyData, &self.data, precision),
+        ]
     }
 }
 

@@ -3,7 +3,8 @@
 //! computation of the pre-computed model (Cotin RR-3510 §4; [`compliance`],
 //! [`cg`]), the tensor-mass arrays (RR-3510 §5; [`tensor_mass`]), the
 //! collision index ([`collision`]), the compressed compliance ([`compress`]:
-//! 16-bit codes, dropped far-field blocks, the error measured at build time),
+//! 16-bit codes, dropped far-field blocks, the error measured at build time; [`hmatrix`]: the hierarchical
+//! compliance),
 //! the table file writer ([`mod@file`], floats of a [`precision`]) and reader
 //! ([`load`]), the size and memory estimate checked before a build
 //! ([`estimate`]), and what `tables info` reports beyond the sections
@@ -16,6 +17,7 @@ pub mod compliance;
 pub mod compress;
 pub mod estimate;
 pub mod file;
+pub mod hmatrix;
 pub mod info_json;
 pub mod load;
 pub mod options;

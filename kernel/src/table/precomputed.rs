@@ -275,10 +275,13 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         if free_seen != self.free_vertex.len() {
             return Err(LoadError::InconsistentHeader);
         }
-        // Touchable vertices come first, in ascending order (format contract).
+        // Touchable vertices come first, in ascending order (format
+        // contract), but for a hierarchical surface part, whose touchable
+        // indices follow its cluster tree's leaves (`format::hierarchy`).
         let touchable = self.free_vertex.get(..self.touchable_count());
         let touchable = touchable.ok_or(LoadError::InconsistentHeader)?;
-        for pair in touchable.windows(2) {
+        let ascending = self.surface.encoding() != format::BlockEncoding::Hierarchical;
+        for pair in touchable.windows(2).filter(|_| ascending) {
             if let [a, b] = *pair
                 && a >= b
             {

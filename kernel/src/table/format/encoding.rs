@@ -66,6 +66,17 @@ impl BlockEncoding {
 /// `precomputed solve` command).
 pub const PROBE_SET_EVERY_TOUCHABLE: u32 = 1;
 
+/// Identifies a sampled probe set: the five contact sets of
+/// [`PROBE_SET_EVERY_TOUCHABLE`] at the touchable indices `⌊i·S/P⌋`,
+/// `i` in `0..P`, `P` = [`PROBE_SAMPLE_COUNT`] (the partners still taken
+/// among every touchable vertex), for a table whose `S` exceeds `P`; its
+/// errors are measured against the exact compliance columns (a
+/// hierarchical table's writer).
+pub const PROBE_SET_SAMPLED: u32 = 2;
+
+/// The touchable indices of [`PROBE_SET_SAMPLED`].
+pub const PROBE_SAMPLE_COUNT: usize = 256;
+
 /// The one element of [`super::SectionKind::ComplianceEncoding`]: how the
 /// compliance is stored, and the error that cost, measured by the host at
 /// build time against the `f32` table of the same compliance.
@@ -97,7 +108,8 @@ pub struct CompressionRecord {
     pub max_surface_displacement_error: f64,
     /// Contact sets in the probe set.
     pub probe_count: u64,
-    /// Which probe set: [`PROBE_SET_EVERY_TOUCHABLE`].
+    /// Which probe set: [`PROBE_SET_EVERY_TOUCHABLE`] or
+    /// [`PROBE_SET_SAMPLED`].
     pub probe_set: u32,
     /// Zero.
     pub reserved: u32,

@@ -13,8 +13,9 @@
 //!
 //! Vertex numbering is the source mesh's input order. The free vertices (not
 //! fixed) are renumbered by a *free index*: first the `touchable_count` free
-//! surface vertices (the ones a tool can touch) in ascending vertex order,
-//! then the interior free vertices in ascending order.
+//! surface vertices (the ones a tool can touch) in ascending vertex order
+//! (in a hierarchical table, the order of its cluster tree's leaves:
+//! [`hierarchy`]), then the interior free vertices in ascending order.
 //!
 //! Compliance blocks `C_nk` (RR-3510 §4, MODELS.md §2; `C = A⁻¹`, `A` the
 //! stiffness restricted to free DOFs; unit m/N) are stored for every free `n`
@@ -106,8 +107,8 @@ mod tet;
 
 pub use encoding::{
     BlockEncoding, COMPRESSION_RECORD_LEN, CompressionRecord, F16_LARGEST_CODE, KEPT_BITS,
-    PROBE_SET_EVERY_TOUCHABLE, Q16_LARGEST_CODE, f16_to_f32, is_kept, kept_position, kept_rank,
-    kept_words,
+    PROBE_SAMPLE_COUNT, PROBE_SET_EVERY_TOUCHABLE, PROBE_SET_SAMPLED, Q16_LARGEST_CODE, f16_to_f32,
+    is_kept, kept_position, kept_rank, kept_words,
 };
 pub use header::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
