@@ -1243,15 +1243,27 @@ fn built_in_organ() {
         })
         .sum::<f64>()
         / 6.0;
-    assert!((tets - enclosed).abs() <= 1e-12 * tets, "{tets} vs {enclosed} m³");
-    assert!((0.4e-3..0.55e-3).contains(&tets), "{tets} m³");
-    let (lo, hi) = m.positions.iter().fold(
-        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-        |(l, h), p| ([0, 1, 2].map(|a| l[a].min(p[a])), [0, 1, 2].map(|a| h[a].max(p[a]))),
+    assert!(
+        (tets - enclosed).abs() <= 1e-12 * tets,
+        "{tets} vs {enclosed} m³"
     );
+    assert!((0.4e-3..0.55e-3).contains(&tets), "{tets} m³");
+    let (lo, hi) =
+        m.positions
+            .iter()
+            .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(l, h), p| {
+                (
+                    [0, 1, 2].map(|a| l[a].min(p[a])),
+                    [0, 1, 2].map(|a| h[a].max(p[a])),
+                )
+            });
     assert!((hi[0] - lo[0] - 0.17).abs() < 0.001, "{lo:?} {hi:?}");
     assert_eq!(lo[2], ORGAN_FLOOR_Z_M);
-    let floor = m.positions.iter().filter(|p| p[2] == ORGAN_FLOOR_Z_M).count();
+    let floor = m
+        .positions
+        .iter()
+        .filter(|p| p[2] == ORGAN_FLOOR_Z_M)
+        .count();
     assert!((10..100).contains(&floor), "{floor} underside vertices");
 }
 

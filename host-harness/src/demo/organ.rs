@@ -2,7 +2,7 @@
 //! ([`Scene::built_in_hybrid`]) in a generated surgery
 //! ([`hepatectomy`], `session generate hepatectomy`): the grasper (tool 0)
 //! holds the right lobe, pre-computed tissue, and pulls it up while the
-//! cutter (tool 1) cuts the left lobe through across its width, 4.4 cm
+//! cutter (tool 1) cuts the left lobe through across its width, 4.5 cm
 //! from its tip, in the cut zone, tensor-mass tissue, so that the tip
 //! comes off; the pre-computed and tensor-mass regions are coupled at
 //! their connection nodes (the hybrid model, MODELS.md §5).
@@ -25,9 +25,7 @@ use super::timing::Costs;
 use crate::mesh::TetMesh;
 use crate::output::vtk;
 use crate::scene::generate::hepatectomy;
-use crate::scene::{
-    HEPATECTOMY_ZONE_PAST_CUT_M, Scene, ToolKind, ToolSpec, ToolState, Trajectory,
-};
+use crate::scene::{HEPATECTOMY_ZONE_PAST_CUT_M, Scene, ToolKind, ToolSpec, ToolState, Trajectory};
 use crate::session::hybrid::HybridSetup;
 use crate::session::model::{SceneModel, SceneTables};
 use crate::session::run::{tick_count, ticks};

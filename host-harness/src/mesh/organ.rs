@@ -4,10 +4,10 @@
 //! neither the file nor Python.
 //!
 //! Shape (m; x from the left lobe's tip to the right lobe, y front to back, z up): a thick right
-//! lobe (up to 6.1 cm high) blending into a thin left lobe (1.3 cm thick 4 cm from its tip), its
-//! underside cut flat at `z = ORGAN_FLOOR_Z_M` below the right lobe; 0.169 m × 0.120 m × 0.061 m,
-//! 0.47 L. Tets of about 5 mm edge over the left lobe (x < −0.02 m), growing to about 13 mm over
-//! the right lobe (x > 0.03 m).
+//! lobe (up to 6.1 cm high) blending into a thin left lobe (1.3 cm thick 4.5 cm from its
+//! tip), its underside cut flat at `z = ORGAN_FLOOR_Z_M` below the right lobe; 0.169 m ×
+//! 0.120 m × 0.061 m, 0.47 L. Tets of about 5 mm edge over the left lobe (x < −0.02 m),
+//! growing to about 13 mm over the right lobe (x > 0.03 m).
 
 use super::{MeshError, MeshFormat, MeshReport, TetMesh, read_mesh_bytes};
 

@@ -38,7 +38,7 @@ pub const HEPATECTOMY_BLADE_M: [f64; 3] = [0.0, 0.0, -0.02];
 pub const HEPATECTOMY_DT_S: f64 = 0.00025;
 
 /// Where the built-in hybrid scene's tools work on the organ's rest surface (m): the grasper on
-/// the top of the right lobe's dome, the cutter across the left lobe, 4.4 cm from its tip.
+/// the top of the right lobe's dome, the cutter across the left lobe, 4.5 cm from its tip.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HepatectomySites {
     /// The surface point between the grasper's jaws.
