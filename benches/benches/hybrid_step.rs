@@ -1,5 +1,6 @@
-//! The hybrid model (`kernel/src/hybrid`, RR-3510 §6.2) on the liver-like
-//! organ (5868 tets, E = 5 kPa, ν = 0.4, 1000 kg/m³, lowest vertices fixed),
+//! The hybrid model (`kernel/src/hybrid`, RR-3510 §6.2) on the voxel-carved
+//! liver-like organ (`organ_mesh`, 5868 tets, E = 5 kPa, ν = 0.4, 1000 kg/m³,
+//! lowest vertices fixed),
 //! f32, with dynamic fractions of about 10, 20 and 40 % of the tets (the
 //! tets with the lowest centroid x: the left lobe first).
 //!

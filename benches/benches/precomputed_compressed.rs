@@ -1,7 +1,7 @@
 //! The pre-computed model's step on compressed tables (`kernel/src/table/compressed.rs`,
 //! decoded on the fly by `kernel/src/precomputed/model.rs`) next to the f32 table of the same
 //! compliance, on the built-in scene's block (1183 vertices, 409 touchable) and the built-in
-//! hybrid scene's organ all pre-computed (1386 vertices, 612 touchable):
+//! hybrid scene's organ all pre-computed (1118 vertices, 807 touchable):
 //!
 //! - `force_path`: `contact_forces::<4>` for m = 1 and 4 vertex contacts and one barycentric
 //!   contact (the haptic loop's kind: 9 blocks);

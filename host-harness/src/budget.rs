@@ -636,13 +636,13 @@ fn probe_site(k: usize, press: Press) -> Press {
 /// `P` simultaneous contacts, and with two or more points the pinch (tool
 /// points 0 and 1; the others press and hold on their sites); for a scene
 /// with a grasper or a cutter, [`surgery`] (on the built-in block's top),
-/// or [`hepatectomy`] on the generated organ.
+/// or [`hepatectomy`] on the built-in organ.
 pub fn trajectories(scene: &Scene) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
     let err = |e: crate::scene::GenerateError| anyhow::anyhow!("{e}");
     let tool = &scene.tool;
     if tool.kinds.iter().any(|k| *k != ToolKind::Probe) {
         return Ok(match scene.mesh {
-            MeshSource::GeneratedOrgan => {
+            MeshSource::BuiltInOrgan => {
                 vec![("hepatectomy", hepatectomy(tool).map_err(err)?)]
             }
             _ => vec![("surgery", surgery(tool).map_err(err)?)],

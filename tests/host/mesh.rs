@@ -1210,6 +1210,63 @@ fn organ_mesh_other_resolutions() {
     }
 }
 
+/// The built-in organ (`palpate::mesh::organ`, the gmsh mesh of `tools/meshes/organ.py`): it
+/// reads cleanly (nothing skipped, reoriented, unreferenced or warned about), is a manifold
+/// solid, and its tets fill exactly what its boundary encloses: the sum of the tet volumes
+/// equals the divergence-theorem volume of the boundary triangles, `Σ (a × b)·c / 6` (to
+/// 1e-12 relative: rounding of some 10⁴ terms). Its size is the script's shape (half-length
+/// 0.085 m: the x extent within 1 mm of 0.17 m, the surface remeshed by gmsh) and its lowest
+/// vertices are the flat underside, exactly at `ORGAN_FLOOR_Z_M`, a few dozen of them. Counts
+/// describe the committed file.
+#[test]
+fn built_in_organ() {
+    use palpate::mesh::organ::{ORGAN_FLOOR_Z_M, ORGAN_SOURCE, organ};
+    let (m, report) = organ().expect("organ");
+    assert_eq!(report.source, ORGAN_SOURCE);
+    assert_eq!(
+        (report.skipped_elements, report.reoriented_tets),
+        (0, 0),
+        "{report:?}"
+    );
+    assert!(report.unreferenced_vertices.is_empty() && report.warnings.is_empty());
+    assert_eq!((m.positions.len(), m.tets.len()), (1118, 3947));
+    let surface = assert_manifold_solid(&m);
+    let tets: f64 = (0..m.tets.len()).map(|t| m.tet_volume(t)).sum();
+    let enclosed: f64 = surface
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            (a[1] * b[2] - a[2] * b[1]) * c[0]
+                + (a[2] * b[0] - a[0] * b[2]) * c[1]
+                + (a[0] * b[1] - a[1] * b[0]) * c[2]
+        })
+        .sum::<f64>()
+        / 6.0;
+    assert!(
+        (tets - enclosed).abs() <= 1e-12 * tets,
+        "{tets} vs {enclosed} m³"
+    );
+    assert!((0.4e-3..0.55e-3).contains(&tets), "{tets} m³");
+    let (lo, hi) =
+        m.positions
+            .iter()
+            .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(l, h), p| {
+                (
+                    [0, 1, 2].map(|a| l[a].min(p[a])),
+                    [0, 1, 2].map(|a| h[a].max(p[a])),
+                )
+            });
+    assert!((hi[0] - lo[0] - 0.17).abs() < 0.001, "{lo:?} {hi:?}");
+    assert_eq!(lo[2], ORGAN_FLOOR_Z_M);
+    let floor = m
+        .positions
+        .iter()
+        .filter(|p| p[2] == ORGAN_FLOOR_Z_M)
+        .count();
+    assert!((10..100).contains(&floor), "{floor} underside vertices");
+}
+
 /// [`generate::voxel_mesh`] of the unit cubes listed in `cells` (on the lattice ℤ³).
 fn voxels_of(cells: &[[i32; 3]], hi: i32) -> TetMesh {
     generate::voxel_mesh(1.0, [[0.0; 3], [f64::from(hi); 3]], |p| {

@@ -13,10 +13,11 @@ use palpate_tests::scene;
 
 /// `built-in-hybrid` over `session generate hepatectomy`: the cuts and
 /// tears remove tets of the tensor-mass region only (the partition's
-/// dynamic tets), at least the 10 along the cut line (measured 39); the
-/// grasp holds the pre-computed region and pulls the hand (the force's
-/// magnitude above 0.5 N while held, measured 2.2 N); no fault, no failed
-/// physics update.
+/// dynamic tets), at least the 10 along the cut line (measured 344), and
+/// cut the left lobe through (its tip has no face path of live tets to the
+/// right lobe); the grasp holds the pre-computed region and pulls the hand
+/// (the force's magnitude above 0.5 N while held, measured 0.91 N); no
+/// fault, no failed physics update.
 #[test]
 fn built_in_hybrid_cuts_its_tensor_mass_region_and_grasps_its_precomputed_one() {
     let scene = Scene::named("built-in-hybrid").expect("built-in");
@@ -85,6 +86,45 @@ fn built_in_hybrid_cuts_its_tensor_mass_region_and_grasps_its_precomputed_one() 
     assert_eq!(held_only, 0);
     assert!(removed.iter().all(|&t| partition.dynamic[t as usize]));
     assert!(summary.max_force_n > 0.5);
+    // The cut goes through: the live tets leave the left lobe's tip (the tet furthest in −x)
+    // with no face path to the right lobe (the tet furthest in +x).
+    let mut alive = vec![true; mesh.tets.len()];
+    for &t in &removed {
+        alive[t as usize] = false;
+    }
+    let by_x = |t: &usize| mesh.tet_centroid(*t)[0];
+    let tip = (0..mesh.tets.len()).min_by(|a, b| by_x(a).total_cmp(&by_x(b)));
+    let right = (0..mesh.tets.len()).max_by(|a, b| by_x(a).total_cmp(&by_x(b)));
+    let (tip, right) = (tip.expect("tets"), right.expect("tets"));
+    assert!(alive[tip] && alive[right]);
+    assert!(!face_connected(&mesh.tets, &alive, tip, right));
+}
+
+/// Whether a path of face-sharing `alive` tets joins tet `from` to tet `to`.
+fn face_connected(tets: &[[u32; 4]], alive: &[bool], from: usize, to: usize) -> bool {
+    let mut by_face: std::collections::HashMap<[u32; 3], Vec<usize>> = Default::default();
+    for (t, tet) in tets.iter().enumerate().filter(|(t, _)| alive[*t]) {
+        for face in palpate_kernel::table::format::tet_face_vertices(*tet) {
+            let mut key = face;
+            key.sort_unstable();
+            by_face.entry(key).or_default().push(t);
+        }
+    }
+    let (mut seen, mut stack) = (vec![false; tets.len()], vec![from]);
+    seen[from] = true;
+    while let Some(t) = stack.pop() {
+        for face in palpate_kernel::table::format::tet_face_vertices(tets[t]) {
+            let mut key = face;
+            key.sort_unstable();
+            for &n in &by_face[&key] {
+                if !seen[n] {
+                    seen[n] = true;
+                    stack.push(n);
+                }
+            }
+        }
+    }
+    seen[to]
 }
 
 /// A zone over the whole block makes every tet dynamic: the session is

@@ -72,7 +72,7 @@ pub enum TrajectoryKind {
     // The `built-in-tools` scene's grasper (tool 0) and cutter (tool 1) at work together.
     Surgery,
     // The `built-in-hybrid` scene's grasper (tool 0) holding the organ's right lobe while its
-    // cutter (tool 1) cuts a segment off.
+    // cutter (tool 1) cuts the left lobe's tip off.
     Hepatectomy,
 }
 

@@ -2,9 +2,10 @@
 //! ([`Scene::built_in_hybrid`]) in a generated surgery
 //! ([`hepatectomy`], `session generate hepatectomy`): the grasper (tool 0)
 //! holds the right lobe, pre-computed tissue, and pulls it up while the
-//! cutter (tool 1) cuts a 4.7 cm line through the cut zone, tensor-mass
-//! tissue; the pre-computed and tensor-mass regions are coupled at their
-//! connection nodes (the hybrid model, MODELS.md §5).
+//! cutter (tool 1) cuts the left lobe through across its width, 4.5 cm
+//! from its tip, in the cut zone, tensor-mass tissue, so that the tip
+//! comes off; the pre-computed and tensor-mass regions are coupled at
+//! their connection nodes (the hybrid model, MODELS.md §5).
 //!
 //! The session runs as `palpate session run built-in-hybrid` runs it (the
 //! same tables, loop and ticks, [`crate::session::run`]), with each haptic
@@ -24,7 +25,7 @@ use super::timing::Costs;
 use crate::mesh::TetMesh;
 use crate::output::vtk;
 use crate::scene::generate::hepatectomy;
-use crate::scene::{HEPATECTOMY_CUT_RADIUS_M, Scene, ToolKind, ToolSpec, ToolState, Trajectory};
+use crate::scene::{HEPATECTOMY_ZONE_PAST_CUT_M, Scene, ToolKind, ToolSpec, ToolState, Trajectory};
 use crate::session::hybrid::HybridSetup;
 use crate::session::model::{SceneModel, SceneTables};
 use crate::session::run::{tick_count, ticks};
@@ -69,13 +70,14 @@ pub fn run(dir: &Path, length_s: Option<f64>, out: &mut dyn Write) -> anyhow::Re
     writeln!(
         out,
         "scene: organ, {} vertices, {} tets, E = {} Pa, nu = {}, underside fixed; tensor-mass \
-         region: {} tets within {:.0} mm of the cut line, {} connection nodes to the pre-computed rest",
+         region: {} tets, the left lobe to {:.0} mm past the cut line, {} connection nodes to the \
+         pre-computed rest",
         mesh.positions.len(),
         mesh.tets.len(),
         scene.material.elastic.young_pa,
         scene.material.elastic.poisson,
         partition.dynamic.iter().filter(|&&d| d).count(),
-        HEPATECTOMY_CUT_RADIUS_M * 1e3,
+        HEPATECTOMY_ZONE_PAST_CUT_M * 1e3,
         partition.connection_nodes.len()
     )?;
     let SceneTables::Hybrid(files, spec) = model.tables(&scene, &mesh, &report, None)? else {

@@ -14,6 +14,7 @@ mod cursor;
 mod error;
 pub mod generate;
 mod gmsh;
+pub mod organ;
 mod surface;
 mod tetgen;
 mod validate;

@@ -18,49 +18,59 @@ use super::tool::{DEFAULT_TOOL_POINTS, DEFAULT_TOOL_RADIUS_M, ToolKind, ToolSpec
 use super::zones::{PartitionSpec, Zone, ZoneKind, ZoneShape};
 use crate::fem::material::Material;
 use crate::fix::FixPredicate;
-use crate::mesh::generate::{ORGAN_CUBE_M, organ_mesh};
+use crate::mesh::organ::{ORGAN_FLOOR_Z_M, organ};
 use crate::mesh::top_height;
 
-/// Radius of the built-in hybrid scene's cut zone around its cut line, m: the blade's 1 cm
-/// and the sphere below it, and a few millimetres.
-pub const HEPATECTOMY_CUT_RADIUS_M: f64 = 0.012;
+/// How far the built-in hybrid scene's cut zone reaches past its cut line into the organ, m:
+/// the blade's sphere (2 mm) and two of the left lobe's 5 mm tets. It is the zone's margin: the
+/// scene adds no element rings (`[partition] margin_rings = 0`; the default 4 rings would make
+/// three quarters of the organ tensor-mass, and leave a few pre-computed surface triangles
+/// with only connection nodes, where a contact is refused).
+pub const HEPATECTOMY_ZONE_PAST_CUT_M: f64 = 0.012;
 
-/// Where the built-in hybrid scene's tools work on the organ's rest surface (m): the right
-/// lobe's upper terrace, flat in the voxel surface (the benches' sites).
+/// The built-in hybrid scene's cutter blade, m: 2 cm straight down from the tool point, longer
+/// than the left lobe is thick where it is cut (1.3 cm), so the cut goes through.
+pub const HEPATECTOMY_BLADE_M: [f64; 3] = [0.0, 0.0, -0.02];
+
+/// The built-in hybrid scene's time step, s: 40 steps per physics update. The organ's
+/// 5 mm tets make symplectic Euler's largest stable step 0.449 ms (`palpate` checks it when a
+/// session starts); 0.25 ms keeps well below it as the cut removes tets.
+pub const HEPATECTOMY_DT_S: f64 = 0.00025;
+
+/// Where the built-in hybrid scene's tools work on the organ's rest surface (m): the grasper on
+/// the top of the right lobe's dome, the cutter across the left lobe, 4.5 cm from its tip.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HepatectomySites {
     /// The surface point between the grasper's jaws.
     pub grasp_m: [f64; 3],
-    /// The cut line on the surface, from and to (along +x).
+    /// Where the cut starts (along +y, front to back): 3 mm inside the left lobe's front rim,
+    /// at the height of the lobe's top on its mid-line (`y = 0`), where the blade tip enters.
     pub cut_from_m: [f64; 3],
-    /// See `cut_from_m`.
+    /// Where the cut ends: 4 mm past the lobe's back rim, at the same height.
     pub cut_to_m: [f64; 3],
     /// Height of the organ's flat underside (its lowest vertices).
     pub floor_m: f64,
 }
 
 impl HepatectomySites {
-    /// The sites on [`organ_mesh`] at [`ORGAN_CUBE_M`]: the grasp at `(0.030, −0.028)`, the
-    /// cut along `y = 2c + 1 mm` (1 mm off a row of vertices) from `x = 0.006` to `0.053`,
-    /// each at the height of the rest surface there.
+    /// The sites on the built-in [`organ`]: the grasp at `(0.04, 0)` (the right lobe's dome,
+    /// 4 cm high), the cut along `x = −0.04` from `y = −0.034` to `0.042` (the lobe spans
+    /// `y` from −0.037 to 0.038 m there, and `z` from −0.006 to 0.008 m), each at the height
+    /// of the rest surface at its `x` on `y = 0`.
     pub fn on_the_organ() -> Self {
-        let mesh = organ_mesh(ORGAN_CUBE_M);
+        // The embedded organ reads (tests::host::mesh reads it).
+        let (mesh, _) = organ().expect("the built-in organ");
         let surface = crate::mesh::boundary_surface(&mesh);
-        let on_top = |x: f64, y: f64| {
-            // The sites are on the organ (a fixed, generated mesh).
-            let z = top_height(&mesh.positions, &surface.triangles, x, y).unwrap_or(0.0);
-            [x, y, z]
+        let top = |x: f64, y: f64| {
+            // The sites are over the organ (a fixed mesh).
+            top_height(&mesh.positions, &surface.triangles, x, y).unwrap_or(0.0)
         };
-        let y = 2.0 * ORGAN_CUBE_M + 0.001;
+        let (x, z) = (-0.04, top(-0.04, 0.0));
         Self {
-            grasp_m: on_top(0.030, -0.028),
-            cut_from_m: on_top(0.006, y),
-            cut_to_m: on_top(0.053, y),
-            floor_m: mesh
-                .positions
-                .iter()
-                .map(|p| p[2])
-                .fold(f64::INFINITY, f64::min),
+            grasp_m: [0.04, 0.0, top(0.04, 0.0)],
+            cut_from_m: [x, -0.034, z],
+            cut_to_m: [x, 0.042, z],
+            floor_m: ORGAN_FLOOR_Z_M,
         }
     }
 }
@@ -150,21 +160,26 @@ impl Scene {
     }
 
     /// The built-in hepatectomy-style scene on the hybrid model (RR-3510 §6.2): the organ
-    /// ([`MeshSource::GeneratedOrgan`], E = 5 kPa, ν = 0.4, 1000 kg/m³, its flat underside
-    /// fixed), a grasper (trajectory tool 0) holding the right lobe on its upper terrace and a
-    /// cutter (tool 1) cutting a segment off along a 4.7 cm line of the same terrace
-    /// ([`HepatectomySites`]); the one `[[zone]]`, a cut capsule of radius
-    /// [`HEPATECTOMY_CUT_RADIUS_M`] around the cut line, with the default margin, makes the
-    /// tensor-mass region (linear: no large-deformation zone), the rest of the organ is
-    /// pre-computed, so the grasper holds pre-computed tissue and the blade cuts tensor-mass
-    /// tissue. Symplectic Euler in 0.5 ms steps, damping 30/s, physics every 10 ticks, tearing
-    /// past 100 % edge elongation. `session generate hepatectomy` writes its trajectory.
+    /// ([`MeshSource::BuiltInOrgan`], E = 5 kPa, ν = 0.4, 1000 kg/m³, its flat underside
+    /// fixed), a grasper (trajectory tool 0) holding the right lobe on its dome and a cutter
+    /// (tool 1, blade [`HEPATECTOMY_BLADE_M`]) cutting the left lobe through, across its width
+    /// ([`HepatectomySites`]), so its tip comes off; the one `[[zone]]`, a cut box holding the
+    /// left lobe from its tip to [`HEPATECTOMY_ZONE_PAST_CUT_M`] past the cut line, with no
+    /// margin rings (the 12 mm are the margin), makes the tensor-mass region (linear: no large-deformation zone), the
+    /// rest of the organ is pre-computed, so the grasper holds pre-computed tissue and the
+    /// blade cuts tensor-mass tissue, and the tip it cuts off is all tensor-mass. Symplectic
+    /// Euler in [`HEPATECTOMY_DT_S`] steps, damping 30/s, physics every 10 ticks, tearing past
+    /// 100 % edge elongation. `session generate hepatectomy` writes its trajectory.
     pub fn built_in_hybrid() -> Scene {
         let sites = HepatectomySites::on_the_organ();
-        let (a, b) = (sites.cut_from_m, sites.cut_to_m);
+        let mut scene = Self::built_in_tools();
+        scene.tool.blade_m = HEPATECTOMY_BLADE_M;
+        if let ModelSpec::Dynamic(dynamic) = &mut scene.model {
+            dynamic.dt_s = HEPATECTOMY_DT_S;
+        }
         Scene {
             source: "built-in hybrid scene".into(),
-            mesh: MeshSource::GeneratedOrgan,
+            mesh: MeshSource::BuiltInOrgan,
             // Parses (a number formatted by Rust).
             fix: format!("z<{}", sites.floor_m + 1e-6)
                 .parse::<FixPredicate>()
@@ -177,15 +192,16 @@ impl Scene {
                 },
                 density_kg_m3: DEFAULT_DENSITY_KG_M3,
             },
+            partition: PartitionSpec { margin_rings: 0 },
+            // The organ lies within 0.1 m of the origin.
             zones: vec![Zone {
                 kind: ZoneKind::Cut,
-                shape: ZoneShape::Capsule {
-                    a_m: a,
-                    b_m: b,
-                    radius_m: HEPATECTOMY_CUT_RADIUS_M,
+                shape: ZoneShape::Box {
+                    min_m: [-0.2, -0.2, -0.2],
+                    max_m: [sites.cut_from_m[0] + HEPATECTOMY_ZONE_PAST_CUT_M, 0.2, 0.2],
                 },
             }],
-            ..Self::built_in_tools()
+            ..scene
         }
     }
 

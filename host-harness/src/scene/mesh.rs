@@ -1,9 +1,10 @@
 //! Where a scene's tissue mesh comes from ([`MeshSource`]: a file, a generated box or the
-//! generated organ), the ranges of a generated box, and the mesh loaded.
+//! built-in organ), the ranges of a generated box, and the mesh loaded.
 
 use std::path::PathBuf;
 
-use crate::mesh::generate::{ORGAN_CUBE_M, box_mesh, organ_mesh};
+use crate::mesh::generate::box_mesh;
+use crate::mesh::organ::organ;
 use crate::mesh::{MeshError, MeshReport, TetMesh, read_mesh};
 
 /// Largest vertex count of a `[generated]` box, so a typo cannot ask for a mesh that does not
@@ -24,15 +25,17 @@ pub enum MeshSource {
         /// Cells per axis, each ≥ 1 (6 tets per cell).
         cells: [usize; 3],
     },
-    /// The generated liver-like organ ([`organ_mesh`] at [`ORGAN_CUBE_M`]: 1386 vertices,
-    /// 5868 tets, its flat underside the lowest vertices); the built-in hybrid scene's.
-    GeneratedOrgan,
+    /// The built-in liver-like organ ([`organ`]: the smooth gmsh mesh embedded in the binary,
+    /// 1118 vertices, 3947 tets, its flat underside the lowest vertices); the built-in hybrid
+    /// scene's.
+    BuiltInOrgan,
 }
 
 impl MeshSource {
     /// Load (or generate) the mesh. A generated box is built by [`box_mesh`] and satisfies the
     /// [`TetMesh`] invariants by construction; its report names it (`generated box ...`) and is
-    /// otherwise empty. A file's errors name the file (see [`read_mesh`]).
+    /// otherwise empty. A file's errors name the file (see [`read_mesh`]); the built-in organ is
+    /// read from the binary as a file is.
     pub fn load(&self) -> Result<(TetMesh, MeshReport), MeshError> {
         match self {
             MeshSource::File(path) => read_mesh(path),
@@ -47,13 +50,7 @@ impl MeshSource {
                 };
                 Ok((mesh, report))
             }
-            MeshSource::GeneratedOrgan => Ok((
-                organ_mesh(ORGAN_CUBE_M),
-                MeshReport {
-                    source: format!("generated organ, {ORGAN_CUBE_M} m cubes"),
-                    ..MeshReport::default()
-                },
-            )),
+            MeshSource::BuiltInOrgan => organ(),
         }
     }
 

@@ -24,7 +24,9 @@ pub mod trajectory;
 pub mod validate;
 pub mod zones;
 
-pub use built_in::{HEPATECTOMY_CUT_RADIUS_M, HepatectomySites};
+pub use built_in::{
+    HEPATECTOMY_BLADE_M, HEPATECTOMY_DT_S, HEPATECTOMY_ZONE_PAST_CUT_M, HepatectomySites,
+};
 pub use error::SceneError;
 pub use generate::{
     CutLine, GenerateError, Generator, GraspPull, Keyframe, Pinch, Poke, Press, PressHold, Slide,

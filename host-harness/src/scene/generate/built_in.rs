@@ -48,9 +48,12 @@ pub fn surgery(tool: &ToolSpec) -> Result<Trajectory, GenerateError> {
 
 /// The built-in hybrid scene's tools at work on the organ
 /// ([`crate::scene::Scene::built_in_hybrid`], sites [`HepatectomySites`]): the
-/// grasper (tool 0) grasps the right lobe's terrace and pulls it up, the cutter (tool 1, the
-/// scene's blade) cuts along the cut line at the same time; 1 kHz with the tool columns
-/// (`session generate hepatectomy`).
+/// grasper (tool 0) grasps the right lobe's dome and pulls it up ([`GraspPull`]'s defaults);
+/// at the same time the cutter (tool 1, the scene's blade) goes in at the cut line's start,
+/// its tip [`HEPATECTOMY_CUT_DEPTH_M`] below the lobe's top (the blade's upper end 2 mm above
+/// it), cuts along the line at 20 mm/s (through the lobe, whose tip comes off), and comes out
+/// 25 mm ([`CutLine`]'s other defaults); 1 kHz with the tool columns (`session generate
+/// hepatectomy`).
 pub fn hepatectomy(tool: &ToolSpec) -> Result<Trajectory, GenerateError> {
     let sites = HepatectomySites::on_the_organ();
     let mut keyframes = GraspPull {
@@ -59,13 +62,22 @@ pub fn hepatectomy(tool: &ToolSpec) -> Result<Trajectory, GenerateError> {
         ..GraspPull::default()
     }
     .keyframes()?;
+    let (a, b) = (sites.cut_from_m, sites.cut_to_m);
     let mut cut = CutLine {
         tool: 1,
         blade_m: tool.blade_m,
-        distance_m: sites.cut_to_m[0] - sites.cut_from_m[0],
+        direction: [b[0] - a[0], b[1] - a[1], 0.0],
+        distance_m: (b[0] - a[0]).hypot(b[1] - a[1]),
+        cut_speed_m_s: 0.02,
+        withdraw_m: 0.025,
         ..CutLine::default()
     };
-    cut.press.surface_m = sites.cut_from_m;
+    cut.press.surface_m = a;
+    cut.press.depth_m = HEPATECTOMY_CUT_DEPTH_M;
     keyframes.extend(cut.keyframes()?);
     sample_keyframes_with_tool_columns(&keyframes, 1000.0, true)
 }
+
+/// How deep the hepatectomy's blade tip goes below the lobe's top, m: 18 mm, through the
+/// 1.3 cm thick left lobe with the scene's 2 cm blade.
+const HEPATECTOMY_CUT_DEPTH_M: f64 = 0.018;
