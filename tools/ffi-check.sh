@@ -20,8 +20,7 @@ mkdir -p "$out"
 
 (cd tools/ffi-header && cargo run -q)
 
-cargo build -q -p palpate-ffi
-lib="$root/target/debug/libpalpate_ffi.a"
+lib="$(tools/ffi-lib.sh)"
 table="$(tools/box-table.sh)"
 tensor_table="$(tools/box-table.sh --tensor-mass)"
 hybrid_tables="$(tools/hybrid-tables.sh)"

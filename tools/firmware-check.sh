@@ -67,9 +67,8 @@ c_mode() {
     cargo build -q -p palpate-ffi --release --target thumbv7em-none-eabihf --features prove-no-panic
     cp "$thumb" "$c_out/libpalpate_ffi-proof.a"
     # The same C for the host, for the haptic loop's lines.
-    cargo build -q -p palpate-ffi
     make -s -C tools/firmware-c firmware host TABLE="$table" FFI_LIB="$c_out/libpalpate_ffi.a" \
-        HOST_LIB="$root/target/debug/libpalpate_ffi.a" OUT="$c_out"
+        HOST_LIB="$(tools/ffi-lib.sh)" OUT="$c_out"
 
     # No panic reachable from any entry point.
     if ! make -s -C tools/firmware-c no-panic FFI_PROOF_LIB="$c_out/libpalpate_ffi-proof.a" \

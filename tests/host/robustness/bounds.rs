@@ -5,7 +5,7 @@
 //! its build's memory, estimated from the mesh's counts
 //! (`palpate::table::estimate`). These run in process; the probes that need
 //! the binary (`precomputed solve /dev/zero`, a piped table, a run under a
-//! memory limit) are in `host-harness/tests/robustness_bounds.rs`.
+//! memory limit) are in `host-harness/tests/cli/robustness/bounds.rs`.
 
 use core::time::Duration;
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! (`palpate::output::atomic`); an output that is an input is refused.
 //! These run in process; the probes that need the binary (a killed run, a
 //! closed or full standard output) are in
-//! `host-harness/tests/robustness_output.rs`.
+//! `host-harness/tests/cli/robustness/output.rs`.
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};

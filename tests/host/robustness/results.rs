@@ -2,7 +2,7 @@
 //! result with exit 0 (or an error that named nothing); each is now a clear
 //! error naming the file, line, key or element, or a correct result. The
 //! command-line side (exit status 2, one line) is in
-//! `host-harness/tests/robustness_results.rs`.
+//! `host-harness/tests/cli/robustness/results.rs`.
 
 use std::path::Path;
 

@@ -2,9 +2,7 @@
 //! the generated fit's JSON, the same fit from its own curves written back
 //! (`--curves-out` then `--curves`), and bad inputs as one line, exit 2.
 
-mod common;
-
-use common::{assert_one_line_error, fresh_dir, palpate, stderr};
+use crate::common::{assert_one_line_error, fresh_dir, palpate, stderr};
 
 fn fit(extra: &[&str]) -> std::process::Output {
     let mut args = vec!["remap", "fit", "--young", "5000", "--poisson", "0.4"];

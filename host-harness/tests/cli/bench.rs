@@ -2,9 +2,7 @@
 //! run --precision`. No timed assertion: the timings are checked for their
 //! shape (positive, ordered quantiles), never for their value.
 
-mod common;
-
-use common::{assert_one_line_error, palpate, reference};
+use crate::common::{assert_one_line_error, palpate, reference};
 use palpate::fem::material::Material;
 use palpate::mesh::read_mesh;
 use palpate::table::build::{BuildOptions, build};

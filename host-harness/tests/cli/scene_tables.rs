@@ -2,11 +2,9 @@
 //! (`tools/firmware-m4f/hybrid-scene.toml`): the three tables of each precision, the replay of
 //! the firmware's sequence on them, and each bad input as one line and exit status 2.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{assert_one_line_error, fresh_dir, palpate, stderr, text};
+use crate::common::{assert_one_line_error, fresh_dir, palpate, stderr, text};
 use palpate::hybrid::owned::with_hybrid_files;
 use palpate::table::load::TableFile;
 use palpate_kernel::table::format::TableKind;

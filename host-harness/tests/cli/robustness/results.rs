@@ -4,18 +4,16 @@
 //! `error: …` naming the file, line, key or element (or gives the correct
 //! result). The in-process side is `tests/host/robustness/results.rs`.
 
-mod common;
-
-use common::{build_cube, build_cube_table, build_table, palpate, reference, temp, text};
+use crate::common::{build_cube, build_cube_table, build_table, palpate, reference, temp, text};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-/// [`common::assert_one_line_error`] (exit 2, stderr ending with its only
+/// [`crate::common::assert_one_line_error`] (exit 2, stderr ending with its only
 /// `error: …` line, containing every needle, no panic; `tables build`
 /// prints its size estimate on stderr before it starts), and besides:
 /// `error:` nowhere else on stderr, nothing on stdout.
 fn assert_one_line_error(out: &Output, needles: &[&str]) {
-    common::assert_one_line_error(out, needles);
+    crate::common::assert_one_line_error(out, needles);
     let stderr = text(&out.stderr);
     assert_eq!(stderr.matches("error:").count(), 1, "{stderr}");
     assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
@@ -454,7 +452,7 @@ fn messages_name_what_to_change_in_one_bounded_line() {
         palpate(&args)
     };
     let out = dynamic(&["--damping", "1", "--dt", "1e-4", "--gravity", "nan,0,0"]);
-    common::assert_one_line_error(&out, &["--gravity", "finite number"]);
+    crate::common::assert_one_line_error(&out, &["--gravity", "finite number"]);
     for (extra, needle) in [
         (
             ["--damping", "1", "--dt", "-1"],
@@ -466,7 +464,7 @@ fn messages_name_what_to_change_in_one_bounded_line() {
         ),
     ] {
         let out = dynamic(&extra);
-        common::assert_one_line_error(&out, &[needle]);
+        crate::common::assert_one_line_error(&out, &[needle]);
         assert!(
             text(&out.stderr).lines().count() <= 3,
             "{}",
@@ -479,7 +477,7 @@ fn messages_name_what_to_change_in_one_bounded_line() {
         "5000",
         &["--compress", "f16", "--drop-below", "-0.5"],
     );
-    common::assert_one_line_error(
+    crate::common::assert_one_line_error(
         &out,
         &["'--drop-below <REL>': must be a fraction in [0, 1)"],
     );

@@ -11,9 +11,7 @@
 //! glyph outlines; the hybrid's run, maps and trajectories; the press
 //! past buckling; and `--mesh`.
 
-mod common;
-
-use common::{fresh_dir, palpate, stderr};
+use crate::common::{fresh_dir, palpate, stderr};
 
 #[test]
 fn quick_chart_writes_report_charts_and_json() {

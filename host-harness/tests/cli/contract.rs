@@ -1,9 +1,7 @@
 //! The `palpate` command-line contract (README.md): exact commands, JSON
 //! shapes, and exit status 2 with a one-line error for bad input.
 
-mod common;
-
-use common::{
+use crate::common::{
     assert_one_line_error, build_cube, build_cube_table, fresh_dir, palpate, reference, temp,
 };
 use std::process::Output;

@@ -1,14 +1,7 @@
-//! Helpers shared by the process-level tests (`tests/cli.rs` and
-//! `tests/robustness_*.rs`): running the `palpate` binary, finding the
-//! reference data, per-process temporary paths, the one-line error check
-//! and building the reference cube's table. Each test file says
-//! `mod common;`; cargo does not build `tests/common/mod.rs` as a test
-//! binary of its own.
-
-// Each test binary compiles its own copy of this module and uses only a
-// subset of it: without this, the helpers one binary does not call are
-// dead-code warnings (errors under clippy's `-D warnings`).
-#![allow(dead_code)]
+//! Helpers shared by the process-level tests (every module of this test
+//! binary): running the `palpate` binary, finding the reference data,
+//! per-module temporary paths, the one-line error check and building the
+//! reference cube's table.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -52,12 +45,18 @@ pub fn reference(rel: &str) -> String {
         .to_string()
 }
 
-/// The path `name` in this test binary's own temporary folder
-/// (`palpate-<test file>-<process id>`, created if missing). The file
-/// itself is not created.
+/// The path `name` in the calling test module's own temporary folder
+/// (`palpate-cli-<module file>-<process id>`, created if missing: the
+/// modules' tests run in one process and may use the same file names).
+/// The file itself is not created.
+#[track_caller]
 pub fn temp(name: &str) -> PathBuf {
+    let module = Path::new(core::panic::Location::caller().file())
+        .file_stem()
+        .and_then(|stem| stem.to_str())
+        .expect("a test module's file name");
     let dir = std::env::temp_dir().join(format!(
-        "palpate-{}-{}",
+        "palpate-{}-{module}-{}",
         env!("CARGO_CRATE_NAME"),
         std::process::id()
     ));
@@ -65,8 +64,9 @@ pub fn temp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
-/// An empty folder of its own for test `name` (under [`temp`]'s folder;
-/// removed first if a previous use left it).
+/// An empty folder of its own for test `name` (under [`temp`]'s folder of
+/// the calling module; removed first if a previous use left it).
+#[track_caller]
 pub fn fresh_dir(name: &str) -> PathBuf {
     let dir = temp(name);
     let _ = std::fs::remove_dir_all(&dir);

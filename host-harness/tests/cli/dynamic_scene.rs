@@ -6,9 +6,7 @@
 //! tensor-mass: both are the global linear solution at rest, MODELS.md §5);
 //! `critical-dt` prints the hybrid's step next to its region alone's.
 
-mod common;
-
-use common::{fresh_dir, palpate};
+use crate::common::{fresh_dir, palpate};
 
 /// A 4 × 4 × 2-cell block of 1 cm (75 vertices, 192 tets), base fixed.
 const BLOCK: &str = "fix = [\"z<0.0001\"]\n[generated]\nbox_m = [0.04, 0.04, 0.02]\ncells = [4, 4, 2]\n[material]\nyoung_pa = 5000.0\npoisson = 0.3\n";

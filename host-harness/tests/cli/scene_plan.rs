@@ -1,11 +1,9 @@
 //! `palpate scene plan` (README "scene plan"): the JSON contract on a scene file written here,
 //! the VTK region field read back, and each bad input as one line and exit status 2.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 
-use common::{assert_one_line_error, fresh_dir, palpate, stderr, text};
+use crate::common::{assert_one_line_error, fresh_dir, palpate, stderr, text};
 use palpate::mesh::generate::box_mesh;
 
 /// A 6 × 6 × 3-cell block of 1 cm (648 tets, 196 vertices), base fixed, then `extra` TOML.

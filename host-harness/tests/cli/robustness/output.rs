@@ -5,9 +5,7 @@
 //! (exit 2), never a panic. The in-process probes are in
 //! `tests/host/robustness/output.rs`.
 
-mod common;
-
-use common::{
+use crate::common::{
     assert_one_line_error, build_cube_table, build_table, fresh_dir, palpate, palpate_command,
     reference, stderr,
 };
