@@ -18,7 +18,9 @@ fn material() -> Material {
 }
 
 fn cube() -> TetMesh {
-    read_mesh(&reference_dir().join("meshes/cube.msh")).expect("cube.msh").0
+    read_mesh(&reference_dir().join("meshes/cube.msh"))
+        .expect("cube.msh")
+        .0
 }
 
 /// Forces (N) and energy (J) of `mesh` deformed to `x` (m).
@@ -28,7 +30,10 @@ fn evaluate(mesh: &TetMesh, law: ElasticLaw, x: &[[f64; 3]]) -> (Vec<[f64; 3]>, 
 
 /// `x ↦ Q x + t` applied to every point.
 fn moved(points: &[[f64; 3]], q: &Matrix3<f64>, t: Vector3<f64>) -> Vec<[f64; 3]> {
-    points.iter().map(|p| (q * Vector3::from(*p) + t).into()).collect()
+    points
+        .iter()
+        .map(|p| (q * Vector3::from(*p) + t).into())
+        .collect()
 }
 
 /// Largest entry of `a − b` and of `b`.
@@ -66,7 +71,11 @@ fn rotations() -> Vec<Matrix3<f64>> {
 fn rotated_pure_strain_gives_the_rotated_linear_force() {
     let mesh = cube();
     let e = Matrix3::new(1e-3, 4e-4, -2e-4, 4e-4, -6e-4, 3e-4, -2e-4, 3e-4, 5e-4);
-    let strained = moved(&mesh.positions, &(Matrix3::identity() + e), Vector3::zeros());
+    let strained = moved(
+        &mesh.positions,
+        &(Matrix3::identity() + e),
+        Vector3::zeros(),
+    );
     let (linear, _) = evaluate(&mesh, ElasticLaw::Linear, &strained);
     for q in rotations() {
         let x = moved(&strained, &q, Vector3::new(0.3, -0.2, 0.1));
@@ -83,9 +92,16 @@ fn rotated_pure_strain_gives_the_rotated_linear_force() {
 #[test]
 fn rigid_motion_gives_no_force() {
     let mesh = cube();
-    let strained = moved(&mesh.positions, &(Matrix3::identity() * 1.001), Vector3::zeros());
+    let strained = moved(
+        &mesh.positions,
+        &(Matrix3::identity() * 1.001),
+        Vector3::zeros(),
+    );
     let (reference, _) = evaluate(&mesh, ElasticLaw::Corotational, &strained);
-    let scale = reference.iter().flatten().fold(0.0f64, |m, f| m.max(f.abs()));
+    let scale = reference
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, f| m.max(f.abs()));
     for q in rotations() {
         let x = moved(&mesh.positions, &q, Vector3::new(-1.0, 2.0, 0.5));
         let (forces, energy) = evaluate(&mesh, ElasticLaw::Corotational, &x);
@@ -109,7 +125,11 @@ fn forces_rotate_with_the_deformed_state() {
         .collect();
     let (forces, energy) = evaluate(&mesh, ElasticLaw::Corotational, &x);
     for q in rotations() {
-        let (rotated, rotated_energy) = evaluate(&mesh, ElasticLaw::Corotational, &moved(&x, &q, Vector3::zeros()));
+        let (rotated, rotated_energy) = evaluate(
+            &mesh,
+            ElasticLaw::Corotational,
+            &moved(&x, &q, Vector3::zeros()),
+        );
         let (diff, scale) = max_diff(&rotated, &moved(&forces, &q, Vector3::zeros()));
         assert!(diff <= 1e-10 * scale, "{q}: {diff:e} vs {scale:e}");
         assert!((rotated_energy - energy).abs() <= 1e-10 * energy);
@@ -133,7 +153,11 @@ fn rotated_small_deformation_gives_the_rotated_linear_force() {
     let (linear, _) = evaluate(&mesh, ElasticLaw::Linear, &x);
     let mut worst: f64 = 0.0;
     for q in rotations() {
-        let (corotational, _) = evaluate(&mesh, ElasticLaw::Corotational, &moved(&x, &q, Vector3::zeros()));
+        let (corotational, _) = evaluate(
+            &mesh,
+            ElasticLaw::Corotational,
+            &moved(&x, &q, Vector3::zeros()),
+        );
         let (diff, scale) = max_diff(&corotational, &moved(&linear, &q, Vector3::zeros()));
         worst = worst.max(diff / scale);
     }

@@ -22,7 +22,12 @@ fn evaluate(mesh: &TetMesh, law: ElasticLaw, x: &[[f64; 3]]) -> (Vec<[f64; 3]>, 
 /// The largest difference between the forces and the central difference
 /// `−(W(x + h e) − W(x − h e))/2h` over every degree of freedom of the
 /// vertices `vertices`, and the largest force.
-fn gradient_error(mesh: &TetMesh, law: ElasticLaw, x: &[[f64; 3]], vertices: &[usize]) -> (f64, f64) {
+fn gradient_error(
+    mesh: &TetMesh,
+    law: ElasticLaw,
+    x: &[[f64; 3]],
+    vertices: &[usize],
+) -> (f64, f64) {
     let (forces, _) = evaluate(mesh, law, x);
     let h = 1e-7;
     let mut worst: f64 = 0.0;
@@ -43,7 +48,12 @@ fn gradient_error(mesh: &TetMesh, law: ElasticLaw, x: &[[f64; 3]], vertices: &[u
 /// The unit corner tet with its apex at height `z` (m; 1 at rest, below 0
 /// inverted).
 fn corner_tet(z: f64) -> (TetMesh, Vec<[f64; 3]>) {
-    let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
     let mesh = TetMesh {
         positions,
         tets: vec![[0, 1, 2, 3]],
@@ -79,7 +89,16 @@ fn forces_are_minus_the_energy_gradient() {
 /// gradient is the force everywhere. Bound 1e-6 relative, as above.
 #[test]
 fn forces_are_the_energy_gradient_across_the_floor_and_inverted() {
-    for z in [1.2, 0.5, NEO_HOOKEAN_J_FLOOR + 1e-4, NEO_HOOKEAN_J_FLOOR - 1e-4, 0.05, 0.0, -0.3, -2.0] {
+    for z in [
+        1.2,
+        0.5,
+        NEO_HOOKEAN_J_FLOOR + 1e-4,
+        NEO_HOOKEAN_J_FLOOR - 1e-4,
+        0.05,
+        0.0,
+        -0.3,
+        -2.0,
+    ] {
         let (mesh, x) = corner_tet(z);
         let (worst, scale) = gradient_error(&mesh, ElasticLaw::NeoHookean, &x, &[0, 1, 2, 3]);
         assert!(worst <= 1e-6 * scale, "z = {z}: {worst:e} vs {scale:e}");
@@ -101,7 +120,10 @@ fn inverted_tets_get_a_finite_restoring_force() {
         assert!(energy.is_finite() && forces.iter().flatten().all(|f| f.is_finite()));
         let fz = forces[3][2];
         assert!(fz > 0.0, "z = {z}: apex force {fz} N does not restore");
-        assert!(fz > previous, "z = {z}: {fz} N not above {previous} N higher up");
+        assert!(
+            fz > previous,
+            "z = {z}: {fz} N not above {previous} N higher up"
+        );
         previous = fz;
     }
 }

@@ -76,7 +76,10 @@ fn closest_rotation_is_a_proper_rotation_satisfying_the_polar_condition() {
             }
             let g = r.transpose() * f;
             let symmetry = (g - g.transpose()).abs().max() / norm;
-            assert!(symmetry <= 1e-11, "{s:?}: RᵀF asymmetric by {symmetry:e} |F|");
+            assert!(
+                symmetry <= 1e-11,
+                "{s:?}: RᵀF asymmetric by {symmetry:e} |F|"
+            );
             worst_symmetry = worst_symmetry.max(symmetry);
             let trace = g.trace();
             for axis in [Vector3::x(), Vector3::y(), Vector3::z()] {
@@ -115,7 +118,10 @@ fn closest_rotation_in_f32_is_orthonormal() {
                 let f = Matrix3::from_fn(|i, j| f64::from(f32_rows[i][j]));
                 let g = r.transpose() * f;
                 let symmetry = (g - g.transpose()).abs().max() / f.norm();
-                assert!(symmetry <= 1e-4, "{s:?}: RᵀF asymmetric by {symmetry:e} |F|");
+                assert!(
+                    symmetry <= 1e-4,
+                    "{s:?}: RᵀF asymmetric by {symmetry:e} |F|"
+                );
             }
         }
     }

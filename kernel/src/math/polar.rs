@@ -42,9 +42,7 @@ pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
     let v = right_vectors(f);
     // Columns of V: v[.][k]; b_k = F v_k.
     let b = |k: usize| -> [T; 3] {
-        core::array::from_fn(|r| {
-            f[r][0] * v[0][k] + f[r][1] * v[1][k] + f[r][2] * v[2][k]
-        })
+        core::array::from_fn(|r| f[r][0] * v[0][k] + f[r][1] * v[1][k] + f[r][2] * v[2][k])
     };
     let tiny = T::of_f64(TINY2);
     let b1 = b(0);
@@ -79,7 +77,8 @@ pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
 fn right_vectors<T: Real>(f: &Mat3<T>) -> Mat3<T> {
     let column = |c: usize| [f[0][c], f[1][c], f[2][c]];
     let cols = [column(0), column(1), column(2)];
-    let mut s: Mat3<T> = core::array::from_fn(|i| core::array::from_fn(|j| dot(&cols[i], &cols[j])));
+    let mut s: Mat3<T> =
+        core::array::from_fn(|i| core::array::from_fn(|j| dot(&cols[i], &cols[j])));
     let (zero, one) = (T::zero(), T::one());
     let mut v = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
     for _ in 0..JACOBI_SWEEPS {

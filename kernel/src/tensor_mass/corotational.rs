@@ -65,9 +65,21 @@ impl<T: Real> Block<'_, T> {
             // V σ, symmetric.
             let diagonal = lambda * trace;
             let sigma = [
-                [(diagonal + two_mu * e00) * v, two_mu * e01 * v, two_mu * e02 * v],
-                [two_mu * e01 * v, (diagonal + two_mu * e11) * v, two_mu * e12 * v],
-                [two_mu * e02 * v, two_mu * e12 * v, (diagonal + two_mu * e22) * v],
+                [
+                    (diagonal + two_mu * e00) * v,
+                    two_mu * e01 * v,
+                    two_mu * e02 * v,
+                ],
+                [
+                    two_mu * e01 * v,
+                    (diagonal + two_mu * e11) * v,
+                    two_mu * e12 * v,
+                ],
+                [
+                    two_mu * e02 * v,
+                    two_mu * e12 * v,
+                    (diagonal + two_mu * e22) * v,
+                ],
             ];
             // V P = R (V σ).
             let vp: [[T; 3]; 3] = core::array::from_fn(|i| {

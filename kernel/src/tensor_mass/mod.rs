@@ -38,8 +38,8 @@ pub use edges::{EDGE_LANES, EdgeGroup};
 pub use integrator::Integrator;
 pub use law::{ElasticLaw, StvkForm};
 pub use limits::Limits;
-pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
 pub use model::{DynamicParams, InputError, StepError, StepReport, TensorMassModel};
+pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
 pub use state::{Fault, StateBuffers, StateError, VertexMode};
 pub(crate) use surface::check_lengths;
 pub use surface::{

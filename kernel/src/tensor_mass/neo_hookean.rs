@@ -102,8 +102,9 @@ impl<T: Real> Block<'_, T> {
             let g = -mu * log + lambda * half * log * log + (g1 + half * g2 * d) * d;
             let slope = g1 + g2 * d;
             let f = [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]];
-            let vp: [[T; 3]; 3] =
-                core::array::from_fn(|r| core::array::from_fn(|c| (mu * f[r][c] + slope * cof[r][c]) * v));
+            let vp: [[T; 3]; 3] = core::array::from_fn(|r| {
+                core::array::from_fn(|c| (mu * f[r][c] + slope * cof[r][c]) * v)
+            });
             self.store_gradients(l, &vp, &mut gradients);
             let i1 = f00 * f00
                 + f01 * f01
