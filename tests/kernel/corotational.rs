@@ -54,7 +54,7 @@ fn rotations() -> Vec<Matrix3<f64>> {
         (Vector3::new(1.0, 2.0, 3.0), 0.7),
         (Vector3::new(-1.0, 0.5, 0.2), 2.0),
         (Vector3::new(0.3, -1.0, 0.4), 3.1),
-        (Vector3::new(1.0, 1.0, 0.0), std::f64::consts::PI),
+        (Vector3::new(1.0, 1.0, 0.0), core::f64::consts::PI),
     ]
     .into_iter()
     .map(|(axis, angle)| *Rotation3::new(axis.normalize() * angle).matrix())

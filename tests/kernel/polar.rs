@@ -8,10 +8,7 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 use palpate_kernel::math::polar::closest_rotation;
 use palpate_tests::Lcg;
 
-fn rows<T: Copy>(m: &Matrix3<T>) -> [[T; 3]; 3]
-where
-    T: nalgebra::Scalar,
-{
+fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     [
         [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
         [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
@@ -25,7 +22,7 @@ fn matrix(r: &[[f64; 3]; 3]) -> Matrix3<f64> {
 
 fn random_rotation(rng: &mut Lcg) -> Matrix3<f64> {
     let axis = Vector3::new(rng.signed(), rng.signed(), rng.signed());
-    let angle = std::f64::consts::PI * rng.signed();
+    let angle = core::f64::consts::PI * rng.signed();
     *Rotation3::new(axis.normalize() * angle).matrix()
 }
 
