@@ -34,6 +34,10 @@ pub type Mat3<T> = [[T; 3]; 3];
 /// direction): the frame falls back to a fixed orthogonal choice.
 const TINY2: f64 = 1e-30;
 
+/// Off-diagonal entries of `FᵀF` below this fraction of their diagonal
+/// pair are treated as zero by the Jacobi rotation ([`rotate`]).
+const FLUSH: f64 = 1e-18;
+
 /// The proper rotation closest to `f` (rows), `R = U Vᵀ` of the signed SVD
 /// (see the module documentation). Always inlined, so that a lane loop that
 /// calls it stays one loop.
@@ -115,7 +119,16 @@ fn right_vectors<T: Real>(f: &Mat3<T>) -> Mat3<T> {
 #[inline(always)]
 fn rotate<T: Real>(s: &mut Mat3<T>, v: &mut Mat3<T>, p: usize, q: usize, r: usize) {
     let (zero, one) = (T::zero(), T::one());
-    let (spp, sqq, spq) = (s[p][p], s[q][q], s[p][q]);
+    let (spp, sqq) = (s[p][p], s[q][q]);
+    // An off-diagonal already below 1e-18 of the diagonal counts as zero:
+    // below f64's rounding, and it keeps the squares and products of the
+    // later sweeps out of the subnormal range (f32 below 1.2e-38), whose
+    // arithmetic is a hundred times slower on x86.
+    let spq = if s[p][q].abs() > T::of_f64(FLUSH) * (spp.abs() + sqq.abs()) {
+        s[p][q]
+    } else {
+        zero
+    };
     let tau = sqq - spp;
     let sign = if tau < zero { -one } else { one };
     let denominator = tau.abs() + (tau * tau + T::of_f64(4.0) * spq * spq).sqrt();
