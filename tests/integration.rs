@@ -54,12 +54,15 @@ mod host {
 
 mod kernel {
     mod candidates;
+    mod corotational;
     mod haptic;
     mod haptic_dynamic;
     mod haptic_settle;
     mod haptic_tools;
     mod hybrid;
     mod layers;
+    mod neo_hookean;
+    mod polar;
     mod precomputed;
     mod remap;
     mod stvk;

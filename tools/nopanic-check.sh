@@ -45,8 +45,8 @@ if cargo build --release 2>"$log"; then
         "PrecomputedTable::load, contact_forces::<MAX_CONTACTS>, free_displacements," \
         "displacements (f32, f16, q16 and hmatrix tables); TensorMassTable::load, TensorMassModel::new, reset," \
         "set_external_force, set_velocity, impose, release, clear_external_forces," \
-        "step (explicit Euler, symplectic Euler, RK4, central difference; linear and" \
-        "St Venant-Kirchhoff, incompressibility on and off), remove_tet, cut_with_tool," \
+        "step (explicit Euler, symplectic Euler, RK4, central difference; linear, St Venant-Kirchhoff," \
+        "co-rotational and neo-Hookean, incompressibility on and off), remove_tet, cut_with_tool," \
         "tear, surface_triangles, displacements_m, velocities_m_s, elastic_forces_n, fault;" \
         "HapticLoop::new, tick_tools, reset (pre-computed); DynamicTissue::new, HapticLoop::new," \
         "tick_tools (touch, grip, cut), physics_update (blades, tearing, exposed faces), removed," \

@@ -1,7 +1,8 @@
 //! One symplectic-Euler step of the tensor-mass model per elastic law
 //! (`kernel/src/tensor_mass`), f32 tables (the firmware precision): linear,
 //! St Venant-Kirchhoff per tet, St Venant-Kirchhoff by Picinbono's split
-//! terms, and per tet with the incompressibility penalty. Meshes: the
+//! terms, per tet with the incompressibility penalty, co-rotational and
+//! neo-Hookean (per tet, the same blocks). Meshes: the
 //! generated cylinder (3240 tets), the liver-like organ (5868 tets, the size
 //! of Picinbono's 6342-tet liver) and a 20³-cell tissue cube (48 000 tets);
 //! each fixed at its base, deformed by a 20 % shear first so that every
@@ -9,7 +10,8 @@
 //!
 //! Targets (the non-linear model's speed targets): a St Venant-Kirchhoff step on ~6000 tets in ≤ 200 µs
 //! (5 kHz) on one core; non-linear/linear cost ratio ≤ 2.5 (Picinbono 2001
-//! §3.3: 5×, 9 Hz for 6342 tets on a 600 MHz PIII). Printed after the group:
+//! §3.3: 5×, 9 Hz for 6342 tets on a 600 MHz PIII); co-rotational ≤ 1.6× the
+//! linear step, neo-Hookean ≤ 1.3× St Venant-Kirchhoff per tet. Printed after the group:
 //! steps per second and the ratio to the linear step, per mesh.
 //!
 //! Run: `RUSTFLAGS="-C target-cpu=native" cargo bench -p palpate-benches --bench stvk_step`.
@@ -29,7 +31,7 @@ use palpate_kernel::tensor_mass::{
 };
 
 /// The laws timed, with their penalty γ (N) and a name.
-const LAWS: [(&str, ElasticLaw, Option<f32>); 4] = [
+const LAWS: [(&str, ElasticLaw, Option<f32>); 6] = [
     ("linear", ElasticLaw::Linear, None),
     (
         "stvk_per_tet",
@@ -46,6 +48,8 @@ const LAWS: [(&str, ElasticLaw, Option<f32>); 4] = [
         ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
         Some(0.5),
     ),
+    ("corotational", ElasticLaw::Corotational, None),
+    ("neo_hookean", ElasticLaw::NeoHookean, None),
 ];
 
 fn meshes() -> Vec<(&'static str, TetMesh)> {

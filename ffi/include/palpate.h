@@ -658,6 +658,14 @@ enum palpate_law
    triangles and tets (Picinbono 2001 eq. 13-15; more memory).
    */
   PALPATE_LAW_STVK_TENSORS = 2,
+  /*
+   Co-rotational linear, per tet (Muller & Gross 2004).
+   */
+  PALPATE_LAW_COROTATIONAL = 3,
+  /*
+   Compressible neo-Hookean, per tet (Bonet & Wood).
+   */
+  PALPATE_LAW_NEO_HOOKEAN = 4,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L

@@ -247,6 +247,10 @@ pub enum Law {
     /// St Venant-Kirchhoff by the split terms on vertices, edges,
     /// triangles and tets (Picinbono 2001 eq. 13-15; more memory).
     StvkTensors = 2,
+    /// Co-rotational linear, per tet (Muller & Gross 2004).
+    Corotational = 3,
+    /// Compressible neo-Hookean, per tet (Bonet & Wood).
+    NeoHookean = 4,
 }
 
 /// The explicit integrator (`palpate_physics_config::integrator`).
@@ -327,6 +331,8 @@ impl PhysicsConfig {
             l if l == Law::StvkTensors as u32 => {
                 Ok(ElasticLaw::StVenantKirchhoff(StvkForm::Tensors))
             }
+            l if l == Law::Corotational as u32 => Ok(ElasticLaw::Corotational),
+            l if l == Law::NeoHookean as u32 => Ok(ElasticLaw::NeoHookean),
             _ => Err(Status::BadArgument),
         }
     }

@@ -15,8 +15,8 @@ use palpate::output::stderr;
 mod commands;
 
 use commands::{
-    bench, budget, chart, demo, dynamic, experiment, precomputed, remap, scene, session, stvk,
-    tables,
+    bench, budget, chart, demo, dynamic, experiment, forces, precomputed, remap, scene, session,
+    stvk, tables,
 };
 
 #[derive(Parser)]
@@ -44,6 +44,10 @@ enum Command {
     /// The St Venant-Kirchhoff force (Picinbono 2001, MODELS.md §4).
     #[command(subcommand)]
     Stvk(stvk::StvkCommand),
+    /// Internal elastic forces (−∂W/∂x, free body) and energy of a deformed
+    /// mesh under a per-tet law: St Venant-Kirchhoff, neo-Hookean,
+    /// co-rotational (MODELS.md §4, §8).
+    Forces(forces::ForcesArgs),
     /// Experiments that reproduce the papers' figures.
     #[command(subcommand)]
     Experiment(experiment::ExperimentCommand),
@@ -98,6 +102,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> anyhow::Result<()> {
         Command::Precomputed(command) => precomputed::run(command, group),
         Command::Dynamic(command) => dynamic::run(command),
         Command::Stvk(command) => stvk::run(command),
+        Command::Forces(args) => forces::run(&args),
         Command::Experiment(command) => experiment::run(command),
         Command::Remap(command) => remap::run(command),
         Command::Session(command) => session::run(command),

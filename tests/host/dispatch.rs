@@ -140,10 +140,10 @@ fn dispatched_steps_equal_portable_steps_bit_for_bit() {
             compared += check_steps::<f64>(&mesh, Precision::F64, level);
         }
     }
-    // 5 laws (linear; St Venant-Kirchhoff per tet and split terms, each
-    // with and without the penalty) × 4 integrators × 2 precisions × 2
-    // meshes, per level.
-    assert_eq!(compared, 5 * 4 * 2 * 2 * levels.len());
+    // 9 laws (linear; St Venant-Kirchhoff per tet and split terms,
+    // co-rotational and neo-Hookean, each with and without the penalty) × 4
+    // integrators × 2 precisions × 2 meshes, per level.
+    assert_eq!(compared, 9 * 4 * 2 * 2 * levels.len());
 }
 
 /// The pre-computed tables of the update check: dense, and (f32) compressed

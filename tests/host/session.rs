@@ -216,6 +216,20 @@ fn dynamic_defaults_step_once_per_physics_period() {
         assert_eq!(d.integrator, integrator);
         assert_eq!(d.law, ElasticLaw::StVenantKirchhoff(StvkForm::PerTet));
     }
+    // The per-tet laws without a form.
+    for (name, law) in [
+        ("corotational", ElasticLaw::Corotational),
+        ("neo-hookean", ElasticLaw::NeoHookean),
+    ] {
+        let s = scene(&format!(
+            "mesh = \"a.msh\"\n[material]\nyoung_pa = 3000\npoisson = 0.45\n\
+             [model]\nkind = \"dynamic\"\nlaw = \"{name}\"\ndamping_per_s = 0\n"
+        ));
+        let ModelSpec::Dynamic(d) = s.model else {
+            panic!("not dynamic")
+        };
+        assert_eq!((d.law, d.incompressibility_n), (law, None));
+    }
 }
 
 #[test]
@@ -334,8 +348,8 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
             "bad.toml: line 7: unknown variant `hybrid`, expected `precomputed` or `dynamic`",
         ),
         (
-            dynamic("law = \"neo-hookean\"\ndamping_per_s = 1\n"),
-            "bad.toml: line 8: unknown variant `neo-hookean`, expected one of `linear`, `stvk`, `stvk-incompressible`",
+            dynamic("law = \"mooney-rivlin\"\ndamping_per_s = 1\n"),
+            "bad.toml: line 8: unknown variant `mooney-rivlin`, expected one of `linear`, `stvk`, `stvk-incompressible`, `corotational`, `neo-hookean`",
         ),
         (
             format!("{BASE_SCENE}density = 1000\n"),
@@ -451,6 +465,14 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
         (
             dynamic("form = \"tensors\"\ndamping_per_s = 1\n"),
             "bad.toml: [model] form: applies to law = \"stvk\" or \"stvk-incompressible\" only",
+        ),
+        (
+            dynamic("law = \"neo-hookean\"\nform = \"per-tet\"\ndamping_per_s = 1\n"),
+            "bad.toml: [model] form: applies to law = \"stvk\" or \"stvk-incompressible\" only",
+        ),
+        (
+            dynamic("law = \"corotational\"\nincompressibility_n = 1\ndamping_per_s = 1\n"),
+            "bad.toml: [model] incompressibility_n: applies to law = \"stvk-incompressible\" only",
         ),
         (
             dynamic("law = \"stvk-incompressible\"\nincompressibility_n = -1\ndamping_per_s = 1\n"),

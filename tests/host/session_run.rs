@@ -220,7 +220,8 @@ fn dynamic_slide_crosses_triangles_and_writes_frames() {
 
 /// A dynamic scene runs with every elastic law the scene file offers
 /// (linear, St Venant-Kirchhoff per tet and in Picinbono's tensor form,
-/// with the incompressibility penalty), on a coarse block: the poke makes
+/// with the incompressibility penalty, co-rotational, neo-Hookean), on a
+/// coarse block: the poke makes
 /// contact, pushes the probe out, and no physics update fails. The two St
 /// Venant-Kirchhoff forms compute the same forces, so their peaks agree to
 /// f32 rounding (measured 9e-8 relative; bound 1e-5).
@@ -237,6 +238,8 @@ fn dynamic_sessions_run_with_every_law() {
         (ElasticLaw::StVenantKirchhoff(StvkForm::PerTet), None),
         (ElasticLaw::StVenantKirchhoff(StvkForm::Tensors), None),
         (ElasticLaw::StVenantKirchhoff(StvkForm::PerTet), Some(0.05)),
+        (ElasticLaw::Corotational, None),
+        (ElasticLaw::NeoHookean, None),
     ];
     let trajectory = Poke::default().trajectory().expect("poke");
     let mut peaks = Vec::new();

@@ -138,7 +138,7 @@ fn a_malformed_recording_is_refused_with_its_reason() {
         (with_word(2, 5), RecordingError::Points(5)),
         // The dynamic flag, then the law.
         (with_word(9, 2), RecordingError::Code(9)),
-        (with_word(10, 3), RecordingError::Code(10)),
+        (with_word(10, 5), RecordingError::Code(10)),
         (
             good[..good.len() - 4].to_vec(),
             RecordingError::Length {

@@ -498,7 +498,7 @@ static void test_dynamic_loop(const char *path, const char *tensor_path) {
     EXPECT(PALPATE_STATUS_BAD_ARGUMENT,
            palpate_dynamic_loop_create(loop, &table, &config, &bad, memory, bytes, &error));
     bad = physics;
-    bad.law = 3;
+    bad.law = 5;
     EXPECT(PALPATE_STATUS_BAD_ARGUMENT,
            palpate_dynamic_loop_create(loop, &table, &config, &bad, memory, bytes, &error));
     bad = physics;
@@ -593,10 +593,11 @@ static void test_dynamic_loop(const char *path, const char *tensor_path) {
     EXPECT(PALPATE_STATUS_OK, palpate_dynamic_loop_displacements(loop, u, VERTICES, &error));
 
     /* Every law and integrator builds and steps over its own memory size. */
-    const uint32_t laws[] = {PALPATE_LAW_LINEAR, PALPATE_LAW_STVK, PALPATE_LAW_STVK_TENSORS};
+    const uint32_t laws[] = {PALPATE_LAW_LINEAR, PALPATE_LAW_STVK, PALPATE_LAW_STVK_TENSORS,
+                             PALPATE_LAW_COROTATIONAL, PALPATE_LAW_NEO_HOOKEAN};
     const uint32_t integrators[] = {PALPATE_INTEGRATOR_EXPLICIT_EULER, PALPATE_INTEGRATOR_SYMPLECTIC_EULER,
                                     PALPATE_INTEGRATOR_RK4, PALPATE_INTEGRATOR_CENTRAL_DIFFERENCE};
-    for (size_t l = 0; l < 3; l++) {
+    for (size_t l = 0; l < 5; l++) {
         for (size_t i = 0; i < 4; i++) {
             palpate_physics_config p = physics;
             p.law = laws[l];

@@ -39,17 +39,23 @@ pub enum BenchModel {
     StvkIncompressible,
     /// St Venant-Kirchhoff split terms with the incompressibility penalty.
     StvkTensorsIncompressible,
+    /// Co-rotational linear, per tet.
+    Corotational,
+    /// Neo-Hookean, per tet.
+    NeoHookean,
 }
 
 impl BenchModel {
     /// Every model, in the order a run measures them.
-    pub const ALL: [BenchModel; 6] = [
+    pub const ALL: [BenchModel; 8] = [
         BenchModel::Precomputed,
         BenchModel::Linear,
         BenchModel::Stvk,
         BenchModel::StvkTensors,
         BenchModel::StvkIncompressible,
         BenchModel::StvkTensorsIncompressible,
+        BenchModel::Corotational,
+        BenchModel::NeoHookean,
     ];
 
     /// The tensor-mass law and whether the penalty is on; `None` for the
@@ -63,6 +69,8 @@ impl BenchModel {
             BenchModel::StvkTensors => Some((stvk(StvkForm::Tensors), false)),
             BenchModel::StvkIncompressible => Some((stvk(StvkForm::PerTet), true)),
             BenchModel::StvkTensorsIncompressible => Some((stvk(StvkForm::Tensors), true)),
+            BenchModel::Corotational => Some((ElasticLaw::Corotational, false)),
+            BenchModel::NeoHookean => Some((ElasticLaw::NeoHookean, false)),
         }
     }
 }
@@ -95,7 +103,8 @@ pub struct What {
     /// `force-path`, `displacement-update`, `haptic-tick` or `step`.
     pub group: &'static str,
     /// `precomputed`, or the tensor-mass law (`linear`, `stvk`,
-    /// `stvk-tensors`, `stvk-incompressible`, `stvk-tensors-incompressible`).
+    /// `stvk-tensors`, `stvk-incompressible`, `stvk-tensors-incompressible`,
+    /// `corotational`, `neo-hookean`).
     pub model: &'static str,
     /// The step's integrator (`euler`, `symplectic`, `rk4`, `central`),
     /// `null` for the pre-computed model.

@@ -59,8 +59,9 @@ pub struct StepConfig {
 impl StepConfig {
     /// The law, form and penalty as `palpate bench --models` names them:
     /// `linear`, `stvk`, `stvk-tensors`, `stvk-incompressible`,
-    /// `stvk-tensors-incompressible` (a linear law with the penalty is
-    /// `linear-incompressible`, which no command measures).
+    /// `stvk-tensors-incompressible`, `corotational`, `neo-hookean` (a
+    /// linear, co-rotational or neo-Hookean law with the penalty is
+    /// `…-incompressible`, which no command measures).
     pub fn model_name(&self) -> &'static str {
         let penalty = self.incompressibility_n.is_some();
         match (self.law, penalty) {
@@ -72,6 +73,10 @@ impl StepConfig {
             (ElasticLaw::StVenantKirchhoff(StvkForm::Tensors), true) => {
                 "stvk-tensors-incompressible"
             }
+            (ElasticLaw::Corotational, false) => "corotational",
+            (ElasticLaw::Corotational, true) => "corotational-incompressible",
+            (ElasticLaw::NeoHookean, false) => "neo-hookean",
+            (ElasticLaw::NeoHookean, true) => "neo-hookean-incompressible",
         }
     }
 }
@@ -116,7 +121,8 @@ impl StepCounts {
     /// - linear force pass: vertex tensors (9 scalars each), the edge
     ///   groups (36 scalars and 4 columns of 4 bytes each) and their row
     ///   starts (4 bytes each), `u` and `f` (3 each);
-    /// - per-tet St Venant-Kirchhoff pass, and the penalty's pass: the tets
+    /// - per-tet pass (St Venant-Kirchhoff, co-rotational, neo-Hookean),
+    ///   and the penalty's pass: the tets
     ///   (16 bytes), rest shapes (13 scalars), Lamé pairs (2), alive flags
     ///   (1 byte), `u` and `f`;
     /// - split terms: the linear pass, then the terms' pass over vertices
@@ -146,7 +152,9 @@ impl StepCounts {
             + 2 * vector;
         let law = match config.law {
             ElasticLaw::Linear => linear,
-            ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => tet_pass,
+            ElasticLaw::StVenantKirchhoff(StvkForm::PerTet)
+            | ElasticLaw::Corotational
+            | ElasticLaw::NeoHookean => tet_pass,
             ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => linear + terms,
         };
         let forces = law

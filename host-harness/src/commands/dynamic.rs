@@ -43,8 +43,9 @@ pub enum DynamicCommand {
         /// Tets to remove before the first step: <i>,<j>,...
         #[arg(long = "cut-tets", value_delimiter = ',')]
         cut_tets: Vec<u32>,
-        /// Elastic law: linear tensor-mass, St Venant-Kirchhoff, or St
-        /// Venant-Kirchhoff with the incompressibility penalty.
+        /// Elastic law: linear tensor-mass, St Venant-Kirchhoff, St
+        /// Venant-Kirchhoff with the incompressibility penalty,
+        /// co-rotational linear, or neo-Hookean (the last two per tet).
         #[arg(long = "model", value_enum, default_value = "linear")]
         law: ModelArg,
         /// How the St Venant-Kirchhoff force is evaluated.
@@ -166,6 +167,8 @@ pub enum ModelArg {
     Linear,
     Stvk,
     StvkIncompressible,
+    Corotational,
+    NeoHookean,
 }
 
 impl ModelArg {
@@ -179,6 +182,8 @@ impl ModelArg {
         match (self, incompressibility) {
             (ModelArg::Linear, None) => Ok((ElasticLaw::Linear, None)),
             (ModelArg::Stvk, None) => Ok((stvk, None)),
+            (ModelArg::Corotational, None) => Ok((ElasticLaw::Corotational, None)),
+            (ModelArg::NeoHookean, None) => Ok((ElasticLaw::NeoHookean, None)),
             (ModelArg::StvkIncompressible, Some(gamma)) if gamma.is_finite() && gamma >= 0.0 => {
                 Ok((stvk, Some(gamma)))
             }

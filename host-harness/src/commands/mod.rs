@@ -10,6 +10,7 @@ pub mod chart;
 pub mod demo;
 pub mod dynamic;
 pub mod experiment;
+pub mod forces;
 pub mod precomputed;
 pub mod remap;
 pub mod scene;

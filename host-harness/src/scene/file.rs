@@ -14,7 +14,8 @@
 //!
 //! [model]                      # default: kind = "precomputed"
 //! kind = "dynamic"             # "precomputed" or "dynamic"; the keys below are dynamic-only
-//! law = "stvk"                 # "linear" (default), "stvk" or "stvk-incompressible"
+//! law = "stvk"                 # "linear" (default), "stvk", "stvk-incompressible",
+//!                              # "corotational" or "neo-hookean"
 //! form = "per-tet"             # St Venant-Kirchhoff form: "per-tet" (default) or "tensors"
 //! integrator = "symplectic"    # "euler", "symplectic" (default), "rk4" or "central"
 //! dt_s = 0.0005                # default: the physics period (physics_every / haptic_hz)
@@ -168,6 +169,8 @@ enum LawName {
     Linear,
     Stvk,
     StvkIncompressible,
+    Corotational,
+    NeoHookean,
 }
 
 #[derive(Clone, Copy, Deserialize)]
@@ -533,7 +536,11 @@ fn model_spec(
         Some(FormName::Tensors) => StvkForm::Tensors,
     };
     let law_name = raw.law.unwrap_or(LawName::Linear);
-    if matches!(law_name, LawName::Linear) && raw.form.is_some() {
+    let per_tet_only = matches!(
+        law_name,
+        LawName::Linear | LawName::Corotational | LawName::NeoHookean
+    );
+    if per_tet_only && raw.form.is_some() {
         return Err((
             "[model] form".into(),
             "applies to law = \"stvk\" or \"stvk-incompressible\" only".into(),
@@ -542,6 +549,8 @@ fn model_spec(
     let (law, incompressibility_n) = match (law_name, raw.incompressibility_n) {
         (LawName::Linear, None) => (ElasticLaw::Linear, None),
         (LawName::Stvk, None) => (ElasticLaw::StVenantKirchhoff(form), None),
+        (LawName::Corotational, None) => (ElasticLaw::Corotational, None),
+        (LawName::NeoHookean, None) => (ElasticLaw::NeoHookean, None),
         (LawName::StvkIncompressible, Some(gamma)) => {
             (ElasticLaw::StVenantKirchhoff(form), Some(gamma))
         }

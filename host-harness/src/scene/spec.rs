@@ -31,7 +31,9 @@ pub enum ModelSpec {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicSpec {
     /// The elastic law: `law = "linear"` → [`ElasticLaw::Linear`], `"stvk"` and
-    /// `"stvk-incompressible"` → [`ElasticLaw::StVenantKirchhoff`] in the given `form`.
+    /// `"stvk-incompressible"` → [`ElasticLaw::StVenantKirchhoff`] in the given `form`,
+    /// `"corotational"` → [`ElasticLaw::Corotational`], `"neo-hookean"` →
+    /// [`ElasticLaw::NeoHookean`].
     pub law: ElasticLaw,
     /// Incompressibility penalty `γ`, N (Picinbono 2001 §3.2): `Some` exactly for
     /// `law = "stvk-incompressible"`, finite and ≥ 0.

@@ -98,6 +98,10 @@ impl SceneModel {
             (ElasticLaw::Linear, true) => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
             (law, _) => law,
         };
+        // The penalty corrects St Venant-Kirchhoff's softening in
+        // compression; a scene's neo-Hookean law has its own volume energy
+        // and a co-rotational one is linear in volume: neither takes it.
+        let penalty = penalty && matches!(law, ElasticLaw::StVenantKirchhoff(_));
         let incompressibility_n = match (spec.incompressibility_n, penalty) {
             (None, true) => {
                 let (region, _) = sub_mesh(mesh, &dynamic);

@@ -383,9 +383,10 @@ fn dynamic_run_prints_the_contract_json() {
     assert_eq!(out.status.code(), Some(2));
 }
 
-/// `dynamic run --model stvk|stvk-incompressible`: the same JSON contract;
-/// under the same load the St Venant-Kirchhoff cube moves (not the same as
-/// the linear one at this 10 % strain), and the penalty needs its γ.
+/// `dynamic run --model stvk|stvk-incompressible|corotational|neo-hookean`:
+/// the same JSON contract; under the same load the St Venant-Kirchhoff cube
+/// moves (not the same as the linear one at this 10 % strain), every law
+/// presses the loaded vertex down, and the penalty needs its γ.
 #[test]
 fn dynamic_run_takes_the_elastic_law() {
     let common = [
@@ -406,6 +407,8 @@ fn dynamic_run_takes_the_elastic_law() {
         &["--model", "stvk"],
         &["--model", "stvk", "--form", "tensors"],
         &["--model", "stvk-incompressible", "--incompressibility", "5"],
+        &["--model", "corotational"],
+        &["--model", "neo-hookean"],
     ] {
         let out = dynamic_run(&[&common[..], model].concat());
         assert!(
@@ -417,7 +420,10 @@ fn dynamic_run_takes_the_elastic_law() {
         assert!(json["fault"].is_null(), "{model:?}: {json}");
         tips.push(json["displacements"][194][2].as_f64().unwrap());
     }
-    println!("vertex 194 z displacement, linear / StVK / StVK tensors / + penalty: {tips:?}");
+    println!(
+        "vertex 194 z displacement, linear / StVK / StVK tensors / + penalty / co-rotational / \
+         neo-Hookean: {tips:?}"
+    );
     assert!(tips.iter().all(|&z| z < 0.0));
     assert_ne!(tips[0], tips[1]);
     // The two St Venant-Kirchhoff forms agree to rounding (f64).

@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use super::coupling::CouplingForces;
 use super::edges::{EdgeTensors, add_edge_forces};
 use super::law::{ElasticLaw, StvkForm};
-use super::stvk::TetPass;
+use super::stvk::{Block, TetPass, TetTerms};
 use super::stvk_terms::NonLinearTerms;
 use crate::Real;
 use crate::math::Dispatch;
@@ -37,12 +37,10 @@ impl<T: Real> InternalForces<'_, '_, T> {
     pub(crate) fn forces(&self, dispatch: impl Dispatch, u: &[[T; 3]], f: &mut [[T; 3]]) {
         match self.law {
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
-                f.fill([T::zero(); 3]);
-                dispatch.run(
-                    #[inline(always)]
-                    || self.tets.add_stvk_forces(u, f),
-                );
+                self.per_tet_forces(dispatch, u, f, |b| b.elastic());
             }
+            ElasticLaw::NeoHookean => self.per_tet_forces(dispatch, u, f, |b| b.neo_hookean()),
+            ElasticLaw::Corotational => self.per_tet_forces(dispatch, u, f, |b| b.corotational()),
             // One call site of the (always inlined) linear pass for both
             // laws that read the tensors: one copy of it in the firmware.
             law => {
@@ -68,6 +66,23 @@ impl<T: Real> InternalForces<'_, '_, T> {
         }
     }
 
+    /// Overwrites `f` with the forces (N) of a per-tet `law` at
+    /// displacements `u` (m), the pass run through `dispatch`.
+    #[inline(always)]
+    fn per_tet_forces(
+        &self,
+        dispatch: impl Dispatch,
+        u: &[[T; 3]],
+        f: &mut [[T; 3]],
+        law: impl Fn(&Block<'_, T>) -> TetTerms<T>,
+    ) {
+        f.fill([T::zero(); 3]);
+        dispatch.run(
+            #[inline(always)]
+            || self.tets.add_tet_forces(u, f, law),
+        );
+    }
+
     /// The elastic energy (J) of displacements `u` (m) under the law, plus
     /// a coupled pre-computed region's ([`CouplingForces::energy_j`]); the
     /// incompressibility penalty has no energy (its force is not a gradient)
@@ -88,7 +103,11 @@ impl<T: Real> InternalForces<'_, '_, T> {
         coupled
             + match self.law {
                 ElasticLaw::Linear => quadratic(),
-                ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => self.tets.stvk_energy_j(u),
+                ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
+                    self.tets.tet_energy_j(u, |b| b.elastic())
+                }
+                ElasticLaw::NeoHookean => self.tets.tet_energy_j(u, |b| b.neo_hookean()),
+                ElasticLaw::Corotational => self.tets.tet_energy_j(u, |b| b.corotational()),
                 ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => {
                     quadratic() + self.terms.energy_j(u)
                 }

@@ -11,6 +11,17 @@ pub enum ElasticLaw {
     /// invariant, evaluated in the given form (both give the same force to
     /// rounding).
     StVenantKirchhoff(StvkForm),
+    /// Co-rotational linear elasticity (stiffness warping, Müller & Gross
+    /// 2004; MODELS.md §8), tet by tet: the linear force in each tet's
+    /// rotated frame, `f_e = −R K_e (Rᵀ x_e − X_e)`, `R` the closest
+    /// rotation to the tet's deformation gradient. Rotation invariant; the
+    /// linear law's stiffness at rest.
+    Corotational,
+    /// Compressible neo-Hookean (Bonet & Wood; MODELS.md §8), tet by tet,
+    /// with the volume energy continued quadratically below
+    /// [`crate::tensor_mass::NEO_HOOKEAN_J_FLOOR`] so that inverted tets get
+    /// a finite restoring force.
+    NeoHookean,
 }
 
 /// How the St Venant-Kirchhoff force is evaluated.
@@ -27,9 +38,11 @@ pub enum StvkForm {
 
 impl ElasticLaw {
     /// Every law and form, in documentation order.
-    pub const ALL: [ElasticLaw; 3] = [
+    pub const ALL: [ElasticLaw; 5] = [
         ElasticLaw::Linear,
         ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
         ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
+        ElasticLaw::Corotational,
+        ElasticLaw::NeoHookean,
     ];
 }

@@ -17,6 +17,7 @@
 //! model as a tissue). Depends on [`crate::math`], [`crate::table`] and
 //! [`crate::contact`].
 
+mod corotational;
 mod coupling;
 mod cut;
 mod edges;
@@ -25,6 +26,7 @@ mod integrator;
 mod law;
 mod limits;
 mod model;
+mod neo_hookean;
 mod state;
 mod stvk;
 pub mod stvk_terms;
@@ -37,6 +39,7 @@ pub use integrator::Integrator;
 pub use law::{ElasticLaw, StvkForm};
 pub use limits::Limits;
 pub use model::{DynamicParams, InputError, StepError, StepReport, TensorMassModel};
+pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
 pub use state::{Fault, StateBuffers, StateError, VertexMode};
 pub(crate) use surface::check_lengths;
 pub use surface::{

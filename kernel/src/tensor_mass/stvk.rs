@@ -27,10 +27,14 @@ pub(crate) struct TetPass<'b, 'a, T: Real> {
 /// `[T; LANES]` arrays, which the compiler turns into SIMD operations (8 f32
 /// per AVX2 register), while gathering and scattering stay per tet. The
 /// table's `tet-lanes` blocks hold the rest data in this layout.
-const LANES: usize = TET_LANES;
+pub(super) const LANES: usize = TET_LANES;
 
 /// One value per lane.
-type Lanes<T> = [T; LANES];
+pub(super) type Lanes<T> = [T; LANES];
+
+/// What a per-tet law computes for a block: per lane, the gradients
+/// `V P a_j` (N, `j = 1..3`, by component) and the energies (J).
+pub(super) type TetTerms<T> = ([[Lanes<T>; 3]; 3], Lanes<T>);
 
 /// Lane `l` of three per-lane rows: `[x, y, z]` (zero for a lane out of range).
 #[inline(always)]
@@ -52,11 +56,11 @@ fn lane<T: Real>(rows: &[Lanes<T>; 3], l: usize) -> [T; 3] {
 /// (cut, torn, or past the last tet) has zero edge displacements, so
 /// `F = I`, and computes a zero force, energy and penalty; it is not
 /// scattered.
-struct Block<'t, T> {
+pub(super) struct Block<'t, T> {
     corners: [[u32; 4]; LANES],
     live: [bool; LANES],
     du: [[Lanes<T>; 3]; 3],
-    rest: &'t TetLanes<T>,
+    pub(super) rest: &'t TetLanes<T>,
 }
 
 // The lane loops index fixed-size arrays with literals < 3 and loop
@@ -87,7 +91,7 @@ impl<'t, T: Real> Block<'t, T> {
 
     /// Gradient component `c` of `a_{j+1}`, per lane.
     #[inline(always)]
-    fn a(&self, j: usize, c: usize) -> &'t Lanes<T> {
+    pub(super) fn a(&self, j: usize, c: usize) -> &'t Lanes<T> {
         &self.rest[3 * j + c]
     }
 
@@ -95,7 +99,7 @@ impl<'t, T: Real> Block<'t, T> {
     /// by entry (no `from_fn` loop) so the lane loops that call it stay
     /// vectorizable.
     #[inline(always)]
-    fn deformation(&self, l: usize) -> [[T; 3]; 3] {
+    pub(super) fn deformation(&self, l: usize) -> [[T; 3]; 3] {
         let (du, one) = (&self.du, T::one());
         let g = |r: usize, c: usize| {
             du[0][r][l] * self.a(0, c)[l]
@@ -109,6 +113,23 @@ impl<'t, T: Real> Block<'t, T> {
         ]
     }
 
+    /// Stores lane `l`'s gradients `(V P) a_j` (N, `j = 1..3`) from `vp`,
+    /// the first Piola-Kirchhoff stress times the rest volume (N·m, rows).
+    #[inline(always)]
+    pub(super) fn store_gradients(
+        &self,
+        l: usize,
+        vp: &[[T; 3]; 3],
+        gradients: &mut [[Lanes<T>; 3]; 3],
+    ) {
+        for (j, out) in gradients.iter_mut().enumerate() {
+            let (g0, g1, g2) = (self.a(j, 0)[l], self.a(j, 1)[l], self.a(j, 2)[l]);
+            for (row, p) in out.iter_mut().zip(vp) {
+                row[l] = p[0] * g0 + p[1] * g1 + p[2] * g2;
+            }
+        }
+    }
+
     /// Per lane, the gradients `V P a_j` (N, `j = 1..3`, by component) of
     /// the St Venant-Kirchhoff energy, `P = F S`, whose negatives are the
     /// forces on corners 1–3 (corner 0 takes minus their sum, since
@@ -118,7 +139,7 @@ impl<'t, T: Real> Block<'t, T> {
     /// One loop over the lanes with a branch-free body on
     /// structure-of-arrays data: the form the compiler vectorizes.
     #[inline(always)]
-    fn elastic(&self) -> ([[Lanes<T>; 3]; 3], Lanes<T>) {
+    pub(super) fn elastic(&self) -> TetTerms<T> {
         let z = [T::zero(); LANES];
         let mut gradients = [[z; 3]; 3];
         let mut energy = z;
@@ -268,17 +289,25 @@ impl<T: Real> TetPass<'_, '_, T> {
         }
     }
 
-    /// Adds to `f` (N) the St Venant-Kirchhoff forces `f_j = −V F S a_j`
-    /// of displacements `u` (m) with each tet's Lamé coefficients (Pa),
-    /// see [`Block::elastic`]. Always inlined, with its block visit, so that
-    /// a [`crate::math::Dispatch`] compiles it where it runs.
+    /// Adds to `f` (N) the forces `f_j = −V P a_j` of displacements `u`
+    /// (m) under a per-tet law: `law` gives a block's gradients `V P a_j`
+    /// (`j = 1..3`) and energies ([`Block::elastic`] for St Venant-Kirchhoff,
+    /// [`Block::neo_hookean`], [`Block::corotational`]); corner 0 takes
+    /// minus their sum (`a_0 = −(a_1 + a_2 + a_3)`). Always inlined, with its
+    /// block visit, so that a [`crate::math::Dispatch`] compiles it where it
+    /// runs.
     #[inline(always)]
-    pub(crate) fn add_stvk_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
+    pub(super) fn add_tet_forces(
+        &self,
+        u: &[[T; 3]],
+        f: &mut [[T; 3]],
+        law: impl Fn(&Block<'_, T>) -> TetTerms<T>,
+    ) {
         self.for_each_block(
             u,
             #[inline(always)]
             |block| {
-                let ([r1, r2, r3], _) = block.elastic();
+                let ([r1, r2, r3], _) = law(block);
                 for (l, tet) in block.corners.iter().enumerate() {
                     if block.live.get(l) != Some(&true) {
                         continue;
@@ -324,13 +353,17 @@ impl<T: Real> TetPass<'_, '_, T> {
         );
     }
 
-    /// The St Venant-Kirchhoff energy `Σ V (λ/2 (tr E)² + μ tr E²)` (J) of
-    /// displacements `u` (m), each tet with its own `λ`, `μ`.
-    pub(crate) fn stvk_energy_j(&self, u: &[[T; 3]]) -> T {
+    /// The energy `Σ V ψ` (J) of displacements `u` (m) under a per-tet law
+    /// (see [`Self::add_tet_forces`]), each tet with its own `λ`, `μ`.
+    pub(super) fn tet_energy_j(
+        &self,
+        u: &[[T; 3]],
+        law: impl Fn(&Block<'_, T>) -> TetTerms<T>,
+    ) -> T {
         let mut energy = T::zero();
         self.for_each_block(u, |block| {
             // A lane without a live tet has `F = I`: zero energy.
-            let (_, w) = block.elastic();
+            let (_, w) = law(block);
             for x in w {
                 energy += x;
             }

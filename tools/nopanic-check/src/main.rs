@@ -23,7 +23,7 @@
 //! - table validation, `TensorMassTable::load`;
 //! - `TensorMassModel::new` (buffer-length and parameter checks) and `reset`, on
 //!   `StateBuffers` sliced from fixed-capacity arrays, with each
-//!   `ElasticLaw` (linear, St Venant-Kirchhoff) and the incompressibility
+//!   `ElasticLaw` (linear, St Venant-Kirchhoff, co-rotational, neo-Hookean) and the incompressibility
 //!   penalty on or off;
 //! - the inputs `set_external_force`, `set_velocity`, `impose`, `release`,
 //!   `clear_external_forces`;
@@ -839,7 +839,7 @@ struct TensorInputs {
     rounds: u32,
     /// Non-zero: `reset` at the start of the round.
     reset: u8,
-    /// `ElasticLaw` by index (any value: taken modulo 3; the tensor form of
+    /// `ElasticLaw` by index (any value: taken modulo 5; the tensor form of
     /// St Venant-Kirchhoff is refused by `new` without the term buffers).
     law: u8,
     /// Non-zero: the incompressibility penalty is on, with this `γ`, N.
@@ -1086,10 +1086,12 @@ fn integrator(code: u8) -> Integrator {
 /// The dynamic parameters of `inputs` (law, penalty, damping, gravity,
 /// divergence limits).
 fn params(inputs: &TensorInputs) -> DynamicParams<f32> {
-    let law = match inputs.law % 3 {
+    let law = match inputs.law % 5 {
         0 => ElasticLaw::Linear,
         1 => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
-        _ => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
+        2 => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
+        3 => ElasticLaw::Corotational,
+        _ => ElasticLaw::NeoHookean,
     };
     DynamicParams::linear(inputs.damping_per_s, inputs.max_displacement_m)
         .with_law(law)

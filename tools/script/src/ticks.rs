@@ -289,6 +289,8 @@ fn params_words(p: &DynamicParams<f32>) -> [u32; DYNAMIC_WORDS] {
         ElasticLaw::Linear => 0,
         ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => 1,
         ElasticLaw::StVenantKirchhoff(StvkForm::Tensors) => 2,
+        ElasticLaw::Corotational => 3,
+        ElasticLaw::NeoHookean => 4,
     };
     let (penalty, gamma) = option_words(p.incompressibility_n);
     [
@@ -376,6 +378,8 @@ impl Words<'_> {
                 0 => ElasticLaw::Linear,
                 1 => ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
                 2 => ElasticLaw::StVenantKirchhoff(StvkForm::Tensors),
+                3 => ElasticLaw::Corotational,
+                4 => ElasticLaw::NeoHookean,
                 _ => return Err(RecordingError::Code(at)),
             },
             incompressibility_n: self.option(at + 1)?,
