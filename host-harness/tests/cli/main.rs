@@ -19,6 +19,7 @@ mod bench;
 mod chart;
 mod contract;
 mod dynamic_scene;
+mod forces;
 mod remap;
 mod robustness;
 mod scene_plan;

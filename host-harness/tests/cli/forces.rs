@@ -3,9 +3,7 @@
 //! to minus the central difference of the printed energy, and the
 //! co-rotational energy `null` with zero forces under a rigid rotation.
 
-mod common;
-
-use common::{palpate, reference, temp};
+use crate::common::{palpate, reference, temp};
 
 /// The cube (216 vertices, cells of 0.2 m) with every vertex moved by a
 /// deterministic pattern of up to 0.03 m per axis (strains of 10–20 %).
