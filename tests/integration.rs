@@ -38,6 +38,7 @@ mod host {
     mod partition;
     mod remap;
     mod robustness;
+    mod scene_tables;
     mod session;
     mod session_generate_tools;
     mod session_hybrid;

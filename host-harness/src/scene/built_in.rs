@@ -14,6 +14,7 @@ use super::spec::{
     DEFAULT_MAX_FORCE_N, DEFAULT_MAX_SLEW_N_PER_S, DEFAULT_PHYSICS_EVERY, DynamicSpec, ModelSpec,
     Rates, Scene, TearingSpec,
 };
+use super::tables::TablesSpec;
 use super::tool::{DEFAULT_TOOL_POINTS, DEFAULT_TOOL_RADIUS_M, ToolKind, ToolSpec};
 use super::zones::{PartitionSpec, Zone, ZoneKind, ZoneShape};
 use crate::fem::material::Material;
@@ -114,6 +115,7 @@ impl Scene {
             },
             zones: Vec::new(),
             partition: PartitionSpec::default(),
+            tables: TablesSpec::default(),
         }
     }
 

@@ -64,6 +64,7 @@
 //! young_pa = 30000.0
 //! poisson = 0.45
 //! # [[zone]] and [partition]: where the hybrid model must be dynamic (crate::scene::zones)
+//! # [tables]: how a pre-computed scene's compliance is stored (crate::scene::tables)
 //! ```
 //!
 //! Unknown keys are refused, so a typo is an error, not a silently ignored setting. TOML integers
@@ -90,6 +91,7 @@ use super::spec::{
     DEFAULT_MAX_FORCE_N, DEFAULT_MAX_SLEW_N_PER_S, DEFAULT_PHYSICS_EVERY, DynamicSpec, ModelSpec,
     Rates, Scene, TearingSpec,
 };
+use super::tables::{TablesFile, TablesSpec};
 use super::tool::{
     DEFAULT_BLADE_M, DEFAULT_GRIP_OPENING_RADII, DEFAULT_JAW_AXIS, DEFAULT_TOOL_POINTS,
     DEFAULT_TOOL_RADIUS_M, MAX_TOOL_POINTS, ToolKind, ToolSpec, normalized,
@@ -125,6 +127,8 @@ struct SceneFile {
     #[serde(default)]
     zone: Vec<ZoneFile>,
     partition: Option<PartitionFile>,
+    #[serde(default)]
+    tables: TablesFile,
 }
 
 #[derive(Deserialize)]
@@ -452,6 +456,7 @@ impl Scene {
         let model = model_spec(&raw.model, raw.rates.haptic_hz, raw.rates.physics_every)
             .map_err(|(key, msg)| invalid(&key, msg))?;
         let tool = tool_spec(&raw.tool).map_err(|(key, msg)| invalid(&key, msg))?;
+        let tables = TablesSpec::new(&raw.tables).map_err(|(key, msg)| invalid(&key, msg))?;
         let (zones, partition) =
             zones_spec(&raw.zone, raw.partition.as_ref(), base_dir, raw.tool.points)
                 .map_err(|(key, msg)| invalid(&key, msg))?;
@@ -501,6 +506,7 @@ impl Scene {
             },
             zones,
             partition,
+            tables,
         };
         scene.validate()?;
         Ok(scene)

@@ -19,6 +19,7 @@ pub mod generate;
 pub mod materials;
 pub mod mesh;
 pub mod spec;
+pub mod tables;
 pub mod tool;
 pub mod trajectory;
 pub mod validate;
@@ -39,6 +40,7 @@ pub use spec::{
     DEFAULT_MAX_FORCE_N, DEFAULT_MAX_SLEW_N_PER_S, DEFAULT_PHYSICS_EVERY, DynamicSpec,
     MAX_CAPACITY_TETS, MAX_SUBSTEPS, ModelSpec, Rates, Scene, TearingSpec,
 };
+pub use tables::{TableCode, TablesSpec};
 pub use tool::{
     DEFAULT_BLADE_M, DEFAULT_GRIP_OPENING_RADII, DEFAULT_JAW_AXIS, DEFAULT_TOOL_POINTS,
     DEFAULT_TOOL_RADIUS_M, MAX_BLADE_M, MAX_TOOL_POINTS, MAX_TOOL_RADIUS_FRACTION, ToolKind,

@@ -8,6 +8,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
 use super::error::SceneError;
 use super::materials::{MaterialSpec, RegionSpec, tet_materials};
 use super::mesh::MeshSource;
+use super::tables::TablesSpec;
 use super::tool::ToolSpec;
 use super::zones::{PartitionSpec, Zone};
 use crate::fem::material::TetMaterials;
@@ -140,6 +141,8 @@ pub struct Scene {
     pub zones: Vec<Zone>,
     /// How the zones become tets (`[partition]`).
     pub partition: PartitionSpec,
+    /// How a pre-computed scene's compliance table is stored (`[tables]`).
+    pub tables: TablesSpec,
 }
 
 impl Scene {

@@ -17,10 +17,12 @@ use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
 use crate::partition::{Partition, RegionModel, cost::sub_mesh};
 use crate::scene::{DynamicSpec, ModelSpec, Scene};
+use crate::scene::{TableCode, TablesSpec};
 use crate::table::build::build;
-use crate::table::compress::Compression;
+use crate::table::compress::{BlockCode, Compression, ContactBlocks};
 use crate::table::estimate::SizeLimits;
 use crate::table::file::Precision;
+use crate::table::hmatrix::DEFAULT_TOLERANCE;
 use crate::table::load::TableFile;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -124,7 +126,8 @@ impl SceneModel {
     /// The f32 tables of the model (the scene's materials per tet, density
     /// and supports), built in memory with the pipeline of `palpate tables
     /// build`; a pre-computed model's compliance compressed with
-    /// `compression` (`tables build --compress`; refused for the others).
+    /// `compression` (`tables build --compress`), else as the scene's
+    /// `[tables]` says ([`scene_compression`]); refused for the others.
     pub fn tables(
         self,
         scene: &Scene,
@@ -138,6 +141,18 @@ impl SceneModel {
                 scene.source
             );
         }
+        if scene.tables.compress.is_some() && !matches!(self, Self::Precomputed) {
+            bail!(
+                "{}: [tables] compress applies to a pre-computed scene (its compliance table); \
+                 this scene's model is {}",
+                scene.source,
+                match self {
+                    Self::Dynamic(_) => "dynamic (tensor-mass)",
+                    _ => "hybrid",
+                }
+            );
+        }
+        let compression = compression.or_else(|| scene_compression(&scene.tables));
         let single = |options| -> anyhow::Result<TableFile> {
             let built = build(mesh, report, &options).with_context(|| scene.source.clone())?;
             Ok(TableFile::from_bytes(&built.bytes))
@@ -164,6 +179,23 @@ impl SceneModel {
             }
         })
     }
+}
+
+/// The compression a scene's `[tables]` asks for, `None` for the f32 table
+/// (defaults: the build's hmatrix tolerance, nothing dropped, the contact
+/// blocks coded).
+pub fn scene_compression(tables: &TablesSpec) -> Option<Compression> {
+    let code = match tables.compress? {
+        TableCode::F16 => BlockCode::F16,
+        TableCode::Q16 => BlockCode::Q16,
+        TableCode::Hmatrix => BlockCode::Hmatrix,
+    };
+    Some(Compression {
+        code,
+        drop_below: tables.drop_below.unwrap_or(0.0),
+        contact: ContactBlocks::Coded,
+        tolerance: tables.tolerance.unwrap_or(DEFAULT_TOLERANCE),
+    })
 }
 
 /// The hybrid's three tables for `partition` of `scene` (its materials per

@@ -1,0 +1,85 @@
+//! A scene's `[tables]` table: how the pre-computed model's compliance table
+//! is stored, the scene-file form of `tables build --compress`.
+//!
+//! ```toml
+//! [tables]
+//! compress = "hmatrix"   # "f16", "q16" or "hmatrix"; absent: the f32 table
+//! tolerance = 1e-4       # hmatrix only: the far blocks' relative truncation
+//!                        # tolerance, in (0, 1); default the build's
+//! drop_below = 0.01      # f16 and q16 only: the interior blocks dropped below this
+//!                        # fraction of their column's largest, in [0, 1); default 0
+//! ```
+//!
+//! Only a pre-computed scene's table is compressed; on another model the
+//! session refuses it (`crate::session::model`).
+
+use serde::Deserialize;
+
+/// How the compliance is stored, `compress = …`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TableCode {
+    /// IEEE 754 binary16 codes times a per-column scale.
+    F16,
+    /// 16-bit fixed point times a per-column scale.
+    Q16,
+    /// A hierarchical matrix: near blocks and low-rank far blocks.
+    Hmatrix,
+}
+
+/// The `[tables]` table, validated ([`TablesSpec::new`]): `compress`
+/// absent means the f32 table, and then neither option is given.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TablesSpec {
+    /// The code, `None` for the f32 table.
+    pub compress: Option<TableCode>,
+    /// `hmatrix` only: the far blocks' relative tolerance, in `(0, 1)`;
+    /// `None`: the build's default.
+    pub tolerance: Option<f64>,
+    /// `f16`/`q16` only: the drop threshold, in `[0, 1)`; `None`: 0.
+    pub drop_below: Option<f64>,
+}
+
+/// `[tables]` as written.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TablesFile {
+    compress: Option<TableCode>,
+    tolerance: Option<f64>,
+    drop_below: Option<f64>,
+}
+
+impl TablesSpec {
+    /// Checks `[tables]`: each option only with the code it applies to, in
+    /// its range. Errors are `(key, message)`.
+    pub(super) fn new(raw: &TablesFile) -> Result<Self, (String, String)> {
+        let spec = Self {
+            compress: raw.compress,
+            tolerance: raw.tolerance,
+            drop_below: raw.drop_below,
+        };
+        let hmatrix = spec.compress == Some(TableCode::Hmatrix);
+        let coded = matches!(spec.compress, Some(TableCode::F16 | TableCode::Q16));
+        let fail = |key: &str, msg: &str| Err((format!("[tables] {key}"), msg.to_owned()));
+        if let Some(tolerance) = spec.tolerance {
+            if !hmatrix {
+                return fail("tolerance", "applies to compress = \"hmatrix\" only");
+            }
+            if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+                return fail("tolerance", "must be a relative tolerance in (0, 1)");
+            }
+        }
+        if let Some(drop_below) = spec.drop_below {
+            if !coded {
+                return fail(
+                    "drop_below",
+                    "applies to compress = \"f16\" or \"q16\" only",
+                );
+            }
+            if !(drop_below.is_finite() && (0.0..1.0).contains(&drop_below)) {
+                return fail("drop_below", "must be a fraction in [0, 1)");
+            }
+        }
+        Ok(spec)
+    }
+}
