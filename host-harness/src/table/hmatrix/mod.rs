@@ -49,6 +49,24 @@ use crate::output::stderr;
 /// displacement errors below `1e-3` (docs/tables.md, "Hierarchical tables").
 pub const DEFAULT_TOLERANCE: f64 = 1e-4;
 
+/// The far-block rank a size estimate assumes: the largest mean far rank
+/// measured at the default tolerance (docs/tables.md, "Hierarchical
+/// tables"), so the estimate is an upper figure for it.
+pub const ESTIMATE_RANK: usize = 12;
+
+/// The scalars of a hierarchical table's data and the bytes of its other
+/// hierarchy sections, estimated before a build from the touchable
+/// vertices' rest positions `points` (m): the cluster tree and partition
+/// are those of the build, every far block at [`ESTIMATE_RANK`].
+pub fn estimate(points: &[[f64; 3]]) -> (u64, u64) {
+    let tree = ClusterTree::new(points, LEAF_SIZE);
+    let partition = Partition::new(&tree, ETA);
+    let blocks = partition.blocks.len() as u64;
+    let entries: u64 = partition.columns.iter().map(|c| c.len() as u64).sum();
+    let other = 40 + 8 * (tree.leaves.len() as u64 + 1) + 32 * blocks + 4 * entries;
+    (partition.data_len_at_rank(&tree, ESTIMATE_RANK), other)
+}
+
 /// A hierarchical table built: its bytes, the free ordering it uses and
 /// the time of the compliance stage.
 pub struct HierarchicalTable {
