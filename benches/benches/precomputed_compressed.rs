@@ -33,6 +33,7 @@ fn settings() -> Vec<(&'static str, Option<Compression>)> {
         code: BlockCode::Q16,
         drop_below,
         contact,
+        tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
     };
     vec![
         ("f32", None),
@@ -42,6 +43,7 @@ fn settings() -> Vec<(&'static str, Option<Compression>)> {
                 code: BlockCode::F16,
                 drop_below: 0.0,
                 contact: ContactBlocks::Coded,
+                tolerance: palpate::table::hmatrix::DEFAULT_TOLERANCE,
             }),
         ),
         ("q16", Some(q16(0.0, ContactBlocks::Coded))),
