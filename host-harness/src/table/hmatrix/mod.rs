@@ -32,15 +32,15 @@ use bytemuck::Zeroable;
 use palpate_kernel::table::format::{BlockEncoding, CompressionRecord};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
-use self::assemble::{Assembler, Hierarchy, batches};
+use self::assemble::{Assembler, batches};
 use self::cluster::{ClusterTree, LEAF_SIZE};
 use self::columns::ColumnSolver;
 use self::partition::{ETA, Partition};
-use super::build::Stages;
-use super::compress::{CodedPart, CompressedCompliance};
+use super::compress::{CodedPart, CompressedCompliance, Hierarchy};
 use super::file::{Precision, TableContents, write_table};
 use super::load::TableFile;
 use crate::fem::assembly::FreeOrdering;
+use crate::fem::material::TetMaterials;
 use crate::mesh::TetMesh;
 use crate::output::stderr;
 
@@ -91,22 +91,37 @@ pub fn clustered(positions: &[[f64; 3]], ordering: FreeOrdering) -> (ClusterTree
     (tree, ordering)
 }
 
-/// Builds the hierarchical table of `mesh` (module docs): the table's
-/// tolerance `tolerance`, `f32` only; `contents` gives everything but the
-/// compliance (and its ordering, replaced by the clustered one).
-pub(crate) fn build(
+/// What a hierarchical build takes besides the mesh and the table's other
+/// contents.
+pub struct Inputs<'a> {
+    /// Per mesh vertex, fixed.
+    pub fixed: &'a [bool],
+    /// The boundary surface's vertices (the touchable ones are those not
+    /// fixed).
+    pub surface_vertices: &'a [u32],
+    /// Per-tet materials.
+    pub materials: &'a TetMaterials,
+    /// The far blocks' relative tolerance, in `(0, 1)`.
+    pub tolerance: f64,
+    /// Show a progress bar over the columns.
+    pub progress: bool,
+}
+
+/// Builds the hierarchical table of `mesh` (module docs), `f32` only;
+/// `contents` gives everything but the compliance (and its ordering,
+/// replaced by the clustered one).
+pub fn build(
     mesh: &TetMesh,
-    stages: &Stages<'_>,
+    inputs: &Inputs<'_>,
     contents: TableContents<'_>,
-    tolerance: f64,
-    progress: bool,
 ) -> anyhow::Result<HierarchicalTable> {
+    let (tolerance, progress) = (inputs.tolerance, inputs.progress);
     let start = Instant::now();
-    let ordering = FreeOrdering::new(mesh.positions.len(), stages.fixed, &stages.surface.vertices);
+    let ordering = FreeOrdering::new(mesh.positions.len(), inputs.fixed, inputs.surface_vertices);
     let (tree, ordering) = clustered(&mesh.positions, ordering);
     let s = ordering.touchable_count;
     let partition = Partition::new(&tree, ETA);
-    let solver = ColumnSolver::new(&mesh.positions, &mesh.tets, stages.materials, &ordering)?;
+    let solver = ColumnSolver::new(&mesh.positions, &mesh.tets, inputs.materials, &ordering)?;
     log::debug!(
         "hmatrix: {s} touchable vertices, {} leaves, {} blocks, {} scalars in L",
         tree.leaves.len(),
