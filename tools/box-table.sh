@@ -11,7 +11,9 @@
 #                                             with blocks dropped below 0.2 of their columns'
 #                                             largest in both parts (--contact-blocks dropped),
 #                                             so that both kept-block bitmaps are exercised
-#                                             (default OUT: target/firmware/box-table-CODE.bin)
+#                                             (default OUT: target/firmware/box-table-CODE.bin);
+#                                             CODE hmatrix: the hierarchical table (default
+#                                             tolerance, nothing dropped)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 kind=(--kind precomputed)
@@ -21,9 +23,13 @@ if [[ "${1:-}" == --tensor-mass ]]; then
     kind=(--kind tensor-mass --density 1000)
     out_default=target/firmware/box-tensor-table.bin
 elif [[ "${1:-}" == --compress ]]; then
-    code="${2:?usage: tools/box-table.sh --compress f16|q16 [OUT]}"
+    code="${2:?usage: tools/box-table.sh --compress f16|q16|hmatrix [OUT]}"
     shift 2
-    kind=(--kind precomputed --compress "$code" --drop-below 0.2 --contact-blocks dropped)
+    if [[ "$code" == hmatrix ]]; then
+        kind=(--kind precomputed --compress hmatrix)
+    else
+        kind=(--kind precomputed --compress "$code" --drop-below 0.2 --contact-blocks dropped)
+    fi
     out_default="target/firmware/box-table-$code.bin"
 fi
 out="${1:-$out_default}"

@@ -382,7 +382,14 @@ fn hierarchical(
         compressed: None,
         collision: &collision,
     };
-    let built = super::hmatrix::build(mesh, stages, contents, tolerance, options.progress)
+    let inputs = super::hmatrix::Inputs {
+        fixed: stages.fixed,
+        surface_vertices: &stages.surface.vertices,
+        materials: stages.materials,
+        tolerance,
+        progress: options.progress,
+    };
+    let built = super::hmatrix::build(mesh, &inputs, contents)
         .with_context(|| format!("{}: building the hierarchical compliance", report.source))?;
     Ok(BuiltTable {
         bytes: built.bytes,

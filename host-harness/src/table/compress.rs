@@ -33,13 +33,12 @@ use anyhow::{Context, bail, ensure};
 use bytemuck::Zeroable;
 use nalgebra::Vector3;
 use palpate_kernel::table::format::{
-    self, BlockEncoding, CompressionRecord, KEPT_BITS, PROBE_SET_EVERY_TOUCHABLE,
-    surface_block_index,
+    self, BlockEncoding, CompressionRecord, HierarchyBlock, HierarchyRecord, KEPT_BITS,
+    PROBE_SET_EVERY_TOUCHABLE, surface_block_index,
 };
 use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 
 use super::compliance::Compliance;
-use super::hmatrix::assemble::Hierarchy;
 use super::load::TableFile;
 
 /// The 16-bit code of a compressed table.
@@ -51,7 +50,7 @@ pub enum BlockCode {
     Q16,
     /// A hierarchical matrix of the touchable compliance (near blocks in
     /// f32, far blocks as low-rank factors within `--tolerance`); the
-    /// interior displacements are not stored ([`super::hmatrix`]).
+    /// interior displacements are not stored (`table::hmatrix`).
     Hmatrix,
 }
 
@@ -200,9 +199,27 @@ pub struct CompressedCompliance {
     pub surface: Option<CodedPart>,
     /// The interior part coded.
     pub interior: CodedPart,
-    /// The surface part as a hierarchical matrix (`--compress hmatrix`,
-    /// [`super::hmatrix`]), `None` otherwise.
+    /// The surface part as a hierarchical matrix (`--compress hmatrix`, built
+    /// by `table::hmatrix`), `None` otherwise.
     pub hierarchy: Option<Hierarchy>,
+}
+
+/// The hierarchy sections of a table, in `f64` before the writer rounds the
+/// data to the table scalar (layout: `palpate_kernel::table::format::hierarchy`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Hierarchy {
+    /// Counts, bounds, tolerance, `η`.
+    pub record: HierarchyRecord,
+    /// Per leaf and one past the last: `[first touchable index, first
+    /// column-list entry]`.
+    pub leaves: Vec<[u32; 2]>,
+    /// The partition's blocks, both triangles.
+    pub blocks: Vec<HierarchyBlock>,
+    /// The leaves' column lists, concatenated.
+    pub column_blocks: Vec<u32>,
+    /// Near entries and far factors, m/N (a far factor's scale is the
+    /// square root of the block's).
+    pub data: Vec<f64>,
 }
 
 /// Largest entry magnitude of a block.

@@ -33,6 +33,7 @@ use bytemuck::Zeroable;
 use palpate_kernel::table::format::{RawHeader, SectionKind, TableKind};
 
 use super::collision::{CELLS_PER_SURFACE_VERTEX, collision_index};
+use super::compress::BlockCode;
 use super::file::{Precision, layout};
 use super::options::{BuildOptions, TableKindOptions};
 use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
@@ -43,6 +44,11 @@ use crate::mesh::{MeshReport, Surface, TetMesh};
 /// and row indices per free vertex, 2.2 kB), the orderings, the surface and the collision index.
 /// A generous round figure: it matters only for meshes whose table is small.
 pub const BUILD_BYTES_PER_VERTEX: u64 = 4096;
+
+/// Scalars of the sparse Cholesky factor per free DOF assumed by a hierarchical build's peak
+/// (AMD fill of a tetrahedral mesh's stiffness: about 150–400 per DOF from 10k to 200k tets;
+/// measured in docs/tables.md, "Hierarchical tables").
+const FACTOR_SCALARS_PER_DOF: u64 = 500;
 
 /// Bytes of one f64 3×3 block: the compliance as computed, before it is rounded for the file.
 const F64_BLOCK_BYTES: u64 = 72;
@@ -118,6 +124,9 @@ pub struct TableEstimate {
     /// A compressed pre-computed table (`--compress`): [`Self::table_bytes`] is the f32
     /// table's, a bound of the compressed one's, which the f32 table is built beside.
     pub compressed: bool,
+    /// A hierarchical table (`--compress hmatrix`): [`Self::table_bytes`] is its own
+    /// estimate ([`Self::hierarchical`]), not the f32 table's.
+    pub hierarchical: bool,
 }
 
 impl TableEstimate {
@@ -138,6 +147,14 @@ impl TableEstimate {
         };
         let counts = TableCounts::of(mesh, report, fixed, surface);
         let mut estimate = Self::new(kind, options.precision, counts);
+        if let TableKindOptions::Precomputed {
+            compression: Some(c),
+            ..
+        } = options.kind
+            && c.code == BlockCode::Hmatrix
+        {
+            return estimate.hierarchical(mesh, fixed, surface);
+        }
         if compressed {
             // The f32 table's size bounds the compressed one's (`describe`
             // says so); its build also holds the draft, the final table and
@@ -148,6 +165,51 @@ impl TableEstimate {
                 .saturating_add(estimate.table_bytes.saturating_mul(4));
         }
         estimate
+    }
+
+    /// The estimate of a hierarchical table (`--compress hmatrix`) from `self`, the dense
+    /// table's: the dense compliance sections replaced by the hierarchy
+    /// ([`super::hmatrix::estimate`]: its partition, every far block at
+    /// [`super::hmatrix::ESTIMATE_RANK`]) and one interior scale per touchable vertex. Peak:
+    /// the Cholesky factor (about [`FACTOR_SCALARS_PER_DOF`] scalars per free DOF), one batch
+    /// of columns (`3F × 3b` f64, `b` ≤ 2 × 64 vertices), the hierarchy as built (f64), the
+    /// table and its draft, and [`BUILD_BYTES_PER_VERTEX`] per vertex, plus half of that.
+    fn hierarchical(self, mesh: &TetMesh, fixed: &[bool], surface: &Surface) -> Self {
+        let c = &self.counts;
+        let points: Vec<[f64; 3]> = surface
+            .vertices
+            .iter()
+            .filter(|&&v| fixed.get(v as usize) == Some(&false))
+            .map(|&v| mesh.positions[v as usize])
+            .collect();
+        let (data, other) = super::hmatrix::estimate(&points);
+        let scalar = u64::from(self.precision.scalar_bytes());
+        let dense = self.blocks.saturating_mul(9 * scalar);
+        let table = self
+            .table_bytes
+            .saturating_sub(dense)
+            .saturating_add(data.saturating_mul(scalar))
+            .saturating_add(other)
+            .saturating_add(c.touchable.saturating_mul(scalar));
+        let dof = c.free.saturating_mul(3);
+        let factor = dof.saturating_mul(FACTOR_SCALARS_PER_DOF * 8);
+        let batch = dof.saturating_mul(3 * 2 * BATCH_VERTICES * 8);
+        let terms = factor
+            .saturating_add(batch)
+            .saturating_add(data.saturating_mul(8))
+            .saturating_add(table.saturating_mul(2))
+            .saturating_add(c.vertices.saturating_mul(BUILD_BYTES_PER_VERTEX));
+        // The far blocks' factors while they accumulate and the SVDs' workspaces, not
+        // modelled: a 50 % margin (peak RSS 256 MB and 767 MB measured against 190 MB and
+        // 536 MB of the terms, on organs of 22.8k and 72.1k tets).
+        let peak = terms.saturating_add(terms / 2);
+        Self {
+            table_bytes: table,
+            peak_bytes: peak,
+            compressed: true,
+            hierarchical: true,
+            ..self
+        }
     }
 
     /// The estimate of a table of `kind` in `precision` for `mesh` with `fixed` vertices and
@@ -248,6 +310,7 @@ impl TableEstimate {
             table_bytes,
             peak_bytes,
             compressed: false,
+            hierarchical: false,
         }
     }
 
@@ -275,7 +338,9 @@ impl TableEstimate {
                 precision_name(self.precision)
             ),
         };
-        let compressed = if self.compressed {
+        let compressed = if self.hierarchical {
+            " (hierarchical, far blocks estimated at rank 12)"
+        } else if self.compressed {
             " (uncompressed; compressed, about half that or less)"
         } else {
             ""

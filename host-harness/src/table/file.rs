@@ -3,8 +3,7 @@
 use bytemuck::Zeroable;
 
 use super::collision::CollisionIndex;
-use super::compress::{CodedPart, CompressedCompliance};
-use super::hmatrix::assemble::Hierarchy;
+use super::compress::{CodedPart, CompressedCompliance, Hierarchy};
 use palpate_kernel::table::format::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,
     SectionEntry, SectionKind, TableKind,

@@ -109,6 +109,30 @@ fn build_tensor_mass_table_needs_density() {
     assert_one_line_error(&out, &["--density applies to --kind tensor-mass only"]);
 }
 
+/// `tables build --compress hmatrix [--tolerance REL]`: the options of the 16-bit codes refused
+/// with it, `--tolerance` refused without it and outside `(0, 1)`, each in one line.
+#[test]
+fn hmatrix_options_are_checked() {
+    let out = |extra: &[&str]| build_cube(&temp("cube-hmatrix-bad.tbl"), "5000", extra);
+    let codes_only = "--drop-below and --contact-blocks apply to --compress f16|q16";
+    assert_one_line_error(
+        &out(&["--compress", "hmatrix", "--drop-below", "0.1"]),
+        &[codes_only],
+    );
+    assert_one_line_error(
+        &out(&["--compress", "hmatrix", "--contact-blocks", "f32"]),
+        &[codes_only],
+    );
+    assert_one_line_error(
+        &out(&["--compress", "q16", "--tolerance", "1e-4"]),
+        &["--tolerance applies to --compress hmatrix"],
+    );
+    assert_one_line_error(
+        &out(&["--compress", "hmatrix", "--tolerance", "2"]),
+        &["--tolerance 2", "(0, 1)"],
+    );
+}
+
 /// `tables build --compress q16 --drop-below REL`: a table about half the f32 one that
 /// `tables info` reports (its flash footprint by section, the encoding and the errors measured
 /// at build) and that `precomputed solve` reads; the flags' refusals, one line each.

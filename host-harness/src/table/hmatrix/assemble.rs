@@ -26,27 +26,10 @@ use palpate_kernel::table::format::{
     HIERARCHY_MAX_RANK, HIERARCHY_MIRRORED, HierarchyBlock, HierarchyRecord,
 };
 
+use super::super::compress::Hierarchy;
 use super::cluster::ClusterTree;
 use super::lowrank::TruncatedSvd;
 use super::partition::Partition;
-
-/// The hierarchy sections of a table, in `f64` before the writer rounds the
-/// data to the table scalar (layout: `palpate_kernel::table::format::hierarchy`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Hierarchy {
-    /// Counts, bounds, tolerance, `η`.
-    pub record: HierarchyRecord,
-    /// Per leaf and one past the last: `[first touchable index, first
-    /// column-list entry]`.
-    pub leaves: Vec<[u32; 2]>,
-    /// The partition's blocks, both triangles.
-    pub blocks: Vec<HierarchyBlock>,
-    /// The leaves' column lists, concatenated.
-    pub column_blocks: Vec<u32>,
-    /// Near entries and far factors, m/N (a far factor's scale is the
-    /// square root of the block's).
-    pub data: Vec<f64>,
-}
 
 /// Touchable vertices per batch of columns, at least (whole leaves are
 /// added until it is reached): 64 vertices, 192 right-hand sides, as the

@@ -34,9 +34,9 @@ impl BoundingBox {
             max: [f64::NEG_INFINITY; 3],
         };
         for p in points {
-            for a in 0..3 {
-                b.min[a] = b.min[a].min(p[a]);
-                b.max[a] = b.max[a].max(p[a]);
+            for (a, &x) in p.iter().enumerate() {
+                b.min[a] = b.min[a].min(x);
+                b.max[a] = b.max[a].max(x);
             }
         }
         b

@@ -114,6 +114,10 @@ fn free_index(c: &impl AsConstraint<f32>, slot: &[Option<u32>]) -> Option<usize>
     }
 }
 
+/// A contact set's exact forces (N, per contact) and free displacements (m,
+/// per free vertex).
+type Reference = (Vec<Vector3<f64>>, Vec<Vector3<f64>>);
+
 /// The exact forces (N, per contact) and free displacements (m, per free
 /// vertex) of a set of vertex contacts, from the columns `x` (`3F` rows,
 /// column `3·column(k) + b` that of `(k, b)`). `None` if a contact is not
@@ -123,7 +127,7 @@ fn reference(
     slot: &[Option<u32>],
     x: &faer::Mat<f64>,
     column: impl Fn(usize) -> Option<usize>,
-) -> Option<(Vec<Vector3<f64>>, Vec<Vector3<f64>>)> {
+) -> Option<Reference> {
     let m = set.len();
     let at: Vec<(usize, usize)> = set
         .iter()

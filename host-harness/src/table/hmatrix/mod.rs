@@ -32,15 +32,15 @@ use bytemuck::Zeroable;
 use palpate_kernel::table::format::{BlockEncoding, CompressionRecord};
 use palpate_kernel::{PrecomputedModel, PrecomputedTable};
 
-use self::assemble::{Assembler, Hierarchy, batches};
+use self::assemble::{Assembler, batches};
 use self::cluster::{ClusterTree, LEAF_SIZE};
 use self::columns::ColumnSolver;
 use self::partition::{ETA, Partition};
-use super::build::Stages;
-use super::compress::{CodedPart, CompressedCompliance};
+use super::compress::{CodedPart, CompressedCompliance, Hierarchy};
 use super::file::{Precision, TableContents, write_table};
 use super::load::TableFile;
 use crate::fem::assembly::FreeOrdering;
+use crate::fem::material::TetMaterials;
 use crate::mesh::TetMesh;
 use crate::output::stderr;
 
@@ -48,6 +48,24 @@ use crate::output::stderr;
 /// ‖C_b‖_F`: `1e-4`, which keeps the measured contact-force and touchable
 /// displacement errors below `1e-3` (docs/tables.md, "Hierarchical tables").
 pub const DEFAULT_TOLERANCE: f64 = 1e-4;
+
+/// The far-block rank a size estimate assumes: the largest mean far rank
+/// measured at the default tolerance (docs/tables.md, "Hierarchical
+/// tables"), so the estimate is an upper figure for it.
+pub const ESTIMATE_RANK: usize = 12;
+
+/// The scalars of a hierarchical table's data and the bytes of its other
+/// hierarchy sections, estimated before a build from the touchable
+/// vertices' rest positions `points` (m): the cluster tree and partition
+/// are those of the build, every far block at [`ESTIMATE_RANK`].
+pub fn estimate(points: &[[f64; 3]]) -> (u64, u64) {
+    let tree = ClusterTree::new(points, LEAF_SIZE);
+    let partition = Partition::new(&tree, ETA);
+    let blocks = partition.blocks.len() as u64;
+    let entries: u64 = partition.columns.iter().map(|c| c.len() as u64).sum();
+    let other = 40 + 8 * (tree.leaves.len() as u64 + 1) + 32 * blocks + 4 * entries;
+    (partition.data_len_at_rank(&tree, ESTIMATE_RANK), other)
+}
 
 /// A hierarchical table built: its bytes, the free ordering it uses and
 /// the time of the compliance stage.
@@ -73,22 +91,37 @@ pub fn clustered(positions: &[[f64; 3]], ordering: FreeOrdering) -> (ClusterTree
     (tree, ordering)
 }
 
-/// Builds the hierarchical table of `mesh` (module docs): the table's
-/// tolerance `tolerance`, `f32` only; `contents` gives everything but the
-/// compliance (and its ordering, replaced by the clustered one).
-pub(crate) fn build(
+/// What a hierarchical build takes besides the mesh and the table's other
+/// contents.
+pub struct Inputs<'a> {
+    /// Per mesh vertex, fixed.
+    pub fixed: &'a [bool],
+    /// The boundary surface's vertices (the touchable ones are those not
+    /// fixed).
+    pub surface_vertices: &'a [u32],
+    /// Per-tet materials.
+    pub materials: &'a TetMaterials,
+    /// The far blocks' relative tolerance, in `(0, 1)`.
+    pub tolerance: f64,
+    /// Show a progress bar over the columns.
+    pub progress: bool,
+}
+
+/// Builds the hierarchical table of `mesh` (module docs), `f32` only;
+/// `contents` gives everything but the compliance (and its ordering,
+/// replaced by the clustered one).
+pub fn build(
     mesh: &TetMesh,
-    stages: &Stages<'_>,
+    inputs: &Inputs<'_>,
     contents: TableContents<'_>,
-    tolerance: f64,
-    progress: bool,
 ) -> anyhow::Result<HierarchicalTable> {
+    let (tolerance, progress) = (inputs.tolerance, inputs.progress);
     let start = Instant::now();
-    let ordering = FreeOrdering::new(mesh.positions.len(), stages.fixed, &stages.surface.vertices);
+    let ordering = FreeOrdering::new(mesh.positions.len(), inputs.fixed, inputs.surface_vertices);
     let (tree, ordering) = clustered(&mesh.positions, ordering);
     let s = ordering.touchable_count;
     let partition = Partition::new(&tree, ETA);
-    let solver = ColumnSolver::new(&mesh.positions, &mesh.tets, stages.materials, &ordering)?;
+    let solver = ColumnSolver::new(&mesh.positions, &mesh.tets, inputs.materials, &ordering)?;
     log::debug!(
         "hmatrix: {s} touchable vertices, {} leaves, {} blocks, {} scalars in L",
         tree.leaves.len(),

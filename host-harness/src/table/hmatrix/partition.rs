@@ -112,3 +112,25 @@ fn split(tree: &ClusterTree, eta: f64, row: usize, col: usize, out: &mut Vec<Par
         }
     }
 }
+
+impl Partition {
+    /// The hierarchy's data (scalars) if every far block had rank `rank`
+    /// (stored as entries where the factors would not be smaller), with the
+    /// owned blocks only (a mirror shares its owner's data): the size
+    /// estimate of a build before its ranks are known.
+    pub fn data_len_at_rank(&self, tree: &ClusterTree, rank: usize) -> u64 {
+        self.blocks
+            .iter()
+            .filter(|b| tree.clusters[b.row].range.start <= tree.clusters[b.col].range.start)
+            .map(|b| {
+                let (m, n) = (
+                    tree.clusters[b.row].range.len() as u64,
+                    tree.clusters[b.col].range.len() as u64,
+                );
+                let near = 9 * m * n;
+                let far = 3 * (m + n) * rank as u64;
+                if b.far { near.min(far) } else { near }
+            })
+            .sum()
+    }
+}
