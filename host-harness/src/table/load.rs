@@ -306,35 +306,8 @@ impl TableFile {
                 }
             }
         }
-        if kind == Some(TableKind::Precomputed)
-            && let Ok(AnyModel::F32(model)) = self.model()
-            && let Some(record) = model.table().compression()
-        {
-            let _ = writeln!(out, "compression: {}", describe_compression(record));
-        }
-        if kind == Some(TableKind::Precomputed)
-            && let Ok(model) = self.model()
-        {
-            let hierarchy = match &model {
-                AnyModel::F32(m) => m
-                    .table()
-                    .surface_blocks()
-                    .as_hierarchical()
-                    .map(describe_hierarchy),
-                AnyModel::F64(m) => m
-                    .table()
-                    .surface_blocks()
-                    .as_hierarchical()
-                    .map(describe_hierarchy),
-            };
-            if let Some(hierarchy) = hierarchy {
-                let _ = writeln!(out, "{hierarchy}");
-            }
-        }
-        if kind == Some(TableKind::Precomputed)
-            && let Ok(model) = self.model()
-        {
-            let _ = writeln!(out, "{}", describe_candidates(&model));
+        if kind == Some(TableKind::Precomputed) {
+            self.compliance_lines(&mut out);
         }
         let checksum_ok = bytes.len() >= HEADER_LEN + CRC_LEN && {
             let (body, trailer) = bytes.split_at(bytes.len() - CRC_LEN);
@@ -356,6 +329,40 @@ impl TableFile {
                 Err(out)
             }
         }
+    }
+}
+
+impl TableFile {
+    /// A pre-computed table's compression record, hierarchy and contact
+    /// candidate lists, for [`Self::info`] (nothing for a table that does
+    /// not load).
+    fn compliance_lines(&self, out: &mut String) {
+        let Ok(model) = self.model() else {
+            return;
+        };
+        let (record, hierarchy) = match &model {
+            AnyModel::F32(m) => (
+                m.table().compression().copied(),
+                m.table()
+                    .surface_blocks()
+                    .as_hierarchical()
+                    .map(describe_hierarchy),
+            ),
+            AnyModel::F64(m) => (
+                m.table().compression().copied(),
+                m.table()
+                    .surface_blocks()
+                    .as_hierarchical()
+                    .map(describe_hierarchy),
+            ),
+        };
+        if let Some(record) = record {
+            let _ = writeln!(out, "compression: {}", describe_compression(&record));
+        }
+        if let Some(hierarchy) = hierarchy {
+            let _ = writeln!(out, "{hierarchy}");
+        }
+        let _ = writeln!(out, "{}", describe_candidates(&model));
     }
 }
 
