@@ -56,20 +56,20 @@ pub fn assemble_restricted(
     })
 }
 
-/// [`assemble_restricted`] of any element matrices: `element(t)` gives tet
-/// `t`'s 4×4 blocks of 3×3 (`K[j][k][a][b]`, the stiffness `−∂f_{j,a}/∂x_{k,b}`,
+/// [`assemble_restricted`] of any element matrices of `N`-node tets:
+/// `element(t)` gives tet `t`'s `N`×`N` blocks of 3×3 (`K[j][k][a][b]`, the stiffness `−∂f_{j,a}/∂x_{k,b}`,
 /// N/m) for the `vertex_count`-vertex mesh `tets`. The Newton reference's
 /// tangent ([`super::newton`]) uses it with the St Venant-Kirchhoff tangent.
 ///
 /// # Panics
 /// If `slot.len() != vertex_count`, a slot is `>= slot_count` or a tet
 /// references a vertex `>= vertex_count`.
-pub fn assemble_restricted_with(
+pub fn assemble_restricted_with<const N: usize>(
     vertex_count: usize,
-    tets: &[[u32; 4]],
+    tets: &[[u32; N]],
     slot: &[Option<u32>],
     slot_count: usize,
-    mut element: impl FnMut(usize) -> [[[[f64; 3]; 3]; 4]; 4],
+    mut element: impl FnMut(usize) -> [[[[f64; 3]; 3]; N]; N],
 ) -> SparseColMat<usize, f64> {
     assert_eq!(slot.len(), vertex_count, "one slot per vertex");
     assert!(

@@ -1,5 +1,6 @@
 //! The static equilibrium of a hyperelastic body (St Venant-Kirchhoff,
-//! [`solve_stvk`]; compressible neo-Hookean, [`solve_neo_hookean`]) by
+//! [`solve_stvk`]; compressible neo-Hookean, [`solve_neo_hookean`], and on
+//! 10-node tets [`solve_neo_hookean_p2`]) by
 //! Newton's method with a direct sparse factorization (faer): the converged
 //! references the speed/accuracy study measures the kernel's models
 //! against, independent of the kernel ([`super::stvk`] and
@@ -34,6 +35,7 @@ use super::hyperelastic::HyperelasticTet;
 use super::llt::SparseLlt;
 use super::material::TetMaterials;
 use super::neo_hookean::NeoHookeanTet;
+use super::neo_hookean_p2::NeoHookeanP2Tet;
 use super::stvk::StvkTet;
 
 /// Newton controls.
@@ -74,12 +76,13 @@ impl Default for NewtonOptions {
     }
 }
 
-/// A static problem on a tet mesh.
-pub struct StaticProblem<'a> {
+/// A static problem on a mesh of `N`-node tets (P1: 4; P2: 10, the nodes
+/// of [`super::neo_hookean_p2::P2Mesh`]); "vertex" below is any node.
+pub struct StaticProblem<'a, const N: usize = 4> {
     /// Rest positions, m.
     pub positions: &'a [[f64; 3]],
     /// Tets (positively oriented).
-    pub tets: &'a [[u32; 4]],
+    pub tets: &'a [[u32; N]],
     /// One material per tet.
     pub materials: &'a TetMaterials,
     /// Fixed vertices (zero displacement).
@@ -129,7 +132,7 @@ pub fn solve_stvk(
     problem: &StaticProblem<'_>,
     options: &NewtonOptions,
 ) -> anyhow::Result<Equilibrium> {
-    solve::<StvkTet>(problem, options)
+    solve::<4, StvkTet>(problem, options)
 }
 
 /// Solves `problem` for the compressible neo-Hookean law
@@ -144,18 +147,30 @@ pub fn solve_neo_hookean(
         descent: true,
         ..*options
     };
-    solve::<NeoHookeanTet>(problem, &options)
+    solve::<4, NeoHookeanTet>(problem, &options)
+}
+
+/// [`solve_neo_hookean`] on 10-node tets ([`super::neo_hookean_p2`]).
+pub fn solve_neo_hookean_p2(
+    problem: &StaticProblem<'_, 10>,
+    options: &NewtonOptions,
+) -> anyhow::Result<Equilibrium> {
+    let options = NewtonOptions {
+        descent: true,
+        ..*options
+    };
+    solve::<10, NeoHookeanP2Tet>(problem, &options)
 }
 
 /// Solves `problem` (module documentation) with the element `E`: the load
 /// in [`NewtonOptions::load_steps`] increments (`Discrete::increment`), the
 /// stability of the end state in descent, and the reactions of the
 /// prescribed vertices.
-pub fn solve<E: HyperelasticTet>(
-    problem: &StaticProblem<'_>,
+pub fn solve<const N: usize, E: HyperelasticTet<N>>(
+    problem: &StaticProblem<'_, N>,
     options: &NewtonOptions,
 ) -> anyhow::Result<Equilibrium> {
-    let model = Discrete::<E>::new(problem, options)?;
+    let model = Discrete::<N, E>::new(problem, options)?;
     let mut u = vec![[0.0; 3]; problem.positions.len()];
     let mut iterations = 0;
     let mut residual_n = 0.0;
@@ -194,8 +209,8 @@ struct Increment {
 /// A checked [`StaticProblem`] discretized: one element `E` per tet and
 /// the numbering of the unknown DOFs (the vertices neither fixed nor
 /// prescribed).
-struct Discrete<'p, 'a, E> {
-    problem: &'p StaticProblem<'a>,
+struct Discrete<'p, 'a, const N: usize, E> {
+    problem: &'p StaticProblem<'a, N>,
     /// One element per tet, at the rest positions.
     elements: Vec<E>,
     /// Mesh vertex → unknown index, `None` for a fixed or prescribed vertex.
@@ -204,11 +219,11 @@ struct Discrete<'p, 'a, E> {
     unknown: Vec<usize>,
 }
 
-impl<'p, 'a, E: HyperelasticTet> Discrete<'p, 'a, E> {
+impl<'p, 'a, const N: usize, E: HyperelasticTet<N>> Discrete<'p, 'a, N, E> {
     /// Checks that `problem`'s flags, loads, materials and prescribed
     /// vertices fit its mesh and that `options` has a load step, then builds
     /// the elements and numbers the unknowns.
-    fn new(problem: &'p StaticProblem<'a>, options: &NewtonOptions) -> anyhow::Result<Self> {
+    fn new(problem: &'p StaticProblem<'a, N>, options: &NewtonOptions) -> anyhow::Result<Self> {
         let n = problem.positions.len();
         ensure!(
             problem.fixed.len() == n,
@@ -260,7 +275,7 @@ impl<'p, 'a, E: HyperelasticTet> Discrete<'p, 'a, E> {
 
     /// Deformed corners of tet `t` at displacement `u`, m: rest position
     /// plus displacement.
-    fn corners(&self, t: &[u32; 4], u: &[[f64; 3]]) -> [[f64; 3]; 4] {
+    fn corners(&self, t: &[u32; N], u: &[[f64; 3]]) -> [[f64; 3]; N] {
         t.map(|v| {
             let (p, d) = (self.problem.positions[v as usize], u[v as usize]);
             [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
