@@ -333,7 +333,7 @@ fn every_scene_error_names_the_file_and_what_is_wrong() {
         // Syntax, unknown keys, types: the parser's message with the line.
         (
             format!("colour = 1\n{BASE_SCENE}"),
-            "bad.toml: line 1: unknown field `colour`, expected one of `mesh`, `generated`, `fix`, `material`, `region`, `model`, `tool`, `cutting`, `tearing`, `rates`, `safety`, `zone`, `partition`",
+            "bad.toml: line 1: unknown field `colour`, expected one of `mesh`, `generated`, `fix`, `material`, `region`, `model`, `tool`, `cutting`, `tearing`, `rates`, `safety`, `zone`, `partition`, `tables`",
         ),
         (
             format!("{BASE_SCENE}[tool]\nradius = 0.002\n"),
