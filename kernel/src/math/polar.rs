@@ -85,6 +85,10 @@ pub fn closest_rotations<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; 
 
 /// The columns `u₁, u₂, u₃` of `U` (see the module documentation) for
 /// one matrix `f` and its sorted right singular vectors `v` (columns).
+#[expect(
+    clippy::indexing_slicing,
+    reason = "indices are literals < 3 at every call of the closures"
+)]
 #[inline(always)]
 fn frame<T: Real>(f: &Mat3<T>, v: &Mat3<T>) -> Mat3<T> {
     // b_k = F v_k.
@@ -173,10 +177,12 @@ fn right_vectors<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
             ],
         );
     }
-    let mut v = [[[zero; N]; 3]; 3];
-    for k in 0..3 {
-        v[k][k] = [one; N];
-    }
+    let (zeros, ones) = ([zero; N], [one; N]);
+    let mut v = [
+        [ones, zeros, zeros],
+        [zeros, ones, zeros],
+        [zeros, zeros, ones],
+    ];
     for _ in 0..JACOBI_SWEEPS {
         rotate(&mut s, &mut v, 0, 1, 2);
         rotate(&mut s, &mut v, 0, 2, 1);
