@@ -190,9 +190,11 @@ fn right_vectors<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
     }
     // Sort the eigenvalues s_kk downwards, swapping columns of V; the
     // swapped-in column changes sign so that det V stays +1.
-    for (p, q) in [(0, 1), (1, 2), (0, 1)] {
-        swap_if_smaller(&mut s, &mut v, p, q);
-    }
+    // (Three calls with literal indices, not a loop over pairs, so that
+    // the indices stay constants and no bounds check is left.)
+    swap_if_smaller(&mut s, &mut v, 0, 1);
+    swap_if_smaller(&mut s, &mut v, 1, 2);
+    swap_if_smaller(&mut s, &mut v, 0, 1);
     v
 }
 
