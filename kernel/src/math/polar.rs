@@ -13,6 +13,15 @@
 //! `det F < 0` this puts the sign on the smallest singular value: `R` is
 //! the proper rotation closest to `F`, and `RᵀF` is symmetric.
 //!
+//! Lanes: [`closest_rotations`] computes `N` matrices at once, each entry
+//! a `[T; N]` array (the per-tet pass's structure-of-arrays blocks, `N` =
+//! 8). Every step is a short loop over the lanes with a branch-free scalar
+//! body (selects only, no inner loop), the form the compiler turns into
+//! SIMD operations (square roots and divisions included); a per-lane loop
+//! around the whole computation does not vectorize (its body, with the
+//! sweeps, is too large to unroll first). [`closest_rotation`] is the same
+//! code with one lane.
+//!
 //! Accuracy: `R` is orthonormal with `det R = +1` to rounding by
 //! construction (a product of Givens rotations and a re-orthogonalized
 //! frame). Cyclic Jacobi on a 3×3 symmetric matrix converges
@@ -39,18 +48,53 @@ const TINY2: f64 = 1e-30;
 const FLUSH: f64 = 1e-18;
 
 /// The proper rotation closest to `f` (rows), `R = U Vᵀ` of the signed SVD
-/// (see the module documentation). Always inlined, so that a lane loop that
-/// calls it stays one loop.
-#[expect(
-    clippy::indexing_slicing,
-    reason = "from_fn indices and k are < 3 over 3×3 arrays; tools/nopanic-check proves no panic is left"
-)]
+/// (see the module documentation): [`closest_rotations`] with one lane.
 #[inline(always)]
 pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
+    let one_lane = f.map(|row| row.map(|x| [x]));
+    closest_rotations(&one_lane).map(|row| row.map(|[x]| x))
+}
+
+/// Per lane, the proper rotation closest to `f` (rows; entry `f[i][j][l]`
+/// of lane `l`), `R = U Vᵀ` of the signed SVD (see the module
+/// documentation). Always inlined, so that its lane loops see the
+/// caller's fixed `N`.
+#[expect(
+    clippy::indexing_slicing,
+    reason = "literal indices < 3 and loop counters < N over fixed-size arrays; tools/nopanic-check proves no panic is left"
+)]
+#[inline(always)]
+pub fn closest_rotations<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
     let v = right_vectors(f);
-    // Columns of V: v[.][k]; b_k = F v_k.
+    let mut r = [[[T::zero(); N]; 3]; 3];
+    for l in 0..N {
+        let (fl, vl) = (lane(f, l), lane(&v, l));
+        let u = frame(&fl, &vl);
+        // R_ij = Σ_k U_ik V_jk, U's columns u_k.
+        let entry =
+            |i: usize, j: usize| u[0][i] * vl[j][0] + u[1][i] * vl[j][1] + u[2][i] * vl[j][2];
+        let rl = [
+            [entry(0, 0), entry(0, 1), entry(0, 2)],
+            [entry(1, 0), entry(1, 1), entry(1, 2)],
+            [entry(2, 0), entry(2, 1), entry(2, 2)],
+        ];
+        set_lane(&mut r, l, &rl);
+    }
+    r
+}
+
+/// The columns `u₁, u₂, u₃` of `U` (see the module documentation) for
+/// one matrix `f` and its sorted right singular vectors `v` (columns).
+#[expect(
+    clippy::indexing_slicing,
+    reason = "indices are literals < 3 at every call of the closures"
+)]
+#[inline(always)]
+fn frame<T: Real>(f: &Mat3<T>, v: &Mat3<T>) -> Mat3<T> {
+    // b_k = F v_k.
     let b = |k: usize| -> [T; 3] {
-        core::array::from_fn(|r| f[r][0] * v[0][k] + f[r][1] * v[1][k] + f[r][2] * v[2][k])
+        let row = |r: usize| f[r][0] * v[0][k] + f[r][1] * v[1][k] + f[r][2] * v[2][k];
+        [row(0), row(1), row(2)]
     };
     let tiny = T::of_f64(TINY2);
     let b1 = b(0);
@@ -63,7 +107,11 @@ pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
     let mut w = b(1);
     for _ in 0..2 {
         let along = dot(&u1, &w);
-        w = core::array::from_fn(|r| w[r] - along * u1[r]);
+        w = [
+            w[0] - along * u1[0],
+            w[1] - along * u1[1],
+            w[2] - along * u1[2],
+        ];
     }
     let n2 = dot(&w, &w);
     let u2 = if n2 > tiny {
@@ -72,27 +120,69 @@ pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
         perpendicular(&u1)
     };
     let u3 = cross(&u1, &u2);
-    let u = [u1, u2, u3];
-    // R_ij = Σ_k U_ik V_jk, U's columns u_k.
-    core::array::from_fn(|i| {
-        core::array::from_fn(|j| u[0][i] * v[j][0] + u[1][i] * v[j][1] + u[2][i] * v[j][2])
-    })
+    [u1, u2, u3]
 }
 
-/// The eigenvectors of `FᵀF` as the columns of a rotation `V` (rows),
-/// sorted by decreasing eigenvalue.
+/// Lane `l` (`< N`) of a matrix of lanes.
 #[expect(
     clippy::indexing_slicing,
-    reason = "from_fn indices and k are < 3 over 3×3 arrays; tools/nopanic-check proves no panic is left"
+    reason = "literal indices < 3; l < N at every call"
 )]
 #[inline(always)]
-fn right_vectors<T: Real>(f: &Mat3<T>) -> Mat3<T> {
-    let column = |c: usize| [f[0][c], f[1][c], f[2][c]];
-    let cols = [column(0), column(1), column(2)];
-    let mut s: Mat3<T> =
-        core::array::from_fn(|i| core::array::from_fn(|j| dot(&cols[i], &cols[j])));
+fn lane<T: Real, const N: usize>(m: &Mat3<[T; N]>, l: usize) -> Mat3<T> {
+    [
+        [m[0][0][l], m[0][1][l], m[0][2][l]],
+        [m[1][0][l], m[1][1][l], m[1][2][l]],
+        [m[2][0][l], m[2][1][l], m[2][2][l]],
+    ]
+}
+
+/// Stores `x` in lane `l` (`< N`) of a matrix of lanes.
+#[expect(
+    clippy::indexing_slicing,
+    reason = "literal indices < 3; l < N at every call"
+)]
+#[inline(always)]
+fn set_lane<T: Real, const N: usize>(m: &mut Mat3<[T; N]>, l: usize, x: &Mat3<T>) {
+    for (row, x_row) in m.iter_mut().zip(x) {
+        row[0][l] = x_row[0];
+        row[1][l] = x_row[1];
+        row[2][l] = x_row[2];
+    }
+}
+
+/// Per lane, the eigenvectors of `FᵀF` as the columns of a rotation `V`
+/// (rows), sorted by decreasing eigenvalue.
+#[expect(
+    clippy::indexing_slicing,
+    reason = "literal indices < 3 and loop counters < N over fixed-size arrays"
+)]
+#[inline(always)]
+fn right_vectors<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
     let (zero, one) = (T::zero(), T::one());
-    let mut v = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
+    let mut s = [[[zero; N]; 3]; 3];
+    for l in 0..N {
+        let fl = lane(f, l);
+        // (FᵀF)_ij = Σ_r F_ri F_rj.
+        let g =
+            |i: usize, j: usize| fl[0][i] * fl[0][j] + fl[1][i] * fl[1][j] + fl[2][i] * fl[2][j];
+        let (s01, s02, s12) = (g(0, 1), g(0, 2), g(1, 2));
+        set_lane(
+            &mut s,
+            l,
+            &[
+                [g(0, 0), s01, s02],
+                [s01, g(1, 1), s12],
+                [s02, s12, g(2, 2)],
+            ],
+        );
+    }
+    let (zeros, ones) = ([zero; N], [one; N]);
+    let mut v = [
+        [ones, zeros, zeros],
+        [zeros, ones, zeros],
+        [zeros, zeros, ones],
+    ];
     for _ in 0..JACOBI_SWEEPS {
         rotate(&mut s, &mut v, 0, 1, 2);
         rotate(&mut s, &mut v, 0, 2, 1);
@@ -100,77 +190,102 @@ fn right_vectors<T: Real>(f: &Mat3<T>) -> Mat3<T> {
     }
     // Sort the eigenvalues s_kk downwards, swapping columns of V; the
     // swapped-in column changes sign so that det V stays +1.
-    for (p, q) in [(0, 1), (1, 2), (0, 1)] {
-        swap_if_smaller(&mut s, &mut v, p, q);
-    }
+    // (Three calls with literal indices, not a loop over pairs, so that
+    // the indices stay constants and no bounds check is left.)
+    swap_if_smaller(&mut s, &mut v, 0, 1);
+    swap_if_smaller(&mut s, &mut v, 1, 2);
+    swap_if_smaller(&mut s, &mut v, 0, 1);
     v
 }
 
-/// One Jacobi rotation in the `(p, q)` plane (`r` the third index) that
-/// zeroes `s_pq` of the symmetric `s`, accumulated into `v`'s columns
-/// (Numerical Recipes §11.1, eq. 11.1.8–11.1.18): `θ = (s_qq − s_pp)/(2s_pq)`,
-/// `t = sgn θ/(|θ| + √(θ²+1))`, written as
+/// Per lane, one Jacobi rotation in the `(p, q)` plane (`r` the third
+/// index) that zeroes `s_pq` of the symmetric `s`, accumulated into `v`'s
+/// columns (Numerical Recipes §11.1, eq. 11.1.8–11.1.18):
+/// `θ = (s_qq − s_pp)/(2s_pq)`, `t = sgn θ/(|θ| + √(θ²+1))`, written as
 /// `t = 2 s_pq sgn(τ)/(|τ| + √(τ² + 4 s_pq²))` with `τ = s_qq − s_pp`, so
 /// that `s_pq = 0` gives `t = 0` and no division by zero.
 #[expect(
     clippy::indexing_slicing,
-    reason = "p, q, r are literals < 3 at every call"
+    reason = "p, q, r are literals < 3 at every call; l < N"
 )]
 #[inline(always)]
-fn rotate<T: Real>(s: &mut Mat3<T>, v: &mut Mat3<T>, p: usize, q: usize, r: usize) {
+fn rotate<T: Real, const N: usize>(
+    s: &mut Mat3<[T; N]>,
+    v: &mut Mat3<[T; N]>,
+    p: usize,
+    q: usize,
+    r: usize,
+) {
     let (zero, one) = (T::zero(), T::one());
-    let (spp, sqq) = (s[p][p], s[q][q]);
-    // An off-diagonal already below 1e-18 of the diagonal counts as zero:
-    // below f64's rounding, and it keeps the squares and products of the
-    // later sweeps out of the subnormal range (f32 below 1.2e-38), whose
-    // arithmetic is a hundred times slower on x86.
-    let spq = if s[p][q].abs() > T::of_f64(FLUSH) * (spp.abs() + sqq.abs()) {
-        s[p][q]
-    } else {
-        zero
-    };
-    let tau = sqq - spp;
-    let sign = if tau < zero { -one } else { one };
-    let denominator = tau.abs() + (tau * tau + T::of_f64(4.0) * spq * spq).sqrt();
-    let t = if denominator > zero {
-        (spq + spq) * sign / denominator
-    } else {
-        zero
-    };
-    let c = one / (one + t * t).sqrt();
-    let sn = t * c;
-    s[p][p] = spp - t * spq;
-    s[q][q] = sqq + t * spq;
-    s[p][q] = zero;
-    s[q][p] = zero;
-    let (srp, srq) = (s[r][p], s[r][q]);
-    s[r][p] = c * srp - sn * srq;
-    s[r][q] = sn * srp + c * srq;
-    s[p][r] = s[r][p];
-    s[q][r] = s[r][q];
+    let (mut c, mut sn) = ([zero; N], [zero; N]);
+    for l in 0..N {
+        let (spp, sqq) = (s[p][p][l], s[q][q][l]);
+        // An off-diagonal already below 1e-18 of the diagonal counts as
+        // zero: below f64's rounding, and it keeps the squares and products
+        // of the later sweeps out of the subnormal range (f32 below
+        // 1.2e-38), whose arithmetic is a hundred times slower on x86.
+        let spq = if s[p][q][l].abs() > T::of_f64(FLUSH) * (spp.abs() + sqq.abs()) {
+            s[p][q][l]
+        } else {
+            zero
+        };
+        let tau = sqq - spp;
+        let sign = if tau < zero { -one } else { one };
+        let denominator = tau.abs() + (tau * tau + T::of_f64(4.0) * spq * spq).sqrt();
+        let t = if denominator > zero {
+            (spq + spq) * sign / denominator
+        } else {
+            zero
+        };
+        let cl = one / (one + t * t).sqrt();
+        let sl = t * cl;
+        s[p][p][l] = spp - t * spq;
+        s[q][q][l] = sqq + t * spq;
+        s[p][q][l] = zero;
+        s[q][p][l] = zero;
+        let (srp, srq) = (s[r][p][l], s[r][q][l]);
+        s[r][p][l] = cl * srp - sl * srq;
+        s[r][q][l] = sl * srp + cl * srq;
+        s[p][r][l] = s[r][p][l];
+        s[q][r][l] = s[r][q][l];
+        c[l] = cl;
+        sn[l] = sl;
+    }
     for row in v.iter_mut() {
-        let (vp, vq) = (row[p], row[q]);
-        row[p] = c * vp - sn * vq;
-        row[q] = sn * vp + c * vq;
+        for l in 0..N {
+            let (vp, vq) = (row[p][l], row[q][l]);
+            row[p][l] = c[l] * vp - sn[l] * vq;
+            row[q][l] = sn[l] * vp + c[l] * vq;
+        }
     }
 }
 
-/// Swaps eigenvalues `p < q` (the diagonal of `s`) and `v`'s columns when
-/// `s_pp < s_qq`, negating the new column `q` (det `v` unchanged).
-#[expect(clippy::indexing_slicing, reason = "p, q are literals < 3")]
+/// Per lane, swaps eigenvalues `p < q` (the diagonal of `s`) and `v`'s
+/// columns when `s_pp < s_qq`, negating the new column `q` (det `v`
+/// unchanged).
+#[expect(clippy::indexing_slicing, reason = "p, q are literals < 3; l < N")]
 #[inline(always)]
-fn swap_if_smaller<T: Real>(s: &mut Mat3<T>, v: &mut Mat3<T>, p: usize, q: usize) {
-    let swap = s[p][p] < s[q][q];
-    let (spp, sqq) = (s[p][p], s[q][q]);
-    s[p][p] = if swap { sqq } else { spp };
-    s[q][q] = if swap { spp } else { sqq };
+fn swap_if_smaller<T: Real, const N: usize>(
+    s: &mut Mat3<[T; N]>,
+    v: &mut Mat3<[T; N]>,
+    p: usize,
+    q: usize,
+) {
+    let mut swap = [false; N];
+    for l in 0..N {
+        let (spp, sqq) = (s[p][p][l], s[q][q][l]);
+        swap[l] = spp < sqq;
+        s[p][p][l] = if swap[l] { sqq } else { spp };
+        s[q][q][l] = if swap[l] { spp } else { sqq };
+    }
     for row in v.iter_mut() {
-        let (vp, vq) = (row[p], row[q]);
-        row[p] = if swap { vq } else { vp };
-        row[q] = if swap { -vp } else { vq };
+        for l in 0..N {
+            let (vp, vq) = (row[p][l], row[q][l]);
+            row[p][l] = if swap[l] { vq } else { vp };
+            row[q][l] = if swap[l] { -vp } else { vq };
+        }
     }
 }
-
 /// A unit vector perpendicular to the unit vector `u`: `u × e_x` when `u`
 /// is far from `e_x` (`|u_x| < ½`, length ≥ √3/2), else `u × e_y` (length
 /// ≥ ½ since then `|u_y|² ≤ ¾`).

@@ -20,9 +20,9 @@
 //! strain (`F` symmetric positive definite, `R = I`); rotating the
 //! deformed state rotates the forces.
 
-use super::stvk::{Block, LANES, TetTerms};
+use super::stvk::{Block, LANES, Lanes, TetTerms};
 use crate::Real;
-use crate::math::polar::closest_rotation;
+use crate::math::polar::{Mat3, closest_rotations};
 use crate::table::format::tet_lane_row;
 
 #[expect(
@@ -46,10 +46,22 @@ impl<T: Real> Block<'_, T> {
             &rest[tet_lane_row::LAMBDA],
             &rest[tet_lane_row::MU],
         );
+        // F per lane, then R for all lanes at once (its lane loops are
+        // what vectorizes the polar step).
+        let mut f_lanes: Mat3<Lanes<T>> = [[z; 3]; 3];
+        for l in 0..LANES {
+            let f = self.deformation(l);
+            for (row, f_row) in f_lanes.iter_mut().zip(&f) {
+                row[0][l] = f_row[0];
+                row[1][l] = f_row[1];
+                row[2][l] = f_row[2];
+            }
+        }
+        let r_lanes = closest_rotations(&f_lanes);
         for l in 0..LANES {
             let (lambda, mu, v) = (lambda[l], mu[l], volume[l]);
             let f = self.deformation(l);
-            let r = closest_rotation(&f);
+            let r = [0, 1, 2].map(|i| [0, 1, 2].map(|j| r_lanes[i][j][l]));
             // G = RᵀF; ε = sym(G) − I.
             let g: [[T; 3]; 3] = core::array::from_fn(|i| {
                 core::array::from_fn(|k| r[0][i] * f[0][k] + r[1][i] * f[1][k] + r[2][i] * f[2][k])

@@ -36,11 +36,21 @@ impl<T: Real> InternalForces<'_, '_, T> {
     /// pass over the mesh runs through `dispatch` ([`Dispatch`]).
     pub(crate) fn forces(&self, dispatch: impl Dispatch, u: &[[T; 3]], f: &mut [[T; 3]]) {
         match self.law {
+            // The law closures are always inlined, so that they are
+            // compiled inside the dispatched pass, for its CPU features.
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
                 self.per_tet_forces(dispatch, u, f, |b| b.elastic());
             }
             ElasticLaw::NeoHookean => self.per_tet_forces(dispatch, u, f, |b| b.neo_hookean()),
-            ElasticLaw::Corotational => self.per_tet_forces(dispatch, u, f, |b| b.corotational()),
+            ElasticLaw::Corotational => {
+                self.per_tet_forces(
+                    dispatch,
+                    u,
+                    f,
+                    #[inline(always)]
+                    |b| b.corotational(),
+                );
+            }
             // One call site of the (always inlined) linear pass for both
             // laws that read the tensors: one copy of it in the firmware.
             law => {
