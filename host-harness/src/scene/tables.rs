@@ -27,7 +27,7 @@ pub enum TableCode {
     Hmatrix,
 }
 
-/// The `[tables]` table, validated ([`TablesSpec::new`]): `compress`
+/// The `[tables]` table, validated (`TablesSpec::new`): `compress`
 /// absent means the f32 table, and then neither option is given.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TablesSpec {

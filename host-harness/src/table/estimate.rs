@@ -125,7 +125,7 @@ pub struct TableEstimate {
     /// table's, a bound of the compressed one's, which the f32 table is built beside.
     pub compressed: bool,
     /// A hierarchical table (`--compress hmatrix`): [`Self::table_bytes`] is its own
-    /// estimate ([`Self::hierarchical`]), not the f32 table's.
+    /// estimate (`Self::hierarchical`), not the f32 table's.
     pub hierarchical: bool,
 }
 

@@ -1,6 +1,6 @@
 //! The hierarchical surface compliance of a pre-computed table as stored
 //! ([`super::format::hierarchy`]): checked once at load
-//! ([`HierarchicalBlocks::load`]), then read by the step path in bounded
+//! (`HierarchicalBlocks::load`), then read by the step path in bounded
 //! time: a contact block `C_nk` by two binary searches and `9r`
 //! multiply-adds ([`HierarchicalBlocks::block`]), a compliance column by one
 //! pass over the blocks of its leaf column ([`HierarchicalBlocks::add_column`],
@@ -17,7 +17,7 @@ use crate::Real;
 use crate::math::block;
 
 /// A hierarchical surface part, validated at load. Invariants from
-/// [`Self::load`]:
+/// `load`:
 /// - `leaves` is `0`, strictly ascending, `S` last (`leaf_count + 1`
 ///   entries);
 /// - every block spans a non-empty range of rows and of columns within

@@ -50,7 +50,7 @@ pub fn surgery(tool: &ToolSpec) -> Result<Trajectory, GenerateError> {
 /// ([`crate::scene::Scene::built_in_hybrid`], sites [`HepatectomySites`]): the
 /// grasper (tool 0) grasps the right lobe's dome and pulls it up ([`GraspPull`]'s defaults);
 /// at the same time the cutter (tool 1, the scene's blade) goes in at the cut line's start,
-/// its tip [`HEPATECTOMY_CUT_DEPTH_M`] below the lobe's top (the blade's upper end 2 mm above
+/// its tip `HEPATECTOMY_CUT_DEPTH_M` below the lobe's top (the blade's upper end 2 mm above
 /// it), cuts along the line at 20 mm/s (through the lobe, whose tip comes off), and comes out
 /// 25 mm ([`CutLine`]'s other defaults); 1 kHz with the tool columns (`session generate
 /// hepatectomy`).
