@@ -22,7 +22,7 @@
 //! term always pushes the tet back towards positive volume, with a
 //! stiffness `V g''(J₀)` that grows linearly in how far it is inverted.
 
-use super::stvk::{Block, LANES, TetTerms};
+use super::stvk::{Block, LANES, TetTerms, cofactor};
 use crate::Real;
 use crate::table::format::tet_lane_row;
 
@@ -77,23 +77,7 @@ impl<T: Real> Block<'_, T> {
         for l in 0..LANES {
             let (lambda, mu, v, jc, log) = (lambda[l], mu[l], volume[l], clamped[l], logs[l]);
             let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = self.deformation(l);
-            let cof = [
-                [
-                    f11 * f22 - f12 * f21,
-                    f12 * f20 - f10 * f22,
-                    f10 * f21 - f11 * f20,
-                ],
-                [
-                    f02 * f21 - f01 * f22,
-                    f00 * f22 - f02 * f20,
-                    f01 * f20 - f00 * f21,
-                ],
-                [
-                    f01 * f12 - f02 * f11,
-                    f02 * f10 - f00 * f12,
-                    f00 * f11 - f01 * f10,
-                ],
-            ];
+            let cof = cofactor(&[[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]]);
             let j = f00 * cof[0][0] + f01 * cof[0][1] + f02 * cof[0][2];
             // d = J − J₀ below the floor, 0 above it (then J = jc exactly).
             let d = j - jc;

@@ -206,23 +206,7 @@ impl<'t, T: Real> Block<'t, T> {
         let mut forces = [[z; 3]; 4];
         for l in 0..LANES {
             let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = self.deformation(l);
-            let cof = [
-                [
-                    f11 * f22 - f12 * f21,
-                    f12 * f20 - f10 * f22,
-                    f10 * f21 - f11 * f20,
-                ],
-                [
-                    f02 * f21 - f01 * f22,
-                    f00 * f22 - f02 * f20,
-                    f01 * f20 - f00 * f21,
-                ],
-                [
-                    f01 * f12 - f02 * f11,
-                    f02 * f10 - f00 * f12,
-                    f00 * f11 - f01 * f10,
-                ],
-            ];
+            let cof = cofactor(&[[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]]);
             let change = f00 * cof[0][0] + f01 * cof[0][1] + f02 * cof[0][2] - T::one();
             let magnitude = gamma_n * change * change.abs();
             let a1: [T; 3] = core::array::from_fn(|c| self.a(0, c)[l]);
@@ -370,4 +354,29 @@ impl<T: Real> TetPass<'_, '_, T> {
         });
         energy
     }
+}
+
+/// The cofactor matrix `cof F = J F⁻ᵀ` of a 3×3 `F` (row-major), written
+/// entry by entry so that the lane loops calling it stay vectorizable;
+/// `J = Σ_b F_0b cof_0b`.
+#[inline(always)]
+pub(super) fn cofactor<T: Real>(f: &[[T; 3]; 3]) -> [[T; 3]; 3] {
+    let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = *f;
+    [
+        [
+            f11 * f22 - f12 * f21,
+            f12 * f20 - f10 * f22,
+            f10 * f21 - f11 * f20,
+        ],
+        [
+            f02 * f21 - f01 * f22,
+            f00 * f22 - f02 * f20,
+            f01 * f20 - f00 * f21,
+        ],
+        [
+            f01 * f12 - f02 * f11,
+            f02 * f10 - f00 * f12,
+            f00 * f11 - f01 * f10,
+        ],
+    ]
 }
