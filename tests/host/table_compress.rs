@@ -64,16 +64,17 @@ fn cube() -> (TetMesh, MeshReport, BuildOptions, Compliance, usize) {
         Solver::Cholesky,
         palpate::table::file::Precision::F32,
     );
-    let (compliance, s) = f64_compliance(&mesh, &report, &options);
-    (mesh, report, options, compliance, s)
+    let (compliance, ordering) = f64_compliance(&mesh, &report, &options);
+    (mesh, report, options, compliance, ordering.touchable_count)
 }
 
-/// The f64 compliance a build with `options` computes, and its touchable count.
-fn f64_compliance(
+/// The f64 compliance a build with `options` computes (uncompressed: the
+/// touchable vertices in ascending order), and its free ordering.
+pub(super) fn f64_compliance(
     mesh: &TetMesh,
     report: &MeshReport,
     options: &BuildOptions,
-) -> (Compliance, usize) {
+) -> (Compliance, FreeOrdering) {
     let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
     let surface = boundary_surface(mesh);
     let ordering = FreeOrdering::new(mesh.positions.len(), &fixed, &surface.vertices);
@@ -87,7 +88,7 @@ fn f64_compliance(
         false,
     )
     .expect("compliance");
-    (compliance, ordering.touchable_count)
+    (compliance, ordering)
 }
 
 /// The table of `mesh` built with `options`, compressed as `compression` says.

@@ -5,14 +5,14 @@
 //! contact sets within the team's bound, the errors stored in the record,
 //! and corrupted tables refused.
 
+use super::table_compress::f64_compliance;
 use nalgebra::Vector3;
 use palpate::fem::assembly::FreeOrdering;
 use palpate::fem::material::Material;
-use palpate::fix::fixed_vertices;
 use palpate::mesh::generate::box_mesh;
-use palpate::mesh::{MeshReport, TetMesh, boundary_surface};
+use palpate::mesh::{MeshReport, TetMesh};
 use palpate::table::build::{BuildOptions, DEFAULT_LIST_TOOL_RADIUS_M, TableKindOptions, build};
-use palpate::table::compliance::{Compliance, Solver, compute_compliance};
+use palpate::table::compliance::{Compliance, Solver};
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
@@ -56,28 +56,6 @@ fn table(mesh: &TetMesh, report: &MeshReport, options: &BuildOptions, hmatrix: b
     TableFile::from_bytes(&build(mesh, report, &options).expect("build").bytes)
 }
 
-/// The dense f64 compliance in the default ordering.
-fn dense(
-    mesh: &TetMesh,
-    report: &MeshReport,
-    options: &BuildOptions,
-) -> (Compliance, FreeOrdering) {
-    let (fixed, _) = fixed_vertices(&mesh.positions, &options.fix, &report.unreferenced_vertices);
-    let surface = boundary_surface(mesh);
-    let ordering = FreeOrdering::new(mesh.positions.len(), &fixed, &surface.vertices);
-    let materials = options.materials_for(mesh.tets.len()).expect("materials");
-    let c = compute_compliance(
-        &mesh.positions,
-        &mesh.tets,
-        &materials,
-        &ordering,
-        Solver::Cholesky,
-        false,
-    )
-    .expect("compliance");
-    (c, ordering)
-}
-
 /// `C_nk` (mesh vertices `vn`, `vk`, both touchable) of the dense compliance.
 fn dense_block(c: &Compliance, ordering: &FreeOrdering, vn: u32, vk: u32) -> [f64; 9] {
     let (n, k) = (
@@ -97,7 +75,7 @@ fn far_blocks_are_within_their_tolerance_and_near_blocks_exact() {
     let (mesh, report, options) = mesh();
     let file = table(&mesh, &report, &options, true);
     let t = PrecomputedTable::<f32>::load(file.bytes()).expect("loads");
-    let (c, ordering) = dense(&mesh, &report, &options);
+    let (c, ordering) = f64_compliance(&mesh, &report, &options);
     let h = *t.surface_blocks().as_hierarchical().expect("hierarchical");
     let touchable = &t.free_vertices()[..t.touchable_count()];
     let mut far = 0;
