@@ -374,3 +374,38 @@ fn margin_default_is_where_a_pulled_cut_is_back_in_the_linear_range() {
         "{largest:?}"
     );
 }
+
+/// No pre-computed boundary face has three connection nodes (held in the pre-computed region's
+/// table: it could answer no contact there). On the built-in organ under the built-in hybrid
+/// scene's cut zone, margin rings 1–4 left such faces before the planner moved their tets into
+/// the tensor-mass region; the count is exact (every face is checked).
+#[test]
+fn no_precomputed_boundary_face_is_all_connection_nodes_on_the_organ() {
+    use palpate::mesh::{boundary_face_slots, organ::organ};
+    use palpate::scene::Scene;
+    use palpate_kernel::table::format::tet_face_vertices;
+
+    let (mesh, report) = organ().unwrap();
+    let boundary = boundary_face_slots(&mesh);
+    let mut scene = Scene::built_in_hybrid();
+    for rings in 0..=4 {
+        scene.partition.margin_rings = rings;
+        let p = Partition::of_scene(&scene, &mesh, &report).unwrap();
+        let connection = brute_connection_nodes(&mesh, &p.dynamic);
+        let whole = (0..mesh.tets.len())
+            .filter(|&t| !p.dynamic[t])
+            .flat_map(|t| {
+                let faces = tet_face_vertices(mesh.tets[t]);
+                (0..4).map(move |j| (t, j, faces[j]))
+            })
+            .filter(|&(t, j, face)| {
+                boundary[4 * t + j] && face.iter().all(|v| connection.binary_search(v).is_ok())
+            })
+            .count();
+        assert_eq!(
+            whole, 0,
+            "margin rings {rings}: all-connection boundary faces"
+        );
+        assert_eq!(p.connection_nodes, connection, "margin rings {rings}");
+    }
+}

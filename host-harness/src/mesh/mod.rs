@@ -21,7 +21,7 @@ mod validate;
 mod vtk;
 
 pub use error::MeshError;
-pub use surface::{Surface, boundary_surface, top_height};
+pub use surface::{Surface, boundary_face_slots, boundary_surface, top_height};
 pub use tetgen::read_tetgen;
 
 /// A validated tetrahedral mesh (linear 4-node tets).

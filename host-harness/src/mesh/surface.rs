@@ -50,8 +50,13 @@ pub fn boundary_surface(mesh: &TetMesh) -> Surface {
     boundary_from(mesh, &sorted_faces(mesh))
 }
 
-fn boundary_from(mesh: &TetMesh, sorted: &[([u32; 3], usize)]) -> Surface {
-    // Which tet faces are on the boundary, then the triangles in tet order, then face order.
+/// Per tet face slot `4·tet + j` (the face opposite local vertex `j`, as
+/// [`faces`]), whether it is on the boundary (belongs to no other tet).
+pub fn boundary_face_slots(mesh: &TetMesh) -> Vec<bool> {
+    boundary_slots(mesh, &sorted_faces(mesh))
+}
+
+fn boundary_slots(mesh: &TetMesh, sorted: &[([u32; 3], usize)]) -> Vec<bool> {
     let mut on_boundary = vec![false; 4 * mesh.tets.len()];
     for run in face_runs(sorted) {
         if let [(_, slot)] = run
@@ -60,6 +65,12 @@ fn boundary_from(mesh: &TetMesh, sorted: &[([u32; 3], usize)]) -> Surface {
             *b = true;
         }
     }
+    on_boundary
+}
+
+fn boundary_from(mesh: &TetMesh, sorted: &[([u32; 3], usize)]) -> Surface {
+    // Which tet faces are on the boundary, then the triangles in tet order, then face order.
+    let on_boundary = boundary_slots(mesh, sorted);
     let mut triangles = Vec::new();
     for (t, &tet) in mesh.tets.iter().enumerate() {
         for (j, f) in faces(tet).into_iter().enumerate() {

@@ -8,6 +8,11 @@
 //! - Regions: the pre-computed tets form one region (in one or more pieces); the dynamic tets
 //!   form one region per connected component. Tets are connected when they share a vertex (a
 //!   shared vertex is a shared degree of freedom in either model).
+//! - Held faces: a pre-computed tet with a boundary face whose three vertices are all
+//!   connection nodes joins the dynamic set: the connection nodes are held in the pre-computed
+//!   region's table, so it could answer no contact on that face, while the tensor-mass region
+//!   can. Repeated until no such tet remains (each pass only grows the set). Faces held by
+//!   fixed vertices are left as they are: the fixed side is where the organ rests.
 //! - Connection nodes: vertices of both a dynamic and a pre-computed tet.
 //! - Law of a dynamic component: linear (MODELS.md §3) unless it holds a tet of a
 //!   large-deformation zone, then St Venant-Kirchhoff (MODELS.md §4), with the incompressibility
@@ -20,11 +25,12 @@
 //! Cost: linear in the mesh per ring and per component pass, plus the zone tests of the tets
 //! near each zone.
 
+use palpate_kernel::table::format::tet_face_vertices;
 use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 
 use super::geometry::TetGrid;
 use crate::fix::fixed_vertices;
-use crate::mesh::{MeshReport, TetMesh};
+use crate::mesh::{MeshReport, TetMesh, boundary_face_slots};
 use crate::scene::{Scene, Zone, ZoneKind};
 
 /// Poisson ratio from which a St Venant-Kirchhoff region gets the incompressibility penalty
@@ -229,6 +235,7 @@ pub fn plan(input: &PlanInput<'_>) -> Result<Partition, PlanError> {
     } = zone_tets(input)?;
     let adjacency = VertexTets::new(mesh);
     grow_rings(mesh, &adjacency, &mut dynamic, input.margin_rings);
+    absorb_held_faces(mesh, &mut dynamic);
     let connection = connection_vertices(mesh, &dynamic);
     let connection_nodes: Vec<u32> = (0..connection.len() as u32)
         .filter(|&v| connection[v as usize])
@@ -291,6 +298,29 @@ fn zone_tets(input: &PlanInput<'_>) -> Result<ZoneTets, PlanError> {
         dynamic,
         large,
     })
+}
+
+/// Moves into the `dynamic` set every pre-computed tet with a held boundary face (module doc),
+/// pass after pass until none remains: at most one pass per tet, as each pass that changes
+/// nothing ends it.
+fn absorb_held_faces(mesh: &TetMesh, dynamic: &mut [bool]) {
+    let boundary = boundary_face_slots(mesh);
+    loop {
+        let connection = connection_vertices(mesh, dynamic);
+        let mut moved = false;
+        for (t, &tet) in mesh.tets.iter().enumerate() {
+            let held = |(j, face): (usize, &[u32; 3])| {
+                boundary[4 * t + j] && face.iter().all(|&v| connection[v as usize])
+            };
+            if !dynamic[t] && tet_face_vertices(tet).iter().enumerate().any(held) {
+                dynamic[t] = true;
+                moved = true;
+            }
+        }
+        if !moved {
+            return;
+        }
+    }
 }
 
 /// Per vertex, whether it is a connection node: a vertex of both a
