@@ -25,8 +25,7 @@ use crate::mesh::top_height;
 /// How far the built-in hybrid scene's cut zone reaches past its cut line into the organ, m:
 /// the blade's sphere (2 mm) and two of the left lobe's 5 mm tets. It is the zone's margin: the
 /// scene adds no element rings (`[partition] margin_rings = 0`; the default 4 rings would make
-/// three quarters of the organ tensor-mass, and leave a few pre-computed surface triangles
-/// with only connection nodes, where a contact is refused).
+/// three quarters of the organ tensor-mass).
 pub const HEPATECTOMY_ZONE_PAST_CUT_M: f64 = 0.012;
 
 /// The built-in hybrid scene's cutter blade, m: 2 cm straight down from the tool point, longer
