@@ -49,7 +49,7 @@ pub enum TablesCommand {
         #[arg(long, value_enum, value_name = "CODE")]
         compress: Option<BlockCode>,
         /// With --compress hmatrix: the far blocks' relative truncation
-        /// tolerance (Frobenius norm per block), in (0, 1); default 1e-4.
+        /// tolerance (Frobenius norm per block), in (0, 1); default 1e-5.
         #[arg(long, value_name = "REL")]
         tolerance: Option<f64>,
         /// With --compress: leave out each interior compliance block whose

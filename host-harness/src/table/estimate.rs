@@ -339,11 +339,14 @@ impl TableEstimate {
             ),
         };
         let compressed = if self.hierarchical {
-            " (hierarchical, far blocks estimated at rank 12)"
+            format!(
+                " (hierarchical, far blocks estimated at rank {})",
+                super::hmatrix::ESTIMATE_RANK
+            )
         } else if self.compressed {
-            " (uncompressed; compressed, about half that or less)"
+            " (uncompressed; compressed, about half that or less)".to_owned()
         } else {
-            ""
+            String::new()
         };
         format!(
             "{what} would be {}{compressed}, and its build needs about {} of memory",
