@@ -81,8 +81,11 @@ pub struct TableInfo {
     pub connection_count: u32,
 }
 
-/// A validated view, of one of the three kinds.
+/// A validated view, of one of the three kinds. Held in place in the
+/// caller's fixed-size handle (no allocator: a variant cannot be boxed), so
+/// the largest variant's size is the handle's whatever the others'.
 #[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)]
 pub enum View {
     /// A pre-computed table.
     Precomputed(PrecomputedTable<'static, f32>),
