@@ -13,7 +13,8 @@
 #                                             so that both kept-block bitmaps are exercised
 #                                             (default OUT: target/firmware/box-table-CODE.bin);
 #                                             CODE hmatrix: the hierarchical table (default
-#                                             tolerance, nothing dropped)
+#                                             tolerance, nothing dropped); hmatrix-q16: the
+#                                             same in 16-bit codes
 set -euo pipefail
 cd "$(dirname "$0")/.."
 kind=(--kind precomputed)
@@ -23,10 +24,10 @@ if [[ "${1:-}" == --tensor-mass ]]; then
     kind=(--kind tensor-mass --density 1000)
     out_default=target/firmware/box-tensor-table.bin
 elif [[ "${1:-}" == --compress ]]; then
-    code="${2:?usage: tools/box-table.sh --compress f16|q16|hmatrix [OUT]}"
+    code="${2:?usage: tools/box-table.sh --compress f16|q16|hmatrix|hmatrix-q16 [OUT]}"
     shift 2
-    if [[ "$code" == hmatrix ]]; then
-        kind=(--kind precomputed --compress hmatrix)
+    if [[ "$code" == hmatrix || "$code" == hmatrix-q16 ]]; then
+        kind=(--kind precomputed --compress "$code")
     else
         kind=(--kind precomputed --compress "$code" --drop-below 0.2 --contact-blocks dropped)
     fi

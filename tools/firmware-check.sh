@@ -10,6 +10,11 @@
 #                                      the same with the table compressed (CODE f16 or
 #                                      q16; `box-table.sh --compress CODE`): the kernel
 #                                      decodes it on the fly on both sides
+#   tools/firmware-check.sh --organ    the built-in organ (host-harness/assets/organ.msh,
+#                                      1118 vertices) in its hierarchical q16 table
+#                                      (`--compress hmatrix-q16 --tolerance 3e-3`, under 1 MB),
+#                                      organ-sequence.txt (1 to 4 contacts), vs `palpate
+#                                      precomputed replay`
 #   tools/firmware-check.sh --hybrid   the hybrid (RR-3510 §6.2): hybrid-tables.sh's three
 #                                      tables, hybrid-sequence.txt, firmware built with
 #                                      `--features hybrid`, vs `palpate scene replay-hybrid`
@@ -151,6 +156,15 @@ if [[ "${1:-}" == --hybrid ]]; then
     sequence="$root/tools/firmware-m4f/hybrid-sequence.txt"
     host=(scene replay-hybrid "$tables" "$sequence")
     build=(env PALPATE_HYBRID_TABLES="$tables" cargo build -q --release --features hybrid)
+elif [[ "${1:-}" == --organ ]]; then
+    mode=organ-hmatrix-q16
+    table="$out/organ-hmatrix-q16.bin"
+    tools/palpate.sh tables build host-harness/assets/organ.msh --young 5000 --poisson 0.4 \
+        --fix 'z<0.001' --compress hmatrix-q16 --tolerance 3e-3 --quiet -o "$table" >&2
+    sequence="$root/tools/firmware-m4f/organ-sequence.txt"
+    host=(precomputed replay "$table" "$sequence")
+    build=(env PALPATE_TABLE="$table" PALPATE_SEQUENCE="$sequence" PALPATE_VERTICES=1118
+        cargo build -q --release)
 else
     mode=precomputed
     compress=()
@@ -161,7 +175,8 @@ else
     table="$(tools/box-table.sh "${compress[@]}")" # host CLI (tools/palpate.sh); prints the table path
     sequence="$root/tools/firmware-m4f/sequence.txt"
     host=(precomputed replay "$table" "$sequence")
-    build=(env PALPATE_TABLE="$table" cargo build -q --release)
+    build=(env PALPATE_TABLE="$table" PALPATE_SEQUENCE="$sequence" PALPATE_VERTICES=64
+        cargo build -q --release)
 fi
 host_txt="$out/$mode-host.txt"
 firmware_txt="$out/$mode-firmware.txt"

@@ -115,14 +115,14 @@
 /*
  Words of a `palpate_table` on 64-bit targets (the host).
  */
-#define PALPATE_TABLE_WORDS 81
+#define PALPATE_TABLE_WORDS 84
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_table` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_TABLE_WORDS 57
+#define PALPATE_TABLE_WORDS 59
 #endif
 
 /*
@@ -134,14 +134,14 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 394
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 397
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 350
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 352
 #endif
 
 #if defined(PALPATE_POINTER_64)
@@ -162,14 +162,14 @@
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 629
+#define PALPATE_HYBRID_LOOP_WORDS 635
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 504
+#define PALPATE_HYBRID_LOOP_WORDS 508
 #endif
 
 /*

@@ -143,14 +143,14 @@ fn stored_values_are_within_half_a_quantum() {
             let scale = match code {
                 BlockCode::Q16 => f64::from((column_max / 32767.0) as f32),
                 BlockCode::F16 => f64::from(column_max as f32),
-                BlockCode::Hmatrix => unreachable!("16-bit codes only"),
+                BlockCode::Hmatrix | BlockCode::HmatrixQ16 => unreachable!("16-bit codes only"),
             };
             for (&got, &x) in stored.iter().zip(exact) {
                 let error = (f64::from(got) - x).abs();
                 let bound = match code {
                     BlockCode::Q16 => scale / 2.0,
                     BlockCode::F16 => (x.abs() * 2f64.powi(-11)).max(scale * 2f64.powi(-25)),
-                    BlockCode::Hmatrix => unreachable!("16-bit codes only"),
+                    BlockCode::Hmatrix | BlockCode::HmatrixQ16 => unreachable!("16-bit codes only"),
                 } * (1.0 + 1e-12)
                     + x.abs() * 2f64.powi(-24);
                 assert!(
@@ -289,7 +289,7 @@ fn single_press_forces_are_within_the_bound_of_the_code() {
             let entry = match code {
                 BlockCode::Q16 => column_max / 65534.0,
                 BlockCode::F16 => column_max * 2f64.powi(-11),
-                BlockCode::Hmatrix => unreachable!("16-bit codes only"),
+                BlockCode::Hmatrix | BlockCode::HmatrixQ16 => unreachable!("16-bit codes only"),
             } + column_max * 2f64.powi(-24);
             let r = 3.0 * entry / hi;
             let bound = kappa * r / (1.0 - kappa * r) + 1e-5 * kappa;
@@ -443,7 +443,7 @@ fn trajectory_forces_match_the_f32_table() {
                 let bound = match c.code {
                     BlockCode::Q16 => 1e-3,
                     BlockCode::F16 => 1e-2,
-                    BlockCode::Hmatrix => unreachable!("16-bit codes only"),
+                    BlockCode::Hmatrix | BlockCode::HmatrixQ16 => unreachable!("16-bit codes only"),
                 };
                 assert!(diff <= bound * peak, "{name} {c:?}: {diff:e} N of {peak} N");
             }

@@ -17,7 +17,8 @@ use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate_kernel::table::format::{
-    HIERARCHY_BLOCK_LEN, HIERARCHY_MAX_RANK, PROBE_SET_SAMPLED, SectionKind, surface_block_index,
+    BlockEncoding, HIERARCHY_BLOCK_LEN, HIERARCHY_MAX_RANK, PROBE_SET_SAMPLED, SectionKind,
+    surface_block_index,
 };
 use palpate_kernel::{Constraint, LoadError, MAX_CONTACTS, PrecomputedModel, PrecomputedTable};
 use palpate_tests::{Lcg, patch_section};
@@ -39,8 +40,18 @@ fn mesh() -> (TetMesh, MeshReport, BuildOptions) {
 }
 
 fn table(mesh: &TetMesh, report: &MeshReport, options: &BuildOptions, hmatrix: bool) -> TableFile {
-    let compression = hmatrix.then_some(Compression {
-        code: BlockCode::Hmatrix,
+    coded_table(mesh, report, options, hmatrix.then_some(BlockCode::Hmatrix))
+}
+
+/// The table of `mesh` with the compliance coded as `code` (`None`: f32).
+fn coded_table(
+    mesh: &TetMesh,
+    report: &MeshReport,
+    options: &BuildOptions,
+    code: Option<BlockCode>,
+) -> TableFile {
+    let compression = code.map(|code| Compression {
+        code,
         drop_below: 0.0,
         contact: ContactBlocks::Coded,
         tolerance: TOLERANCE,
@@ -246,4 +257,118 @@ fn corrupted_hierarchies_are_refused() {
             put(b, 4, x);
         }
     )));
+}
+
+/// `--compress hmatrix-q16` on the same box: every entry of a block stored
+/// entry by entry within half its q16 quantum of the dense compliance,
+/// every factored block within its tolerance plus the factors' q16
+/// rounding, the measured force error within the team's bound; and
+/// corrupted codes and scales refused at load.
+#[test]
+fn q16_hierarchy_is_within_its_bound_and_corrupted_codes_are_refused() {
+    // The box at a coarser 12 × 4 × 4 cells (325 vertices):
+    // still near, factored and far blocks, at a fraction of the build.
+    let (_, report, options) = mesh();
+    let mesh = box_mesh([12, 4, 4], [0.2, 0.1, 0.1]);
+    let file = coded_table(&mesh, &report, &options, Some(BlockCode::HmatrixQ16));
+    let t = PrecomputedTable::<f32>::load(file.bytes()).expect("loads");
+    assert_eq!(
+        t.surface_blocks().encoding(),
+        BlockEncoding::HierarchicalQ16
+    );
+    let record = t.compression().expect("record");
+    // The team's bound on a hierarchical table's force error (the f32
+    // hierarchy's test above): the q16 rounding must not break it.
+    assert!(record.max_force_error <= 1e-3, "{record:?}");
+    let (c, ordering) = f64_compliance(&mesh, &report, &options);
+    let h = *t.surface_blocks().as_hierarchical().expect("hierarchical");
+    assert!(h.is_q16() && h.value_bytes() == 2);
+    let touchable = &t.free_vertices()[..t.touchable_count()];
+    let (mut near, mut far) = (0, 0);
+    for b in h.blocks() {
+        let pairs = || {
+            (b.row_start as usize..b.row_end as usize)
+                .flat_map(|n| (b.col_start as usize..b.col_end as usize).map(move |k| (n, k)))
+        };
+        let want = |n: usize, k: usize| dense_block(&c, &ordering, touchable[n], touchable[k]);
+        let largest = pairs()
+            .flat_map(|(n, k)| want(n, k))
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        let (mut diff2, mut norm2, mut count) = (0.0f64, 0.0f64, 0.0f64);
+        for (n, k) in pairs() {
+            let got = h.block(n, k).expect("in range");
+            for (g, w) in got.iter().zip(want(n, k)) {
+                let e = f64::from(*g) - w;
+                diff2 += e * e;
+                norm2 += w * w;
+                count += 1.0;
+            }
+        }
+        if b.rank == 0 {
+            near += 1;
+            // Entries: exact, or a far block's truncated product (within
+            // its tolerance), then each within half the quantum
+            // `largest / 32767` (its f32 rounding 1e-6; the f32 product's
+            // and the diagonal's symmetrization: relative 1e-6).
+            let q16 = count.sqrt() * 0.5 * largest / 32767.0 * (1.0 + 1e-6);
+            let bound = (TOLERANCE * 1.001 + 1e-6) * norm2.sqrt() + q16;
+            assert!(
+                diff2.sqrt() <= bound,
+                "near block {b:?}: {diff2:e} vs {bound:e}"
+            );
+        } else {
+            far += 1;
+            // The truncation's bound plus the factors' q16 rounding: each
+            // factor within half a quantum (2^-16 of its largest) per
+            // number; over a rank of at most 64, a relative 1e-3 of the
+            // block at most (the balanced factors' product).
+            let rel = (diff2 / norm2).sqrt();
+            assert!(rel <= TOLERANCE * 1.001 + 1e-3, "far block {b:?}: {rel:e}");
+        }
+    }
+    assert!(near > 0 && far > 0, "{near} near, {far} far blocks");
+    assert_q16_corruptions_refused(file.bytes());
+}
+
+/// A q16 hierarchy with a code −32768, a scale pair missing, a near
+/// block's second scale not 0, or a scale ≤ 0 is refused.
+fn assert_q16_corruptions_refused(bytes: &[u8]) {
+    let refused = |patched: Vec<u8>, section: SectionKind| {
+        let file = TableFile::from_bytes(&patched);
+        match PrecomputedTable::<f32>::load(file.bytes()) {
+            Err(LoadError::BadHierarchy { kind, .. }) => kind == section,
+            other => panic!("{section:?}: {:?}", other.err()),
+        }
+    };
+    let codes = SectionKind::HierarchyCodes;
+    assert!(refused(
+        patch_section(bytes, codes, |b| b[0..2]
+            .copy_from_slice(&0x8000u16.to_le_bytes())),
+        codes
+    ));
+    let scales = SectionKind::HierarchyScales;
+    // Block 0 is the first leaf's diagonal block: near, `[s0, 0]`.
+    let put = |b: &mut [u8], at: usize, x: f32| b[at..at + 4].copy_from_slice(&x.to_le_bytes());
+    assert!(refused(
+        patch_section(bytes, scales, |b| put(b, 4, 1e-9)),
+        scales
+    ));
+    assert!(refused(
+        patch_section(bytes, scales, |b| put(b, 0, -1e-9)),
+        scales
+    ));
+    assert!(refused(
+        patch_section(bytes, scales, |b| put(b, 0, f32::NAN)),
+        scales
+    ));
+    // The record's block count one less: the scales no longer match it
+    // (the blocks section's check comes first and names the record).
+    let blocks = SectionKind::HierarchyRecord;
+    assert!(refused(
+        patch_section(bytes, blocks, |b| {
+            let n = u32::from_le_bytes(b[4..8].try_into().unwrap());
+            b[4..8].copy_from_slice(&(n - 1).to_le_bytes());
+        }),
+        blocks
+    ));
 }

@@ -140,7 +140,7 @@ fn decoded_blocks_are_the_codes_times_their_scales() {
         let value = |c: u16| match code {
             BlockCode::F16 => f16_to_f32(c),
             BlockCode::Q16 => f32::from(c.cast_signed()),
-            BlockCode::Hmatrix => unreachable!("16-bit codes only"),
+            BlockCode::Hmatrix | BlockCode::HmatrixQ16 => unreachable!("16-bit codes only"),
         };
         let expect = |codes: &[u16; 9], scale: f64| codes.map(|c| value(c) * scale as f32);
         let surface = table.surface_blocks();

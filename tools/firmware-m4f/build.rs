@@ -33,6 +33,9 @@ fn main() {
             )
         };
     println!("cargo:rerun-if-env-changed={var}");
+    if std::env::var_os("CARGO_FEATURE_HYBRID").is_none() {
+        precomputed_replay(&out);
+    }
     let Some(path) = std::env::var_os(var).map(PathBuf::from) else {
         panic!("set {var} to {command} (see tools/firmware-check.sh)");
     };
@@ -47,4 +50,26 @@ fn main() {
         std::fs::copy(&from, out.join(to))
             .unwrap_or_else(|e| panic!("{var}: {}: {e}", from.display()));
     }
+}
+
+/// The pre-computed replay's sequence and vertex count: `PALPATE_SEQUENCE`
+/// (default `sequence.txt`) copied to `$OUT_DIR/sequence.txt`, and
+/// `PALPATE_VERTICES` (default 64, `mesh/box`'s) written as the constant
+/// `VERTICES` to `$OUT_DIR/vertices.rs` (the displacement buffer's length).
+fn precomputed_replay(out: &std::path::Path) {
+    println!("cargo:rerun-if-env-changed=PALPATE_SEQUENCE");
+    println!("cargo:rerun-if-env-changed=PALPATE_VERTICES");
+    let sequence = std::env::var_os("PALPATE_SEQUENCE")
+        .map_or_else(|| PathBuf::from("sequence.txt"), PathBuf::from);
+    println!("cargo:rerun-if-changed={}", sequence.display());
+    std::fs::copy(&sequence, out.join("sequence.txt"))
+        .unwrap_or_else(|e| panic!("PALPATE_SEQUENCE: {}: {e}", sequence.display()));
+    let vertices: usize = std::env::var("PALPATE_VERTICES")
+        .map_or(Ok(64), |v| v.parse())
+        .expect("PALPATE_VERTICES: a vertex count");
+    std::fs::write(
+        out.join("vertices.rs"),
+        format!("/// Vertices of the table's mesh (`PALPATE_VERTICES`).\nconst VERTICES: usize = {vertices};\n"),
+    )
+    .expect("write vertices.rs");
 }

@@ -44,11 +44,12 @@ pub enum TablesCommand {
         /// (f16: binary16; q16: fixed point), about half the f32 table; or
         /// (hmatrix) the touchable compliance as a hierarchical matrix,
         /// far blocks low-rank within --tolerance, no interior
-        /// displacements. The force and displacement errors are measured
+        /// displacements; hmatrix-q16: the same in 16-bit fixed point
+        /// with a scale per block, about half the bytes. The force and displacement errors are measured
         /// and stored in the table (`tables info` prints them).
         #[arg(long, value_enum, value_name = "CODE")]
         compress: Option<BlockCode>,
-        /// With --compress hmatrix: the far blocks' relative truncation
+        /// With --compress hmatrix|hmatrix-q16: the far blocks' relative truncation
         /// tolerance (Frobenius norm per block), in (0, 1); default 1e-5.
         #[arg(long, value_name = "REL")]
         tolerance: Option<f64>,
@@ -233,16 +234,16 @@ fn compression(
     drop_below: Option<f64>,
     contact_blocks: Option<ContactBlocks>,
 ) -> anyhow::Result<Option<Compression>> {
-    if compress == Some(BlockCode::Hmatrix) {
+    if compress.is_some_and(BlockCode::is_hierarchical) {
         if drop_below.is_some() || contact_blocks.is_some() {
             bail!(
-                "--drop-below and --contact-blocks apply to --compress f16|q16: --compress hmatrix \
-                 keeps every touchable block (far ones low-rank within --tolerance) and no \
-                 interior one"
+                "--drop-below and --contact-blocks apply to --compress f16|q16: --compress \
+                 hmatrix|hmatrix-q16 keeps every touchable block (far ones low-rank within \
+                 --tolerance) and no interior one"
             );
         }
     } else if tolerance.is_some() {
-        bail!("--tolerance applies to --compress hmatrix");
+        bail!("--tolerance applies to --compress hmatrix|hmatrix-q16");
     }
     if compress.is_none() {
         if drop_below.is_some() {

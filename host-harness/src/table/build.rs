@@ -17,7 +17,7 @@ use palpate_kernel::{LoadError, PrecomputedTable};
 
 use super::collision::collision_index;
 use super::compliance::{Solver, compute_compliance};
-use super::compress::{BlockCode, encode, measured_record};
+use super::compress::{BlockCode, Compression, encode, measured_record};
 use super::estimate::{SizeLimits, TableEstimate};
 use super::file::{Precision, TableContents, write_table};
 use super::load::TableFile;
@@ -272,9 +272,9 @@ pub(crate) fn precomputed(
         compression: Some(c),
         ..
     } = options.kind
-        && c.code == BlockCode::Hmatrix
+        && c.code.is_hierarchical()
     {
-        return hierarchical(mesh, report, options, solver, stages, summary, c.tolerance);
+        return hierarchical(mesh, report, options, solver, stages, summary, c);
     }
     let ordering = FreeOrdering::new(mesh.positions.len(), fixed, &surface.vertices);
     let start = Instant::now();
@@ -355,7 +355,7 @@ fn hierarchical(
     solver: Solver,
     stages: &Stages<'_>,
     summary: BuiltTable,
-    tolerance: f64,
+    compression: Compression,
 ) -> anyhow::Result<BuiltTable> {
     if solver != Solver::Cholesky {
         bail!("--compress hmatrix solves the compliance by sparse Cholesky: drop --solver cg");
@@ -386,7 +386,8 @@ fn hierarchical(
         fixed: stages.fixed,
         surface_vertices: &stages.surface.vertices,
         materials: stages.materials,
-        tolerance,
+        tolerance: compression.tolerance,
+        q16: compression.code == BlockCode::HmatrixQ16,
         progress: options.progress,
     };
     let built = super::hmatrix::build(mesh, &inputs, contents)

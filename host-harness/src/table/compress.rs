@@ -52,6 +52,10 @@ pub enum BlockCode {
     /// f32, far blocks as low-rank factors within `--tolerance`); the
     /// interior displacements are not stored (`table::hmatrix`).
     Hmatrix,
+    /// The same hierarchical matrix with its near entries and far factors
+    /// in 16-bit fixed point, a scale per block and factor (about half the
+    /// bytes).
+    HmatrixQ16,
 }
 
 impl BlockCode {
@@ -61,16 +65,23 @@ impl BlockCode {
             BlockCode::F16 => BlockEncoding::F16,
             BlockCode::Q16 => BlockEncoding::Q16,
             BlockCode::Hmatrix => BlockEncoding::Hierarchical,
+            BlockCode::HmatrixQ16 => BlockEncoding::HierarchicalQ16,
         }
+    }
+
+    /// `true` for the hierarchical tables (`hmatrix`, `hmatrix-q16`).
+    pub fn is_hierarchical(self) -> bool {
+        matches!(self, BlockCode::Hmatrix | BlockCode::HmatrixQ16)
     }
 
     /// The column scale (m/N, an `f32` value) for a column whose largest
     /// entry magnitude is `largest` (m/N; a column of zeros gets 1).
     fn scale(self, largest: f64) -> f64 {
-        // `encode` refuses Hmatrix: it never codes a block.
+        // `encode` refuses Hmatrix: it never codes a block (the q16
+        // hierarchy's quanta are those of Q16).
         let scale = match self {
             BlockCode::F16 | BlockCode::Hmatrix => largest,
-            BlockCode::Q16 => largest / f64::from(format::Q16_LARGEST_CODE),
+            BlockCode::Q16 | BlockCode::HmatrixQ16 => largest / f64::from(format::Q16_LARGEST_CODE),
         };
         if largest > 0.0 {
             f64::from(scale as f32)
@@ -83,7 +94,7 @@ impl BlockCode {
     fn code(self, x: f64, scale: f64) -> u16 {
         match self {
             BlockCode::F16 | BlockCode::Hmatrix => f16_bits(x / scale),
-            BlockCode::Q16 => q16_code(x / scale),
+            BlockCode::Q16 | BlockCode::HmatrixQ16 => q16_code(x / scale),
         }
     }
 }
@@ -124,7 +135,7 @@ impl Compression {
             "--drop-below {}: must be a fraction in [0, 1) of a column's largest compliance",
             self.drop_below
         );
-        if self.code == BlockCode::Hmatrix {
+        if self.code.is_hierarchical() {
             ensure!(
                 self.drop_below == 0.0 && self.contact == ContactBlocks::Coded,
                 "--compress hmatrix stores every touchable block (near ones in f32, far ones as \
@@ -220,6 +231,49 @@ pub struct Hierarchy {
     /// Near entries and far factors, m/N (a far factor's scale is the
     /// square root of the block's).
     pub data: Vec<f64>,
+    /// Store `data` as q16 codes, a scale pair per block
+    /// ([`Hierarchy::q16`]), instead of in the table scalar.
+    pub q16: bool,
+}
+
+impl Hierarchy {
+    /// The q16 coding of `data` (format: `hierarchy`, "q16 data"): per
+    /// block, the quanta `[s₀, s₁]` of the data it reads (near: its
+    /// entries and 0; far: `L`, `R`), each `max |x| / 32767` rounded to
+    /// `f32` ([`BlockCode::HmatrixQ16`]'s scale); each number coded with
+    /// the quantum of the owner block (row start ≤ column start) whose data
+    /// hold it, rounded to nearest. A mirror reads its owner's data: its
+    /// quanta are its owner's (far: swapped).
+    pub fn q16(&self) -> (Vec<u16>, Vec<[f64; 2]>) {
+        let code = BlockCode::HmatrixQ16;
+        let mut codes = vec![0u16; self.data.len()];
+        let mut scales = Vec::with_capacity(self.blocks.len());
+        for b in &self.blocks {
+            let r = b.rank as usize;
+            let parts = if r == 0 {
+                [(b.left, 9 * b.rows() * b.cols()), (0, 0)]
+            } else {
+                [(b.left, 3 * b.rows() * r), (b.right, 3 * b.cols() * r)]
+            };
+            let ranges = parts.map(|(offset, len)| offset as usize..offset as usize + len);
+            let pair = ranges.clone().map(|range| {
+                if range.is_empty() {
+                    0.0
+                } else {
+                    code.scale(self.data[range].iter().fold(0.0f64, |m, x| m.max(x.abs())))
+                }
+            });
+            if b.row_start <= b.col_start {
+                for (range, s) in ranges.into_iter().zip(pair) {
+                    for (q, x) in codes[range.clone()].iter_mut().zip(&self.data[range]) {
+                        *q = code.code(*x, s);
+                    }
+                }
+            }
+            scales.push(pair);
+        }
+        (codes, scales)
+    }
 }
 
 /// Largest entry magnitude of a block.
@@ -236,7 +290,7 @@ pub fn encode(
 ) -> anyhow::Result<CompressedCompliance> {
     compression.check()?;
     ensure!(
-        compression.code != BlockCode::Hmatrix,
+        !compression.code.is_hierarchical(),
         "a hierarchical table is built from the compliance columns (table::hmatrix), not coded \
          from the dense compliance"
     );

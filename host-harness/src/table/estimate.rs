@@ -33,7 +33,6 @@ use bytemuck::Zeroable;
 use palpate_kernel::table::format::{RawHeader, SectionKind, TableKind};
 
 use super::collision::{CELLS_PER_SURFACE_VERTEX, collision_index};
-use super::compress::BlockCode;
 use super::file::{Precision, layout};
 use super::options::{BuildOptions, TableKindOptions};
 use crate::limits::{MAX_TABLE_FILE_BYTES, human_bytes, mem_available_bytes};
@@ -151,9 +150,14 @@ impl TableEstimate {
             compression: Some(c),
             ..
         } = options.kind
-            && c.code == BlockCode::Hmatrix
+            && c.code.is_hierarchical()
         {
-            return estimate.hierarchical(mesh, fixed, surface);
+            return estimate.hierarchical(
+                mesh,
+                fixed,
+                surface,
+                c.code == super::compress::BlockCode::HmatrixQ16,
+            );
         }
         if compressed {
             // The f32 table's size bounds the compressed one's (`describe`
@@ -167,14 +171,15 @@ impl TableEstimate {
         estimate
     }
 
-    /// The estimate of a hierarchical table (`--compress hmatrix`) from `self`, the dense
+    /// The estimate of a hierarchical table (`--compress hmatrix|hmatrix-q16`, `q16` for
+    /// the latter) from `self`, the dense
     /// table's: the dense compliance sections replaced by the hierarchy
     /// ([`super::hmatrix::estimate`]: its partition, every far block at
     /// [`super::hmatrix::ESTIMATE_RANK`]) and one interior scale per touchable vertex. Peak:
     /// the Cholesky factor (about [`FACTOR_SCALARS_PER_DOF`] scalars per free DOF), one batch
     /// of columns (`3F × 3b` f64, `b` ≤ 2 × 64 vertices), the hierarchy as built (f64), the
     /// table and its draft, and [`BUILD_BYTES_PER_VERTEX`] per vertex, plus half of that.
-    fn hierarchical(self, mesh: &TetMesh, fixed: &[bool], surface: &Surface) -> Self {
+    fn hierarchical(self, mesh: &TetMesh, fixed: &[bool], surface: &Surface, q16: bool) -> Self {
         let c = &self.counts;
         let points: Vec<[f64; 3]> = surface
             .vertices
@@ -182,13 +187,15 @@ impl TableEstimate {
             .filter(|&&v| fixed.get(v as usize) == Some(&false))
             .map(|&v| mesh.positions[v as usize])
             .collect();
-        let (data, other) = super::hmatrix::estimate(&points);
         let scalar = u64::from(self.precision.scalar_bytes());
+        // q16: two bytes per number, a scale pair per block.
+        let (number, pair) = if q16 { (2, 2 * scalar) } else { (scalar, 0) };
+        let (data, other) = super::hmatrix::estimate(&points, pair);
         let dense = self.blocks.saturating_mul(9 * scalar);
         let table = self
             .table_bytes
             .saturating_sub(dense)
-            .saturating_add(data.saturating_mul(scalar))
+            .saturating_add(data.saturating_mul(number))
             .saturating_add(other)
             .saturating_add(c.touchable.saturating_mul(scalar));
         let dof = c.free.saturating_mul(3);

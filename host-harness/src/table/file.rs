@@ -168,9 +168,11 @@ impl CodedPart {
 }
 
 impl Hierarchy {
-    /// The five hierarchy sections, the data rounded to `precision`.
+    /// The five hierarchy sections, the data rounded to `precision` (or
+    /// coded: [`Hierarchy::q16`], the data section replaced by the codes
+    /// and scales).
     fn sections(&self, precision: Precision) -> Vec<Section> {
-        vec![
+        let mut sections = vec![
             Section {
                 kind: SectionKind::HierarchyRecord,
                 count: 1,
@@ -179,8 +181,27 @@ impl Hierarchy {
             Section::ints(SectionKind::HierarchyLeaves, &self.leaves),
             Section::ints(SectionKind::HierarchyBlocks, &self.blocks),
             Section::ints(SectionKind::HierarchyColumnBlocks, &self.column_blocks),
-            Section::floats(SectionKind::HierarchyData, &self.data, precision),
-        ]
+        ];
+        if self.q16 {
+            let (codes, scales) = self.q16();
+            sections.push(Section {
+                kind: SectionKind::HierarchyCodes,
+                count: codes.len() as u64,
+                bytes: codes.iter().flat_map(|c| c.to_le_bytes()).collect(),
+            });
+            sections.push(Section::floats(
+                SectionKind::HierarchyScales,
+                &scales,
+                precision,
+            ));
+        } else {
+            sections.push(Section::floats(
+                SectionKind::HierarchyData,
+                &self.data,
+                precision,
+            ));
+        }
+        sections
     }
 }
 

@@ -91,7 +91,7 @@ fn parts<T: Real>(
             "max_column_blocks": r.max_column_blocks,
             "tolerance": r.tolerance,
             "eta": r.eta,
-            "data_bytes": h.data_len() * core::mem::size_of::<T>(),
+            "data_bytes": h.data_len() * h.value_bytes(),
         })
     });
     (

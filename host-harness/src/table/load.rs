@@ -439,7 +439,7 @@ fn footprint(out: &mut String, h: &RawHeader, entries: &[SectionEntry]) {
 /// stored, the drop threshold, and the errors measured at build time.
 pub fn describe_compression(r: &CompressionRecord) -> String {
     let name = |value: u32| BlockEncoding::of_u32(value).map_or("unknown", BlockEncoding::name);
-    if r.surface_encoding == BlockEncoding::Hierarchical as u32 {
+    if BlockEncoding::of_u32(r.surface_encoding).is_some_and(BlockEncoding::is_hierarchical) {
         return format!(
             "contact (surface) blocks {} (no interior rows: the displacements of interior \
              vertices are not stored), interior blocks {}; measured at build against the exact \

@@ -38,7 +38,7 @@ fn stored_bytes(block: &HierarchyBlock, scalar_bytes: usize) -> usize {
 pub fn describe_hierarchy<T: Real>(h: &HierarchicalBlocks<'_, T>) -> String {
     let r = h.record();
     let s = h.touchable_count();
-    let scalar_bytes = core::mem::size_of::<T>();
+    let scalar_bytes = h.value_bytes();
     let blocks = h.blocks();
     let far = blocks.iter().filter(|b| b.rank > 0).count();
     let mut out = String::new();

@@ -11,7 +11,7 @@ use super::LoadError;
 use super::container::{Container, check_finite};
 use super::format::{
     self, BlockEncoding, CompressionRecord, KEPT_BITS, SectionKind, is_kept, kept_position,
-    kept_rank, surface_block_index,
+    kept_rank, q16_value, surface_block_index,
 };
 use super::hierarchical::HierarchicalBlocks;
 use crate::Real;
@@ -37,13 +37,6 @@ impl Code {
     }
 }
 
-/// The value of a [`Code::Q16`] code: the code as a two's complement
-/// `i16` (exact in `f32`).
-#[inline(always)]
-fn q16_value(code: u16) -> f32 {
-    f32::from(code.cast_signed())
-}
-
 /// One compliance part (the surface or the interior blocks, layouts in
 /// [`super::format`]) as the table stores it, validated at load. Blocks are
 /// addressed by their index `j` in the dense layout and the column `k` (the
@@ -56,7 +49,7 @@ pub enum ComplianceBlocks<'a, T: Real> {
     /// 16-bit codes times a per-column scale; a dropped block is zero.
     Coded(CodedBlocks<'a, T>),
     /// The surface part as a hierarchical matrix
-    /// ([`BlockEncoding::Hierarchical`]): block `j` of column `k` of the
+    /// ([`BlockEncoding::Hierarchical`], [`BlockEncoding::HierarchicalQ16`]): block `j` of column `k` of the
     /// packed layout is `C_nk` with `n = j − k(k+1)/2`, or its mirror
     /// `C_knᵀ` read from column `n` (the same numbers by symmetry).
     Hierarchical(HierarchicalBlocks<'a, T>),
@@ -117,6 +110,7 @@ impl<'a, T: Real> ComplianceBlocks<'a, T> {
             ComplianceBlocks::Coded(CodedBlocks {
                 code: Code::Q16, ..
             }) => BlockEncoding::Q16,
+            ComplianceBlocks::Hierarchical(h) if h.is_q16() => BlockEncoding::HierarchicalQ16,
             ComplianceBlocks::Hierarchical(_) => BlockEncoding::Hierarchical,
         }
     }
@@ -348,13 +342,15 @@ const INTERIOR: Part = Part {
     kept: SectionKind::InteriorKept,
 };
 
-/// The sections of a hierarchical surface part.
-const HIERARCHY: [SectionKind; 5] = [
+/// The sections of a hierarchical surface part (either encoding).
+const HIERARCHY: [SectionKind; 7] = [
     SectionKind::HierarchyRecord,
     SectionKind::HierarchyLeaves,
     SectionKind::HierarchyBlocks,
     SectionKind::HierarchyColumnBlocks,
     SectionKind::HierarchyData,
+    SectionKind::HierarchyCodes,
+    SectionKind::HierarchyScales,
 ];
 
 /// The compliance of a pre-computed table as loaded: the encoding record
@@ -379,7 +375,7 @@ pub(crate) fn load_parts<'a, T: Real>(c: &Container<'a>) -> Result<Parts<'a, T>,
             encoding(INTERIOR.dense, r.interior_encoding)?,
         ),
     };
-    if surface != BlockEncoding::Hierarchical
+    if !surface.is_hierarchical()
         && let Some(&kind) = HIERARCHY.iter().find(|&&kind| c.has(kind))
     {
         return Err(LoadError::UnexpectedSection { kind });
@@ -435,7 +431,7 @@ fn load_part<'a, T: Real>(
         }
         BlockEncoding::F16 => Code::F16,
         BlockEncoding::Q16 => Code::Q16,
-        BlockEncoding::Hierarchical => {
+        BlockEncoding::Hierarchical | BlockEncoding::HierarchicalQ16 => {
             // Only the surface part; its dense and coded sections absent.
             if part.dense != SURFACE.dense {
                 return Err(LoadError::UnknownEncoding {
@@ -450,8 +446,9 @@ fn load_part<'a, T: Real>(
                 return Err(LoadError::UnexpectedSection { kind });
             }
             let s = c.header.touchable_count as usize;
+            let q16 = encoding == BlockEncoding::HierarchicalQ16;
             return Ok(ComplianceBlocks::Hierarchical(HierarchicalBlocks::load(
-                c, s,
+                c, s, q16,
             )?));
         }
     };

@@ -14,8 +14,8 @@ use crate::Real;
 /// section up is one load, not a search). Evaluated at compile time: an
 /// index out of range here is a compile error, never a run-time panic.
 #[allow(clippy::indexing_slicing)]
-const SLOT_OF_KIND: [u8; 64] = {
-    let mut slots = [u8::MAX; 64];
+const SLOT_OF_KIND: [u8; 72] = {
+    let mut slots = [u8::MAX; 72];
     let mut i = 0;
     while i < SectionKind::ALL.len() {
         slots[SectionKind::ALL[i] as usize] = i as u8;

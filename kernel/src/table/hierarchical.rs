@@ -5,16 +5,55 @@
 //! multiply-adds ([`HierarchicalBlocks::block`]), a compliance column by one
 //! pass over the blocks of its leaf column ([`HierarchicalBlocks::add_column`],
 //! a hierarchical matrix–vector product with one non-zero input vertex).
+//! Its numbers are the table scalar or q16 codes decoded on the fly, the
+//! block's scale applied once per block (to the input vector).
 
 use nalgebra::Vector3;
 
 use super::LoadError;
 use super::container::Container;
 use super::format::{
-    HIERARCHY_MAX_RANK, HIERARCHY_MIRRORED, HierarchyBlock, HierarchyRecord, SectionKind,
+    HIERARCHY_MAX_RANK, HIERARCHY_MIRRORED, HierarchyBlock, HierarchyRecord, Q16_LARGEST_CODE,
+    SectionKind, q16_value,
 };
 use crate::Real;
 use crate::math::block;
+
+/// The hierarchy's numbers as stored (validated at load: the offsets of
+/// every block lie within them).
+#[derive(Clone, Copy, Debug)]
+enum Values<'a, T: Real> {
+    /// In the table scalar, every one finite
+    /// ([`super::format::BlockEncoding::Hierarchical`]).
+    Scalar(&'a [T]),
+    /// q16 codes (none −32768) and one `[s₀, s₁]` per block
+    /// ([`super::format::BlockEncoding::HierarchicalQ16`]).
+    Q16 {
+        codes: &'a [u16],
+        scales: &'a [[T; 2]],
+    },
+}
+
+/// One stored number: the table scalar itself or a q16 code (its value
+/// before the block's scale).
+trait Stored<T: Real>: Copy {
+    /// The number it stands for.
+    fn value(self) -> T;
+}
+
+impl<T: Real> Stored<T> for T {
+    #[inline(always)]
+    fn value(self) -> T {
+        self
+    }
+}
+
+impl<T: Real> Stored<T> for u16 {
+    #[inline(always)]
+    fn value(self) -> T {
+        T::of_f32(q16_value(self))
+    }
+}
 
 /// A hierarchical surface part, validated at load. Invariants from
 /// `load`:
@@ -22,7 +61,8 @@ use crate::math::block;
 ///   entries);
 /// - every block spans a non-empty range of rows and of columns within
 ///   `0..S`, has a rank `≤ record.max_rank ≤ HIERARCHY_MAX_RANK`, and its
-///   data lie within `data` (every scalar finite);
+///   data lie within `values` (every scalar finite; q16: every scale pair
+///   such that each decoded number is finite);
 /// - each leaf's column list holds at most `record.max_column_blocks`
 ///   blocks, each covering the leaf's columns, sorted by row, their rows
 ///   tiling `0..S`: every `C_nk` is in exactly one listed block of `k`'s
@@ -35,23 +75,40 @@ pub struct HierarchicalBlocks<'a, T: Real> {
     leaves: &'a [[u32; 2]],
     blocks: &'a [HierarchyBlock],
     column_blocks: &'a [u32],
-    data: &'a [T],
+    values: Values<'a, T>,
 }
 
 impl<'a, T: Real> HierarchicalBlocks<'a, T> {
     /// Reads and checks the hierarchy sections of a table of `s` touchable
-    /// vertices (invariants on the type). Linear in the sections' size.
-    pub(crate) fn load(c: &Container<'a>, s: usize) -> Result<Self, LoadError> {
+    /// vertices (invariants on the type), its numbers q16 codes if `q16`
+    /// (else the table scalar). Linear in the sections' size.
+    pub(crate) fn load(c: &Container<'a>, s: usize, q16: bool) -> Result<Self, LoadError> {
         let records: &'a [HierarchyRecord] = c.section(SectionKind::HierarchyRecord)?;
         let record = records.first().ok_or(LoadError::SectionSize {
             kind: SectionKind::HierarchyRecord,
         })?;
+        let unexpected: &[SectionKind] = if q16 {
+            &[SectionKind::HierarchyData]
+        } else {
+            &[SectionKind::HierarchyCodes, SectionKind::HierarchyScales]
+        };
+        if let Some(&kind) = unexpected.iter().find(|&&kind| c.has(kind)) {
+            return Err(LoadError::UnexpectedSection { kind });
+        }
+        let values = if q16 {
+            Values::Q16 {
+                codes: c.section(SectionKind::HierarchyCodes)?,
+                scales: c.section(SectionKind::HierarchyScales)?,
+            }
+        } else {
+            Values::Scalar(c.section(SectionKind::HierarchyData)?)
+        };
         let h = Self {
             record,
             leaves: c.section(SectionKind::HierarchyLeaves)?,
             blocks: c.section(SectionKind::HierarchyBlocks)?,
             column_blocks: c.section(SectionKind::HierarchyColumnBlocks)?,
-            data: c.section(SectionKind::HierarchyData)?,
+            values,
         };
         h.check_record(s)?;
         check_leaves(h.leaves, s)?;
@@ -63,13 +120,74 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
             h.check_column(leaf, s)
                 .map_err(|what| bad(SectionKind::HierarchyColumnBlocks, leaf, what))?;
         }
-        if let Some(index) = h.data.iter().position(|x| !x.finite()) {
-            return Err(LoadError::NonFinite {
-                kind: SectionKind::HierarchyData,
-                index: index as u64,
-            });
-        }
+        h.check_values()?;
         Ok(h)
+    }
+
+    /// The numbers: every scalar finite; q16: no code −32768, one scale
+    /// pair per block, each such that its block's decoded numbers are
+    /// finite (module docs of [`super::format::hierarchy`], "q16 data").
+    fn check_values(&self) -> Result<(), LoadError> {
+        match self.values {
+            Values::Scalar(data) => match data.iter().position(|x| !x.finite()) {
+                Some(index) => Err(LoadError::NonFinite {
+                    kind: SectionKind::HierarchyData,
+                    index: index as u64,
+                }),
+                None => Ok(()),
+            },
+            Values::Q16 { codes, scales } => {
+                if let Some(index) = codes.iter().position(|&q| q == 0x8000) {
+                    return Err(bad(
+                        SectionKind::HierarchyCodes,
+                        index,
+                        "code -32768 (q16 codes lie in -32767..=32767)",
+                    ));
+                }
+                if scales.len() != self.blocks.len() {
+                    return Err(bad(
+                        SectionKind::HierarchyScales,
+                        0,
+                        "scale pair count not the block count",
+                    ));
+                }
+                match self
+                    .blocks
+                    .iter()
+                    .zip(scales)
+                    .position(|(b, s)| !scales_ok(b, *s))
+                {
+                    Some(index) => Err(bad(
+                        SectionKind::HierarchyScales,
+                        index,
+                        "scale not finite and > 0, a near block's second not 0, or a decoded \
+                         number beyond the scalar's range",
+                    )),
+                    None => Ok(()),
+                }
+            }
+        }
+    }
+
+    /// Numbers stored (scalars or codes).
+    fn values_len(&self) -> usize {
+        match self.values {
+            Values::Scalar(data) => data.len(),
+            Values::Q16 { codes, .. } => codes.len(),
+        }
+    }
+
+    /// `true` if the numbers are q16 codes.
+    pub fn is_q16(&self) -> bool {
+        matches!(self.values, Values::Q16 { .. })
+    }
+
+    /// Bytes per stored number: 2 (q16 codes) or the table scalar's.
+    pub fn value_bytes(&self) -> usize {
+        match self.values {
+            Values::Scalar(_) => core::mem::size_of::<T>(),
+            Values::Q16 { .. } => 2,
+        }
     }
 
     /// The record's counts match the sections, its bounds the kernel's.
@@ -107,7 +225,7 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
         let within = |offset: u32, len: u64| {
             u64::from(offset)
                 .checked_add(len)
-                .is_some_and(|end| end <= self.data.len() as u64)
+                .is_some_and(|end| end <= self.values_len() as u64)
         };
         let (rows, cols, rank) = (b.rows() as u64, b.cols() as u64, u64::from(b.rank));
         let ok = if b.rank == 0 {
@@ -188,9 +306,9 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
         self.leaves
     }
 
-    /// Scalars stored (near entries and far factors).
+    /// Numbers stored (near entries and far factors, scalars or codes).
     pub fn data_len(&self) -> usize {
-        self.data.len()
+        self.values_len()
     }
 
     /// The blocks over touchable column `k`'s leaf, sorted by row: empty
@@ -213,7 +331,7 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
 
     /// The block `C_nk` (m/N, row-major) of touchable rows `n` and column
     /// `k`, `None` beyond `0..S`. Two binary searches, then 9 reads (near)
-    /// or `9r` multiply-adds (far).
+    /// or `9r` multiply-adds (far), times the block's scale (q16).
     #[inline]
     pub fn block(&self, n: usize, k: usize) -> Option<[T; 9]> {
         let list = self.column(k);
@@ -222,7 +340,8 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
                 .get(b as usize)
                 .is_some_and(|b| b.row_end as usize <= n)
         });
-        let b = self.blocks.get(*list.get(at)? as usize)?;
+        let index = *list.get(at)? as usize;
+        let b = self.blocks.get(index)?;
         if n < b.row_start as usize {
             return None;
         }
@@ -230,48 +349,20 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
             n - b.row_start as usize,
             k.checked_sub(b.col_start as usize)?,
         );
-        if b.rank == 0 {
-            self.near_entry(b, i, j)
-        } else {
-            let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
-            let left = self.factor_rows(b.left, i, r)?;
-            let right = self.factor_rows(b.right, j, r)?;
-            let mut c = [T::zero(); 9];
-            for (a, row) in c.chunks_exact_mut(3).enumerate() {
-                for (bb, x) in row.iter_mut().enumerate() {
-                    *x = dot(factor_row(left, a, r), factor_row(right, bb, r));
-                }
+        match self.values {
+            Values::Scalar(data) => entries(data, b, i, j),
+            Values::Q16 { codes, scales } => {
+                let scale = block_scale(b, *scales.get(index)?);
+                Some(entries::<T, u16>(codes, b, i, j)?.map(|x| x * scale))
             }
-            Some(c)
         }
-    }
-
-    /// Entry `C_ij` of near block `b` (block-relative `i`, `j`), from its
-    /// data or, mirrored, its mirror's transposed.
-    #[inline(always)]
-    fn near_entry(&self, b: &HierarchyBlock, i: usize, j: usize) -> Option<[T; 9]> {
-        let mirrored = b.flags & HIERARCHY_MIRRORED != 0;
-        let at = if mirrored {
-            j * b.rows() + i
-        } else {
-            i * b.cols() + j
-        };
-        let start = b.left as usize + 9 * at;
-        let d: &[T; 9] = self.data.get(start..start + 9)?.try_into().ok()?;
-        Some(if mirrored { transpose(d) } else { *d })
-    }
-
-    /// The three rows (`3r` scalars) of vertex `i` of a factor at `offset`.
-    #[inline(always)]
-    fn factor_rows(&self, offset: u32, i: usize, r: usize) -> Option<&'a [T]> {
-        let start = offset as usize + 3 * i * r;
-        self.data.get(start..start + 3 * r)
     }
 
     /// `out[i] += C_{first+i, k} w` (m, for `w` in N) for the touchable rows
     /// `first .. first + out.len()` (rows `≥ S` add nothing): one pass over
     /// the blocks of `k`'s leaf column (at most `max_column_blocks`), a far
-    /// block as `L (Rₖᵀ w)` (`3r` then `3r` per row).
+    /// block as `L (Rₖᵀ w)` (`3r` then `3r` per row); q16: `w` times the
+    /// block's scale first.
     #[inline]
     pub fn add_column(&self, k: usize, w: &Vector3<T>, first: usize, out: &mut [[T; 3]]) {
         let end = first + out.len();
@@ -291,62 +382,170 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
                 continue;
             };
             let i0 = lo - b.row_start as usize;
-            if b.rank == 0 {
-                self.add_near(b, i0, j, &w, rows);
-            } else {
-                self.add_far(b, i0, j, &w, rows);
+            match self.values {
+                Values::Scalar(data) => add_block(data, b, i0, j, &w, rows),
+                Values::Q16 { codes, scales } => {
+                    if let Some(&pair) = scales.get(index as usize) {
+                        let s = block_scale(b, pair);
+                        add_block(codes, b, i0, j, &w.map(|x| x * s), rows);
+                    }
+                }
             }
         }
     }
+}
 
-    /// [`Self::add_column`]'s near block: rows `i0..` of column `j`.
-    #[inline(always)]
-    fn add_near(&self, b: &HierarchyBlock, i0: usize, j: usize, w: &[T; 3], rows: &mut [[T; 3]]) {
+/// The factor a q16 block's decoded products take: `s₀` near, `s₀ s₁` far.
+#[inline(always)]
+fn block_scale<T: Real>(b: &HierarchyBlock, [s0, s1]: [T; 2]) -> T {
+    if b.rank == 0 { s0 } else { s0 * s1 }
+}
+
+/// A q16 block's scale pair is valid (module docs of
+/// [`super::format::hierarchy`], "q16 data").
+fn scales_ok<T: Real>(b: &HierarchyBlock, [s0, s1]: [T; 2]) -> bool {
+    let largest = T::of_f32(Q16_LARGEST_CODE);
+    let positive = |s: T| s.finite() && s > T::zero() && (s * largest).finite();
+    if b.rank == 0 {
+        positive(s0) && s1 == T::zero()
+    } else {
+        let rank = T::of_u32(b.rank);
+        positive(s0)
+            && positive(s1)
+            && (s0 * s1 > T::zero())
+            && ((s0 * largest) * (s1 * largest) * rank).finite()
+    }
+}
+
+/// Entry `C_ij` of block `b` (block-relative `i`, `j`) before its scale:
+/// a near block's (or, mirrored, its mirror's transposed), a far block's
+/// `L_i R_jᵀ` (`9r` multiply-adds).
+#[inline(always)]
+fn entries<T: Real, E: Stored<T>>(
+    values: &[E],
+    b: &HierarchyBlock,
+    i: usize,
+    j: usize,
+) -> Option<[T; 9]> {
+    if b.rank == 0 {
+        return near_entry(values, b, i, j);
+    }
+    let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
+    let left = factor_rows(values, b.left, i, r)?;
+    let right = factor_rows(values, b.right, j, r)?;
+    let mut c = [T::zero(); 9];
+    for (a, row) in c.chunks_exact_mut(3).enumerate() {
+        for (bb, x) in row.iter_mut().enumerate() {
+            *x = dot(factor_row(left, a, r), factor_row(right, bb, r));
+        }
+    }
+    Some(c)
+}
+
+/// Entry `C_ij` of near block `b` (block-relative `i`, `j`), from its
+/// data or, mirrored, its mirror's transposed, before its scale.
+#[inline(always)]
+fn near_entry<T: Real, E: Stored<T>>(
+    values: &[E],
+    b: &HierarchyBlock,
+    i: usize,
+    j: usize,
+) -> Option<[T; 9]> {
+    let mirrored = b.flags & HIERARCHY_MIRRORED != 0;
+    let at = if mirrored {
+        j * b.rows() + i
+    } else {
+        i * b.cols() + j
+    };
+    let start = b.left as usize + 9 * at;
+    let d: &[E; 9] = values.get(start..start + 9)?.try_into().ok()?;
+    let d = d.map(E::value);
+    Some(if mirrored { transpose(&d) } else { d })
+}
+
+/// The three rows (`3r` numbers) of vertex `i` of a factor at `offset`.
+#[inline(always)]
+fn factor_rows<E>(values: &[E], offset: u32, i: usize, r: usize) -> Option<&[E]> {
+    let start = offset as usize + 3 * i * r;
+    values.get(start..start + 3 * r)
+}
+
+/// [`HierarchicalBlocks::add_column`]'s work on one block: rows `i0..` of
+/// its column `j` times `w` (already times the block's scale).
+#[inline(always)]
+fn add_block<T: Real, E: Stored<T>>(
+    values: &[E],
+    b: &HierarchyBlock,
+    i0: usize,
+    j: usize,
+    w: &[T; 3],
+    rows: &mut [[T; 3]],
+) {
+    if b.rank == 0 {
         for (i, u) in (i0..).zip(rows) {
-            if let Some(c) = self.near_entry(b, i, j) {
+            if let Some(c) = near_entry(values, b, i, j) {
                 let v = block::mul(&c, w);
                 *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
             }
         }
+    } else {
+        add_far(values, b, i0, j, w, rows);
     }
+}
 
-    /// [`Self::add_column`]'s far block: `t = R_jᵀ w`, then `u_i += L_i t`.
-    #[inline(always)]
-    fn add_far(&self, b: &HierarchyBlock, i0: usize, j: usize, w: &[T; 3], rows: &mut [[T; 3]]) {
-        let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
-        let Some(right) = self.factor_rows(b.right, j, r) else {
-            return;
-        };
-        let mut t = [T::zero(); HIERARCHY_MAX_RANK];
-        let Some(t) = t.get_mut(..r) else {
-            return;
-        };
-        for (bb, &wb) in w.iter().enumerate() {
-            for (tl, &x) in t.iter_mut().zip(factor_row(right, bb, r)) {
-                *tl += x * wb;
-            }
+/// A far block's rows: `t = R_jᵀ w`, then `u_i += L_i t`.
+#[inline(always)]
+fn add_far<T: Real, E: Stored<T>>(
+    values: &[E],
+    b: &HierarchyBlock,
+    i0: usize,
+    j: usize,
+    w: &[T; 3],
+    rows: &mut [[T; 3]],
+) {
+    let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
+    let Some(right) = factor_rows(values, b.right, j, r) else {
+        return;
+    };
+    let mut t = [T::zero(); HIERARCHY_MAX_RANK];
+    let Some(t) = t.get_mut(..r) else {
+        return;
+    };
+    for (bb, &wb) in w.iter().enumerate() {
+        for (tl, &x) in t.iter_mut().zip(factor_row(right, bb, r)) {
+            *tl += x.value() * wb;
         }
-        for (i, u) in (i0..).zip(rows) {
-            let Some(left) = self.factor_rows(b.left, i, r) else {
-                continue;
-            };
-            for (a, x) in u.iter_mut().enumerate() {
-                *x += dot(factor_row(left, a, r), t);
-            }
+    }
+    for (i, u) in (i0..).zip(rows) {
+        let Some(left) = factor_rows(values, b.left, i, r) else {
+            continue;
+        };
+        for (a, x) in u.iter_mut().enumerate() {
+            *x += dot_scalar(factor_row(left, a, r), t);
         }
     }
 }
 
-/// Row `a` (`r` scalars) of a vertex's three factor rows; empty if beyond.
+/// Row `a` (`r` numbers) of a vertex's three factor rows; empty if beyond.
 #[inline(always)]
-fn factor_row<T>(rows: &[T], a: usize, r: usize) -> &[T] {
+fn factor_row<E>(rows: &[E], a: usize, r: usize) -> &[E] {
     rows.get(a * r..a * r + r).unwrap_or(&[])
 }
 
-/// `Σ a_l b_l`.
+/// `Σ a_l b_l` of two stored rows.
 #[inline(always)]
-fn dot<T: Real>(a: &[T], b: &[T]) -> T {
-    a.iter().zip(b).fold(T::zero(), |s, (&x, &y)| s + x * y)
+fn dot<T: Real, E: Stored<T>>(a: &[E], b: &[E]) -> T {
+    a.iter()
+        .zip(b)
+        .fold(T::zero(), |s, (&x, &y)| s + x.value() * y.value())
+}
+
+/// `Σ a_l t_l` of a stored row and scalars.
+#[inline(always)]
+fn dot_scalar<T: Real, E: Stored<T>>(a: &[E], t: &[T]) -> T {
+    a.iter()
+        .zip(t)
+        .fold(T::zero(), |s, (&x, &y)| s + x.value() * y)
 }
 
 /// A row-major 3×3 block transposed.

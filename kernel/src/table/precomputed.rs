@@ -280,7 +280,7 @@ impl<'a, T: Real> PrecomputedTable<'a, T> {
         // indices follow its cluster tree's leaves (`format::hierarchy`).
         let touchable = self.free_vertex.get(..self.touchable_count());
         let touchable = touchable.ok_or(LoadError::InconsistentHeader)?;
-        let ascending = self.surface.encoding() != format::BlockEncoding::Hierarchical;
+        let ascending = !self.surface.encoding().is_hierarchical();
         for pair in touchable.windows(2).filter(|_| ascending) {
             if let [a, b] = *pair
                 && a >= b

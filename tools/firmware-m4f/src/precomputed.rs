@@ -16,12 +16,15 @@ use palpate_kernel::{ContactSolution, MAX_CONTACTS, PrecomputedModel, Precompute
 /// (`build.rs` copies it from `PALPATE_TABLE`), 16-byte aligned in flash as
 /// `PrecomputedTable::load` requires.
 static TABLE: &[u8] = palpate_kernel::include_table!(concat!(env!("OUT_DIR"), "/table.bin"));
-/// The scripted contact sequence (syntax: `palpate-script`), in flash.
-static SEQUENCE: &str = include_str!("../sequence.txt");
-/// Vertices of `mesh/box.node` (4 × 4 × 4): the length of the displacement
-/// buffer. `palpate_script::replay` checks it against the table's
-/// `vertex_count` and refuses a mismatch (printed as `# replay failed: ...`).
-const VERTICES: usize = 64;
+/// The scripted contact sequence (syntax: `palpate-script`), in flash:
+/// `sequence.txt`, or the file `PALPATE_SEQUENCE` names (`build.rs`).
+static SEQUENCE: &str = include_str!(concat!(env!("OUT_DIR"), "/sequence.txt"));
+// `VERTICES`: the vertices of the table's mesh, 64 for `mesh/box.node`
+// (4 × 4 × 4) or `PALPATE_VERTICES` (`build.rs`): the length of the
+// displacement buffer. `palpate_script::replay` checks it against the
+// table's `vertex_count` and refuses a mismatch (printed as
+// `# replay failed: ...`).
+include!(concat!(env!("OUT_DIR"), "/vertices.rs"));
 
 /// Loads the table, reports its figures on a `#` line, and replays the
 /// sequence to semihosting stdout. Any failure is printed on a `#` line.

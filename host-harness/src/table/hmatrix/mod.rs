@@ -61,13 +61,14 @@ pub const ESTIMATE_RANK: usize = 20;
 /// The scalars of a hierarchical table's data and the bytes of its other
 /// hierarchy sections, estimated before a build from the touchable
 /// vertices' rest positions `points` (m): the cluster tree and partition
-/// are those of the build, every far block at [`ESTIMATE_RANK`].
-pub fn estimate(points: &[[f64; 3]]) -> (u64, u64) {
+/// are those of the build, every far block at [`ESTIMATE_RANK`];
+/// `scale_bytes` per block for its scales (q16 data; 0 otherwise).
+pub fn estimate(points: &[[f64; 3]], scale_bytes: u64) -> (u64, u64) {
     let tree = ClusterTree::new(points, LEAF_SIZE);
     let partition = Partition::new(&tree, ETA);
     let blocks = partition.blocks.len() as u64;
     let entries: u64 = partition.columns.iter().map(|c| c.len() as u64).sum();
-    let other = 40 + 8 * (tree.leaves.len() as u64 + 1) + 32 * blocks + 4 * entries;
+    let other = 40 + 8 * (tree.leaves.len() as u64 + 1) + (32 + scale_bytes) * blocks + 4 * entries;
     (partition.data_len_at_rank(&tree, ESTIMATE_RANK), other)
 }
 
@@ -107,6 +108,8 @@ pub struct Inputs<'a> {
     pub materials: &'a TetMaterials,
     /// The far blocks' relative tolerance, in `(0, 1)`.
     pub tolerance: f64,
+    /// Store the numbers as q16 codes (`--compress hmatrix-q16`).
+    pub q16: bool,
     /// Show a progress bar over the columns.
     pub progress: bool,
 }
@@ -146,7 +149,10 @@ pub fn build(
         bar.inc(batch.len() as u64);
     }
     bar.finish_and_clear();
-    let hierarchy = assembler.finish(s, ETA, LEAF_SIZE)?;
+    let hierarchy = Hierarchy {
+        q16: inputs.q16,
+        ..assembler.finish(s, ETA, LEAF_SIZE)?
+    };
     let slot_entries = ordering.slot_entries();
     let contents = TableContents {
         vertex_slot: &slot_entries,
@@ -197,13 +203,18 @@ pub fn build(
 }
 
 /// The compressed compliance of a hierarchical table of `s` touchable
-/// vertices: the surface part the hierarchy, the interior part coded with
+/// vertices: the surface part the hierarchy (in the table scalar or q16),
+/// the interior part coded with
 /// every block dropped (a scale of 1 per column, no codes), the errors
 /// zero until measured.
 fn compressed(hierarchy: Hierarchy, s: usize, probe_set: u32) -> CompressedCompliance {
     CompressedCompliance {
         record: CompressionRecord {
-            surface_encoding: BlockEncoding::Hierarchical as u32,
+            surface_encoding: if hierarchy.q16 {
+                BlockEncoding::HierarchicalQ16
+            } else {
+                BlockEncoding::Hierarchical
+            } as u32,
             interior_encoding: BlockEncoding::F16 as u32,
             probe_set,
             ..CompressionRecord::zeroed()

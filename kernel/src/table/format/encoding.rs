@@ -30,15 +30,21 @@ pub enum BlockEncoding {
     /// entry, far blocks as low-rank factors ([`super::hierarchy`]). Not an
     /// encoding of the interior part.
     Hierarchical = 3,
+    /// The surface part as a hierarchical matrix whose near entries and
+    /// far factors are 16-bit fixed point (`i16` in `−32767..=32767`) times
+    /// a scale per block and factor ([`super::hierarchy`], "q16 data").
+    /// Not an encoding of the interior part.
+    HierarchicalQ16 = 4,
 }
 
 impl BlockEncoding {
     /// Every encoding, in value order.
-    pub const ALL: [BlockEncoding; 4] = [
+    pub const ALL: [BlockEncoding; 5] = [
         BlockEncoding::Scalar,
         BlockEncoding::F16,
         BlockEncoding::Q16,
         BlockEncoding::Hierarchical,
+        BlockEncoding::HierarchicalQ16,
     ];
 
     /// The encoding of a record's value, `None` if unknown.
@@ -47,15 +53,33 @@ impl BlockEncoding {
     }
 
     /// Human-readable name, for `tables info`: `uncompressed` (the table
-    /// scalar), `f16`, `q16`.
+    /// scalar), `f16`, `q16`, `hmatrix`, `hmatrix-q16`.
     pub const fn name(self) -> &'static str {
         match self {
             BlockEncoding::Scalar => "uncompressed",
             BlockEncoding::F16 => "f16",
             BlockEncoding::Q16 => "q16",
             BlockEncoding::Hierarchical => "hmatrix",
+            BlockEncoding::HierarchicalQ16 => "hmatrix-q16",
         }
     }
+
+    /// `true` for the hierarchical encodings of the surface part
+    /// ([`Self::Hierarchical`], [`Self::HierarchicalQ16`]).
+    pub const fn is_hierarchical(self) -> bool {
+        matches!(
+            self,
+            BlockEncoding::Hierarchical | BlockEncoding::HierarchicalQ16
+        )
+    }
+}
+
+/// The value of a q16 code ([`BlockEncoding::Q16`],
+/// [`BlockEncoding::HierarchicalQ16`]): the code as a two's complement
+/// `i16`, exact in `f32`; a table is refused at load if it holds −32768.
+#[inline(always)]
+pub fn q16_value(code: u16) -> f32 {
+    f32::from(code.cast_signed())
 }
 
 /// Identifies the probe set of [`CompressionRecord::probe_set`]: at every

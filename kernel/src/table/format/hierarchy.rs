@@ -52,6 +52,24 @@
 //!   R[(3(j − col_start) + b)·r + l]`, `9r` multiply-adds. A mirror's
 //!   factors are the same numbers with `left` and `right` swapped, so a far
 //!   block is never flagged mirrored.
+//!
+//! **q16 data.** A [`super::BlockEncoding::HierarchicalQ16`] part holds
+//! [`super::SectionKind::HierarchyCodes`] (`u16`, the same count and offsets
+//! as the data above) and [`super::SectionKind::HierarchyScales`] (one
+//! `[s₀, s₁]` per block, in the table scalar) in place of
+//! [`super::SectionKind::HierarchyData`]. A code `q` is the two's complement
+//! `i16` in `−32767..=32767` ([`super::q16_value`]); with `Q`, `Q_L`, `Q_R`
+//! the codes read where the entries, `L` and `R` are read above:
+//! - near: `C_ij = s₀ · Q_ij`, `s₁ = 0` (`s₀ = max |entry| / 32767`, the
+//!   quantum, rounded to the scalar first; the writer rounds `x / s₀` to
+//!   nearest: absolute error `≤ s₀ / 2` per entry);
+//! - far: `C = (s₀ s₁) · Q_L Q_Rᵀ`, `s₀` and `s₁` the quanta of `L` and
+//!   `R` (error `≤ r (|L|_max s₁ + |R|_max s₀) / 2` per entry, first order).
+//!
+//! A block's scales are computed from the data it reads, so a mirrored near
+//! block has its mirror's `s₀` and a far mirror the swapped pair. Every
+//! scale is finite and `> 0` (`s₁` of a near block: 0), and `32767 s` (far:
+//! `r · 32767² s₀ s₁`) finite: every decoded number is.
 
 use bytemuck::{Pod, Zeroable};
 

@@ -98,6 +98,11 @@
 //! the touchable vertices, whose free indices then follow the tree's
 //! leaves. Layout and invariants in [`hierarchy`]. A kernel that predates it
 //! refuses such a table (`unknown block encoding 3`), never misreads it.
+//! [`BlockEncoding::HierarchicalQ16`] stores the same hierarchy with its
+//! numbers as 16-bit codes ([`SectionKind::HierarchyCodes`],
+//! [`SectionKind::HierarchyScales`] in place of
+//! [`SectionKind::HierarchyData`]; [`hierarchy`], "q16 data"): a kernel that
+//! predates it refuses it as `unknown block encoding 4`.
 
 mod encoding;
 mod header;
@@ -108,7 +113,7 @@ mod tet;
 pub use encoding::{
     BlockEncoding, COMPRESSION_RECORD_LEN, CompressionRecord, F16_LARGEST_CODE, KEPT_BITS,
     PROBE_SAMPLE_COUNT, PROBE_SET_EVERY_TOUCHABLE, PROBE_SET_SAMPLED, Q16_LARGEST_CODE, f16_to_f32,
-    is_kept, kept_position, kept_rank, kept_words,
+    is_kept, kept_position, kept_rank, kept_words, q16_value,
 };
 pub use header::{
     CRC_LEN, CRC32, FORMAT_VERSION, HEADER_LEN, MAGIC, RawHeader, SECTION_ALIGN, SECTION_ENTRY_LEN,

@@ -278,7 +278,7 @@ pub enum SectionKind {
     /// `[u32; 2]` × ⌈(F−S)·S / 32⌉: the kept-block bitmap of a coded
     /// interior part that dropped blocks.
     InteriorKept = 56,
-    // ---- Hierarchical compliance ([`super::hierarchy`]): 57..=62. ----
+    // ---- Hierarchical compliance ([`super::hierarchy`]): 57..=64. ----
     /// [`super::HierarchyRecord`] × 1: the hierarchy's counts and bounds.
     HierarchyRecord = 57,
     /// `[u32; 2]` × (leaves + 1): each leaf cluster's first touchable index
@@ -292,6 +292,15 @@ pub enum SectionKind {
     /// `scalar` × entries: near blocks' entries and far blocks' factors, m/N
     /// (a factor's scale is the writer's: only `L Rᵀ` is in m/N).
     HierarchyData = 62,
+    /// `u16` × entries: the q16 codes of a
+    /// [`super::BlockEncoding::HierarchicalQ16`] part, in place of
+    /// [`Self::HierarchyData`] (same offsets; [`super::hierarchy`], "q16
+    /// data").
+    HierarchyCodes = 63,
+    /// `[scalar; 2]` × blocks: per block of [`Self::HierarchyBlocks`], the
+    /// scales of its codes: a near block's quantum (m/N) and 0, a far
+    /// block's `L` and `R` quanta (their product in m/N).
+    HierarchyScales = 64,
 }
 
 /// Marks a boundary face in [`SectionKind::TetNeighbour`].
@@ -332,7 +341,7 @@ pub mod tet_lane_row {
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 51] = [
+    pub const ALL: [SectionKind; 53] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -384,6 +393,8 @@ impl SectionKind {
         SectionKind::HierarchyBlocks,
         SectionKind::HierarchyColumnBlocks,
         SectionKind::HierarchyData,
+        SectionKind::HierarchyCodes,
+        SectionKind::HierarchyScales,
     ];
 
     /// `true` for the sections whose element count the directory declares
@@ -401,6 +412,8 @@ impl SectionKind {
                 | SectionKind::HierarchyBlocks
                 | SectionKind::HierarchyColumnBlocks
                 | SectionKind::HierarchyData
+                | SectionKind::HierarchyCodes
+                | SectionKind::HierarchyScales
         )
     }
 
@@ -461,6 +474,8 @@ impl SectionKind {
             SectionKind::HierarchyLeaves => 8,
             SectionKind::HierarchyColumnBlocks => 4,
             SectionKind::HierarchyData => scalar_bytes,
+            SectionKind::HierarchyCodes => 2,
+            SectionKind::HierarchyScales => 2 * scalar_bytes,
         }
     }
 
@@ -534,8 +549,10 @@ impl SectionKind {
             // the largest rank). The view checks the exact structure.
             SectionKind::HierarchyRecord => Some(1),
             SectionKind::HierarchyLeaves => s.checked_add(1),
-            SectionKind::HierarchyBlocks | SectionKind::HierarchyColumnBlocks => s.checked_mul(s),
-            SectionKind::HierarchyData => s
+            SectionKind::HierarchyBlocks
+            | SectionKind::HierarchyColumnBlocks
+            | SectionKind::HierarchyScales => s.checked_mul(s),
+            SectionKind::HierarchyData | SectionKind::HierarchyCodes => s
                 .checked_mul(s)?
                 .checked_mul(6 * HIERARCHY_MAX_RANK as u64 + 9),
         }
@@ -595,6 +612,8 @@ impl SectionKind {
             SectionKind::HierarchyBlocks => "hierarchy-blocks",
             SectionKind::HierarchyColumnBlocks => "hierarchy-column-blocks",
             SectionKind::HierarchyData => "hierarchy-data",
+            SectionKind::HierarchyCodes => "hierarchy-codes",
+            SectionKind::HierarchyScales => "hierarchy-scales",
         }
     }
 }
