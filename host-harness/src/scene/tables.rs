@@ -10,8 +10,11 @@
 //!                        # fraction of their column's largest, in [0, 1); default 0
 //! ```
 //!
-//! Only a pre-computed scene's table is compressed; on another model the
-//! session refuses it (`crate::session::model`).
+//! A pre-computed scene's compliance table takes every code; a hybrid
+//! scene's `"hmatrix"` only, which stores its interface's condensed
+//! stiffness hierarchically (`crate::hybrid::hmatrix`, `tolerance` its far
+//! blocks'); a tensor-mass scene none (`crate::session::model` refuses
+//! them).
 
 use serde::Deserialize;
 

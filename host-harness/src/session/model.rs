@@ -12,6 +12,7 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use super::options::{precomputed_options, tensor_mass_options};
 use crate::fem::penalty::penalty_n;
 use crate::fix::fixed_vertices;
+use crate::hybrid::hmatrix::InterfaceCompression;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
@@ -127,7 +128,9 @@ impl SceneModel {
     /// and supports), built in memory with the pipeline of `palpate tables
     /// build`; a pre-computed model's compliance compressed with
     /// `compression` (`tables build --compress`), else as the scene's
-    /// `[tables]` says ([`scene_compression`]); refused for the others.
+    /// `[tables]` says ([`scene_compression`]); a hybrid's interface as
+    /// [`hybrid_tables`] says (`--compress` refused); a tensor-mass model's
+    /// refused.
     pub fn tables(
         self,
         scene: &Scene,
@@ -141,15 +144,12 @@ impl SceneModel {
                 scene.source
             );
         }
-        if scene.tables.compress.is_some() && !matches!(self, Self::Precomputed) {
+        if scene.tables.compress.is_some() && matches!(self, Self::Dynamic(_)) {
             bail!(
-                "{}: [tables] compress applies to a pre-computed scene (its compliance table); \
-                 this scene's model is {}",
+                "{}: [tables] compress applies to a pre-computed scene (its compliance table) \
+                 or a hybrid (compress = \"hmatrix\": its interface); this scene's model is \
+                 dynamic (tensor-mass)",
                 scene.source,
-                match self {
-                    Self::Dynamic(_) => "dynamic (tensor-mass)",
-                    _ => "hybrid",
-                }
             );
         }
         let compression = compression.or_else(|| scene_compression(&scene.tables));
@@ -200,7 +200,9 @@ pub fn scene_compression(tables: &TablesSpec) -> Option<Compression> {
 
 /// The hybrid's three tables for `partition` of `scene` (its materials per
 /// tet, density and supports) in `precision`, built in memory
-/// ([`build_hybrid`]).
+/// ([`build_hybrid`]); the interface's condensed stiffness hierarchical
+/// when `[tables] compress = "hmatrix"` (its `tolerance`), and `"f16"` or
+/// `"q16"` refused.
 pub fn hybrid_tables(
     scene: &Scene,
     mesh: &TetMesh,
@@ -208,6 +210,18 @@ pub fn hybrid_tables(
     partition: &Partition,
     precision: Precision,
 ) -> anyhow::Result<HybridTables> {
+    let interface_compression = match scene.tables.compress {
+        None => None,
+        Some(TableCode::Hmatrix) => Some(InterfaceCompression {
+            tolerance: scene.tables.tolerance.unwrap_or(DEFAULT_TOLERANCE),
+            ..InterfaceCompression::default()
+        }),
+        Some(_) => bail!(
+            "{}: [tables] compress = \"f16\" or \"q16\" applies to a pre-computed scene; a \
+             hybrid takes compress = \"hmatrix\" (its interface's condensed stiffness)",
+            scene.source
+        ),
+    };
     let materials = scene.tet_materials(mesh, report)?;
     let options = HybridOptions::new(
         materials.default_material(),
@@ -224,6 +238,7 @@ pub fn hybrid_tables(
             print_estimate: true,
             ..options.limits
         },
+        interface_compression,
         ..options
     };
     build_hybrid(mesh, report, &partition.dynamic, &options).with_context(|| scene.source.clone())

@@ -169,7 +169,7 @@ impl CodedPart {
 
 impl Hierarchy {
     /// The five hierarchy sections, the data rounded to `precision`.
-    fn sections(&self, precision: Precision) -> Vec<Section> {
+    pub fn sections(&self, precision: Precision) -> Vec<Section> {
         vec![
             Section {
                 kind: SectionKind::HierarchyRecord,

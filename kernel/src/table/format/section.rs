@@ -290,8 +290,15 @@ pub enum SectionKind {
     /// `u32` × entries: the blocks over each leaf column, by row.
     HierarchyColumnBlocks = 61,
     /// `scalar` × entries: near blocks' entries and far blocks' factors, m/N
-    /// (a factor's scale is the writer's: only `L Rᵀ` is in m/N).
+    /// (a factor's scale is the writer's: only `L Rᵀ` is in m/N; in an
+    /// interface table, N/m: [`Self::CondensedStiffness`] hierarchical).
     HierarchyData = 62,
+    /// `[u32; 2]` × c (interface tables with a hierarchical condensed
+    /// stiffness, [`super::hierarchy`]): per hierarchy index `i`, the
+    /// connection node numbered `i` in the cluster tree's leaf order; then
+    /// per connection node `j`, its hierarchy index (the inverse
+    /// permutation, so that a load checks the pair in one pass).
+    HierarchyOrder = 63,
 }
 
 /// Marks a boundary face in [`SectionKind::TetNeighbour`].
@@ -332,7 +339,7 @@ pub mod tet_lane_row {
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 51] = [
+    pub const ALL: [SectionKind; 52] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -384,6 +391,7 @@ impl SectionKind {
         SectionKind::HierarchyBlocks,
         SectionKind::HierarchyColumnBlocks,
         SectionKind::HierarchyData,
+        SectionKind::HierarchyOrder,
     ];
 
     /// `true` for the sections whose element count the directory declares
@@ -404,14 +412,18 @@ impl SectionKind {
         )
     }
 
-    /// `true` for the compliance sections a [`super::CompressionRecord`] may
-    /// replace by coded ones: required by [`TableKind::sections`], but
-    /// checked by the pre-computed view against the record, not by the
+    /// `true` for the matrix sections an encoding may replace: the
+    /// compliance sections a [`super::CompressionRecord`] may replace by
+    /// coded or hierarchical ones, and an interface's condensed stiffness,
+    /// which the hierarchy sections may replace. Required by
+    /// [`TableKind::sections`], but checked by the table's view, not by the
     /// container.
     pub const fn encodable(self) -> bool {
         matches!(
             self,
-            SectionKind::ComplianceSurface | SectionKind::ComplianceInterior
+            SectionKind::ComplianceSurface
+                | SectionKind::ComplianceInterior
+                | SectionKind::CondensedStiffness
         )
     }
 
@@ -458,7 +470,7 @@ impl SectionKind {
             SectionKind::SurfaceKept | SectionKind::InteriorKept => 8,
             SectionKind::HierarchyRecord => HIERARCHY_RECORD_LEN as u32,
             SectionKind::HierarchyBlocks => HIERARCHY_BLOCK_LEN as u32,
-            SectionKind::HierarchyLeaves => 8,
+            SectionKind::HierarchyLeaves | SectionKind::HierarchyOrder => 8,
             SectionKind::HierarchyColumnBlocks => 4,
             SectionKind::HierarchyData => scalar_bytes,
         }
@@ -474,6 +486,13 @@ impl SectionKind {
         let tets = u64::from(h.tet_count);
         let edges = u64::from(h.edge_count);
         let c = u64::from(h.connection_count);
+        // The hierarchy's order: the touchable vertices of a pre-computed
+        // table, the connection nodes of an interface.
+        let hs = if h.table_kind == TableKind::Interface as u32 {
+            c
+        } else {
+            s
+        };
         match self {
             SectionKind::ConnectionVertex | SectionKind::LoadForce => Some(c),
             SectionKind::CondensedStiffness => c.checked_mul(c)?.checked_mul(3),
@@ -533,10 +552,11 @@ impl SectionKind {
             // entries of the full matrix and the factors of every block at
             // the largest rank). The view checks the exact structure.
             SectionKind::HierarchyRecord => Some(1),
-            SectionKind::HierarchyLeaves => s.checked_add(1),
-            SectionKind::HierarchyBlocks | SectionKind::HierarchyColumnBlocks => s.checked_mul(s),
-            SectionKind::HierarchyData => s
-                .checked_mul(s)?
+            SectionKind::HierarchyLeaves => hs.checked_add(1),
+            SectionKind::HierarchyBlocks | SectionKind::HierarchyColumnBlocks => hs.checked_mul(hs),
+            SectionKind::HierarchyOrder => Some(c),
+            SectionKind::HierarchyData => hs
+                .checked_mul(hs)?
                 .checked_mul(6 * HIERARCHY_MAX_RANK as u64 + 9),
         }
     }
@@ -595,6 +615,7 @@ impl SectionKind {
             SectionKind::HierarchyBlocks => "hierarchy-blocks",
             SectionKind::HierarchyColumnBlocks => "hierarchy-column-blocks",
             SectionKind::HierarchyData => "hierarchy-data",
+            SectionKind::HierarchyOrder => "hierarchy-order",
         }
     }
 }
