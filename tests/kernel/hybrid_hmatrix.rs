@@ -113,8 +113,7 @@ fn hierarchical_product_is_the_dense_product_within_the_tolerance() {
     assert!(far > 0, "no far block");
     let s_frobenius = (0..c)
         .flat_map(|j| (0..c).map(move |k| (j, k)))
-        .map(|(j, k)| dense.condensed_block(j, k).expect("block"))
-        .flatten()
+        .flat_map(|(j, k)| dense.condensed_block(j, k).expect("block"))
         .map(|x| x * x)
         .sum::<f64>()
         .sqrt();

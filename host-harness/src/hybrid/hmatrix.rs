@@ -12,10 +12,10 @@
 use faer::Mat;
 
 use crate::table::compress::Hierarchy;
-use crate::table::hmatrix::DEFAULT_TOLERANCE;
 use crate::table::hmatrix::assemble::{Assembler, batches};
 use crate::table::hmatrix::cluster::{ClusterTree, LEAF_SIZE};
 use crate::table::hmatrix::partition::{ETA, Partition};
+use crate::table::hmatrix::{DEFAULT_TOLERANCE, estimate_with_leaves};
 
 /// How the interface's condensed stiffness is compressed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,4 +84,21 @@ pub fn compress_condensed(
         order[node][1] = i as u32;
     }
     Ok(CondensedHierarchy { hierarchy, order })
+}
+
+/// The condensed stiffness of `c` connection nodes at rest `points` (m)
+/// compressed as `compression` asks, estimated before a build (the
+/// pre-computed tables' estimate, every far block at its rank,
+/// `crate::table::hmatrix::ESTIMATE_RANK`): its scalars (one multiply-add
+/// each per product `S u`, against `9c²` dense) and the bytes of its
+/// sections in a table of `scalar_bytes`-byte floats (the hierarchy order's
+/// included).
+pub fn estimate(
+    points: &[[f64; 3]],
+    compression: &InterfaceCompression,
+    scalar_bytes: u64,
+) -> (u64, u64) {
+    let (scalars, other) = estimate_with_leaves(points, compression.leaf_size.max(1));
+    let order = 8 * points.len() as u64;
+    (scalars, scalars * scalar_bytes + other + order)
 }

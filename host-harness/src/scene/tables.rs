@@ -18,6 +18,9 @@
 
 use serde::Deserialize;
 
+use crate::hybrid::hmatrix::InterfaceCompression;
+use crate::table::hmatrix::DEFAULT_TOLERANCE;
+
 /// How the compliance is stored, `compress = …`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -84,5 +87,17 @@ impl TablesSpec {
             }
         }
         Ok(spec)
+    }
+}
+
+impl TablesSpec {
+    /// How a hybrid's interface is compressed: its condensed stiffness hierarchical for
+    /// `compress = "hmatrix"` (this `tolerance`, the default leaves), else `None` (dense; a
+    /// hybrid's build refuses the other codes, `crate::session::model::hybrid_tables`).
+    pub fn interface_compression(&self) -> Option<InterfaceCompression> {
+        (self.compress == Some(TableCode::Hmatrix)).then(|| InterfaceCompression {
+            tolerance: self.tolerance.unwrap_or(DEFAULT_TOLERANCE),
+            ..InterfaceCompression::default()
+        })
     }
 }

@@ -12,7 +12,6 @@ use palpate_kernel::tensor_mass::{ElasticLaw, StvkForm};
 use super::options::{precomputed_options, tensor_mass_options};
 use crate::fem::penalty::penalty_n;
 use crate::fix::fixed_vertices;
-use crate::hybrid::hmatrix::InterfaceCompression;
 use crate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::AtomicFile;
@@ -211,11 +210,7 @@ pub fn hybrid_tables(
     precision: Precision,
 ) -> anyhow::Result<HybridTables> {
     let interface_compression = match scene.tables.compress {
-        None => None,
-        Some(TableCode::Hmatrix) => Some(InterfaceCompression {
-            tolerance: scene.tables.tolerance.unwrap_or(DEFAULT_TOLERANCE),
-            ..InterfaceCompression::default()
-        }),
+        None | Some(TableCode::Hmatrix) => scene.tables.interface_compression(),
         Some(_) => bail!(
             "{}: [tables] compress = \"f16\" or \"q16\" applies to a pre-computed scene; a \
              hybrid takes compress = \"hmatrix\" (its interface's condensed stiffness)",

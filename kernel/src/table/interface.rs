@@ -190,7 +190,9 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
                 let at = |i: usize| order.get(i).map(|&[node, _]| node as usize);
                 blocks.products(at, uc, |slot, v| {
                     if let Some(o) = oc.get_mut(slot) {
-                        *o = core::array::from_fn(|a| o[a] + scale * v[a]);
+                        for (x, &y) in o.iter_mut().zip(&v) {
+                            *x += scale * y;
+                        }
                     }
                 });
             }
