@@ -62,6 +62,7 @@ mod kernel {
     mod haptic_settle;
     mod haptic_tools;
     mod hybrid;
+    mod hybrid_hmatrix;
     mod layers;
     mod neo_hookean;
     mod polar;

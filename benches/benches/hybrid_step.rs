@@ -14,9 +14,13 @@
 //!   pre-computed region, one on the tensor-mass region, and both (2 + 2
 //!   contacts: 4), at each fraction. Target ≤ 2 µs, independent of the
 //!   pre-computed region's size.
+//! - `hybrid_hmatrix`, `force_pass_coupled_hmatrix`: the same with the
+//!   interface's condensed stiffness hierarchical (`[tables] compress =
+//!   "hmatrix"`, default tolerance).
 //! - Printed after the groups: per fraction the regions' tets, the
 //!   connection nodes, the three tables' sizes and build time, next to the
-//!   organ's pure pre-computed table.
+//!   organ's pure pre-computed table; and the condensed stiffness's scalars
+//!   and the interface's bytes, dense and hierarchical.
 //!
 //! Run: `RUSTFLAGS="-C target-cpu=native" cargo bench -p palpate-benches --bench hybrid_step`.
 
@@ -26,6 +30,7 @@ use std::time::Instant;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use palpate::fem::material::Material;
+use palpate::hybrid::hmatrix::InterfaceCompression;
 use palpate::hybrid::owned::{OwnedHybridBuffers, with_hybrid_tissue};
 use palpate::hybrid::{HybridOptions, HybridTables, build_hybrid};
 use palpate::mesh::generate::{ORGAN_CUBE_M, organ_mesh};
@@ -38,7 +43,7 @@ use palpate_benches::haptic_config;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::HybridLoop;
 use palpate_kernel::hybrid::HybridModel;
-use palpate_kernel::table::{InterfaceTable, TensorMassTable};
+use palpate_kernel::table::{CondensedStiffness, InterfaceTable, TensorMassTable};
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator, PhysicsConfig, TensorMassModel};
 
 const FRACTIONS: [f64; 3] = [0.1, 0.2, 0.4];
@@ -79,6 +84,9 @@ fn dynamic_tets(mesh: &TetMesh, fraction: f64) -> Vec<bool> {
 struct Built {
     fraction: f64,
     tables: HybridTables,
+    /// The same with the interface's condensed stiffness hierarchical
+    /// (`[tables] compress = "hmatrix"`, default tolerance and leaves).
+    hmatrix: HybridTables,
     build_s: f64,
 }
 
@@ -95,10 +103,23 @@ fn build_all(mesh: &TetMesh) -> Vec<Built> {
                 &options,
             )
             .expect("hybrid tables");
+            let build_s = start.elapsed().as_secs_f64();
+            let options = HybridOptions {
+                interface_compression: Some(InterfaceCompression::default()),
+                ..options
+            };
+            let hmatrix = build_hybrid(
+                mesh,
+                &MeshReport::default(),
+                &dynamic_tets(mesh, fraction),
+                &options,
+            )
+            .expect("hybrid tables");
             Built {
                 fraction,
                 tables,
-                build_s: start.elapsed().as_secs_f64(),
+                hmatrix,
+                build_s,
             }
         })
         .collect()
@@ -152,10 +173,7 @@ fn step(c: &mut Criterion) {
     });
     for b in &built {
         let label = format!("{:.0}%", b.fraction * 100.0);
-        let precomputed =
-            PrecomputedTable::<f32>::load(b.tables.precomputed.bytes()).expect("table");
         let dynamic = TensorMassTable::<f32>::load(b.tables.dynamic.bytes()).expect("table");
-        let interface = InterfaceTable::<f32>::load(b.tables.interface.bytes()).expect("table");
         let n = dynamic.vertex_count();
         let mut alone_state = OwnedState::for_table(&dynamic);
         let mut alone =
@@ -168,21 +186,29 @@ fn step(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("force_pass_alone", &label), |bench| {
             bench.iter(|| alone.elastic_forces_of(black_box(&u), &mut forces))
         });
-        let mut state = OwnedState::for_table(&dynamic);
-        let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
-        let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
-        let (coupling, _) = owned.buffers();
-        let mut hybrid = HybridModel::new(model, precomputed, interface, coupling).expect("hybrid");
-        group.bench_function(BenchmarkId::new("hybrid", &label), |bench| {
-            bench.iter(|| hybrid.step(black_box(Integrator::SymplecticEuler), DT_S))
-        });
-        group.bench_function(BenchmarkId::new("force_pass_coupled", &label), |bench| {
-            bench.iter(|| {
-                hybrid
-                    .dynamic()
-                    .elastic_forces_of(black_box(&u), &mut forces)
-            })
-        });
+        for (kind, tables) in [("", &b.tables), ("_hmatrix", &b.hmatrix)] {
+            let precomputed =
+                PrecomputedTable::<f32>::load(tables.precomputed.bytes()).expect("table");
+            let dynamic = TensorMassTable::<f32>::load(tables.dynamic.bytes()).expect("table");
+            let interface = InterfaceTable::<f32>::load(tables.interface.bytes()).expect("table");
+            let mut state = OwnedState::for_table(&dynamic);
+            let mut owned = OwnedHybridBuffers::for_tables(&precomputed, &dynamic, &interface);
+            let model = TensorMassModel::new(dynamic, state.buffers(), params()).expect("model");
+            let (coupling, _) = owned.buffers();
+            let mut hybrid =
+                HybridModel::new(model, precomputed, interface, coupling).expect("hybrid");
+            group.bench_function(BenchmarkId::new(format!("hybrid{kind}"), &label), |bench| {
+                bench.iter(|| hybrid.step(black_box(Integrator::SymplecticEuler), DT_S))
+            });
+            let name = format!("force_pass_coupled{kind}");
+            group.bench_function(BenchmarkId::new(name, &label), |bench| {
+                bench.iter(|| {
+                    hybrid
+                        .dynamic()
+                        .elastic_forces_of(black_box(&u), &mut forces)
+                })
+            });
+        }
     }
     group.finish();
     let start = Instant::now();
@@ -216,6 +242,24 @@ fn step(c: &mut Criterion) {
         "pure pre-computed: {} bytes {pure_s:.2} s",
         pure.bytes.len()
     );
+    println!(
+        "\ninterface S, dense vs hierarchical (f32): fraction, connection nodes, S scalars (one multiply-add each per product), interface bytes"
+    );
+    for b in &built {
+        let c = b.tables.split.connection.len();
+        let interface = InterfaceTable::<f32>::load(b.hmatrix.interface.bytes()).expect("table");
+        let CondensedStiffness::Hierarchical { blocks, .. } = interface.condensed() else {
+            panic!("a dense interface");
+        };
+        println!(
+            "{:4.0}% {c:4} {:8} vs {:8} scalars, {:9} vs {:9} bytes",
+            b.fraction * 100.0,
+            9 * c * c,
+            blocks.data_len(),
+            b.tables.interface.bytes().len(),
+            b.hmatrix.interface.bytes().len(),
+        );
+    }
 }
 
 fn tick(c: &mut Criterion) {

@@ -148,28 +148,28 @@
 /*
  Words of a `palpate_dynamic_loop` on 64-bit targets (the host).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 456
+#define PALPATE_DYNAMIC_LOOP_WORDS 465
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 369
+#define PALPATE_DYNAMIC_LOOP_WORDS 373
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 635
+#define PALPATE_HYBRID_LOOP_WORDS 653
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 508
+#define PALPATE_HYBRID_LOOP_WORDS 511
 #endif
 
 /*

@@ -40,15 +40,17 @@ fn check<T: Real>(table: &InterfaceTable<'_, T>) {
     for (j, &[vertex, dynamic]) in table.connections().iter().enumerate() {
         assert_eq!(dynamic as usize, j);
         assert_eq!(table.dynamic_vertex(vertex), Some(dynamic));
-        for a in 0..3 {
-            assert!(table.condensed_row(3 * j + a)[j][a] > T::zero());
-        }
+        let d = table.condensed_block(j, j).expect("diagonal block");
+        assert!(d[0] > T::zero() && d[4] > T::zero() && d[8] > T::zero());
     }
     assert!(table.connections().windows(2).all(|w| w[0][0] < w[1][0]));
-    for r in 0..3 * c {
-        assert_eq!(table.condensed_row(r).len(), c);
-    }
-    assert!(table.condensed_row(3 * c).is_empty());
+    assert!(table.condensed_block(c, 0).is_none());
+    assert!(table.condensed_block(0, c).is_none());
+    // The product and the quadratic form over the blocks, in bounded time.
+    let u = vec![[T::one(); 3]; c];
+    let mut out = vec![[T::zero(); 3]; c];
+    table.add_condensed_product(&u, T::one(), &mut out);
+    let _ = table.condensed_quadratic(&u);
     for r in 0..3 * f {
         assert_eq!(table.response_row(r).len(), c);
     }

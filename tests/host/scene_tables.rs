@@ -1,7 +1,8 @@
 //! A scene's `[tables]` (`host-harness/src/scene/tables.rs`, `session::model::scene_compression`):
 //! each option only with its code and in its range, the defaults of `tables build`, and a
 //! pre-computed scene built with the table the scene names (a hierarchical one read back by the
-//! kernel as such), refused on the other models.
+//! kernel as such), a hybrid scene's interface hierarchical for `"hmatrix"`, the other codes
+//! refused on the other models.
 
 use std::path::Path;
 
@@ -92,5 +93,46 @@ fn a_precomputed_scene_builds_the_table_its_tables_name() {
             .to_string()
             .contains("applies to a pre-computed scene"),
         "{error}"
+    );
+}
+
+/// A hybrid scene (a cut sphere in the block) with `compress = "hmatrix"`: its interface's
+/// condensed stiffness hierarchical, read back by the kernel as such (the far-block tolerance
+/// the scene's, in the hierarchy record); `"q16"` refused on a hybrid.
+#[test]
+fn a_hybrid_scene_builds_a_hierarchical_interface() {
+    use palpate_kernel::table::{CondensedStiffness, InterfaceTable};
+    let hybrid = "[model]\nkind = \"dynamic\"\ndamping_per_s = 2\n[[zone]]\nkind = \"cut\"\n\
+                  shape = \"sphere\"\ncenter_m = [0.03, 0.03, 0.03]\nradius_m = 0.005\n";
+    let s = scene(&format!(
+        "{hybrid}[tables]\ncompress = \"hmatrix\"\ntolerance = 1e-3\n"
+    ))
+    .expect("valid");
+    let (mesh, report) = s.load_mesh().expect("mesh");
+    let tables = SceneModel::of(&s, &mesh, &report)
+        .expect("model")
+        .tables(&s, &mesh, &report, None)
+        .expect("tables");
+    let SceneTables::Hybrid(files, _) = tables else {
+        panic!("a hybrid scene");
+    };
+    let interface = InterfaceTable::<f32>::load(files.interface.bytes()).expect("load");
+    let CondensedStiffness::Hierarchical { blocks, .. } = interface.condensed() else {
+        panic!("a dense interface");
+    };
+    assert_eq!(blocks.record().tolerance, 1e-3);
+    assert_eq!(blocks.touchable_count(), interface.connection_count());
+
+    let coded = scene(&format!("{hybrid}[tables]\ncompress = \"q16\"\n")).expect("valid");
+    let error = SceneModel::of(&coded, &mesh, &report)
+        .expect("model")
+        .tables(&coded, &mesh, &report, None)
+        .err()
+        .expect("refused");
+    assert!(
+        error
+            .to_string()
+            .contains("a hybrid takes compress = \"hmatrix\""),
+        "{error:#}"
     );
 }

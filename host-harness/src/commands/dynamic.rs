@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, anyhow, bail};
 use clap::Subcommand;
 use palpate::hybrid::HybridOptions;
+use palpate::hybrid::hmatrix::InterfaceCompression;
 use palpate::hybrid::stability::critical_dt_of_hybrid;
 use palpate::mesh::{MeshReport, TetMesh, read_mesh};
 use palpate::partition::Partition;
@@ -112,6 +113,8 @@ struct Setup {
     /// The tets a scene's zones make dynamic, when they make some but not
     /// all: the hybrid model.
     hybrid: Option<Vec<bool>>,
+    /// The hybrid's interface compressed as the scene's `[tables]` says.
+    interface_compression: Option<InterfaceCompression>,
     /// The mesh file or the scene, for messages.
     name: String,
 }
@@ -139,6 +142,7 @@ impl DynamicModelArgs {
                 report,
                 table,
                 hybrid,
+                interface_compression: scene.tables.interface_compression(),
                 name: scene.source,
             });
         }
@@ -156,6 +160,7 @@ impl DynamicModelArgs {
             report,
             table,
             hybrid: None,
+            interface_compression: None,
             name: path.display().to_string(),
         })
     }
@@ -272,7 +277,13 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             };
             let (mesh, report) = (&setup.mesh, &setup.report);
             let output = match &setup.hybrid {
-                Some(dynamic) => palpate::hybrid::run::run(mesh, report, dynamic, &options),
+                Some(dynamic) => palpate::hybrid::run::run(
+                    mesh,
+                    report,
+                    dynamic,
+                    setup.interface_compression,
+                    &options,
+                ),
                 None => palpate::tensor_mass::run::run(mesh, report, &options),
             }
             .with_context(|| setup.name.clone())?;
@@ -285,7 +296,10 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             let integrator = model.integrator.into();
             let json = match &setup.hybrid {
                 Some(dynamic) => {
-                    let options = HybridOptions::of_tensor_mass(table)?;
+                    let options = HybridOptions {
+                        interface_compression: setup.interface_compression,
+                        ..HybridOptions::of_tensor_mass(table)?
+                    };
                     let result = critical_dt_of_hybrid(
                         mesh,
                         report,

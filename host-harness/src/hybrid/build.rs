@@ -11,6 +11,7 @@ use palpate_kernel::{PrecomputedTable, Real};
 
 use super::condense::{Condensed, condense};
 use super::estimate::{HybridEstimate, PrecomputedRegion};
+use super::hmatrix::{InterfaceCompression, compress_condensed};
 use super::split::RegionSplit;
 use crate::fem::assembly::FreeOrdering;
 use crate::fem::element::shape_gradients;
@@ -42,6 +43,9 @@ pub struct HybridOptions {
     pub point_loads: Vec<(u32, [f64; 3])>,
     /// Which tets' mass the connection nodes carry.
     pub connection_mass: ConnectionMass,
+    /// The interface's condensed stiffness stored hierarchically
+    /// (`[tables] compress = "hmatrix"`), `None`: dense.
+    pub interface_compression: Option<InterfaceCompression>,
     /// What the tables and the build may take ([`SizeLimits::system`] by default), checked
     /// against their estimate ([`HybridEstimate`]) before anything is built.
     pub limits: SizeLimits,
@@ -76,6 +80,7 @@ impl HybridOptions {
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+            interface_compression: None,
             limits: SizeLimits::system(),
         }
     }
@@ -94,6 +99,7 @@ impl HybridOptions {
             gravity_m_s2: [0.0; 3],
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
+            interface_compression: None,
             limits: SizeLimits::system(),
         })
     }
@@ -178,7 +184,8 @@ pub fn build_hybrid(
     let checksums = [&precomputed_summary.bytes, &dynamic].map(|bytes| trailer(bytes));
     let interface = write_interface_table(
         mesh, &split, &ordering, &condensed, &materials, checksums, options,
-    );
+    )
+    .with_context(|| format!("{source}: the interface table"))?;
     let tables = HybridTables {
         precomputed: TableFile::from_bytes(&precomputed_summary.bytes),
         dynamic: TableFile::from_bytes(&dynamic),
@@ -396,7 +403,8 @@ pub fn check_hybrid(
     Ok(prepare(mesh, report, dynamic_tet, options)?.estimate)
 }
 
-/// Serializes the interface table (`TableKind::Interface`).
+/// Serializes the interface table (`TableKind::Interface`), its condensed
+/// stiffness dense or, as `options` ask, hierarchical.
 fn write_interface_table(
     mesh: &TetMesh,
     split: &RegionSplit,
@@ -405,7 +413,7 @@ fn write_interface_table(
     materials: &TetMaterials,
     region_checksums: [u32; 2],
     options: &HybridOptions,
-) -> Vec<u8> {
+) -> anyhow::Result<Vec<u8>> {
     let material = materials.default_material();
     let header = RawHeader {
         table_kind: TableKind::Interface as u32,
@@ -431,9 +439,27 @@ fn write_interface_table(
         .map(|d| d.unwrap_or(FIXED_SLOT))
         .collect();
     let p = options.build.precision;
-    let sections = [
-        Section::ints(SectionKind::ConnectionVertex, &connections),
-        Section::floats(SectionKind::CondensedStiffness, &condensed.condensed, p),
+    let stiffness = match &options.interface_compression {
+        None => vec![Section::floats(
+            SectionKind::CondensedStiffness,
+            &condensed.condensed,
+            p,
+        )],
+        Some(compression) => {
+            let points: Vec<[f64; 3]> = split
+                .connection
+                .iter()
+                .map(|&v| mesh.positions[v as usize])
+                .collect();
+            let h = compress_condensed(&points, &condensed.condensed, compression)?;
+            let mut sections = h.hierarchy.sections(p);
+            sections.push(Section::ints(SectionKind::HierarchyOrder, &h.order));
+            sections
+        }
+    };
+    let mut sections = vec![Section::ints(SectionKind::ConnectionVertex, &connections)];
+    sections.extend(stiffness);
+    sections.extend([
         Section::floats(SectionKind::ConnectionResponse, &condensed.response, p),
         Section::floats(
             SectionKind::LoadDisplacement,
@@ -443,8 +469,8 @@ fn write_interface_table(
         Section::floats(SectionKind::LoadForce, &condensed.load_force, p),
         Section::ints(SectionKind::DynamicVertex, &dynamic_vertex),
         Section::ints(SectionKind::RegionChecksums, &[region_checksums]),
-    ];
-    write_container(header, p, &sections)
+    ]);
+    Ok(write_container(header, p, &sections))
 }
 
 /// A table file's CRC-32 trailer (its last 4 bytes, little-endian).

@@ -2,7 +2,8 @@
 //! `palpate_kernel::hybrid`): a mesh and the tets chosen dynamic →
 //! [`split::RegionSplit`] (the two regions and their connection nodes) →
 //! [`condense::condense`] (the pre-computed region condensed onto the
-//! connection nodes) → [`build::build_hybrid`] (the three tables) →
+//! connection nodes; [`hmatrix`] stores it hierarchically when asked) →
+//! [`build::build_hybrid`] (the three tables) →
 //! [`owned::with_hybrid`] (the kernel model over heap buffers, for the
 //! harness's runs) and [`stability::critical_dt_of_hybrid`] (its stable
 //! step next to its tensor-mass region's alone).
@@ -10,6 +11,7 @@
 pub mod build;
 pub mod condense;
 pub mod estimate;
+pub mod hmatrix;
 pub mod owned;
 pub mod run;
 pub mod split;

@@ -7,6 +7,7 @@ use anyhow::{Context, bail};
 use nalgebra::Vector3;
 
 use super::build::{HybridOptions, build_hybrid};
+use super::hmatrix::InterfaceCompression;
 use super::owned::with_hybrid;
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::number::shown;
@@ -17,12 +18,14 @@ use crate::tensor_mass::run::{RunOptions, RunOutput, host_params, run_steps, vol
 /// the tensor-mass region: a load on a vertex only the pre-computed region
 /// has is built into its table, any other load is an external force of the
 /// tensor-mass model; `--cut-tets` must name dynamic tets (the pre-computed
-/// region cannot be cut). Divergence bound: the mesh's bounding-box
-/// diagonal, as [`crate::tensor_mass::run::run`].
+/// region cannot be cut); the interface's condensed stiffness compressed as
+/// `interface_compression` says (`None`: dense). Divergence bound: the mesh's
+/// bounding-box diagonal, as [`crate::tensor_mass::run::run`].
 pub fn run(
     mesh: &TetMesh,
     report: &MeshReport,
     dynamic_tet: &[bool],
+    interface_compression: Option<InterfaceCompression>,
     options: &RunOptions,
 ) -> anyhow::Result<RunOutput> {
     crate::tensor_mass::run::check_run_steps(mesh, options)?;
@@ -44,6 +47,7 @@ pub fn run(
     let hybrid = HybridOptions {
         gravity_m_s2: options.gravity_m_s2,
         point_loads: precomputed_loads,
+        interface_compression,
         ..HybridOptions::of_tensor_mass(&build)?
     };
     let tables = build_hybrid(mesh, report, dynamic_tet, &hybrid)?;

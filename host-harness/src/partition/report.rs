@@ -84,7 +84,7 @@ pub struct PlanReport {
 /// The cost options of `scene` on `mesh`: its materials per tet (`Scene::tet_materials`, the
 /// sessions' own, with their checks), its tool's radius, and its dynamic settings when
 /// `[model]` is dynamic, else symplectic Euler without damping (its undamped bound
-/// `2/ω_max`).
+/// `2/ω_max`), and a hybrid's interface compressed as its `[tables]` says.
 pub fn cost_options(
     scene: &Scene,
     mesh: &TetMesh,
@@ -102,6 +102,7 @@ pub fn cost_options(
         integrator,
         damping_per_s,
         incompressibility_n,
+        interface_compression: scene.tables.interface_compression(),
     })
 }
 

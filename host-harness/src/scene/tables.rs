@@ -10,10 +10,16 @@
 //!                        # fraction of their column's largest, in [0, 1); default 0
 //! ```
 //!
-//! Only a pre-computed scene's table is compressed; on another model the
-//! session refuses it (`crate::session::model`).
+//! A pre-computed scene's compliance table takes every code; a hybrid
+//! scene's `"hmatrix"` only, which stores its interface's condensed
+//! stiffness hierarchically (`crate::hybrid::hmatrix`, `tolerance` its far
+//! blocks'); a tensor-mass scene none (`crate::session::model` refuses
+//! them).
 
 use serde::Deserialize;
+
+use crate::hybrid::hmatrix::InterfaceCompression;
+use crate::table::hmatrix::DEFAULT_TOLERANCE;
 
 /// How the compliance is stored, `compress = …`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -81,5 +87,17 @@ impl TablesSpec {
             }
         }
         Ok(spec)
+    }
+}
+
+impl TablesSpec {
+    /// How a hybrid's interface is compressed: its condensed stiffness hierarchical for
+    /// `compress = "hmatrix"` (this `tolerance`, the default leaves), else `None` (dense; a
+    /// hybrid's build refuses the other codes, `crate::session::model::hybrid_tables`).
+    pub fn interface_compression(&self) -> Option<InterfaceCompression> {
+        (self.compress == Some(TableCode::Hmatrix)).then(|| InterfaceCompression {
+            tolerance: self.tolerance.unwrap_or(DEFAULT_TOLERANCE),
+            ..InterfaceCompression::default()
+        })
     }
 }

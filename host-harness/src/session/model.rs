@@ -127,7 +127,9 @@ impl SceneModel {
     /// and supports), built in memory with the pipeline of `palpate tables
     /// build`; a pre-computed model's compliance compressed with
     /// `compression` (`tables build --compress`), else as the scene's
-    /// `[tables]` says ([`scene_compression`]); refused for the others.
+    /// `[tables]` says ([`scene_compression`]); a hybrid's interface as
+    /// [`hybrid_tables`] says (`--compress` refused); a tensor-mass model's
+    /// refused.
     pub fn tables(
         self,
         scene: &Scene,
@@ -141,15 +143,12 @@ impl SceneModel {
                 scene.source
             );
         }
-        if scene.tables.compress.is_some() && !matches!(self, Self::Precomputed) {
+        if scene.tables.compress.is_some() && matches!(self, Self::Dynamic(_)) {
             bail!(
-                "{}: [tables] compress applies to a pre-computed scene (its compliance table); \
-                 this scene's model is {}",
+                "{}: [tables] compress applies to a pre-computed scene (its compliance table) \
+                 or a hybrid (compress = \"hmatrix\": its interface); this scene's model is \
+                 dynamic (tensor-mass)",
                 scene.source,
-                match self {
-                    Self::Dynamic(_) => "dynamic (tensor-mass)",
-                    _ => "hybrid",
-                }
             );
         }
         let compression = compression.or_else(|| scene_compression(&scene.tables));
@@ -200,7 +199,9 @@ pub fn scene_compression(tables: &TablesSpec) -> Option<Compression> {
 
 /// The hybrid's three tables for `partition` of `scene` (its materials per
 /// tet, density and supports) in `precision`, built in memory
-/// ([`build_hybrid`]).
+/// ([`build_hybrid`]); the interface's condensed stiffness hierarchical
+/// when `[tables] compress = "hmatrix"` (its `tolerance`), and `"f16"` or
+/// `"q16"` refused.
 pub fn hybrid_tables(
     scene: &Scene,
     mesh: &TetMesh,
@@ -208,6 +209,14 @@ pub fn hybrid_tables(
     partition: &Partition,
     precision: Precision,
 ) -> anyhow::Result<HybridTables> {
+    let interface_compression = match scene.tables.compress {
+        None | Some(TableCode::Hmatrix) => scene.tables.interface_compression(),
+        Some(_) => bail!(
+            "{}: [tables] compress = \"f16\" or \"q16\" applies to a pre-computed scene; a \
+             hybrid takes compress = \"hmatrix\" (its interface's condensed stiffness)",
+            scene.source
+        ),
+    };
     let materials = scene.tet_materials(mesh, report)?;
     let options = HybridOptions::new(
         materials.default_material(),
@@ -224,6 +233,7 @@ pub fn hybrid_tables(
             print_estimate: true,
             ..options.limits
         },
+        interface_compression,
         ..options
     };
     build_hybrid(mesh, report, &partition.dynamic, &options).with_context(|| scene.source.clone())

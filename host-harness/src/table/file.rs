@@ -171,7 +171,7 @@ impl Hierarchy {
     /// The five hierarchy sections, the data rounded to `precision` (or
     /// coded: [`Hierarchy::q16`], the data section replaced by the codes
     /// and scales).
-    fn sections(&self, precision: Precision) -> Vec<Section> {
+    pub fn sections(&self, precision: Precision) -> Vec<Section> {
         let mut sections = vec![
             Section {
                 kind: SectionKind::HierarchyRecord,

@@ -526,6 +526,93 @@ fn add_far<T: Real, E: Stored<T>>(
     }
 }
 
+impl<T: Real> HierarchicalBlocks<'_, T> {
+    /// The product `y = C x` of the whole matrix, delivered in parts: for
+    /// every block `b` and each of its rows `i`, `sink(at(i), v)` with
+    /// `v = Σ_{j ∈ b} C_ij x_{at(j)}`, so that the parts delivered to a slot
+    /// sum to its row of `C x`. `at` maps a hierarchy index to a slot of `x`
+    /// and of the sink (`None`: skipped; the identity for a table numbered
+    /// in leaf order, a permutation for an interface's connection nodes).
+    ///
+    /// One pass over the blocks (the record's block count, checked at load),
+    /// each over its rows and columns: `9·rows·cols` multiply-adds near,
+    /// `3r(rows + cols)` far (`L (Rᵀ x)`, one `r`-vector on the stack); q16:
+    /// each part times the block's scale. No allocation, no panic.
+    #[inline]
+    pub fn products(
+        &self,
+        at: impl Fn(usize) -> Option<usize>,
+        x: &[[T; 3]],
+        mut sink: impl FnMut(usize, [T; 3]),
+    ) {
+        for (index, b) in self.blocks.iter().enumerate() {
+            match self.values {
+                Values::Scalar(data) => block_product(data, b, T::one(), &at, x, &mut sink),
+                Values::Q16 { codes, scales } => {
+                    if let Some(&pair) = scales.get(index) {
+                        block_product(codes, b, block_scale(b, pair), &at, x, &mut sink);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`HierarchicalBlocks::products`]' work on one block, each part times
+/// `scale` (one for table scalars: the same bits).
+#[inline(always)]
+fn block_product<T: Real, E: Stored<T>>(
+    values: &[E],
+    b: &HierarchyBlock,
+    scale: T,
+    at: &impl Fn(usize) -> Option<usize>,
+    x: &[[T; 3]],
+    sink: &mut impl FnMut(usize, [T; 3]),
+) {
+    let input = |j: usize| at(j).and_then(|slot| x.get(slot));
+    let (r0, c0) = (b.row_start as usize, b.col_start as usize);
+    if b.rank == 0 {
+        for i in 0..b.rows() {
+            let mut v = [T::zero(); 3];
+            for j in 0..b.cols() {
+                if let (Some(c), Some(xj)) = (near_entry(values, b, i, j), input(c0 + j)) {
+                    let p = block::mul(&c, xj);
+                    v = [v[0] + p[0], v[1] + p[1], v[2] + p[2]];
+                }
+            }
+            if let Some(slot) = at(r0 + i) {
+                sink(slot, v.map(|e| e * scale));
+            }
+        }
+        return;
+    }
+    let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
+    let mut t = [T::zero(); HIERARCHY_MAX_RANK];
+    let Some(t) = t.get_mut(..r) else {
+        return;
+    };
+    for j in 0..b.cols() {
+        let (Some(right), Some(xj)) = (factor_rows(values, b.right, j, r), input(c0 + j)) else {
+            continue;
+        };
+        for (bb, &xb) in xj.iter().enumerate() {
+            for (tl, &f) in t.iter_mut().zip(factor_row(right, bb, r)) {
+                *tl += f.value() * xb;
+            }
+        }
+    }
+    t.iter_mut().for_each(|tl| *tl = *tl * scale);
+    for i in 0..b.rows() {
+        let (Some(left), Some(slot)) = (factor_rows(values, b.left, i, r), at(r0 + i)) else {
+            continue;
+        };
+        sink(
+            slot,
+            core::array::from_fn(|a| dot_scalar(factor_row(left, a, r), t)),
+        );
+    }
+}
+
 /// Row `a` (`r` numbers) of a vertex's three factor rows; empty if beyond.
 #[inline(always)]
 fn factor_row<E>(rows: &[E], a: usize, r: usize) -> &[E] {

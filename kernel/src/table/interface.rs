@@ -5,7 +5,29 @@
 use super::LoadError;
 use super::container::{Container, check_finite};
 use super::format::{FIXED_SLOT, RawHeader, SectionKind, TableKind};
+use super::hierarchical::HierarchicalBlocks;
 use crate::Real;
+use crate::math::dense::dot;
+
+/// How an interface table stores its condensed stiffness `S` (N/m).
+#[derive(Clone, Copy, Debug)]
+pub enum CondensedStiffness<'a, T: Real> {
+    /// The dense `3c × 3c` matrix ([`SectionKind::CondensedStiffness`]),
+    /// row `r = 3j + a` the `c` triples at `r·c .. (r + 1)·c`.
+    Dense(&'a [[T; 3]]),
+    /// A hierarchical matrix over a cluster tree of the connection nodes
+    /// (the hierarchy sections, [`super::format::hierarchy`], with the
+    /// touchable vertices read as the connection nodes in leaf order) and
+    /// the order that maps it to the connection nodes
+    /// ([`SectionKind::HierarchyOrder`]).
+    Hierarchical {
+        /// The blocks of `S` in hierarchy order.
+        blocks: HierarchicalBlocks<'a, T>,
+        /// Per hierarchy index `i`: `[connection node at i, hierarchy index
+        /// of connection node i]`.
+        order: &'a [[u32; 2]],
+    },
+}
 
 /// An interface table that passed every load-time check.
 ///
@@ -16,9 +38,13 @@ use crate::Real;
 /// - every float is finite, and every diagonal entry of the condensed
 ///   stiffness is positive (a Schur complement of a positive definite
 ///   stiffness is positive definite);
-/// - section lengths match the header's counts: the `3c × 3c` condensed
-///   stiffness and `3F × 3c` response, `F` load displacements and `c` load
-///   forces, `N` dynamic-vertex entries.
+/// - the condensed stiffness is either dense (the `3c × 3c` matrix) or
+///   hierarchical (the hierarchy sections over `c` connection nodes, their
+///   invariants [`HierarchicalBlocks`]'s, and a hierarchy order that is a
+///   permutation of `0..c` stored with its inverse), never both;
+/// - section lengths match the header's counts: the `3F × 3c` response,
+///   `F` load displacements and `c` load forces, `N` dynamic-vertex
+///   entries.
 ///
 /// That the table belongs with a given pre-computed and tensor-mass table
 /// is checked where the three meet ([`crate::hybrid::HybridModel::new`]).
@@ -27,7 +53,7 @@ pub struct InterfaceTable<'a, T: Real> {
     header: RawHeader,
     checksum: u32,
     connections: &'a [[u32; 2]],
-    condensed: &'a [[T; 3]],
+    condensed: CondensedStiffness<'a, T>,
     response: &'a [[T; 3]],
     load_displacement: &'a [[T; 3]],
     load_force: &'a [[T; 3]],
@@ -45,7 +71,7 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
             header: c.header,
             checksum: c.checksum,
             connections: c.section(SectionKind::ConnectionVertex)?,
-            condensed: c.section(SectionKind::CondensedStiffness)?,
+            condensed: condensed_stiffness(&c)?,
             response: c.section(SectionKind::ConnectionResponse)?,
             load_displacement: c.section(SectionKind::LoadDisplacement)?,
             load_force: c.section(SectionKind::LoadForce)?,
@@ -58,7 +84,9 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
                     kind: SectionKind::RegionChecksums,
                 })?,
         };
-        check_finite(SectionKind::CondensedStiffness, table.condensed)?;
+        if let CondensedStiffness::Dense(dense) = table.condensed {
+            check_finite(SectionKind::CondensedStiffness, dense)?;
+        }
         check_finite(SectionKind::ConnectionResponse, table.response)?;
         check_finite(SectionKind::LoadDisplacement, table.load_displacement)?;
         check_finite(SectionKind::LoadForce, table.load_force)?;
@@ -66,13 +94,9 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         for (j, &[vertex, dynamic]) in table.connections.iter().enumerate() {
             let ascending = previous.is_none_or(|p| vertex > p);
             let mapped = table.dynamic_vertex.get(vertex as usize) == Some(&dynamic);
-            let diagonal = (0..3).all(|a| {
-                table
-                    .condensed_row(3 * j + a)
-                    .get(j)
-                    .and_then(|s| s.get(a))
-                    .is_some_and(|&d| d > T::zero())
-            });
+            let diagonal = table
+                .condensed_block(j, j)
+                .is_some_and(|d| [d[0], d[4], d[8]].iter().all(|&x| x > T::zero()));
             if !(ascending && mapped && dynamic == j as u32 && diagonal) {
                 return Err(LoadError::BadConnection {
                     connection: j as u32,
@@ -116,11 +140,92 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         self.connections
     }
 
-    /// Row `r = 3j + a` of the `3c × 3c` condensed stiffness (N/m), as `c`
-    /// triples (columns `3k..3k+3` in triple `k`); empty out of range.
-    pub fn condensed_row(&self, r: usize) -> &'a [[T; 3]] {
+    /// The condensed stiffness as stored.
+    pub fn condensed(&self) -> &CondensedStiffness<'a, T> {
+        &self.condensed
+    }
+
+    /// The block `S_jk` (N/m, row-major 3×3: element `3a + b` is
+    /// `S[(j, a), (k, b)]`) of connection nodes `j` and `k`; `None` out of
+    /// range. Not for the step path (a hierarchical table finds it by two
+    /// binary searches; the product is [`Self::add_condensed_product`]).
+    pub fn condensed_block(&self, j: usize, k: usize) -> Option<[T; 9]> {
         let c = self.connection_count();
-        self.condensed.get(r * c..(r + 1) * c).unwrap_or(&[])
+        match self.condensed {
+            CondensedStiffness::Dense(dense) => {
+                let mut out = [T::zero(); 9];
+                for (a, row) in out.chunks_exact_mut(3).enumerate() {
+                    let at = (3 * j + a).checked_mul(c)?.checked_add(k)?;
+                    row.copy_from_slice(dense.get(at).filter(|_| j < c && k < c)?);
+                }
+                Some(out)
+            }
+            CondensedStiffness::Hierarchical { blocks, order } => {
+                let position = |n: usize| order.get(n).map(|&[_, p]| p as usize);
+                blocks.block(position(j)?, position(k)?)
+            }
+        }
+    }
+
+    /// `out += scale · S u` over the connection nodes (`u` and `out` hold at
+    /// least `c` triples, tensor-mass vertex `j` being connection node `j`;
+    /// nothing is done with fewer): `9c²` multiply-adds over contiguous rows
+    /// dense, one pass over the blocks hierarchical
+    /// ([`HierarchicalBlocks::products`]). No allocation, no panic.
+    #[inline]
+    pub fn add_condensed_product(&self, u: &[[T; 3]], scale: T, out: &mut [[T; 3]]) {
+        let c = self.connection_count();
+        let (Some(uc), Some(oc)) = (u.get(..c), out.get_mut(..c)) else {
+            return;
+        };
+        match self.condensed {
+            CondensedStiffness::Dense(dense) => {
+                let flat = uc.as_flattened();
+                let rows = dense.chunks_exact(c.max(1));
+                for (o, row) in oc.as_flattened_mut().iter_mut().zip(rows) {
+                    *o += scale * dot(row.as_flattened(), flat);
+                }
+            }
+            CondensedStiffness::Hierarchical { blocks, order } => {
+                let at = |i: usize| order.get(i).map(|&[node, _]| node as usize);
+                blocks.products(at, uc, |slot, v| {
+                    if let Some(o) = oc.get_mut(slot) {
+                        for (x, &y) in o.iter_mut().zip(&v) {
+                            *x += scale * y;
+                        }
+                    }
+                });
+            }
+        }
+    }
+
+    /// `uᵀ S u` over the connection nodes (J for `u` in m), with the same
+    /// cost and conventions as [`Self::add_condensed_product`] (`0` with
+    /// fewer than `c` triples).
+    #[inline]
+    pub fn condensed_quadratic(&self, u: &[[T; 3]]) -> T {
+        let c = self.connection_count();
+        let Some(uc) = u.get(..c) else {
+            return T::zero();
+        };
+        let mut sum = T::zero();
+        match self.condensed {
+            CondensedStiffness::Dense(dense) => {
+                let flat = uc.as_flattened();
+                for (&x, row) in flat.iter().zip(dense.chunks_exact(c.max(1))) {
+                    sum += x * dot(row.as_flattened(), flat);
+                }
+            }
+            CondensedStiffness::Hierarchical { blocks, order } => {
+                let at = |i: usize| order.get(i).map(|&[node, _]| node as usize);
+                blocks.products(at, uc, |slot, v| {
+                    if let Some(x) = uc.get(slot) {
+                        sum += x[0] * v[0] + x[1] * v[1] + x[2] * v[2];
+                    }
+                });
+            }
+        }
+        sum
     }
 
     /// Row `r = 3n + a` (free index `n` of the pre-computed table, component
@@ -161,5 +266,51 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
     /// of the pre-computed region only).
     pub fn dynamic_vertices(&self) -> &'a [u32] {
         self.dynamic_vertex
+    }
+}
+
+/// The condensed stiffness of the interface in `c`: the dense section, or
+/// the hierarchy sections and order (checked: [`HierarchicalBlocks`]'s
+/// invariants over `c` connection nodes, the order a permutation stored
+/// with its inverse); one of the two, not both.
+fn condensed_stiffness<'a, T: Real>(
+    c: &Container<'a>,
+) -> Result<CondensedStiffness<'a, T>, LoadError> {
+    let dense = c.has(SectionKind::CondensedStiffness);
+    let hierarchical = c.has(SectionKind::HierarchyRecord);
+    let bad = |kind, index: usize, what| LoadError::BadHierarchy {
+        kind,
+        index: index as u64,
+        what,
+    };
+    match (dense, hierarchical) {
+        (true, false) => Ok(CondensedStiffness::Dense(
+            c.section(SectionKind::CondensedStiffness)?,
+        )),
+        (false, false) => Err(LoadError::MissingSection {
+            kind: SectionKind::CondensedStiffness,
+        }),
+        (true, true) => Err(bad(
+            SectionKind::CondensedStiffness,
+            0,
+            "an interface stores its condensed stiffness dense or hierarchical, not both",
+        )),
+        (false, true) => {
+            let n = c.header.connection_count as usize;
+            let blocks = HierarchicalBlocks::load(c, n, false)?;
+            let order: &'a [[u32; 2]] = c.section(SectionKind::HierarchyOrder)?;
+            // `inverse(node(i)) = i` for every `i`: `node` is injective on
+            // `0..c` into `0..c`, a permutation, and `inverse` its inverse.
+            let node = |i: usize| order.get(i).map(|&[node, _]| node as usize);
+            let inverse = |j: usize| order.get(j).map(|&[_, p]| p as usize);
+            if let Some(i) = (0..n).find(|&i| node(i).and_then(inverse) != Some(i)) {
+                return Err(bad(
+                    SectionKind::HierarchyOrder,
+                    i,
+                    "not a permutation of the connection nodes stored with its inverse",
+                ));
+            }
+            Ok(CondensedStiffness::Hierarchical { blocks, order })
+        }
     }
 }

@@ -38,7 +38,7 @@ pub use grid::{CellBox, Grid, neighbours, within};
 pub use hierarchical::HierarchicalBlocks;
 pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot, max_row};
-pub use interface::InterfaceTable;
+pub use interface::{CondensedStiffness, InterfaceTable};
 pub use plane::Plane;
 pub(crate) use plane::plane_record;
 pub use precomputed::PrecomputedTable;

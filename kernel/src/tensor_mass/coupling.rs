@@ -38,17 +38,24 @@ impl<T: Real> CouplingForces<'_, '_, T> {
     /// vertex `j`, passed force `p_j`): the force of the pre-computed region,
     /// held at the connection displacements with its interior at
     /// equilibrium (static condensation, `S = K_cc − K_ci K_ii⁻¹ K_ic`).
-    /// `9c²` multiply-adds over contiguous rows.
+    /// `S u` dense or hierarchical, as the interface stores it
+    /// ([`InterfaceTable::add_condensed_product`]).
     pub(crate) fn add_forces(&self, u: &[[T; 3]], f: &mut [[T; 3]]) {
         let c = self.interface.connection_count();
-        let (Some(uc), Some(fc)) = (u.get(..c), f.get_mut(..c)) else {
+        if u.len() < c {
+            return;
+        }
+        let Some(fc) = f.get_mut(..c) else {
             return;
         };
-        let uc = uc.as_flattened();
-        let passed = self.passed_force_n.as_flattened();
-        for (r, (fr, &p)) in fc.as_flattened_mut().iter_mut().zip(passed).enumerate() {
-            *fr += p - dot(self.interface.condensed_row(r).as_flattened(), uc);
+        for (fr, &p) in fc
+            .as_flattened_mut()
+            .iter_mut()
+            .zip(self.passed_force_n.as_flattened())
+        {
+            *fr += p;
         }
+        self.interface.add_condensed_product(u, -T::one(), fc);
     }
 
     /// `½ u_cᵀ S u_c − pᵀ u_c` (J): the condensed region's energy at the
@@ -57,14 +64,7 @@ impl<T: Real> CouplingForces<'_, '_, T> {
     pub(crate) fn energy_j(&self, u: &[[T; 3]]) -> T {
         let c = self.interface.connection_count();
         let uc = u.get(..c).unwrap_or(&[]).as_flattened();
-        let passed = self.passed_force_n.as_flattened();
-        let half = T::of_f64(0.5);
-        uc.iter()
-            .zip(passed)
-            .enumerate()
-            .fold(T::zero(), |e, (r, (&x, &p))| {
-                let su = dot(self.interface.condensed_row(r).as_flattened(), uc);
-                e + x * (half * su - p)
-            })
+        let work = dot(uc, self.passed_force_n.as_flattened());
+        T::of_f64(0.5) * self.interface.condensed_quadratic(u) - work
     }
 }

@@ -317,6 +317,7 @@ fn plan_costs_take_the_materials_per_tet() {
         integrator: Integrator::SymplecticEuler,
         damping_per_s: 0.0,
         incompressibility_n: None,
+        interface_compression: None,
     };
     let dt = |materials| {
         let (regions, _, _) = costs(&mesh, &fixed, &partition, &options(materials)).expect("costs");

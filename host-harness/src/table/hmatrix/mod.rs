@@ -64,7 +64,12 @@ pub const ESTIMATE_RANK: usize = 20;
 /// are those of the build, every far block at [`ESTIMATE_RANK`];
 /// `scale_bytes` per block for its scales (q16 data; 0 otherwise).
 pub fn estimate(points: &[[f64; 3]], scale_bytes: u64) -> (u64, u64) {
-    let tree = ClusterTree::new(points, LEAF_SIZE);
+    estimate_with_leaves(points, LEAF_SIZE, scale_bytes)
+}
+
+/// [`estimate`] with leaves of at most `leaf_size` points (`≥ 1`).
+pub fn estimate_with_leaves(points: &[[f64; 3]], leaf_size: usize, scale_bytes: u64) -> (u64, u64) {
+    let tree = ClusterTree::new(points, leaf_size);
     let partition = Partition::new(&tree, ETA);
     let blocks = partition.blocks.len() as u64;
     let entries: u64 = partition.columns.iter().map(|c| c.len() as u64).sum();

@@ -290,7 +290,8 @@ pub enum SectionKind {
     /// `u32` × entries: the blocks over each leaf column, by row.
     HierarchyColumnBlocks = 61,
     /// `scalar` × entries: near blocks' entries and far blocks' factors, m/N
-    /// (a factor's scale is the writer's: only `L Rᵀ` is in m/N).
+    /// (a factor's scale is the writer's: only `L Rᵀ` is in m/N; in an
+    /// interface table, N/m: [`Self::CondensedStiffness`] hierarchical).
     HierarchyData = 62,
     /// `u16` × entries: the q16 codes of a
     /// [`super::BlockEncoding::HierarchicalQ16`] part, in place of
@@ -301,6 +302,12 @@ pub enum SectionKind {
     /// scales of its codes: a near block's quantum (m/N) and 0, a far
     /// block's `L` and `R` quanta (their product in m/N).
     HierarchyScales = 64,
+    /// `[u32; 2]` × c (interface tables with a hierarchical condensed
+    /// stiffness, [`super::hierarchy`]): per hierarchy index `i`, the
+    /// connection node numbered `i` in the cluster tree's leaf order; then
+    /// per connection node `j`, its hierarchy index (the inverse
+    /// permutation, so that a load checks the pair in one pass).
+    HierarchyOrder = 65,
 }
 
 /// Marks a boundary face in [`SectionKind::TetNeighbour`].
@@ -341,7 +348,7 @@ pub mod tet_lane_row {
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 53] = [
+    pub const ALL: [SectionKind; 54] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -395,6 +402,7 @@ impl SectionKind {
         SectionKind::HierarchyData,
         SectionKind::HierarchyCodes,
         SectionKind::HierarchyScales,
+        SectionKind::HierarchyOrder,
     ];
 
     /// `true` for the sections whose element count the directory declares
@@ -417,14 +425,18 @@ impl SectionKind {
         )
     }
 
-    /// `true` for the compliance sections a [`super::CompressionRecord`] may
-    /// replace by coded ones: required by [`TableKind::sections`], but
-    /// checked by the pre-computed view against the record, not by the
+    /// `true` for the matrix sections an encoding may replace: the
+    /// compliance sections a [`super::CompressionRecord`] may replace by
+    /// coded or hierarchical ones, and an interface's condensed stiffness,
+    /// which the hierarchy sections may replace. Required by
+    /// [`TableKind::sections`], but checked by the table's view, not by the
     /// container.
     pub const fn encodable(self) -> bool {
         matches!(
             self,
-            SectionKind::ComplianceSurface | SectionKind::ComplianceInterior
+            SectionKind::ComplianceSurface
+                | SectionKind::ComplianceInterior
+                | SectionKind::CondensedStiffness
         )
     }
 
@@ -471,7 +483,7 @@ impl SectionKind {
             SectionKind::SurfaceKept | SectionKind::InteriorKept => 8,
             SectionKind::HierarchyRecord => HIERARCHY_RECORD_LEN as u32,
             SectionKind::HierarchyBlocks => HIERARCHY_BLOCK_LEN as u32,
-            SectionKind::HierarchyLeaves => 8,
+            SectionKind::HierarchyLeaves | SectionKind::HierarchyOrder => 8,
             SectionKind::HierarchyColumnBlocks => 4,
             SectionKind::HierarchyData => scalar_bytes,
             SectionKind::HierarchyCodes => 2,
@@ -489,6 +501,13 @@ impl SectionKind {
         let tets = u64::from(h.tet_count);
         let edges = u64::from(h.edge_count);
         let c = u64::from(h.connection_count);
+        // The hierarchy's order: the touchable vertices of a pre-computed
+        // table, the connection nodes of an interface.
+        let hs = if h.table_kind == TableKind::Interface as u32 {
+            c
+        } else {
+            s
+        };
         match self {
             SectionKind::ConnectionVertex | SectionKind::LoadForce => Some(c),
             SectionKind::CondensedStiffness => c.checked_mul(c)?.checked_mul(3),
@@ -548,12 +567,13 @@ impl SectionKind {
             // entries of the full matrix and the factors of every block at
             // the largest rank). The view checks the exact structure.
             SectionKind::HierarchyRecord => Some(1),
-            SectionKind::HierarchyLeaves => s.checked_add(1),
+            SectionKind::HierarchyLeaves => hs.checked_add(1),
             SectionKind::HierarchyBlocks
             | SectionKind::HierarchyColumnBlocks
-            | SectionKind::HierarchyScales => s.checked_mul(s),
-            SectionKind::HierarchyData | SectionKind::HierarchyCodes => s
-                .checked_mul(s)?
+            | SectionKind::HierarchyScales => hs.checked_mul(hs),
+            SectionKind::HierarchyOrder => Some(c),
+            SectionKind::HierarchyData | SectionKind::HierarchyCodes => hs
+                .checked_mul(hs)?
                 .checked_mul(6 * HIERARCHY_MAX_RANK as u64 + 9),
         }
     }
@@ -614,6 +634,7 @@ impl SectionKind {
             SectionKind::HierarchyData => "hierarchy-data",
             SectionKind::HierarchyCodes => "hierarchy-codes",
             SectionKind::HierarchyScales => "hierarchy-scales",
+            SectionKind::HierarchyOrder => "hierarchy-order",
         }
     }
 }

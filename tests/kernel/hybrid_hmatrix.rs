@@ -1,0 +1,286 @@
+//! The hybrid with its interface's condensed stiffness stored as a
+//! hierarchical matrix (`palpate::hybrid::hmatrix`, scene `[tables] compress
+//! = "hmatrix"`): its product against the dense interface's exact `S u`, the
+//! hybrid's steady state against one global linear FEM solve of the whole
+//! mesh (`palpate::fem::static_solve`, independent of the condensation), and
+//! corrupt hierarchy sections refused at load.
+
+use std::sync::OnceLock;
+
+use nalgebra::Vector3;
+use palpate::fem::material::{Material, TetMaterials};
+use palpate::fem::static_solve::solve_loaded;
+use palpate::hybrid::hmatrix::InterfaceCompression;
+use palpate::hybrid::owned::with_hybrid;
+use palpate::hybrid::{HybridOptions, HybridTables, build_hybrid};
+use palpate::mesh::generate::box_mesh;
+use palpate::mesh::{MeshReport, TetMesh};
+use palpate::table::file::Precision;
+use palpate_kernel::LoadError;
+use palpate_kernel::table::format::SectionKind;
+use palpate_kernel::table::{CondensedStiffness, InterfaceTable};
+use palpate_kernel::tensor_mass::{DynamicParams, Integrator};
+use palpate_tests::{Lcg, patch_section};
+
+/// The far blocks' relative tolerance of the compressed interface.
+const TOLERANCE: f64 = 1e-4;
+/// Leaves of 4 connection nodes: the slab's 45 connection nodes then make
+/// far blocks (the scene default, 32, would make one leaf of them).
+const LEAF_SIZE: usize = 4;
+/// 8 × 4 × 3 cm slab of 8 × 4 × 3 cells (180 vertices, 576 tets), base fixed.
+const SIZE_M: [f64; 3] = [0.08, 0.04, 0.03];
+
+/// The mesh and the hybrid built twice, dense and compressed interface:
+/// the upper layer of cells dynamic (192 tets, the 45 vertices of the plane
+/// under it the connection nodes).
+struct Built {
+    mesh: TetMesh,
+    dense: HybridTables,
+    compressed: HybridTables,
+}
+
+fn material() -> Material {
+    Material::new(5000.0, 0.3).expect("material")
+}
+
+fn options(compression: Option<InterfaceCompression>) -> HybridOptions {
+    HybridOptions {
+        interface_compression: compression,
+        ..HybridOptions::new(
+            material(),
+            1000.0,
+            vec!["z<0.0001".parse().expect("predicate")],
+            Precision::F64,
+        )
+    }
+}
+
+fn built() -> &'static Built {
+    static BUILT: OnceLock<Built> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        let mesh = box_mesh([8, 4, 3], SIZE_M);
+        let report = MeshReport {
+            source: "slab".into(),
+            ..MeshReport::default()
+        };
+        let upper: Vec<bool> = (0..mesh.tets.len())
+            .map(|t| mesh.tet_centroid(t)[2] > SIZE_M[2] * 2.0 / 3.0)
+            .collect();
+        let compression = InterfaceCompression {
+            tolerance: TOLERANCE,
+            leaf_size: LEAF_SIZE,
+        };
+        let build = |c| build_hybrid(&mesh, &report, &upper, &options(c)).expect("hybrid tables");
+        let (dense, compressed) = (build(None), build(Some(compression)));
+        Built {
+            mesh,
+            dense,
+            compressed,
+        }
+    })
+}
+
+fn interface(tables: &HybridTables) -> InterfaceTable<'_, f64> {
+    InterfaceTable::load(tables.interface.bytes()).expect("interface")
+}
+
+fn norm(v: &[[f64; 3]]) -> f64 {
+    v.iter().flatten().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// `S̃ u` of the hierarchical interface against the dense interface's `S u`
+/// on random `u`: `‖S̃ u − S u‖ ≤ ‖S̃ − S‖_F ‖u‖ ≤ tol · ‖S‖_F ‖u‖` (each far
+/// block within `tol` of its own Frobenius norm, the near blocks exact),
+/// and the quadratic form within `tol · ‖S‖_F ‖u‖²`; a slack of 1e-12
+/// relative for the f64 rounding of the two sums. The hierarchy holds far
+/// blocks (else the test would compare the dense matrix with itself).
+#[test]
+fn hierarchical_product_is_the_dense_product_within_the_tolerance() {
+    let b = built();
+    let (dense, hier) = (interface(&b.dense), interface(&b.compressed));
+    let c = dense.connection_count();
+    assert_eq!(hier.connection_count(), c);
+    let CondensedStiffness::Hierarchical { blocks, .. } = hier.condensed() else {
+        panic!("the compressed interface is not hierarchical");
+    };
+    let far = blocks.blocks().iter().filter(|b| b.rank > 0).count();
+    println!(
+        "{c} connection nodes: {} blocks, {far} far, {} scalars (dense {})",
+        blocks.blocks().len(),
+        blocks.data_len(),
+        9 * c * c
+    );
+    assert!(far > 0, "no far block");
+    let s_frobenius = (0..c)
+        .flat_map(|j| (0..c).map(move |k| (j, k)))
+        .flat_map(|(j, k)| dense.condensed_block(j, k).expect("block"))
+        .map(|x| x * x)
+        .sum::<f64>()
+        .sqrt();
+    let mut rng = Lcg(7);
+    for trial in 0..4 {
+        let u: Vec<[f64; 3]> = (0..c)
+            .map(|_| [rng.signed(), rng.signed(), rng.signed()])
+            .collect();
+        let (mut exact, mut approx) = (vec![[0.0; 3]; c], vec![[0.0; 3]; c]);
+        dense.add_condensed_product(&u, 1.0, &mut exact);
+        hier.add_condensed_product(&u, 1.0, &mut approx);
+        let difference: Vec<[f64; 3]> = exact
+            .iter()
+            .zip(&approx)
+            .map(|(e, a)| [e[0] - a[0], e[1] - a[1], e[2] - a[2]])
+            .collect();
+        let bound = (TOLERANCE + 1e-12) * s_frobenius * norm(&u);
+        let error = norm(&difference);
+        let quadratic = (dense.condensed_quadratic(&u) - hier.condensed_quadratic(&u)).abs();
+        println!(
+            "u #{trial}: |S̃u − Su| {error:.3e} (bound {bound:.3e}), uᵀ(S̃ − S)u {quadratic:.3e}"
+        );
+        assert!(error <= bound, "u #{trial}: {error:e} > {bound:e}");
+        assert!(quadratic <= bound * norm(&u), "u #{trial}: {quadratic:e}");
+        // And `S u` itself is no small number next to the error.
+        assert!(
+            norm(&exact) > 1e3 * error,
+            "u #{trial}: |Su| {}",
+            norm(&exact)
+        );
+    }
+    // Every diagonal block read back exactly (near blocks keep entries).
+    for j in 0..c {
+        let (d, h) = (dense.condensed_block(j, j), hier.condensed_block(j, j));
+        let (d, h) = (d.expect("dense"), h.expect("hierarchical"));
+        let worst = d
+            .iter()
+            .zip(&h)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-12 * s_frobenius, "S_{j}{j}: {worst:e}");
+    }
+}
+
+/// The nodal loads of the whole mesh: `force` (N) on `vertex`, none elsewhere.
+fn loads(mesh: &TetMesh, vertex: u32, force: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut loads = vec![[0.0; 3]; mesh.positions.len()];
+    for (l, f) in loads[vertex as usize].iter_mut().zip(force) {
+        *l += f;
+    }
+    loads
+}
+
+/// A point load on the dynamic region's top: the settled hybrid with the
+/// hierarchical interface equals the global solve. The condensation is
+/// exact, so the error is the compression's: the connection displacements
+/// solve `(K_d + S̃) u = f` instead of `(K_d + S) u = f`, and only the far
+/// blocks of `S̃` differ from `S`, each by at most `tol` of its own norm;
+/// they are the small, smooth part of `S` (its coupling between distant
+/// connection nodes), so the field's relative error stays below `tol`
+/// itself (bound `TOLERANCE`; measured 2.1e-6). The dense interface's
+/// error, the settling's alone (~1e-12), is checked at 1e-6 alongside.
+#[test]
+fn compressed_interface_steady_state_is_the_global_solve() {
+    let b = built();
+    let mesh = &b.mesh;
+    // (4, 2, 3) cm: the middle of the top, in the dynamic region.
+    let top = 3 * 45 + 2 * 9 + 4;
+    let force = [0.0, 0.0, -0.05];
+    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 1e-9).collect();
+    let (global, _) = solve_loaded(
+        &mesh.positions,
+        &mesh.tets,
+        &TetMaterials::uniform(material(), mesh.tets.len()),
+        &fixed,
+        &[],
+        &loads(mesh, top, force),
+    )
+    .expect("global solve");
+    let scale = global.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut errors = Vec::new();
+    for tables in [&b.dense, &b.compressed] {
+        let d = tables.split.dynamic_index[top as usize].expect("dynamic vertex");
+        let field = with_hybrid(tables, DynamicParams::linear(150.0, f64::INFINITY), |h| {
+            h.dynamic_mut()
+                .set_external_force(d, Vector3::from(force))
+                .expect("load");
+            let mut field = vec![[0.0; 3]; mesh.positions.len()];
+            let mut previous = field.clone();
+            for step in 0..40_000 {
+                h.step(Integrator::SymplecticEuler, 2e-4)
+                    .expect("stable step");
+                if step % 100 == 99 {
+                    h.displacements::<1>(None, &mut field).expect("field");
+                    let change = field
+                        .iter()
+                        .flatten()
+                        .zip(previous.iter().flatten())
+                        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+                    if change < 1e-12 * scale {
+                        break;
+                    }
+                    previous.clone_from(&field);
+                }
+            }
+            field
+        })
+        .expect("hybrid");
+        let error = field
+            .iter()
+            .flatten()
+            .zip(global.iter().flatten())
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / scale;
+        errors.push(error);
+    }
+    println!(
+        "relative max error against the global solve: dense {:.2e}, hierarchical {:.2e}",
+        errors[0], errors[1]
+    );
+    assert!(errors[0] <= 1e-6, "dense interface: {:e}", errors[0]);
+    assert!(errors[1] <= TOLERANCE, "hierarchical: {:e}", errors[1]);
+}
+
+/// The hierarchical interface's own sections corrupted behind a valid
+/// checksum: refused at load with the section named, never coupled.
+#[test]
+fn corrupt_interface_hierarchy_is_refused() {
+    let bytes = built().compressed.interface.bytes();
+    let refused = |bytes: Vec<u8>, section: &str| {
+        let error = InterfaceTable::<f64>::load(&bytes).expect_err("corrupt table loaded");
+        let message = error.to_string();
+        println!("{message}");
+        assert!(
+            matches!(error, LoadError::BadHierarchy { .. }) && message.contains(section),
+            "{message}"
+        );
+    };
+    let put = |b: &mut [u8], at: usize, v: u32| b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+    let get = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
+    // Two hierarchy indices mapped to one connection node.
+    refused(
+        patch_section(bytes, SectionKind::HierarchyOrder, |b| {
+            let other = get(b, 8);
+            put(b, 0, other)
+        }),
+        "hierarchy-order",
+    );
+    // A connection node's inverse entry pointing elsewhere.
+    refused(
+        patch_section(bytes, SectionKind::HierarchyOrder, |b| {
+            let i = get(b, 4);
+            put(b, 4, i + 1)
+        }),
+        "hierarchy-order",
+    );
+    // A block's rows beyond the connection nodes (row_end, bytes 4..8).
+    refused(
+        patch_section(bytes, SectionKind::HierarchyBlocks, |b| put(b, 4, 10_000)),
+        "hierarchy-blocks",
+    );
+    // The leaf count one off (bytes 0..4 of the record).
+    refused(
+        patch_section(bytes, SectionKind::HierarchyRecord, |b| {
+            let n = get(b, 0);
+            put(b, 0, n + 1)
+        }),
+        "hierarchy-record",
+    );
+}
