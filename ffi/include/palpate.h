@@ -134,35 +134,35 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 397
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 396
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 352
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 350
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 64-bit targets (the host).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 465
+#define PALPATE_DYNAMIC_LOOP_WORDS 467
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 373
+#define PALPATE_DYNAMIC_LOOP_WORDS 374
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 653
+#define PALPATE_HYBRID_LOOP_WORDS 655
 #endif
 
 #if !defined(PALPATE_POINTER_64)

@@ -27,7 +27,7 @@ use crate::{M, P};
 
 /// Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
 #[cfg(target_pointer_width = "64")]
-pub const PALPATE_HYBRID_LOOP_WORDS: usize = 653;
+pub const PALPATE_HYBRID_LOOP_WORDS: usize = 655;
 /// Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
 pub const PALPATE_HYBRID_LOOP_WORDS: usize = 511;
