@@ -171,8 +171,14 @@ fn tables(name: &str, out_dir: &Path, precision: Precision) -> anyhow::Result<()
 /// tensor-mass region under the law named `law` ([`palpate_script::hybrid::LAWS`]).
 fn replay_hybrid(dir: &Path, sequence: &Path, law: &str) -> anyhow::Result<()> {
     let Some(law) = palpate_script::hybrid::law_named(law) else {
-        let names: Vec<&str> = palpate_script::hybrid::LAWS.iter().map(|(n, _)| *n).collect();
-        bail!("--law {law}: not a law of the hybrid replay; one of {}", names.join(", "));
+        let names: Vec<&str> = palpate_script::hybrid::LAWS
+            .iter()
+            .map(|(n, _)| *n)
+            .collect();
+        bail!(
+            "--law {law}: not a law of the hybrid replay; one of {}",
+            names.join(", ")
+        );
     };
     let [precomputed, dynamic, interface] = TABLE_FILES.map(|f| TableFile::read(&dir.join(f)));
     let text = read_bounded(

@@ -48,8 +48,8 @@ impl<T: Real> Block<'_, T> {
     /// each lane with its tet's `λ`, `μ`. A lane without a live tet has
     /// `F = I`: zero gradients and energy.
     ///
-    /// Three lane loops: `J` (vectorized), `ln max(J, J₀)` (a `ln` call per
-    /// lane), then the stress (vectorized, one division per lane: `g'` and
+    /// Three lane loops: `J` (vectorized), `ln max(J, J₀)` (a
+    /// [`Real::portable_ln`] call per lane: the same bits on every target), then the stress (vectorized, one division per lane: `g'` and
     /// `g''` share `1/max(J, J₀)`, and `J` is not computed twice).
     #[inline(always)]
     pub(super) fn neo_hookean(&self) -> TetTerms<T> {
@@ -65,7 +65,7 @@ impl<T: Real> Block<'_, T> {
         }
         let mut logs = z;
         for (log, &j) in logs.iter_mut().zip(&clamped) {
-            *log = j.ln();
+            *log = j.portable_ln();
         }
         let mut gradients = [[z; 3]; 3];
         let mut energy = z;

@@ -32,9 +32,7 @@ use core::fmt::Write;
 use palpate_kernel::MAX_CONTACTS;
 use palpate_kernel::hybrid::HybridModel;
 use palpate_kernel::precomputed::{Constraint, ContactPoint};
-use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, InputError, Integrator, StvkForm,
-};
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, InputError, Integrator, StvkForm};
 
 use crate::parse::{StepContacts, steps};
 use crate::replay::{ReplayError, check_inputs, hex, largest, write_forces};
