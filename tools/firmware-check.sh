@@ -15,9 +15,14 @@
 #                                      (`--compress hmatrix-q16 --tolerance 3e-3`, under 1 MB),
 #                                      organ-sequence.txt (1 to 4 contacts), vs `palpate
 #                                      precomputed replay`
-#   tools/firmware-check.sh --hybrid   the hybrid (RR-3510 §6.2): hybrid-tables.sh's three
+#   tools/firmware-check.sh --hybrid [--law LAW]
+#                                      the hybrid (RR-3510 §6.2): hybrid-tables.sh's three
 #                                      tables, hybrid-sequence.txt, firmware built with
-#                                      `--features hybrid`, vs `palpate scene replay-hybrid`
+#                                      `--features hybrid`, vs `palpate scene replay-hybrid`;
+#                                      the tensor-mass region's law LAW (linear, the scene's,
+#                                      by default; stvk, corotational, neo-hookean: the
+#                                      firmware gets it in PALPATE_HYBRID_LAW, the host as
+#                                      `--law`)
 #   tools/firmware-check.sh --c        the C example (tools/firmware-c) on the C ABI
 #                                      (palpate-ffi built for thumbv7em-none-eabihf):
 #                                      sequence.txt vs `palpate precomputed replay`, its
@@ -151,11 +156,17 @@ if [[ "${1:-}" == --c ]]; then
 fi
 
 if [[ "${1:-}" == --hybrid ]]; then
+    law=linear
+    if [[ "${2:-}" == --law ]]; then
+        law="${3:?usage: tools/firmware-check.sh --hybrid --law linear|stvk|corotational|neo-hookean}"
+    fi
     mode=hybrid
+    [[ $law == linear ]] || mode="hybrid-$law"
     tables="$(tools/hybrid-tables.sh)" # host CLI (tools/palpate.sh); prints the tables' folder
     sequence="$root/tools/firmware-m4f/hybrid-sequence.txt"
-    host=(scene replay-hybrid "$tables" "$sequence")
-    build=(env PALPATE_HYBRID_TABLES="$tables" cargo build -q --release --features hybrid)
+    host=(scene replay-hybrid "$tables" "$sequence" --law "$law")
+    build=(env PALPATE_HYBRID_TABLES="$tables" PALPATE_HYBRID_LAW="$law"
+        cargo build -q --release --features hybrid)
 elif [[ "${1:-}" == --organ ]]; then
     mode=organ-hmatrix-q16
     table="$out/organ-hmatrix-q16.bin"
@@ -196,7 +207,7 @@ if ! grep -v '^#' "$firmware_txt" | diff -u "$host_txt" -; then
 fi
 steps="$(wc -l <"$host_txt")"
 refused="$(grep -c ' error ' "$host_txt" || true)"
-echo "firmware vs host ($mode): $steps steps ($refused refused), bit-identical f32 device and contact forces, largest displacement$([[ $mode == hybrid ]] && echo ', kinetic energy')"
+echo "firmware vs host ($mode): $steps steps ($refused refused), bit-identical f32 device and contact forces, largest displacement$([[ $mode == hybrid* ]] && echo ', kinetic energy')"
 
 llvm_bin="$(echo "$(rustc --print sysroot)"/lib/rustlib/*/bin)"
 "$llvm_bin/llvm-size" -A "$elf" | awk '

@@ -2,8 +2,10 @@
 //! `include_table!` links them into flash: by default the pre-computed table
 //! named by `PALPATE_TABLE` to `$OUT_DIR/table.bin`; with the `hybrid`
 //! feature the three tables in the folder named by `PALPATE_HYBRID_TABLES`
-//! (`precomputed.bin`, `dynamic.bin`, `interface.bin`). `tools/firmware-check.sh`
-//! builds them with the host CLI and sets the variable.
+//! (`precomputed.bin`, `dynamic.bin`, `interface.bin`), and passes the
+//! tensor-mass law named by `PALPATE_HYBRID_LAW` (default `linear`) to the
+//! crate. `tools/firmware-check.sh` builds the tables with the host CLI and
+//! sets the variables.
 
 use std::path::PathBuf;
 
@@ -33,6 +35,11 @@ fn main() {
             )
         };
     println!("cargo:rerun-if-env-changed={var}");
+    // The hybrid's tensor-mass law (a name of `palpate_script::hybrid::LAWS`;
+    // src/hybrid.rs refuses another one on a `#` line).
+    println!("cargo:rerun-if-env-changed=PALPATE_HYBRID_LAW");
+    let law = std::env::var("PALPATE_HYBRID_LAW").unwrap_or_else(|_| "linear".into());
+    println!("cargo:rustc-env=PALPATE_HYBRID_LAW={law}");
     if std::env::var_os("CARGO_FEATURE_HYBRID").is_none() {
         precomputed_replay(&out);
     }

@@ -56,6 +56,11 @@ pub enum SceneCommand {
         tables: PathBuf,
         /// Sequence file (palpate-script contact syntax, one line per step).
         sequence: PathBuf,
+        /// The tensor-mass region's law: linear (the firmware scene's), stvk (tet by tet),
+        /// corotational or neo-hookean; the firmware takes the same name in
+        /// PALPATE_HYBRID_LAW.
+        #[arg(long, default_value = "linear")]
+        law: String,
     },
 }
 
@@ -72,7 +77,11 @@ pub fn run(command: SceneCommand) -> anyhow::Result<()> {
             out_dir,
             precision,
         } => tables(&scene, &out_dir, precision),
-        SceneCommand::ReplayHybrid { tables, sequence } => replay_hybrid(&tables, &sequence),
+        SceneCommand::ReplayHybrid {
+            tables,
+            sequence,
+            law,
+        } => replay_hybrid(&tables, &sequence, &law),
     }
 }
 
@@ -158,8 +167,19 @@ fn tables(name: &str, out_dir: &Path, precision: Precision) -> anyhow::Result<()
 }
 
 /// `scene replay-hybrid`: the three f32 tables of `dir` and the sequence, through
-/// [`palpate_script::hybrid::replay`] on heap buffers (the firmware's are static arrays).
-fn replay_hybrid(dir: &Path, sequence: &Path) -> anyhow::Result<()> {
+/// [`palpate_script::hybrid::replay`] on heap buffers (the firmware's are static arrays), the
+/// tensor-mass region under the law named `law` ([`palpate_script::hybrid::LAWS`]).
+fn replay_hybrid(dir: &Path, sequence: &Path, law: &str) -> anyhow::Result<()> {
+    let Some(law) = palpate_script::hybrid::law_named(law) else {
+        let names: Vec<&str> = palpate_script::hybrid::LAWS
+            .iter()
+            .map(|(n, _)| *n)
+            .collect();
+        bail!(
+            "--law {law}: not a law of the hybrid replay; one of {}",
+            names.join(", ")
+        );
+    };
     let [precomputed, dynamic, interface] = TABLE_FILES.map(|f| TableFile::read(&dir.join(f)));
     let text = read_bounded(
         sequence,
@@ -174,7 +194,7 @@ fn replay_hybrid(dir: &Path, sequence: &Path) -> anyhow::Result<()> {
     let mut out = String::new();
     with_hybrid_files(
         [&precomputed?, &dynamic?, &interface?],
-        palpate_script::hybrid::params(),
+        palpate_script::hybrid::params(law),
         |model| {
             let mut displacements = vec![[0.0f32; 3]; model.interface().vertex_count()];
             palpate_script::hybrid::replay(model, &text, &mut displacements, &mut out)

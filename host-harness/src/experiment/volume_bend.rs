@@ -1,7 +1,8 @@
 //! `palpate experiment volume-bend`: Picinbono 2001 table 2. A body fixed on
 //! part of its boundary is loaded by a constant force in stages; at each
 //! stage the static equilibria of the linear, St Venant-Kirchhoff and St
-//! Venant-Kirchhoff + incompressibility models are found by dynamic
+//! Venant-Kirchhoff + incompressibility models (the paper's three), and of
+//! the co-rotational and neo-Hookean tensor-mass laws, are found by dynamic
 //! relaxation ([`super::relax`]) under the same force, and their relative
 //! volume changes compared.
 //!
@@ -16,7 +17,7 @@
 //!   found (secant iterations) that brings its [`Scene::measure`] to the
 //!   stage's target (the cylinder's top-face tilt).
 //!
-//! Either way the stage's force is then applied to all three models. Plain St Venant-Kirchhoff
+//! Either way the stage's force is then applied to all five models. Plain St Venant-Kirchhoff
 //! is not used to define stages because it collapses: under strong
 //! compression (stretch below `1/√3`) its stress softens and tets invert
 //! (Picinbono 2001 §3.2, the reason for the penalty); such an equilibrium
@@ -106,7 +107,7 @@ pub struct Equilibrium {
     pub residual_n: f64,
 }
 
-/// One stage: the force and the three equilibria.
+/// One stage: the force and the five equilibria.
 #[derive(Clone, Debug, Serialize)]
 pub struct Stage {
     /// [`Protocol::Tilt`]: target of the measure on the penalized St
@@ -121,6 +122,10 @@ pub struct Stage {
     pub stvk: Equilibrium,
     /// St Venant-Kirchhoff with the incompressibility penalty.
     pub stvk_incompressible: Equilibrium,
+    /// Co-rotational linear elasticity (not in the paper).
+    pub corotational: Equilibrium,
+    /// Compressible neo-Hookean (not in the paper).
+    pub neo_hookean: Equilibrium,
 }
 
 /// A scene's results.
@@ -241,15 +246,26 @@ pub fn inverted_tets(mesh: &TetMesh, u: &[[f64; 3]]) -> usize {
         .count()
 }
 
+/// The models of each stage, in the order of [`Stage`]'s equilibria: the
+/// law and the incompressibility penalty (`true`: the scene's γ).
+const MODELS: [(ElasticLaw, bool); 5] = [
+    (ElasticLaw::Linear, false),
+    (ElasticLaw::StVenantKirchhoff(StvkForm::PerTet), false),
+    (ElasticLaw::StVenantKirchhoff(StvkForm::PerTet), true),
+    (ElasticLaw::Corotational, false),
+    (ElasticLaw::NeoHookean, false),
+];
+
 /// Relaxations [`run_scene`] runs at most (each of at most
 /// `controls.max_steps` steps): under [`Protocol::PaperLoads`] the probe of
-/// the unit force and three models per stage; under [`Protocol::Tilt`] per
+/// the unit force and five models per stage; under [`Protocol::Tilt`] per
 /// stage the force search's two first evaluations and
-/// `controls.max_iterations` secant ones, then three models.
+/// `controls.max_iterations` secant ones, then five models.
 pub fn relaxations_bound(scene: &Scene, protocol: Protocol, controls: &Controls) -> usize {
+    let models = MODELS.len();
     match protocol {
-        Protocol::PaperLoads => 1 + 3 * scene.paper_loads.multiples.len(),
-        Protocol::Tilt => scene.targets.len() * (controls.max_iterations + 2 + 3),
+        Protocol::PaperLoads => 1 + models * scene.paper_loads.multiples.len(),
+        Protocol::Tilt => scene.targets.len() * (controls.max_iterations + 2 + models),
     }
 }
 
@@ -268,19 +284,14 @@ pub fn run_scene(
     let table = TensorMassTable::<f64>::load(file.bytes()).context("tensor-mass table")?;
     let n = scene.mesh.positions.len();
 
-    let laws = [
-        (ElasticLaw::Linear, None),
-        (ElasticLaw::StVenantKirchhoff(StvkForm::PerTet), None),
-        (
-            ElasticLaw::StVenantKirchhoff(StvkForm::PerTet),
-            Some(scene.incompressibility_n),
-        ),
-    ];
-    let mut states: Vec<OwnedState<f64>> =
-        laws.iter().map(|_| OwnedState::for_table(&table)).collect();
+    let mut states: Vec<OwnedState<f64>> = MODELS
+        .iter()
+        .map(|_| OwnedState::for_table(&table))
+        .collect();
     let mut bodies = Vec::new();
     let mut dt_s = 0.0;
-    for ((law, gamma), state) in laws.into_iter().zip(states.iter_mut()) {
+    for ((law, penalized), state) in MODELS.into_iter().zip(states.iter_mut()) {
+        let gamma = penalized.then_some(scene.incompressibility_n);
         // The linear model's equilibria at the later stages lie several body
         // sizes away (its large-rotation error is the point of the
         // experiment): only a displacement of 100 body sizes is divergence.
@@ -304,8 +315,8 @@ pub fn run_scene(
             last: vec![[0.0; 3]; n],
         });
     }
-    let [linear, stvk, incompressible] = &mut bodies[..] else {
-        bail!("three models expected");
+    let [linear, stvk, incompressible, corotational, neo_hookean] = &mut bodies[..] else {
+        bail!("five models expected");
     };
 
     let (targets, unit_force_n) = match protocol {
@@ -349,6 +360,8 @@ pub fn run_scene(
             stvk_incompressible: solve(incompressible, "stvk+incompressibility")?,
             linear: solve(linear, "linear")?,
             stvk: solve(stvk, "stvk")?,
+            corotational: solve(corotational, "corotational")?,
+            neo_hookean: solve(neo_hookean, "neo-hookean")?,
         });
     }
     Ok(SceneResult {
@@ -497,7 +510,8 @@ pub const PAPER_TABLE_2: [(&str, [&[f64]; 3]); 2] = [
     ("organ", [&[9.0], &[1.5], &[0.7]]),
 ];
 
-/// The results as a text table beside the paper's numbers.
+/// The results as a text table beside the paper's numbers (the co-rotational
+/// and neo-Hookean columns have none).
 pub fn table(results: &[SceneResult]) -> String {
     use core::fmt::Write;
     let mut out = String::new();
@@ -511,7 +525,7 @@ pub fn table(results: &[SceneResult]) -> String {
     );
     let _ = writeln!(
         out,
-        "{:<9} {:>8} {:>11} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7} | {:>9}",
+        "{:<9} {:>8} {:>11} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7} | {:>10} | {:>10} | {:>9}",
         "scene",
         "stage",
         "force N",
@@ -521,6 +535,8 @@ pub fn table(results: &[SceneResult]) -> String {
         "paper",
         "StVK+inc",
         "paper",
+        "co-rot",
+        "neo-Hooke",
         "measure"
     );
     for result in results {
@@ -549,7 +565,7 @@ pub fn table(results: &[SceneResult]) -> String {
             };
             let _ = writeln!(
                 out,
-                "{:<9} {:>8} {:>11.4e} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7} | {:>9.1}",
+                "{:<9} {:>8} {:>11.4e} | {:>10} {:>7} | {:>10} {:>7} | {:>10} {:>7} | {:>10} | {:>10} | {:>9.1}",
                 result.name,
                 stage_label,
                 stage.force_n,
@@ -559,6 +575,8 @@ pub fn table(results: &[SceneResult]) -> String {
                 p(1),
                 v(&stage.stvk_incompressible),
                 p(2),
+                v(&stage.corotational),
+                v(&stage.neo_hookean),
                 stage.stvk_incompressible.measure,
             );
         }
@@ -583,7 +601,8 @@ pub fn table(results: &[SceneResult]) -> String {
     }
     let _ = writeln!(
         out,
-        "* some tets inverted (plain St Venant-Kirchhoff collapses under strong compression); ! relaxation diverged"
+        "* some tets inverted (plain St Venant-Kirchhoff collapses under strong compression); ! relaxation diverged; \
+         co-rot, neo-Hooke: the co-rotational and neo-Hookean laws (not in the paper)"
     );
     out
 }

@@ -55,12 +55,16 @@ fn writes_three_tables_that_belong_together_in_each_precision() {
         );
         // The kernel couples them (vertex numbering, connection nodes, rest positions).
         let counts = match precision {
-            "f32" => with_hybrid_files(files.each_ref(), palpate_script::hybrid::params(), |h| {
-                (
-                    h.interface().vertex_count(),
-                    h.interface().connection_count(),
-                )
-            }),
+            "f32" => with_hybrid_files(
+                files.each_ref(),
+                palpate_script::hybrid::params(palpate_kernel::tensor_mass::ElasticLaw::Linear),
+                |h| {
+                    (
+                        h.interface().vertex_count(),
+                        h.interface().connection_count(),
+                    )
+                },
+            ),
             _ => with_hybrid_files(
                 files.each_ref(),
                 palpate_kernel::tensor_mass::DynamicParams::linear(20.0, 0.01),

@@ -1,17 +1,38 @@
 //! The rotation closest to a 3×3 matrix (the rotation factor of its polar
-//! decomposition, with the sign fixed so that it is a proper rotation), by a
-//! fixed number of Jacobi sweeps: bounded, branch-free per lane (selects
-//! only), no panic and a finite result for every finite input.
+//! decomposition, with the sign fixed so that it is a proper rotation):
+//! bounded work, branch-free per lane (selects only), no panic and a finite
+//! result for every finite input.
 //!
-//! Method (the signed SVD of Irving, Teran & Fedkiw 2004 §5, computed as
-//! McAdams et al. 2011 "Computing the singular value decomposition of 3×3
-//! matrices with minimal branching" §2–4, with exact Jacobi rotations):
-//! the eigenvectors `V` of `FᵀF` by [`JACOBI_SWEEPS`] cyclic Jacobi sweeps,
-//! sorted by decreasing eigenvalue with `det V = +1`; `U` from `F V`:
+//! Fast path (every tet of a step that is neither inverted nor extremely
+//! distorted): the scaled Newton iteration for the polar factor (Higham
+//! 1986, "Computing the polar decomposition — with applications", §3;
+//! Higham, "Functions of Matrices" §8.6), `X₀ = F`,
+//! `X_{k+1} = ½ (γ_k X_k + γ_k⁻¹ X_k⁻ᵀ)` with `X⁻ᵀ = cof X / det X` and the
+//! Frobenius scaling `γ = (|X⁻¹| / |X|)^½` on the first
+//! [`NEWTON_SCALED_STEPS`] steps, [`NEWTON_STEPS`] steps in all. Writing
+//! `F = R S` (`S` symmetric positive definite when `det F > 0`), every
+//! iterate is `R S_k` with `S_k → I` quadratically: the convergence
+//! depends on `F`'s singular values only, not on its rotation, so a fixed
+//! count serves tets rotated by any angle, cold (no previous rotation is
+//! kept). A lane is accepted when `det F > 0` (the iteration keeps the
+//! sign of `det`, so its limit is then a proper rotation) and the last
+//! step moved no entry by more than `√ε` of the scalar ([`crate::Real`]'s
+//! `MIN_PIVOT_RATIO`): quadratic convergence then leaves an error of
+//! order `ε`.
+//!
+//! Fallback (a block with any lane not accepted: an inverted or nearly
+//! degenerate tet, or a singular-value ratio beyond about 10³): the signed
+//! SVD of Irving, Teran & Fedkiw 2004 §5, computed as McAdams et al. 2011
+//! "Computing the singular value decomposition of 3×3 matrices with
+//! minimal branching" §2–4, with exact Jacobi rotations: the eigenvectors
+//! `V` of `FᵀF` by [`JACOBI_SWEEPS`] cyclic Jacobi sweeps, sorted by
+//! decreasing eigenvalue with `det V = +1`; `U` from `F V`:
 //! `u₁ = b₁/|b₁|`, `u₂` = `b₂` orthogonalized against `u₁` (twice) and
 //! normalized, `u₃ = u₁ × u₂`, so that `det U = +1`; `R = U Vᵀ`. When
 //! `det F < 0` this puts the sign on the smallest singular value: `R` is
-//! the proper rotation closest to `F`, and `RᵀF` is symmetric.
+//! the proper rotation closest to `F`, and `RᵀF` is symmetric. Both paths
+//! compute the same rotation to rounding; which one ran depends only on
+//! the block's input, the same on every target (bit-identical firmware).
 //!
 //! Lanes: [`closest_rotations`] computes `N` matrices at once, each entry
 //! a `[T; N]` array (the per-tet pass's structure-of-arrays blocks, `N` =
@@ -19,22 +40,30 @@
 //! body (selects only, no inner loop), the form the compiler turns into
 //! SIMD operations (square roots and divisions included); a per-lane loop
 //! around the whole computation does not vectorize (its body, with the
-//! sweeps, is too large to unroll first). [`closest_rotation`] is the same
-//! code with one lane.
+//! iterations, is too large to unroll first). [`closest_rotation`] is the
+//! same code with one lane.
 //!
-//! Accuracy: `R` is orthonormal with `det R = +1` to rounding by
-//! construction (a product of Givens rotations and a re-orthogonalized
-//! frame). Cyclic Jacobi on a 3×3 symmetric matrix converges
-//! quadratically: four sweeps leave off-diagonal residuals at rounding for
-//! singular-value ratios up to `1e6`, so `RᵀF` is symmetric to about
-//! `1e-12 |F|` in f64 (`1e-5 |F|` in f32); tests/kernel/polar.rs measures
-//! it on random and near-singular `F`. Degenerate inputs (`F = 0`, rank
-//! one) give a rotation among the equally close ones.
+//! Accuracy: `R` is orthonormal with `det R = +1` to rounding (Newton:
+//! accepted only once converged; Jacobi: by construction, a product of
+//! Givens rotations and a re-orthogonalized frame). Cyclic Jacobi on a 3×3
+//! symmetric matrix converges quadratically: four sweeps leave
+//! off-diagonal residuals at rounding for singular-value ratios up to
+//! `1e6`, so `RᵀF` is symmetric to about `1e-12 |F|` in f64 (`1e-5 |F|` in
+//! f32); tests/kernel/polar.rs measures it on random and near-singular `F`.
+//! Degenerate inputs (`F = 0`, rank one) give a rotation among the equally
+//! close ones.
 
 use crate::Real;
 
-/// Cyclic Jacobi sweeps (three rotations each) on `FᵀF`.
+/// Cyclic Jacobi sweeps (three rotations each) on `FᵀF` (the fallback).
 pub const JACOBI_SWEEPS: usize = 4;
+
+/// Newton steps of the fast path, in all.
+pub const NEWTON_STEPS: usize = 4;
+
+/// Of [`NEWTON_STEPS`], the first ones with the Frobenius scaling (the
+/// later ones start close to the rotation, where `γ ≈ 1`).
+pub const NEWTON_SCALED_STEPS: usize = 2;
 
 /// A 3×3 matrix by rows.
 pub type Mat3<T> = [[T; 3]; 3];
@@ -47,8 +76,8 @@ const TINY2: f64 = 1e-30;
 /// pair are treated as zero by the Jacobi rotation ([`rotate`]).
 const FLUSH: f64 = 1e-18;
 
-/// The proper rotation closest to `f` (rows), `R = U Vᵀ` of the signed SVD
-/// (see the module documentation): [`closest_rotations`] with one lane.
+/// The proper rotation closest to `f` (rows) (see the module
+/// documentation): [`closest_rotations`] with one lane.
 #[inline(always)]
 pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
     let one_lane = f.map(|row| row.map(|x| [x]));
@@ -56,15 +85,132 @@ pub fn closest_rotation<T: Real>(f: &Mat3<T>) -> Mat3<T> {
 }
 
 /// Per lane, the proper rotation closest to `f` (rows; entry `f[i][j][l]`
-/// of lane `l`), `R = U Vᵀ` of the signed SVD (see the module
+/// of lane `l`): the Newton iteration when it converges on every lane,
+/// else the signed SVD for the whole block (see the module
 /// documentation). Always inlined, so that its lane loops see the
 /// caller's fixed `N`.
+#[inline(always)]
+pub fn closest_rotations<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
+    let (r, accepted) = newton_rotations(f);
+    if accepted.iter().all(|&a| a) {
+        r
+    } else {
+        svd_rotations(f)
+    }
+}
+
+/// Per lane, [`NEWTON_STEPS`] Newton steps from `f` (see the module
+/// documentation), and whether the lane is accepted: `det f > 0` and the
+/// last step moved no entry by more than `MIN_PIVOT_RATIO` (`√ε`). A
+/// non-finite iterate is not accepted (its comparisons are false).
+#[expect(
+    clippy::indexing_slicing,
+    reason = "i, j are literals < 3 at every call of the closures"
+)]
+#[inline(always)]
+fn newton_rotations<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> (Mat3<[T; N]>, [bool; N]) {
+    let zero = T::zero();
+    let mut x = *f;
+    let mut accepted = [false; N];
+    for (l, ok) in accepted.iter_mut().enumerate() {
+        *ok = determinant(&lane(f, l)) > zero;
+    }
+    for step in 0..NEWTON_STEPS - 1 {
+        let scaled = step < NEWTON_SCALED_STEPS;
+        for l in 0..N {
+            let next = newton_step(&lane(&x, l), scaled);
+            set_lane(&mut x, l, &next);
+        }
+    }
+    for (l, ok) in accepted.iter_mut().enumerate() {
+        let xl = lane(&x, l);
+        let next = newton_step(&xl, NEWTON_STEPS <= NEWTON_SCALED_STEPS);
+        let moved = [0, 1, 2].map(|i| {
+            let d = |j: usize| (next[i][j] - xl[i][j]).abs();
+            d(0).larger(d(1)).larger(d(2))
+        });
+        let moved = moved[0].larger(moved[1]).larger(moved[2]);
+        *ok = *ok && moved <= T::MIN_PIVOT_RATIO;
+        set_lane(&mut x, l, &next);
+    }
+    (x, accepted)
+}
+
+/// One Newton step `½ (γ X + γ⁻¹ X⁻ᵀ)`, `X⁻ᵀ = cof X / det X`, with the
+/// Frobenius scaling `γ = (|X⁻¹| / |X|)^½ = (|cof X| / (|det X| |X|))^½`
+/// when `scaled`, else `γ = 1`.
+#[expect(
+    clippy::indexing_slicing,
+    reason = "i is a literal < 3 at every call of the closure"
+)]
+#[inline(always)]
+fn newton_step<T: Real>(x: &Mat3<T>, scaled: bool) -> Mat3<T> {
+    let half = T::of_f64(0.5);
+    let c = cofactor(x);
+    let inverse_det = T::one() / (x[0][0] * c[0][0] + x[0][1] * c[0][1] + x[0][2] * c[0][2]);
+    let (a, b) = if scaled {
+        let gamma2 = (frobenius2(&c) / frobenius2(x)).sqrt() * inverse_det.abs();
+        let gamma = gamma2.sqrt();
+        (half * gamma, half * inverse_det * gamma / gamma2)
+    } else {
+        (half, half * inverse_det)
+    };
+    let row = |i: usize| {
+        [
+            a * x[i][0] + b * c[i][0],
+            a * x[i][1] + b * c[i][1],
+            a * x[i][2] + b * c[i][2],
+        ]
+    };
+    [row(0), row(1), row(2)]
+}
+
+/// `det m`.
+#[inline(always)]
+fn determinant<T: Real>(m: &Mat3<T>) -> T {
+    let c = cofactor(m);
+    m[0][0] * c[0][0] + m[0][1] * c[0][1] + m[0][2] * c[0][2]
+}
+
+/// `|m|²`, the sum of the squared entries.
+#[inline(always)]
+fn frobenius2<T: Real>(m: &Mat3<T>) -> T {
+    dot(&m[0], &m[0]) + dot(&m[1], &m[1]) + dot(&m[2], &m[2])
+}
+
+/// The cofactor matrix `cof F = det F · F⁻ᵀ` of a 3×3 `F` (row-major),
+/// written entry by entry so that the lane loops calling it stay
+/// vectorizable; `det F = Σ_b F_0b cof_0b`.
+#[inline(always)]
+pub(crate) fn cofactor<T: Real>(f: &Mat3<T>) -> Mat3<T> {
+    let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = *f;
+    [
+        [
+            f11 * f22 - f12 * f21,
+            f12 * f20 - f10 * f22,
+            f10 * f21 - f11 * f20,
+        ],
+        [
+            f02 * f21 - f01 * f22,
+            f00 * f22 - f02 * f20,
+            f01 * f20 - f00 * f21,
+        ],
+        [
+            f01 * f12 - f02 * f11,
+            f02 * f10 - f00 * f12,
+            f00 * f11 - f01 * f10,
+        ],
+    ]
+}
+
+/// Per lane, the proper rotation closest to `f`, `R = U Vᵀ` of the signed
+/// SVD (the fallback; see the module documentation).
 #[expect(
     clippy::indexing_slicing,
     reason = "literal indices < 3 and loop counters < N over fixed-size arrays; tools/nopanic-check proves no panic is left"
 )]
 #[inline(always)]
-pub fn closest_rotations<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
+fn svd_rotations<T: Real, const N: usize>(f: &Mat3<[T; N]>) -> Mat3<[T; N]> {
     let v = right_vectors(f);
     let mut r = [[[T::zero(); N]; 3]; 3];
     for l in 0..N {

@@ -39,6 +39,12 @@ pub trait Real:
     /// Truncates towards zero to `u32`, saturating (NaN gives 0), in the
     /// scalar itself.
     fn trunc_u32(self) -> u32;
+    /// The natural logarithm by the `libm` crate's software `logf` / `log`
+    /// on every target, so that the host and the firmware compute the same
+    /// bits (`ln` is the platform C library's on a host with `std`): the
+    /// neo-Hookean law's `ln J`. Accurate to about one unit in the last
+    /// place.
+    fn portable_ln(self) -> Self;
     /// The larger of `self` and `other` by `>` (`other` when either is
     /// NaN): one compare, where `max` is a `fmaxf` call on a target
     /// without a maximum instruction (FPv4-SP).
@@ -97,6 +103,9 @@ impl Real for f32 {
     fn of_u32(x: u32) -> Self {
         x as f32
     }
+    fn portable_ln(self) -> Self {
+        libm::logf(self)
+    }
     same_in_both!();
 }
 
@@ -116,6 +125,9 @@ impl Real for f64 {
     }
     fn of_u32(x: u32) -> Self {
         f64::from(x)
+    }
+    fn portable_ln(self) -> Self {
+        libm::log(self)
     }
     same_in_both!();
 }

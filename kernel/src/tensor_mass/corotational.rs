@@ -4,7 +4,7 @@
 //! of the per-tet pass ([`super::stvk`]).
 //!
 //! With `R` the proper rotation closest to the deformation gradient `F`
-//! ([`closest_rotation`]), the element force
+//! ([`closest_rotations`]), the element force
 //! `f_e = −R K_e (Rᵀ x_e − X_e)` with `K_e` the linear tet stiffness
 //! (MODELS.md §1, [`crate::math::element::stiffness_block`]) is, corner by
 //! corner, `f_j = −V R σ a_j` with the linear stress `σ = λ tr(ε) I + 2μ ε`
@@ -16,9 +16,15 @@
 //! energy `ψ = μ |F − R|² + λ/2 (tr(RᵀF) − 3)²` (McAdams et al. 2011,
 //! "Efficient elasticity for character skinning with contact and
 //! collisions", §4): the force is the gradient of `V ψ`, which this pass
-//! also returns. Zero for any rigid motion; the linear force for a pure
-//! strain (`F` symmetric positive definite, `R = I`); rotating the
-//! deformed state rotates the forces.
+//! also returns, and the pass evaluates it in that form (no product
+//! `RᵀF`, no second product by `R`). Zero for any rigid motion; the linear
+//! force for a pure strain (`F` symmetric positive definite, `R = I`);
+//! rotating the deformed state rotates the forces.
+//!
+//! Cost: the rotation ([`closest_rotations`]: a few Newton steps, cold,
+//! for all lanes at once) and two branch-free lane loops (`F`, then the
+//! stress, the gradients and the energy), vectorized as the St Venant-
+//! Kirchhoff pass.
 
 use super::stvk::{Block, LANES, Lanes, TetTerms};
 use crate::Real;
@@ -39,7 +45,8 @@ impl<T: Real> Block<'_, T> {
         let z = [T::zero(); LANES];
         let mut gradients = [[z; 3]; 3];
         let mut energy = z;
-        let (one, half) = (T::one(), T::of_f64(0.5));
+        let half = T::of_f64(0.5);
+        let three = T::of_f64(3.0);
         let rest = self.rest;
         let (volume, lambda, mu) = (
             &rest[tet_lane_row::VOLUME],
@@ -60,50 +67,43 @@ impl<T: Real> Block<'_, T> {
         let r_lanes = closest_rotations(&f_lanes);
         for l in 0..LANES {
             let (lambda, mu, v) = (lambda[l], mu[l], volume[l]);
-            let f = self.deformation(l);
-            let r = [0, 1, 2].map(|i| [0, 1, 2].map(|j| r_lanes[i][j][l]));
-            // G = RᵀF; ε = sym(G) − I.
-            let g: [[T; 3]; 3] = core::array::from_fn(|i| {
-                core::array::from_fn(|k| r[0][i] * f[0][k] + r[1][i] * f[1][k] + r[2][i] * f[2][k])
-            });
-            let e00 = g[0][0] - one;
-            let e11 = g[1][1] - one;
-            let e22 = g[2][2] - one;
-            let e01 = (g[0][1] + g[1][0]) * half;
-            let e02 = (g[0][2] + g[2][0]) * half;
-            let e12 = (g[1][2] + g[2][1]) * half;
-            let trace = e00 + e11 + e22;
-            let two_mu = mu + mu;
-            // V σ, symmetric.
-            let diagonal = lambda * trace;
-            let sigma = [
-                [
-                    (diagonal + two_mu * e00) * v,
-                    two_mu * e01 * v,
-                    two_mu * e02 * v,
-                ],
-                [
-                    two_mu * e01 * v,
-                    (diagonal + two_mu * e11) * v,
-                    two_mu * e12 * v,
-                ],
-                [
-                    two_mu * e02 * v,
-                    two_mu * e12 * v,
-                    (diagonal + two_mu * e22) * v,
-                ],
+            let f = |i: usize, j: usize| f_lanes[i][j][l];
+            let r = |i: usize, j: usize| r_lanes[i][j][l];
+            // tr(RᵀF) − 3 = tr ε, and F − R.
+            let trace = r(0, 0) * f(0, 0)
+                + r(0, 1) * f(0, 1)
+                + r(0, 2) * f(0, 2)
+                + r(1, 0) * f(1, 0)
+                + r(1, 1) * f(1, 1)
+                + r(1, 2) * f(1, 2)
+                + r(2, 0) * f(2, 0)
+                + r(2, 1) * f(2, 1)
+                + r(2, 2) * f(2, 2)
+                - three;
+            let d = |i: usize, j: usize| f(i, j) - r(i, j);
+            let d = [
+                [d(0, 0), d(0, 1), d(0, 2)],
+                [d(1, 0), d(1, 1), d(1, 2)],
+                [d(2, 0), d(2, 1), d(2, 2)],
             ];
-            // V P = R (V σ).
-            let vp: [[T; 3]; 3] = core::array::from_fn(|i| {
-                core::array::from_fn(|k| {
-                    r[i][0] * sigma[0][k] + r[i][1] * sigma[1][k] + r[i][2] * sigma[2][k]
-                })
-            });
+            // V P = V (2μ (F − R) + λ tr ε R).
+            let (two_mu_v, lambda_trace_v) = ((mu + mu) * v, lambda * trace * v);
+            let p = |i: usize, j: usize| two_mu_v * d[i][j] + lambda_trace_v * r(i, j);
+            let vp = [
+                [p(0, 0), p(0, 1), p(0, 2)],
+                [p(1, 0), p(1, 1), p(1, 2)],
+                [p(2, 0), p(2, 1), p(2, 2)],
+            ];
             self.store_gradients(l, &vp, &mut gradients);
-            let squares = e00 * e00
-                + e11 * e11
-                + e22 * e22
-                + (e01 * e01 + e02 * e02 + e12 * e12) * (one + one);
+            let squares = d[0][0] * d[0][0]
+                + d[0][1] * d[0][1]
+                + d[0][2] * d[0][2]
+                + d[1][0] * d[1][0]
+                + d[1][1] * d[1][1]
+                + d[1][2] * d[1][2]
+                + d[2][0] * d[2][0]
+                + d[2][1] * d[2][1]
+                + d[2][2] * d[2][2];
             energy[l] = v * (lambda * half * trace * trace + mu * squares);
         }
         (gradients, energy)

@@ -22,8 +22,9 @@
 //! term always pushes the tet back towards positive volume, with a
 //! stiffness `V g''(J₀)` that grows linearly in how far it is inverted.
 
-use super::stvk::{Block, LANES, TetTerms, cofactor};
+use super::stvk::{Block, LANES, TetTerms};
 use crate::Real;
+use crate::math::polar::cofactor;
 use crate::table::format::tet_lane_row;
 
 /// The volume ratio `J₀` below which the neo-Hookean volume energy is its
@@ -47,23 +48,24 @@ impl<T: Real> Block<'_, T> {
     /// each lane with its tet's `λ`, `μ`. A lane without a live tet has
     /// `F = I`: zero gradients and energy.
     ///
-    /// Three lane loops: `J` (vectorized), `ln max(J, J₀)` (a `ln` call per
-    /// lane), then the stress (vectorized).
+    /// Three lane loops: `J` (vectorized), `ln max(J, J₀)` (a
+    /// [`Real::portable_ln`] call per lane: the same bits on every target), then the stress (vectorized, one division per lane: `g'` and
+    /// `g''` share `1/max(J, J₀)`, and `J` is not computed twice).
     #[inline(always)]
     pub(super) fn neo_hookean(&self) -> TetTerms<T> {
         let z = [T::zero(); LANES];
         let floor = T::of_f64(NEO_HOOKEAN_J_FLOOR);
-        let mut clamped = z;
-        for (l, j) in clamped.iter_mut().enumerate() {
+        let (mut dets, mut clamped) = (z, z);
+        for (l, (det, j)) in dets.iter_mut().zip(&mut clamped).enumerate() {
             let [f0, f1, f2] = self.deformation(l);
-            let det = f0[0] * (f1[1] * f2[2] - f1[2] * f2[1])
+            *det = f0[0] * (f1[1] * f2[2] - f1[2] * f2[1])
                 + f0[1] * (f1[2] * f2[0] - f1[0] * f2[2])
                 + f0[2] * (f1[0] * f2[1] - f1[1] * f2[0]);
             *j = det.larger(floor);
         }
         let mut logs = z;
         for (log, &j) in logs.iter_mut().zip(&clamped) {
-            *log = j.ln();
+            *log = j.portable_ln();
         }
         let mut gradients = [[z; 3]; 3];
         let mut energy = z;
@@ -76,20 +78,26 @@ impl<T: Real> Block<'_, T> {
         );
         for l in 0..LANES {
             let (lambda, mu, v, jc, log) = (lambda[l], mu[l], volume[l], clamped[l], logs[l]);
-            let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = self.deformation(l);
-            let cof = cofactor(&[[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]]);
-            let j = f00 * cof[0][0] + f01 * cof[0][1] + f02 * cof[0][2];
+            let f = self.deformation(l);
+            let cof = cofactor(&f);
             // d = J − J₀ below the floor, 0 above it (then J = jc exactly).
-            let d = j - jc;
-            let g1 = (lambda * log - mu) / jc;
-            let g2 = (lambda * (one - log) + mu) / (jc * jc);
-            let g = -mu * log + lambda * half * log * log + (g1 + half * g2 * d) * d;
+            let d = dets[l] - jc;
+            let inverse = one / jc;
+            let g1 = (lambda * log - mu) * inverse;
+            let g2 = (lambda * (one - log) + mu) * inverse * inverse;
+            let g = (lambda * half * log - mu) * log + (g1 + half * g2 * d) * d;
             let slope = g1 + g2 * d;
-            let f = [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]];
-            let vp: [[T; 3]; 3] = core::array::from_fn(|r| {
-                core::array::from_fn(|c| (mu * f[r][c] + slope * cof[r][c]) * v)
-            });
-            self.store_gradients(l, &vp, &mut gradients);
+            // V P = V (μ F + g'(J) cof F).
+            let (mu_v, slope_v) = (mu * v, slope * v);
+            let p = |r: usize| {
+                [
+                    mu_v * f[r][0] + slope_v * cof[r][0],
+                    mu_v * f[r][1] + slope_v * cof[r][1],
+                    mu_v * f[r][2] + slope_v * cof[r][2],
+                ]
+            };
+            self.store_gradients(l, &[p(0), p(1), p(2)], &mut gradients);
+            let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = f;
             let i1 = f00 * f00
                 + f01 * f01
                 + f02 * f02

@@ -12,6 +12,7 @@
 //! `tet-material` section: heterogeneous tissue).
 
 use crate::Real;
+use crate::math::polar::cofactor;
 use crate::table::TensorMassTable;
 use crate::table::TetLanes;
 use crate::table::format::{TET_LANES, tet_lane_row};
@@ -354,29 +355,4 @@ impl<T: Real> TetPass<'_, '_, T> {
         });
         energy
     }
-}
-
-/// The cofactor matrix `cof F = J F⁻ᵀ` of a 3×3 `F` (row-major), written
-/// entry by entry so that the lane loops calling it stay vectorizable;
-/// `J = Σ_b F_0b cof_0b`.
-#[inline(always)]
-pub(super) fn cofactor<T: Real>(f: &[[T; 3]; 3]) -> [[T; 3]; 3] {
-    let [[f00, f01, f02], [f10, f11, f12], [f20, f21, f22]] = *f;
-    [
-        [
-            f11 * f22 - f12 * f21,
-            f12 * f20 - f10 * f22,
-            f10 * f21 - f11 * f20,
-        ],
-        [
-            f02 * f21 - f01 * f22,
-            f00 * f22 - f02 * f20,
-            f01 * f20 - f00 * f21,
-        ],
-        [
-            f01 * f12 - f02 * f11,
-            f02 * f10 - f00 * f12,
-            f00 * f11 - f01 * f10,
-        ],
-    ]
 }

@@ -9,9 +9,10 @@
 //!
 //! Memory: the tables and the sequence are read in place from flash; the
 //! static RAM (`.bss`) is [`State`]: the tensor-mass region's state (no RK4
-//! scratch, no split St Venant-Kirchhoff terms: the run is linear,
-//! symplectic Euler), the coupling buffers and the displacement of every
-//! mesh vertex. Each buffer is an array of a fixed capacity sliced to the
+//! scratch, no split St Venant-Kirchhoff terms: the run is symplectic Euler
+//! with the linear law, or with a per-tet law chosen at build time,
+//! [`LAW`]), the coupling buffers and the displacement of every mesh
+//! vertex. Each buffer is an array of a fixed capacity sliced to the
 //! tables' count; a table that needs more than a capacity is refused by the
 //! kernel on a `#` line naming the buffer.
 
@@ -33,6 +34,9 @@ static PRECOMPUTED: &[u8] = include_table!(concat!(env!("OUT_DIR"), "/precompute
 static DYNAMIC: &[u8] = include_table!(concat!(env!("OUT_DIR"), "/dynamic.bin"));
 /// The interface table.
 static INTERFACE: &[u8] = include_table!(concat!(env!("OUT_DIR"), "/interface.bin"));
+/// The tensor-mass region's law, a name of `palpate_script::hybrid::LAWS`
+/// (`PALPATE_HYBRID_LAW` at build time, default `linear`; `build.rs`).
+const LAW: &str = env!("PALPATE_HYBRID_LAW");
 /// The scripted sequence (syntax: `palpate_script::hybrid`), in flash.
 static SEQUENCE: &str = include_str!("../hybrid-sequence.txt");
 
@@ -147,7 +151,11 @@ pub fn run() -> Result<(), ()> {
             tet: &mut [],
         },
     };
-    let model = match TensorMassModel::new(dynamic, buffers, palpate_script::hybrid::params()) {
+    let Some(law) = palpate_script::hybrid::law_named(LAW) else {
+        refused("PALPATE_HYBRID_LAW", &LAW);
+        return Err(());
+    };
+    let model = match TensorMassModel::new(dynamic, buffers, palpate_script::hybrid::params(law)) {
         Ok(model) => model,
         Err(e) => {
             refused("tensor-mass region", &e);

@@ -32,7 +32,7 @@ use core::fmt::Write;
 use palpate_kernel::MAX_CONTACTS;
 use palpate_kernel::hybrid::HybridModel;
 use palpate_kernel::precomputed::{Constraint, ContactPoint};
-use palpate_kernel::tensor_mass::{DynamicParams, InputError, Integrator};
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, InputError, Integrator, StvkForm};
 
 use crate::parse::{StepContacts, steps};
 use crate::replay::{ReplayError, check_inputs, hex, largest, write_forces};
@@ -47,14 +47,32 @@ pub const DT_S: f32 = 5e-4;
 /// Physics steps per sequence line.
 pub const STEPS_PER_LINE: u32 = 4;
 
-/// The tensor-mass region's parameters: linear law, mass-proportional
-/// damping 20 /s (the scene's `[model] damping_per_s`), divergence bound
-/// 0.01 m (a third of the box).
-pub fn params() -> DynamicParams<f32> {
-    DynamicParams::linear(20.0, 0.01)
+/// The tensor-mass region's laws the replay can run, by the name `palpate
+/// scene replay-hybrid --law` and `tools/firmware-check.sh --hybrid --law`
+/// take (the scene's `[model] law` names): linear (the scene's), St
+/// Venant-Kirchhoff tet by tet, co-rotational, neo-Hookean. None needs a
+/// buffer beyond the linear law's (no split St Venant-Kirchhoff terms).
+pub const LAWS: [(&str, ElasticLaw); 4] = [
+    ("linear", ElasticLaw::Linear),
+    ("stvk", ElasticLaw::StVenantKirchhoff(StvkForm::PerTet)),
+    ("corotational", ElasticLaw::Corotational),
+    ("neo-hookean", ElasticLaw::NeoHookean),
+];
+
+/// The law of [`LAWS`] named `name`, `None` for another name.
+pub fn law_named(name: &str) -> Option<ElasticLaw> {
+    LAWS.iter().find(|(n, _)| *n == name).map(|&(_, law)| law)
 }
 
-/// Runs every line of `sequence` on `model` (f32, built with [`params`]) and
+/// The tensor-mass region's parameters: elastic `law` (the scene's is
+/// linear), mass-proportional damping 20 /s (the scene's `[model]
+/// damping_per_s`), divergence bound 0.01 m (a third of the box).
+pub fn params(law: ElasticLaw) -> DynamicParams<f32> {
+    DynamicParams::linear(20.0, 0.01).with_law(law)
+}
+
+/// Runs every line of `sequence` on `model` (f32, built with [`params`] of a
+/// law of [`LAWS`]) and
 /// writes one line per step to `out`; `displacements` holds one entry per
 /// mesh vertex. The whole sequence is parsed before anything is written.
 pub fn replay<W: Write>(
