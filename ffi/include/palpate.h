@@ -79,7 +79,7 @@
  `palpate_abi_version()` with it at start-up to catch a header and a
  library of different versions.
  */
-#define PALPATE_ABI_VERSION 4
+#define PALPATE_ABI_VERSION 5
 
 /*
  The table format version this library reads (`palpate tables build`
