@@ -79,7 +79,7 @@
  `palpate_abi_version()` with it at start-up to catch a header and a
  library of different versions.
  */
-#define PALPATE_ABI_VERSION 4
+#define PALPATE_ABI_VERSION 5
 
 /*
  The table format version this library reads (`palpate tables build`
@@ -148,28 +148,28 @@
 /*
  Words of a `palpate_dynamic_loop` on 64-bit targets (the host).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 456
+#define PALPATE_DYNAMIC_LOOP_WORDS 462
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 369
+#define PALPATE_DYNAMIC_LOOP_WORDS 373
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 629
+#define PALPATE_HYBRID_LOOP_WORDS 635
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 504
+#define PALPATE_HYBRID_LOOP_WORDS 508
 #endif
 
 /*

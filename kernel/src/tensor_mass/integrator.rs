@@ -4,6 +4,7 @@
 use nalgebra::Vector3;
 
 use super::force::{InternalForces, vec3};
+use super::split::SplitBuffers;
 use super::state::VertexMode;
 use crate::Real;
 use crate::math::Dispatch;
@@ -76,12 +77,13 @@ impl<T: Real> Loads<'_, T> {
         &self,
         dispatch: impl Dispatch,
         forces: &InternalForces<'_, '_, T>,
+        split: Option<&mut SplitBuffers<'_, T>>,
         damping_per_s: T,
         u: &[[T; 3]],
         v: &[[T; 3]],
         a: &mut [[T; 3]],
     ) {
-        forces.forces(dispatch, u, a);
+        forces.forces(dispatch, split, u, a);
         dispatch.run(
             #[inline(always)]
             || {
