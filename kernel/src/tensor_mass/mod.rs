@@ -28,6 +28,7 @@ mod limits;
 mod model;
 mod neo_hookean;
 mod split;
+mod split_model;
 mod state;
 mod stvk;
 pub mod stvk_terms;

@@ -13,7 +13,7 @@
 //!    `V P a_j` (N, `j = 1..3`) into [`SplitBuffers::gradients`];
 //! 2. vertices `v₀..v₁` per part: each vertex gathers its corners' forces
 //!    from the list [`SplitBuffers::corners`] (its tets in index order,
-//!    built once by [`super::TensorMassModel::with_split`]), subtracting
+//!    built once by `TensorMassModel::with_split`), subtracting
 //!    them in that order from zero: the same operations in the same order
 //!    as the scatter, so the same bits.
 //!
@@ -31,7 +31,7 @@ use crate::table::TensorMassTable;
 use crate::table::span;
 
 /// Caller-provided storage of the split per-tet pass (module docs), for
-/// [`super::TensorMassModel::with_split`]: `N` vertices, `M` tets, `B`
+/// `TensorMassModel::with_split`: `N` vertices, `M` tets, `B`
 /// blocks of [`crate::table::format::TET_LANES`] tets.
 pub struct SplitBuffers<'s, T> {
     /// `N + 1`: where each vertex's entries of [`Self::corners`] start, and
@@ -202,18 +202,5 @@ fn corner_force<T: Real>(gradients: &[[T; 3]], t: usize, c: usize) -> [T; 3] {
             ]
         }
         c => g(c - 1),
-    }
-}
-
-impl<'a, 's, T: Real> super::TensorMassModel<'a, 's, T> {
-    /// The same model with its per-tet force pass split into
-    /// `dispatch.parts()` parts whenever a step's [`Dispatch`] has more than
-    /// one (module docs; same results for any number of parts), on
-    /// `buffers` ([`SplitBuffers::lengths`]). Fails on a buffer of the wrong
-    /// length. Cost: two passes over the tets (the corner lists).
-    pub fn with_split(mut self, mut buffers: SplitBuffers<'s, T>) -> Result<Self, StateError> {
-        buffers.prepare(&self.table)?;
-        self.split = Some(buffers);
-        Ok(self)
     }
 }
