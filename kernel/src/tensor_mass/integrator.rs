@@ -73,6 +73,10 @@ impl<T: Real> Loads<'_, T> {
     /// mass (MODELS.md §3 with `γ_i = c m_i`, `c = damping_per_s`), zero for
     /// fixed, imposed and massless vertices (a vertex left without tets by a
     /// cut keeps still).
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the state (u, v), its output, the damping and the force pass with its split scratch"
+    )]
     pub(crate) fn accelerations(
         &self,
         dispatch: impl Dispatch,

@@ -6,11 +6,10 @@ use super::model::TensorMassModel;
 use super::split::SplitBuffers;
 use super::state::StateError;
 use crate::Real;
-use crate::math::Dispatch;
 
 impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// The same model with its per-tet force pass split into
-    /// `dispatch.parts()` parts whenever a step's [`Dispatch`] has more than
+    /// `dispatch.parts()` parts whenever a step's [`crate::math::Dispatch`] has more than
     /// one (the corner gradients by blocks of tets, then each vertex gathering
     /// its corners in tet order: the same results for any number of parts), on
     /// `buffers` ([`SplitBuffers::lengths`]). Fails on a buffer of the wrong
