@@ -27,7 +27,7 @@ pub const MAX_THREADS: usize = 4;
 /// capped at [`MAX_THREADS`] (1 when unknown).
 pub fn default_threads() -> usize {
     std::thread::available_parallelism()
-        .map_or(1, std::num::NonZeroUsize::get)
+        .map_or(1, core::num::NonZeroUsize::get)
         .min(MAX_THREADS)
 }
 
@@ -110,9 +110,9 @@ impl<T: Real> OwnedSplit<T> {
     }
 }
 
-/// `model` with its per-tet pass split on `split`'s buffers when `threads
-/// > 1`, unchanged otherwise (one thread runs the pass in one piece, as a
-/// model without split buffers always does).
+/// `model` with its per-tet pass split on `split`'s buffers when more
+/// than one thread runs it, unchanged otherwise (one thread runs the pass
+/// in one piece, as a model without split buffers always does).
 pub fn split_model<'a, 's, T: Real>(
     model: TensorMassModel<'a, 's, T>,
     split: &'s mut Option<OwnedSplit<T>>,
