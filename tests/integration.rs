@@ -52,6 +52,7 @@ mod host {
     mod table_compress;
     mod table_hmatrix;
     mod table_info;
+    mod threads;
 }
 
 mod kernel {

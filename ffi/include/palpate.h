@@ -148,28 +148,28 @@
 /*
  Words of a `palpate_dynamic_loop` on 64-bit targets (the host).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 467
+#define PALPATE_DYNAMIC_LOOP_WORDS 473
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 374
+#define PALPATE_DYNAMIC_LOOP_WORDS 377
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 655
+#define PALPATE_HYBRID_LOOP_WORDS 661
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 511
+#define PALPATE_HYBRID_LOOP_WORDS 514
 #endif
 
 /*

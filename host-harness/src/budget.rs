@@ -330,7 +330,9 @@ fn probe_with<const P: usize>(
             })
         }
         SceneTables::Hybrid(files, spec) => HybridSetup::of(scene, spec, files)?
-            .with_loop::<P, _>(|haptic| probe_ticks(haptic, scene, trajectory, physics_update)),
+            .with_loop::<P, _, _>(Portable, |haptic| {
+                probe_ticks(haptic, scene, trajectory, physics_update)
+            }),
     }
 }
 

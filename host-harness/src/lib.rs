@@ -28,3 +28,4 @@ pub mod scene;
 pub mod session;
 pub mod table;
 pub mod tensor_mass;
+pub mod threads;

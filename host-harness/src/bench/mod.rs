@@ -10,8 +10,11 @@
 //! in one process. [`tensor_mass::TensorMassBench::time_step`] (or
 //! [`tensor_mass::time_step_on_mesh`]) times one configuration on a mesh
 //! and returns its median and spread ([`measure::Timing`]).
+//! [`scene`] times a scene's own model stage by stage against its real-time
+//! periods (`palpate bench --scene`).
 
 pub mod measure;
 pub mod precomputed;
 pub mod run;
+pub mod scene;
 pub mod tensor_mass;

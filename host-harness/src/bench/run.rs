@@ -336,20 +336,7 @@ fn precision_name(precision: Precision) -> &'static str {
 /// estimate.
 pub fn check(mesh: &TetMesh, options: &BenchOptions) -> anyhow::Result<RunEstimate> {
     let s = &options.sampling;
-    if s.samples == 0 || s.samples.saturating_add(s.warmup) > MAX_BENCH_SAMPLES {
-        bail!(
-            "--samples must be at least 1 and --samples + --warmup at most {MAX_BENCH_SAMPLES} (MAX_BENCH_SAMPLES), got {} + {}",
-            s.samples,
-            s.warmup
-        );
-    }
-    if !(s.sample_s > 0.0 && s.sample_s <= MAX_BENCH_SAMPLE_S) {
-        bail!(
-            "--sample-ms must be > 0 and at most {} ms (MAX_BENCH_SAMPLE_S), got {}",
-            MAX_BENCH_SAMPLE_S * 1e3,
-            shown(s.sample_s * 1e3)
-        );
-    }
+    check_sampling(s)?;
     let items = plan(options, 0.0);
     if items.is_empty() {
         bail!(
@@ -366,6 +353,26 @@ pub fn check(mesh: &TetMesh, options: &BenchOptions) -> anyhow::Result<RunEstima
         );
     }
     Ok(estimate)
+}
+
+/// Refuses `--samples` 0, `--samples` + `--warmup` above
+/// [`MAX_BENCH_SAMPLES`] and a `--sample-ms` not in (0, [`MAX_BENCH_SAMPLE_S`]].
+pub fn check_sampling(s: &Sampling) -> anyhow::Result<()> {
+    if s.samples == 0 || s.samples.saturating_add(s.warmup) > MAX_BENCH_SAMPLES {
+        bail!(
+            "--samples must be at least 1 and --samples + --warmup at most {MAX_BENCH_SAMPLES} (MAX_BENCH_SAMPLES), got {} + {}",
+            s.samples,
+            s.warmup
+        );
+    }
+    if !(s.sample_s > 0.0 && s.sample_s <= MAX_BENCH_SAMPLE_S) {
+        bail!(
+            "--sample-ms must be > 0 and at most {} ms (MAX_BENCH_SAMPLE_S), got {}",
+            MAX_BENCH_SAMPLE_S * 1e3,
+            shown(s.sample_s * 1e3)
+        );
+    }
+    Ok(())
 }
 
 /// Runs the measurements of `options` on `mesh` (named `name`), after

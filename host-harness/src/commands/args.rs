@@ -51,6 +51,25 @@ pub fn parse_fix(s: &str) -> Result<FixPredicate, String> {
     s.parse()
 }
 
+/// `--threads` of a command that steps a tensor-mass model.
+#[derive(clap::Args, Clone, Copy)]
+pub struct ThreadsArgs {
+    /// Threads of the per-tet force pass (St Venant-Kirchhoff per tet,
+    /// co-rotational, neo-Hookean; 1 to 8): the results are the same bits for
+    /// any count, 1 runs the pass in one piece. Default 1 (threads started
+    /// per pass cost more than they save; docs/bench.md).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
+    pub threads: Option<u8>,
+}
+
+impl ThreadsArgs {
+    /// The thread count: `--threads`, or [`palpate::threads::default_threads`].
+    pub fn count(&self) -> usize {
+        self.threads
+            .map_or_else(palpate::threads::default_threads, usize::from)
+    }
+}
+
 /// `--json` of a command whose only output format is one JSON object.
 #[derive(clap::Args)]
 pub struct JsonArgs {

@@ -6,28 +6,50 @@ use std::path::PathBuf;
 
 use palpate::bench::measure::Sampling;
 use palpate::bench::run::{BenchModel, BenchOptions, Record, check, run};
+use palpate::bench::scene::{SceneBenchOptions, bench_scene, check_scene_bench};
 use palpate::dispatch::HostDispatch;
+use palpate::fem::material::Material;
 use palpate::mesh::read_mesh;
 use palpate::output::stderr;
+use palpate::scene::Scene;
 use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
 
-use super::args::{FixArgs, MaterialArgs};
+use super::args::{FixArgs, ThreadsArgs};
 use super::dynamic::IntegratorArg;
 use super::stdout;
 
-/// `palpate bench`: time the models on a mesh.
+/// `palpate bench`: time the models on a mesh, or a scene's own model
+/// (`--scene`).
 #[derive(clap::Args)]
+#[command(mut_arg("fix", |a| a.required(false).required_unless_present("scene")))]
 pub struct BenchArgs {
     /// Input mesh (.msh, .node/.ele, .vtk), metres.
-    mesh: PathBuf,
-    #[command(flatten)]
-    material: MaterialArgs,
+    #[arg(required_unless_present = "scene")]
+    mesh: Option<PathBuf>,
+    /// A scene (file, or a built-in name) in place of the mesh and its
+    /// options: its own model timed stage by stage (physics update,
+    /// interface update of a hybrid, haptic tick with 1-4 tool points)
+    /// against each stage's real-time period. Takes --samples, --warmup,
+    /// --sample-ms, --threads and --json only.
+    #[arg(long, conflicts_with_all = [
+        "mesh", "young", "poisson", "density", "fix", "models", "integrators", "precision",
+        "dispatch",
+    ])]
+    scene: Option<String>,
+    /// Young's modulus, Pa.
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
+    young: Option<f64>,
+    /// Poisson ratio, in [0, 0.4999].
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
+    poisson: Option<f64>,
     /// Mass density, kg/m3.
-    #[arg(long)]
-    density: f64,
+    #[arg(long, required_unless_present = "scene")]
+    density: Option<f64>,
     #[command(flatten)]
     fix: FixArgs,
+    #[command(flatten)]
+    threads: ThreadsArgs,
     /// Models to time (comma-separated; default all).
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = BenchModel::ALL)]
     models: Vec<BenchModel>,
@@ -52,7 +74,8 @@ pub struct BenchArgs {
     /// Target duration of one sample (a batch of calls), ms.
     #[arg(long, default_value_t = Sampling::default().sample_s * 1e3)]
     sample_ms: f64,
-    /// One JSON object per measurement and line, instead of the table.
+    /// One JSON object per measurement and line, instead of the table
+    /// (with --scene: one JSON object for the run).
     #[arg(long)]
     json: bool,
 }
@@ -76,7 +99,18 @@ enum DispatchChoice {
 
 /// Runs `palpate bench`.
 pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
-    let (mesh, report) = read_mesh(&args.mesh)?;
+    let sampling = Sampling {
+        warmup: args.warmup,
+        samples: args.samples,
+        sample_s: args.sample_ms / 1e3,
+    };
+    let (Some(path), Some(young), Some(poisson), Some(density)) =
+        (&args.mesh, args.young, args.poisson, args.density)
+    else {
+        let scene = Scene::named(args.scene.as_deref().unwrap_or_default())?;
+        return run_scene_bench(&scene, sampling, args.threads.count(), args.json);
+    };
+    let (mesh, report) = read_mesh(path)?;
     for w in &report.warnings {
         stderr::line(&format!("warning: {w}"));
     }
@@ -89,8 +123,8 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
         DispatchChoice::All => HostDispatch::available(),
     };
     let options = BenchOptions {
-        material: args.material.material()?,
-        density_kg_m3: args.density,
+        material: Material::new(young, poisson)?,
+        density_kg_m3: density,
         fix: args.fix.fix.clone(),
         models: args.models.clone(),
         integrators: args.integrators.iter().map(|&i| i.into()).collect(),
@@ -100,13 +134,9 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
             PrecisionChoice::Both => vec![Precision::F32, Precision::F64],
         },
         dispatches,
-        sampling: Sampling {
-            warmup: args.warmup,
-            samples: args.samples,
-            sample_s: args.sample_ms / 1e3,
-        },
+        sampling,
     };
-    let name = args.mesh.display().to_string();
+    let name = path.display().to_string();
     let estimate = check(&mesh, &options)?;
     stderr::line(&format!(
         "bench {name}: {} vertices, {} tets; {} measurements, estimated {:.0} s \
@@ -185,4 +215,50 @@ fn seconds(s: f64) -> String {
     } else {
         format!("{:.2} ms", s * 1e3)
     }
+}
+
+/// `palpate bench --scene`: the scene's stages (`palpate::bench::scene`),
+/// as a table or one JSON object.
+fn run_scene_bench(
+    scene: &Scene,
+    sampling: Sampling,
+    threads: usize,
+    json: bool,
+) -> anyhow::Result<()> {
+    let options = SceneBenchOptions { sampling, threads };
+    let estimate_s = check_scene_bench(&options)?;
+    stderr::line(&format!(
+        "bench --scene {}: building its tables, then up to {} measurements, estimated {:.0} s \
+         (at most {} s); tensor-mass steps on {threads} threads",
+        scene.source,
+        palpate::bench::scene::MAX_SCENE_STAGES,
+        estimate_s.ceil(),
+        palpate::limits::MAX_BENCH_ESTIMATE_S,
+    ));
+    let bench = bench_scene(scene, &options)?;
+    if json {
+        stdout::println(&serde_json::to_string(&bench)?)?;
+        return Ok(());
+    }
+    stdout::println(&format!(
+        "{} ({} model, {} vertices, {} tets, {} in the tensor-mass region, {} threads)",
+        bench.scene, bench.model, bench.vertices, bench.tets, bench.dynamic_tets, bench.threads
+    ))?;
+    stdout::println(&format!(
+        "{:<17} {:>6} {:>8} {:>10}  {:<21} {:>10} {:>10}",
+        "stage", "points", "contacts", "median", "q1-q3", "period", "real-time"
+    ))?;
+    for s in &bench.stages {
+        stdout::println(&format!(
+            "{:<17} {:>6} {:>8} {:>10}  {:<21} {:>10} {:>9.2}x",
+            s.stage,
+            s.tool_points,
+            s.contacts,
+            seconds(s.median_s),
+            format!("{}-{}", seconds(s.q1_s), seconds(s.q3_s)),
+            seconds(s.period_s),
+            s.real_time_factor
+        ))?;
+    }
+    Ok(())
 }

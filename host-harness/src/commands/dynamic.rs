@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, anyhow, bail};
 use clap::Subcommand;
+use palpate::dispatch::HostDispatch;
 use palpate::hybrid::HybridOptions;
 use palpate::hybrid::hmatrix::InterfaceCompression;
 use palpate::hybrid::stability::critical_dt_of_hybrid;
@@ -16,10 +17,12 @@ use palpate::session::options::tensor_mass_options;
 use palpate::table::build::BuildOptions;
 use palpate::table::file::Precision;
 use palpate::tensor_mass::run::RunOptions;
+use palpate::threads::Threaded;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
 
 use super::args::{
-    FixArgs, FormArg, JsonArgs, MaterialArgs, finite_vector, non_negative, optional_fix, positive,
+    FixArgs, FormArg, JsonArgs, MaterialArgs, ThreadsArgs, finite_vector, non_negative,
+    optional_fix, positive,
 };
 use super::stdout;
 
@@ -61,6 +64,8 @@ pub enum DynamicCommand {
         /// JSON either way. A hybrid scene runs in f64 only.
         #[arg(long, value_enum, default_value = "f64")]
         precision: Precision,
+        #[command(flatten)]
+        threads: ThreadsArgs,
     },
     /// Largest stable time step of an integrator (bisection) next to 2/ω_max.
     CriticalDt {
@@ -256,6 +261,7 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
             form,
             incompressibility,
             precision,
+            threads,
         } => {
             let setup = model.read("run")?;
             let (law, incompressibility_n) = law.law(form, incompressibility)?;
@@ -284,7 +290,10 @@ pub fn run(command: DynamicCommand) -> anyhow::Result<()> {
                     setup.interface_compression,
                     &options,
                 ),
-                None => palpate::tensor_mass::run::run(mesh, report, &options),
+                None => {
+                    let dispatch = Threaded::new(HostDispatch::detect(), threads.count());
+                    palpate::tensor_mass::run::run_with(mesh, report, &options, dispatch)
+                }
             }
             .with_context(|| setup.name.clone())?;
             stdout::println(&serde_json::to_string(&output)?)?;

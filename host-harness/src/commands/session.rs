@@ -11,8 +11,9 @@ use palpate::scene::{
     CutLine, Generator, GraspPull, MeshSource, Pinch, Poke, PressHold, Scene, Slide, Strike,
     Trajectory,
 };
-use palpate::session::run::{removed_path, removes_tets, run_session_to_files};
+use palpate::session::run::{removed_path, removes_tets, run_session_to_files_threads};
 
+use super::args::ThreadsArgs;
 use super::mesh_files;
 
 #[derive(Subcommand)]
@@ -45,6 +46,8 @@ pub enum SessionCommand {
         /// feed them to the kernel, for robustness runs.
         #[arg(long)]
         lenient: bool,
+        #[command(flatten)]
+        threads: ThreadsArgs,
     },
     /// Write a generated trajectory for the built-in scene.
     Generate {
@@ -85,6 +88,7 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             out,
             vtk,
             lenient,
+            threads,
         } => {
             // The outputs: never an input, nor inside the VTK folder they
             // replace; checked before anything is read (and again with the
@@ -117,7 +121,13 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             } else {
                 Trajectory::read(&trajectory, points)?
             };
-            let summary = run_session_to_files(&scene, &trajectory, &out, vtk.as_deref())?;
+            let summary = run_session_to_files_threads(
+                &scene,
+                &trajectory,
+                &out,
+                vtk.as_deref(),
+                threads.count(),
+            )?;
             stderr::line(&format!(
                 "{} ticks ({} in contact, {} clamped, {} faulted); max force {:.3} N, max jump {:.4} N per tick; {} VTK frames",
                 summary.ticks,

@@ -20,6 +20,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use nalgebra::Vector3;
 use palpate_kernel::haptic::{ForceOutput, HybridLoop, OutputStatus};
+use palpate_kernel::math::Portable;
 
 use super::timing::Costs;
 use crate::mesh::TetMesh;
@@ -137,7 +138,8 @@ impl ForToolPoints for Surgery<'_> {
     type Output = anyhow::Result<(OrganRun, Phases)>;
 
     fn call<const P: usize>(self) -> Self::Output {
-        self.setup.with_loop::<P, _>(|haptic| self.drive(haptic))
+        self.setup
+            .with_loop::<P, _, _>(Portable, |haptic| self.drive(haptic))
     }
 }
 

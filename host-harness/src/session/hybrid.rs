@@ -6,6 +6,7 @@ use anyhow::Context;
 use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::HybridLoop;
 use palpate_kernel::hybrid::HybridTissue;
+use palpate_kernel::math::Dispatch;
 use palpate_kernel::table::{InterfaceTable, TensorMassTable};
 
 use super::model::HybridFiles;
@@ -55,30 +56,45 @@ impl<'t> HybridSetup<'t> {
     }
 
     /// Builds the tissue and the loop at rest on heap buffers and runs
-    /// `body` on the loop.
-    pub fn with_loop<const P: usize, R>(
+    /// `body` on the loop, the tensor-mass region's steps through
+    /// `dispatch` (its per-tet pass split into `dispatch.parts()`).
+    pub fn with_loop<const P: usize, R, D: Dispatch>(
         &self,
-        body: impl FnOnce(&mut HybridLoop<'_, '_, f32, P, P>) -> anyhow::Result<R>,
+        dispatch: D,
+        body: impl FnOnce(&mut HybridLoop<'_, '_, f32, P, P, D>) -> anyhow::Result<R>,
     ) -> anyhow::Result<R> {
-        let table = self.dynamic.table();
-        let mut owned = OwnedHybridBuffers::for_tables(&self.precomputed, &table, &self.interface);
-        self.dynamic.with_parts(|model, buffers, forces| {
-            let (coupling, surface) = owned.buffers();
-            let tissue = HybridTissue::<f32, P, P>::new(
-                model,
-                buffers,
-                forces,
-                self.dynamic.physics(),
-                self.precomputed,
-                self.interface,
-                coupling,
-                surface,
-            )
-            .map_err(|e| anyhow::anyhow!("hybrid tissue: {e}"))?;
-            let mut haptic = HybridLoop::<f32, P, P>::new(tissue, self.dynamic.config())
+        self.with_tissue::<P, _, _>(dispatch, |tissue| {
+            let mut haptic = HybridLoop::<f32, P, P, D>::new(tissue, self.dynamic.config())
                 .map_err(|e| anyhow::anyhow!("haptic loop: {e}"))?;
             body(&mut haptic)
         })
+    }
+
+    /// Builds the tissue at rest on heap buffers, its tensor-mass region's
+    /// steps through `dispatch`, and runs `body` on it.
+    pub fn with_tissue<const P: usize, R, D: Dispatch>(
+        &self,
+        dispatch: D,
+        body: impl FnOnce(HybridTissue<'_, '_, f32, P, P, D>) -> anyhow::Result<R>,
+    ) -> anyhow::Result<R> {
+        let table = self.dynamic.table();
+        let mut owned = OwnedHybridBuffers::for_tables(&self.precomputed, &table, &self.interface);
+        self.dynamic
+            .with_parts(dispatch.parts(), |model, buffers, forces| {
+                let (coupling, surface) = owned.buffers();
+                let tissue = HybridTissue::<f32, P, P>::new(
+                    model,
+                    buffers,
+                    forces,
+                    self.dynamic.physics(),
+                    self.precomputed,
+                    self.interface,
+                    coupling,
+                    surface,
+                )
+                .map_err(|e| anyhow::anyhow!("hybrid tissue: {e}"))?;
+                body(tissue.with_dispatch(dispatch))
+            })
     }
 }
 
@@ -96,8 +112,10 @@ pub struct HybridView<'v> {
     tet_count: usize,
 }
 
-impl<const P: usize> PhysicsView<HybridTissue<'_, '_, f32, P, P>> for HybridView<'_> {
-    fn removed(&self, tissue: &HybridTissue<'_, '_, f32, P, P>) -> Vec<u32> {
+impl<const P: usize, D: Dispatch> PhysicsView<HybridTissue<'_, '_, f32, P, P, D>>
+    for HybridView<'_>
+{
+    fn removed(&self, tissue: &HybridTissue<'_, '_, f32, P, P, D>) -> Vec<u32> {
         let removed = tissue.dynamic().removed().iter();
         removed
             .filter_map(|&t| self.mesh_tet.get(t as usize).copied())
@@ -106,7 +124,7 @@ impl<const P: usize> PhysicsView<HybridTissue<'_, '_, f32, P, P>> for HybridView
 
     fn frame(
         &self,
-        tissue: &HybridTissue<'_, '_, f32, P, P>,
+        tissue: &HybridTissue<'_, '_, f32, P, P, D>,
     ) -> anyhow::Result<(Vec<[f32; 3]>, Vec<bool>)> {
         let model = tissue.dynamic().model();
         let mut u = vec![[0.0f32; 3]; tissue.region().interface().vertex_count()];

@@ -33,7 +33,7 @@ use palpate_kernel::PrecomputedTable;
 use palpate_kernel::haptic::{
     ForceOutput, HapticLoop, LoopConfig, OutputStatus, PhysicsTissue, PrecomputedLoop, ToolInput,
 };
-use palpate_kernel::math::Dispatch;
+use palpate_kernel::math::{Dispatch, Portable};
 use palpate_kernel::precomputed::PrecomputedTissue;
 use palpate_kernel::table::TensorMassTable;
 use palpate_kernel::tensor_mass::DynamicTissue;
@@ -53,6 +53,7 @@ use crate::output::atomic::{self, AtomicFile, SeriesDir};
 use crate::output::number::time_s;
 use crate::output::vtk;
 use crate::scene::{ModelSpec, Scene, ToolKind, ToolSpec, ToolState, Trajectory};
+use crate::threads::{Threaded, default_threads};
 
 /// The number of ticks of `trajectory` at period `tick_s` (s): one at its
 /// start, then one every `tick_s` up to its end,
@@ -174,6 +175,18 @@ pub fn run_session_to_files(
     out: &Path,
     vtk: Option<&Path>,
 ) -> anyhow::Result<SessionSummary> {
+    run_session_to_files_threads(scene, trajectory, out, vtk, default_threads())
+}
+
+/// [`run_session_to_files`] with the tensor-mass steps' per-tet force pass
+/// on `threads` threads ([`run_session_threads`]).
+pub fn run_session_to_files_threads(
+    scene: &Scene,
+    trajectory: &Trajectory,
+    out: &Path,
+    vtk: Option<&Path>,
+    threads: usize,
+) -> anyhow::Result<SessionSummary> {
     if let Some(dir) = vtk {
         atomic::refuse_inside(("--vtk", dir), &[("--out", out)])?;
     }
@@ -182,7 +195,7 @@ pub fn run_session_to_files(
         .then(|| AtomicFile::create(&removed_path(out)))
         .transpose()?;
     let series = vtk.map(SeriesDir::create).transpose()?;
-    let summary = run_session_into(
+    let summary = run_session_threads(
         scene,
         trajectory,
         SessionOutputs {
@@ -191,6 +204,7 @@ pub fn run_session_to_files(
             vtk_dir: series.as_ref().map(SeriesDir::dir),
             vtk_name: series.as_ref().map(SeriesDir::path),
         },
+        threads,
     )?;
     // The CSVs are complete and synced before the series replaces the old
     // one: after the swap only the CSVs' renames are left to fail.
@@ -276,6 +290,18 @@ pub fn run_session_into(
     trajectory: &Trajectory,
     outputs: SessionOutputs<'_>,
 ) -> anyhow::Result<SessionSummary> {
+    run_session_threads(scene, trajectory, outputs, default_threads())
+}
+
+/// [`run_session_into`] with the tensor-mass steps' per-tet force pass on
+/// `threads` threads (dynamic and hybrid scenes; the results are the same
+/// bits for any count, [`crate::threads`]).
+pub fn run_session_threads(
+    scene: &Scene,
+    trajectory: &Trajectory,
+    outputs: SessionOutputs<'_>,
+    threads: usize,
+) -> anyhow::Result<SessionSummary> {
     let SessionOutputs {
         csv: out,
         mut removed,
@@ -310,6 +336,7 @@ pub fn run_session_into(
         tools: &scene.tool,
         tick_s: scene.tick_s(),
         every: scene.rates.physics_every.max(1) as usize,
+        threads,
     };
     let tables = SceneModel::of(scene, &mesh, &report)?.tables(scene, &mesh, &report, None)?;
     let load = |e| anyhow::anyhow!("session table: {e}");
@@ -366,12 +393,14 @@ impl ForToolPoints for SessionTicks<'_, '_, '_, '_> {
     }
 }
 
-/// The trajectory's ticks, the tools and the physics period in ticks.
+/// The trajectory's ticks, the tools, the physics period in ticks and the
+/// threads of the tensor-mass steps' per-tet pass.
 struct Ticks<'r> {
     trajectory: &'r Trajectory,
     tools: &'r ToolSpec,
     tick_s: f64,
     every: usize,
+    threads: usize,
 }
 
 impl Ticks<'_> {
@@ -405,7 +434,7 @@ impl Ticks<'_> {
         setup: &DynamicSetup<'_>,
         session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
-        let dispatch = HostDispatch::detect();
+        let dispatch = Threaded::new(HostDispatch::detect(), self.threads);
         setup.with_loop::<P, _, _>(dispatch, |haptic| {
             self.physics_ticks(haptic, session, &DynamicView)
         })
@@ -417,7 +446,10 @@ impl Ticks<'_> {
         session: &mut Session<'_, '_>,
     ) -> anyhow::Result<()> {
         let view = setup.view();
-        setup.with_loop::<P, _>(|haptic| self.physics_ticks(haptic, session, &view))
+        let dispatch = Threaded::new(Portable, self.threads);
+        setup.with_loop::<P, _, _>(dispatch, |haptic| {
+            self.physics_ticks(haptic, session, &view)
+        })
     }
 
     /// The ticks of a tissue stepped at the physics rate: a physics update

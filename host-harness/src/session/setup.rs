@@ -14,6 +14,7 @@ use palpate_kernel::tensor_mass::{
 use crate::scene::{DynamicSpec, Scene};
 use crate::tensor_mass::run::diagonal;
 use crate::tensor_mass::{OwnedState, OwnedSurface};
+use crate::threads::split_model;
 
 /// The haptic loop configuration of `scene` (f32).
 pub fn loop_config(scene: &Scene) -> LoopConfig<f32> {
@@ -87,7 +88,7 @@ impl<'t> DynamicSetup<'t> {
         dispatch: D,
         body: impl FnOnce(&mut DynamicLoop<'_, '_, f32, P, P, D>) -> anyhow::Result<R>,
     ) -> anyhow::Result<R> {
-        self.with_parts(|model, buffers, forces| {
+        self.with_parts(dispatch.parts(), |model, buffers, forces| {
             let tissue = DynamicTissue::<f32, P>::new(model, buffers, forces, self.physics)
                 .map_err(|e| anyhow::anyhow!("dynamic tissue: {e}"))?
                 .with_dispatch(dispatch);
@@ -99,10 +100,12 @@ impl<'t> DynamicSetup<'t> {
 
     /// Builds the model at rest and its surface buffers and force scratch
     /// on the heap (the split-term buffers only for the form that reads
-    /// them), and runs `body` on them: what a dynamic or hybrid tissue is
-    /// built from.
+    /// them; the split per-tet pass's for `threads > 1`,
+    /// [`crate::threads::split_model`]), and runs `body` on them: what a
+    /// dynamic or hybrid tissue is built from.
     pub fn with_parts<R>(
         &self,
+        threads: usize,
         body: impl FnOnce(
             TensorMassModel<'_, '_, f32>,
             SurfaceBuffers<'_, f32>,
@@ -115,7 +118,9 @@ impl<'t> DynamicSetup<'t> {
         } else {
             state.without_split_terms()
         };
+        let mut split = None;
         let model = TensorMassModel::new(self.table, state.buffers(), self.params)
+            .and_then(|model| split_model(model, &mut split, threads))
             .map_err(|e| anyhow::anyhow!("dynamic model: {e}"))?;
         let mut surface = OwnedSurface::for_model(&model);
         let (buffers, forces) = surface.buffers();

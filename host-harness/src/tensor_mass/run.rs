@@ -21,6 +21,7 @@ use crate::output::number::shown;
 use crate::table::build::{BuildOptions, build};
 use crate::table::file::Precision;
 use crate::table::load::TableFile;
+use crate::threads::{Threaded, default_threads, split_model};
 
 /// A scripted dynamic run.
 #[derive(Clone, Debug)]
@@ -67,14 +68,17 @@ pub struct RunOutput {
 }
 
 /// Runs `options` on `mesh`, the step's passes on the best this CPU runs
-/// ([`HostDispatch::detect`]). Divergence bound: a displacement larger than
+/// ([`HostDispatch::detect`]), the per-tet force pass on
+/// [`default_threads`] threads (the same results on any number). Divergence bound: a displacement larger than
 /// the mesh's bounding-box diagonal (a body that moves more than its own
 /// size has diverged); the kinetic energy is not bounded.
 pub fn run(mesh: &TetMesh, report: &MeshReport, options: &RunOptions) -> anyhow::Result<RunOutput> {
-    run_with(mesh, report, options, HostDispatch::detect())
+    let dispatch = Threaded::new(HostDispatch::detect(), default_threads());
+    run_with(mesh, report, options, dispatch)
 }
 
-/// [`run`] with the step's passes run through `dispatch`.
+/// [`run`] with the step's passes run through `dispatch`, the per-tet
+/// force pass split into `dispatch.parts()` ([`crate::threads`]).
 pub fn run_with(
     mesh: &TetMesh,
     report: &MeshReport,
@@ -102,11 +106,13 @@ fn run_in<T: Real>(
 ) -> anyhow::Result<RunOutput> {
     let table = TensorMassTable::<T>::load(file.bytes()).context("tensor-mass table")?;
     let mut state = OwnedState::for_table(&table);
+    let mut split = None;
     let params = host_params(&mesh.positions, options.damping_per_s)
         .with_law(options.law)
         .with_incompressibility(options.incompressibility_n.map(T::of_f64))
         .with_gravity(vector(options.gravity_m_s2));
-    let mut model = TensorMassModel::new(table, state.buffers(), params)?;
+    let model = TensorMassModel::new(table, state.buffers(), params)?;
+    let mut model = split_model(model, &mut split, dispatch.parts())?;
     for &tet in &options.cut_tets {
         model
             .remove_tet(tet)

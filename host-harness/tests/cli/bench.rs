@@ -322,3 +322,61 @@ fn dynamic_run_in_f32_matches_f64() {
     ]);
     assert_one_line_error(&scene_f32, &["a hybrid scene runs in f64 only"]);
 }
+
+/// `bench --scene built-in-dynamic --json --threads 2`, sampled once: one
+/// JSON object with the documented fields; the physics update first, then
+/// the tick with 1, 2, … tool points; every cost finite and positive, the
+/// quartiles around the median, each period the scene's (a physics update
+/// every 10 ticks of 1 kHz: 10 ms; a tick 1 ms) and the real-time factor
+/// `period_s / median_s` (to 1e-12 relative: one division of the printed
+/// numbers, round-tripped exactly by the JSON's shortest form).
+#[test]
+fn bench_scene_prints_each_stage_against_its_period() {
+    let out = palpate(&[
+        "bench",
+        "--scene",
+        "built-in-dynamic",
+        "--json",
+        "--threads",
+        "2",
+        "--samples",
+        "1",
+        "--warmup",
+        "0",
+        "--sample-ms",
+        "0.1",
+    ]);
+    let objects = lines(&out);
+    assert_eq!(objects.len(), 1, "one JSON object");
+    let o = &objects[0];
+    assert_eq!(o["model"], "dynamic");
+    assert_eq!(o["scene"], "built-in dynamic scene");
+    assert_eq!(o["vertices"], 1183);
+    assert_eq!(o["tets"], 5184);
+    assert_eq!(o["dynamic_tets"], 5184);
+    assert_eq!(o["threads"], 2);
+    let stages = o["stages"].as_array().unwrap();
+    assert_eq!(stages[0]["stage"], "physics-update");
+    let ticks = &stages[1..];
+    assert!(!ticks.is_empty() && ticks.len() <= 4, "{stages:?}");
+    for (k, s) in ticks.iter().enumerate() {
+        assert_eq!(s["stage"], "haptic-tick");
+        assert_eq!(s["tool_points"], k + 1);
+    }
+    for s in stages {
+        let f = |key: &str| s[key].as_f64().unwrap_or_else(|| panic!("{key} in {s}"));
+        let (median, q1, q3, period) = (f("median_s"), f("q1_s"), f("q3_s"), f("period_s"));
+        assert!(median.is_finite() && median > 0.0, "{s}");
+        assert!(q1 <= median && median <= q3, "{s}");
+        let expected = if s["stage"] == "physics-update" {
+            0.01
+        } else {
+            0.001
+        };
+        assert!((period - expected).abs() < 1e-12, "{s}");
+        let factor = f("real_time_factor");
+        assert!((factor - period / median).abs() <= 1e-12 * factor, "{s}");
+        assert!(s["contacts"].as_u64().unwrap() <= s["tool_points"].as_u64().unwrap());
+        assert_eq!(s["samples"], 1);
+    }
+}

@@ -112,8 +112,8 @@ pub type DynamicLoop<'a, 's, T, const P: usize, const M: usize, D = Portable> =
     HapticLoop<T, DynamicTissue<'a, 's, T, P, D>, P, M>;
 
 /// The loop over the hybrid model.
-pub type HybridLoop<'a, 's, T, const P: usize, const M: usize> =
-    HapticLoop<T, HybridTissue<'a, 's, T, P, M>, P, M>;
+pub type HybridLoop<'a, 's, T, const P: usize, const M: usize, D = Portable> =
+    HapticLoop<T, HybridTissue<'a, 's, T, P, M, D>, P, M>;
 
 impl<T: Real, B: Tissue<T, M>, const P: usize, const M: usize> HapticLoop<T, B, P, M> {
     /// A loop at rest (no contact, zero force) over `tissue`.
@@ -431,8 +431,8 @@ impl<T: Real, const P: usize, const M: usize, D: Dispatch> PhysicsTissue<T, M>
     }
 }
 
-impl<T: Real, const P: usize, const M: usize> PhysicsTissue<T, M>
-    for HybridTissue<'_, '_, T, P, M>
+impl<T: Real, const P: usize, const M: usize, D: Dispatch> PhysicsTissue<T, M>
+    for HybridTissue<'_, '_, T, P, M, D>
 {
     fn update(
         &mut self,

@@ -19,6 +19,7 @@ use super::surface::{HybridSurface, HybridSurfaceBuffers, SlotRegion};
 use crate::contact::{
     Contact, ContactRefs, ContactSet, Refusal, Supports, SurfaceGeometry, Tissue, lend,
 };
+use crate::math::{Dispatch, Portable};
 use crate::precomputed::ContactSolution;
 use crate::table::{InterfaceTable, PrecomputedTable, VertexIndex};
 use crate::tensor_mass::{
@@ -52,8 +53,11 @@ impl core::error::Error for HybridTissueError {}
 
 /// The tensor-mass region's tissue, the condensed pre-computed region, the
 /// whole surface and the last solution of the pre-computed contacts.
-pub struct HybridTissue<'a, 's, T: Real, const P: usize, const M: usize> {
-    dynamic: DynamicTissue<'a, 's, T, P>,
+///
+/// `D`: where the tensor-mass region's steps run ([`Self::with_dispatch`];
+/// portable by default).
+pub struct HybridTissue<'a, 's, T: Real, const P: usize, const M: usize, D: Dispatch = Portable> {
+    dynamic: DynamicTissue<'a, 's, T, P, D>,
     region: CondensedRegion<'a, 's, T>,
     surface: HybridSurface<'s, T>,
     solution: Option<ContactSolution<T, M>>,
@@ -99,9 +103,35 @@ impl<'a, 's, T: Real, const P: usize, const M: usize> HybridTissue<'a, 's, T, P,
             fault: None,
         })
     }
+}
+
+impl<'a, 's, T: Real, const P: usize, const M: usize, D: Dispatch>
+    HybridTissue<'a, 's, T, P, M, D>
+{
+    /// The same tissue with its tensor-mass region's steps run through
+    /// `dispatch` ([`DynamicTissue::with_dispatch`]; same results).
+    pub fn with_dispatch<E: Dispatch>(self, dispatch: E) -> HybridTissue<'a, 's, T, P, M, E> {
+        HybridTissue {
+            dynamic: self.dynamic.with_dispatch(dispatch),
+            region: self.region,
+            surface: self.surface,
+            solution: self.solution,
+            fault: self.fault,
+        }
+    }
+
+    /// The interface part of [`Self::update`] alone: the pre-computed
+    /// region's touchable background at the tensor-mass region's current
+    /// displacements ([`CondensedRegion::update_background`]), for timing
+    /// it; the next update recomputes it anyway.
+    pub fn update_background(&mut self) -> Result<(), crate::tensor_mass::Fault> {
+        let touchable = self.region.precomputed().table().touchable_count();
+        self.region
+            .update_background(self.dynamic.model(), touchable)
+    }
 
     /// The tensor-mass region's tissue (its model, removed tets, holds).
-    pub fn dynamic(&self) -> &DynamicTissue<'a, 's, T, P> {
+    pub fn dynamic(&self) -> &DynamicTissue<'a, 's, T, P, D> {
         &self.dynamic
     }
 
@@ -209,7 +239,9 @@ impl<'a, 's, T: Real, const P: usize, const M: usize> HybridTissue<'a, 's, T, P,
     }
 }
 
-impl<T: Real, const P: usize, const M: usize> Tissue<T, M> for HybridTissue<'_, '_, T, P, M> {
+impl<T: Real, const P: usize, const M: usize, D: Dispatch> Tissue<T, M>
+    for HybridTissue<'_, '_, T, P, M, D>
+{
     fn with_geometry<R>(&self, f: impl FnOnce(&SurfaceGeometry<'_, T>) -> R) -> R {
         f(&self.surface.geometry(Supports::Hybrid {
             precomputed: self.region.precomputed().table(),

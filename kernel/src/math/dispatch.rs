@@ -19,12 +19,39 @@
 //! order as the portable one (wider vectors, not other arithmetic): the
 //! results are the same bits.
 
+/// Most parts a split pass is cut into ([`Dispatch::parts`]): the length
+/// of the item arrays of [`Dispatch::each`].
+pub const MAX_PARTS: usize = 8;
+
 /// Runs a hot pass of the step path (see the module documentation).
 pub trait Dispatch: Copy {
     /// Calls `pass` once and returns its result. An implementation may only
     /// change where the code of `pass` is compiled for, never what it
     /// computes or how often it runs.
     fn run<R>(self, pass: impl FnOnce() -> R) -> R;
+
+    /// How many parts a pass that can be split is cut into, `1..=`
+    /// [`MAX_PARTS`] (a larger value counts as [`MAX_PARTS`]). 1, the
+    /// default: no pass is split, and the kernel runs the passes as it
+    /// always has.
+    fn parts(self) -> usize {
+        1
+    }
+
+    /// Calls `job` once on every item of `items`, each inside
+    /// [`Self::run`], and returns when all have returned. The default calls
+    /// them in order on this thread; a host may call them on several
+    /// threads at once. Each item owns the data its job writes (disjoint
+    /// parts of an array), so what is computed never depends on how the
+    /// items are run.
+    fn each<I: Send>(self, items: [Option<I>; MAX_PARTS], job: impl Fn(I) + Sync) {
+        for item in items.into_iter().flatten() {
+            self.run(
+                #[inline(always)]
+                || job(item),
+            );
+        }
+    }
 }
 
 /// The build's own instruction set: `pass` is called in place.

@@ -16,5 +16,5 @@ pub(crate) mod ldlt;
 pub mod polar;
 mod scalar;
 
-pub use dispatch::{Dispatch, Portable};
+pub use dispatch::{Dispatch, MAX_PARTS, Portable};
 pub use scalar::Real;

@@ -8,6 +8,7 @@ use nalgebra::Vector3;
 use super::coupling::CouplingForces;
 use super::edges::{EdgeTensors, add_edge_forces};
 use super::law::{ElasticLaw, StvkForm};
+use super::split::SplitBuffers;
 use super::stvk::{Block, TetPass, TetTerms};
 use super::stvk_terms::NonLinearTerms;
 use crate::Real;
@@ -33,18 +34,29 @@ impl<T: Real> InternalForces<'_, '_, T> {
     /// Overwrites `f` with the internal forces (N) of displacements `u` (m):
     /// the elastic force of the law, plus the incompressibility penalty, plus
     /// the coupled pre-computed region's force on the connection nodes. Each
-    /// pass over the mesh runs through `dispatch` ([`Dispatch`]).
-    pub(crate) fn forces(&self, dispatch: impl Dispatch, u: &[[T; 3]], f: &mut [[T; 3]]) {
+    /// pass over the mesh runs through `dispatch` ([`Dispatch`]); with
+    /// `split` and `dispatch.parts() > 1` the per-tet pass is cut into
+    /// parts ([`super::split`]: the same bits).
+    pub(crate) fn forces(
+        &self,
+        dispatch: impl Dispatch,
+        split: Option<&mut SplitBuffers<'_, T>>,
+        u: &[[T; 3]],
+        f: &mut [[T; 3]],
+    ) {
         match self.law {
             // The law closures are always inlined, so that they are
             // compiled inside the dispatched pass, for its CPU features.
             ElasticLaw::StVenantKirchhoff(StvkForm::PerTet) => {
-                self.per_tet_forces(dispatch, u, f, |b| b.elastic());
+                self.per_tet_forces(dispatch, split, u, f, |b| b.elastic());
             }
-            ElasticLaw::NeoHookean => self.per_tet_forces(dispatch, u, f, |b| b.neo_hookean()),
+            ElasticLaw::NeoHookean => {
+                self.per_tet_forces(dispatch, split, u, f, |b| b.neo_hookean());
+            }
             ElasticLaw::Corotational => {
                 self.per_tet_forces(
                     dispatch,
+                    split,
                     u,
                     f,
                     #[inline(always)]
@@ -77,20 +89,29 @@ impl<T: Real> InternalForces<'_, '_, T> {
     }
 
     /// Overwrites `f` with the forces (N) of a per-tet `law` at
-    /// displacements `u` (m), the pass run through `dispatch`.
+    /// displacements `u` (m), the pass run through `dispatch`, split into
+    /// its parts with `split` when `dispatch` has more than one.
     #[inline(always)]
     fn per_tet_forces(
         &self,
         dispatch: impl Dispatch,
+        split: Option<&mut SplitBuffers<'_, T>>,
         u: &[[T; 3]],
         f: &mut [[T; 3]],
-        law: impl Fn(&Block<'_, T>) -> TetTerms<T>,
+        law: impl Fn(&Block<'_, T>) -> TetTerms<T> + Sync,
     ) {
-        f.fill([T::zero(); 3]);
-        dispatch.run(
-            #[inline(always)]
-            || self.tets.add_tet_forces(u, f, law),
-        );
+        match split {
+            Some(split) if dispatch.parts() > 1 => {
+                split.tet_forces(dispatch, &self.tets, u, f, &law);
+            }
+            _ => {
+                f.fill([T::zero(); 3]);
+                dispatch.run(
+                    #[inline(always)]
+                    || self.tets.add_tet_forces(u, f, law),
+                );
+            }
+        }
     }
 
     /// The elastic energy (J) of displacements `u` (m) under the law, plus

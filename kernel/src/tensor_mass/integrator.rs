@@ -4,6 +4,7 @@
 use nalgebra::Vector3;
 
 use super::force::{InternalForces, vec3};
+use super::split::SplitBuffers;
 use super::state::VertexMode;
 use crate::Real;
 use crate::math::Dispatch;
@@ -72,16 +73,21 @@ impl<T: Real> Loads<'_, T> {
     /// mass (MODELS.md §3 with `γ_i = c m_i`, `c = damping_per_s`), zero for
     /// fixed, imposed and massless vertices (a vertex left without tets by a
     /// cut keeps still).
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the state (u, v), its output, the damping and the force pass with its split scratch"
+    )]
     pub(crate) fn accelerations(
         &self,
         dispatch: impl Dispatch,
         forces: &InternalForces<'_, '_, T>,
+        split: Option<&mut SplitBuffers<'_, T>>,
         damping_per_s: T,
         u: &[[T; 3]],
         v: &[[T; 3]],
         a: &mut [[T; 3]],
     ) {
-        forces.forces(dispatch, u, a);
+        forces.forces(dispatch, split, u, a);
         dispatch.run(
             #[inline(always)]
             || {

@@ -27,6 +27,8 @@ mod law;
 mod limits;
 mod model;
 mod neo_hookean;
+mod split;
+mod split_model;
 mod state;
 mod stvk;
 pub mod stvk_terms;
@@ -40,6 +42,7 @@ pub use law::{ElasticLaw, StvkForm};
 pub use limits::Limits;
 pub use model::{DynamicParams, InputError, StepError, StepReport, TensorMassModel};
 pub use neo_hookean::NEO_HOOKEAN_J_FLOOR;
+pub use split::SplitBuffers;
 pub use state::{Fault, StateBuffers, StateError, VertexMode};
 pub(crate) use surface::check_lengths;
 pub use surface::{

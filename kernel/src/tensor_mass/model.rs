@@ -10,6 +10,7 @@ use super::force::{InternalForces, Stiffness, vec3};
 use super::integrator::{Integrator, Loads};
 use super::law::{ElasticLaw, StvkForm};
 use super::limits::{Limits, Watch};
+use super::split::SplitBuffers;
 use super::state::{Fault, StateBuffers, StateError, VertexMode};
 use super::stvk::TetPass;
 use super::stvk_terms::{NonLinearTerms, TermArraysMut};
@@ -165,6 +166,8 @@ pub struct TensorMassModel<'a, 's, T: Real> {
     previous_valid: bool,
     fault: Option<Fault>,
     coupling: Option<Coupling<'a, 's, T>>,
+    /// The split per-tet pass's storage ([`Self::with_split`]), `None`: never split.
+    pub(super) split: Option<SplitBuffers<'s, T>>,
 }
 
 impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
@@ -215,6 +218,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             previous_valid: false,
             fault: None,
             coupling: None,
+            split: None,
         };
         model.reset();
         Ok(model)
@@ -423,7 +427,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
     /// current stiffness and the configured law and penalty (energy and
     /// eigenvalue estimates, finite-difference checks).
     pub fn elastic_forces_of(&self, u: &[[T; 3]], out: &mut [[T; 3]]) {
-        self.internal_forces().forces(Portable, u, out);
+        self.internal_forces().forces(Portable, None, u, out);
     }
 
     /// The elastic energy (J) of any displacement field `u` (m) under the
@@ -527,7 +531,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             self.coupling.as_ref(),
         );
         let (u, v, f) = (s.displacement_m, s.velocity_m_s, s.force_n);
-        forces.forces(dispatch, u, f);
+        forces.forces(dispatch, self.split.as_mut(), u, f);
         let c = self.params.damping_per_s;
         let limits = &self.params.limits;
         // `move`: the scalars and `loads` live in the pass's registers, not
@@ -588,7 +592,8 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
         ];
         for (weight, next) in stages {
             let c = self.params.damping_per_s;
-            loads.accelerations(dispatch, &forces, c, su, sv, a);
+            let split = self.split.as_mut();
+            loads.accelerations(dispatch, &forces, split, c, su, sv, a);
             dispatch.run(
                 #[inline(always)]
                 || {
@@ -649,7 +654,7 @@ impl<'a, 's, T: Real> TensorMassModel<'a, 's, T> {
             s.previous_displacement_m,
             s.force_n,
         );
-        forces.forces(dispatch, u, f);
+        forces.forces(dispatch, self.split.as_mut(), u, f);
         let c_half = self.params.damping_per_s * dt / T::of_f64(2.0);
         let two = T::of_f64(2.0);
         let limits = &self.params.limits;

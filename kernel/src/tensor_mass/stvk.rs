@@ -245,9 +245,24 @@ impl<T: Real> TetPass<'_, '_, T> {
     /// compiles for more CPU features, the compiler left a zip's `next` out
     /// of line, a call per tet.
     #[inline(always)]
-    fn for_each_block(&self, u: &[[T; 3]], mut visit: impl FnMut(&Block<'_, T>)) {
-        let tets = self.table.tets();
-        for (b, rest) in self.table.tet_lanes().iter().enumerate() {
+    fn for_each_block(&self, u: &[[T; 3]], visit: impl FnMut(&Block<'_, T>)) {
+        self.for_blocks(0..self.table.tet_lanes().len(), u, visit);
+    }
+
+    /// [`Self::for_each_block`] on the blocks `blocks` only (those past the
+    /// last left out).
+    #[inline(always)]
+    fn for_blocks(
+        &self,
+        blocks: core::ops::Range<usize>,
+        u: &[[T; 3]],
+        mut visit: impl FnMut(&Block<'_, T>),
+    ) {
+        let (tets, lanes) = (self.table.tets(), self.table.tet_lanes());
+        for b in blocks {
+            let Some(rest) = lanes.get(b) else {
+                break;
+            };
             let z = [T::zero(); LANES];
             let mut block = Block {
                 corners: [[0; 4]; LANES],
@@ -307,6 +322,39 @@ impl<T: Real> TetPass<'_, '_, T> {
                         if let Some(out) = f.get_mut(v as usize) {
                             *out = [out[0] - gv[0], out[1] - gv[1], out[2] - gv[2]];
                         }
+                    }
+                }
+            },
+        );
+    }
+
+    /// Writes the gradients `V P a_j` (N, `j = 1..3`) of a per-tet `law`
+    /// (see [`Self::add_tet_forces`]) at displacements `u` (m) of the
+    /// blocks from `first_block` on, as many as `out` holds, into `out`:
+    /// `3·LANES` entries per block, tet `8b + l`'s at `3l..3l + 3` of block
+    /// `b`'s (a lane without a live tet gets zeros, which nothing reads).
+    #[inline(always)]
+    pub(super) fn store_gradients(
+        &self,
+        first_block: usize,
+        u: &[[T; 3]],
+        out: &mut [[T; 3]],
+        law: impl Fn(&Block<'_, T>) -> TetTerms<T>,
+    ) {
+        let blocks = first_block..first_block + out.len() / (3 * LANES);
+        let mut chunks = out.chunks_exact_mut(3 * LANES);
+        self.for_blocks(
+            blocks,
+            u,
+            #[inline(always)]
+            |block| {
+                let ([r1, r2, r3], _) = law(block);
+                let Some(chunk) = chunks.next() else {
+                    return;
+                };
+                for (l, slot) in chunk.chunks_exact_mut(3).enumerate() {
+                    for (s, r) in slot.iter_mut().zip([&r1, &r2, &r3]) {
+                        *s = lane(r, l);
                     }
                 }
             },
