@@ -601,7 +601,7 @@ fn block_product<T: Real, E: Stored<T>>(
             }
         }
     }
-    t.iter_mut().for_each(|tl| *tl = *tl * scale);
+    t.iter_mut().for_each(|tl| *tl *= scale);
     for i in 0..b.rows() {
         let (Some(left), Some(slot)) = (factor_rows(values, b.left, i, r), at(r0 + i)) else {
             continue;
