@@ -28,7 +28,7 @@
 #                                      sequence.txt vs `palpate precomputed replay`, its
 #                                      haptic-loop lines vs the same C built for the host;
 #                                      sizes, stack high-water mark, the pre-computed haptic
-#                                      path's flash (target <= 29 KB), and the link-time proof
+#                                      path's flash (target <= 32 KB), and the link-time proof
 #                                      that no entry point can panic
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -136,16 +136,17 @@ c_mode() {
     local path with_load
     path="$(section_sizes "$c_out/haptic-path.elf" .text | awk '{ print $2 }')"
     with_load="$(section_sizes "$c_out/haptic-path-with-load.elf" .text | awk '{ print $2 }')"
-    # 29 KB: 23 528 bytes before the deep inside check (a tool point inside
+    # 32 KB: 23 528 bytes before the deep inside check (a tool point inside
     # the body is reported, docs/haptic.md), 25 516 with it, 28 796 with the
     # hierarchical compliance's reader (the contact solve reads a block
-    # through the same match over the table's encodings); the 24 KB target
+    # through the same match over the table's encodings), 32 056 with its q16
+    # codes (hmatrix-q16) beside it; the 24 KB target
     # is to be won back with a cheaper check (docs/cycles.md) and an
     # encoding chosen at build time.
-    echo "pre-computed haptic path (loop create, tick, reset): .text $path bytes (target <= 29696);" \
+    echo "pre-computed haptic path (loop create, tick, reset): .text $path bytes (target <= 32768);" \
         "with the table's load and validation: $with_load bytes"
-    if [ "$path" -gt 29696 ]; then
-        echo "FAIL: the pre-computed haptic path's .text exceeds 29 KB" >&2
+    if [ "$path" -gt 32768 ]; then
+        echo "FAIL: the pre-computed haptic path's .text exceeds 32 KB" >&2
         exit 1
     fi
 }
