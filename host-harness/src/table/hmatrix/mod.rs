@@ -46,7 +46,7 @@ use crate::output::stderr;
 
 /// The default relative tolerance of a far block, `‖C_b − L Rᵀ‖_F ≤ tol ·
 /// ‖C_b‖_F`: `1e-5`, which keeps the measured contact-force and touchable
-/// displacement errors below `1e-3` with a margin of 3.7 or more on every
+/// displacement errors below `1e-3` with a margin of 2.9 or more on every
 /// organ measured (docs/tables.md, "Hierarchical tables"); at `1e-4` the
 /// touchable displacement error reached `2.75e-3` on a 55k-tet organ, at
 /// `3e-5` `6.6e-4` on a 19k-tet one.
