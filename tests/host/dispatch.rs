@@ -27,6 +27,7 @@ use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
 use palpate::tensor_mass::OwnedState;
 use palpate::tensor_mass::run::host_params;
+use palpate::threads::{OwnedSplit, split_model};
 use palpate_kernel::math::{Dispatch, Portable};
 use palpate_kernel::precomputed::{QuasiNonLinear, Remap};
 use palpate_kernel::table::TensorMassTable;
@@ -35,12 +36,14 @@ use palpate_kernel::{Constraint, MAX_CONTACTS, PrecomputedModel, PrecomputedTabl
 
 /// The meshes: the cylinder of 6 × 6 × 4 cells (245 vertices, 864 tets:
 /// 108 full blocks of 8 tets in the per-tet pass) and a 3³-cell box (64
-/// vertices, 162 tets: the last block has 2 tets).
-fn meshes() -> [TetMesh; 2] {
+/// vertices, 162 tets: the last block has 2 tets, and 3 parts do not divide
+/// the blocks evenly). Shared with `host::threads`.
+pub fn meshes() -> [TetMesh; 2] {
     [cylinder_mesh(0.04, 3, 4), box_mesh([3; 3], [0.03; 3])]
 }
 
-fn options(precision: Precision) -> BuildOptions {
+/// The tensor-mass table options of the stepped cases (E 5 kPa, ν 0.4, the base fixed).
+pub fn options(precision: Precision) -> BuildOptions {
     BuildOptions::tensor_mass(
         Material::new(5000.0, 0.4).unwrap(),
         1000.0,
@@ -49,9 +52,11 @@ fn options(precision: Precision) -> BuildOptions {
     )
 }
 
-/// The displacements and velocities after `steps` steps of `integrator`
-/// from a 20 % shear with a load on the top, passes through `dispatch`.
-fn stepped<T: Real>(
+/// The displacements and velocities after 4 steps of `integrator` from a
+/// 20 % shear with a load on the top and tets 5 and 17 removed, the passes
+/// through `dispatch` (the per-tet pass split when it has more than one
+/// part). Shared with `host::threads`.
+pub fn stepped<T: Real>(
     mesh: &TetMesh,
     file: &TableFile,
     law: ElasticLaw,
@@ -61,10 +66,15 @@ fn stepped<T: Real>(
 ) -> Vec<[T; 3]> {
     let table = TensorMassTable::<T>::load(file.bytes()).unwrap();
     let mut state = OwnedState::for_table(&table);
+    let mut split: Option<OwnedSplit<T>> = None;
     let params = host_params(&mesh.positions, 3.0)
         .with_law(law)
         .with_incompressibility(penalty.map(T::of_f64));
-    let mut model = TensorMassModel::new(table, state.buffers(), params).unwrap();
+    let model = TensorMassModel::new(table, state.buffers(), params).unwrap();
+    let mut model = split_model(model, &mut split, dispatch.parts()).unwrap();
+    for tet in [5, 17] {
+        model.remove_tet(tet).unwrap();
+    }
     let top = mesh.positions.len() as u32 - 1;
     for (v, p) in mesh.positions.iter().enumerate() {
         let d = Vector3::new(T::of_f64(0.2 * p[2]), T::zero(), T::of_f64(-0.05 * p[2]));
@@ -75,7 +85,7 @@ fn stepped<T: Real>(
     model
         .set_external_force(top, Vector3::new(T::zero(), T::of_f64(0.01), T::zero()))
         .unwrap();
-    for _ in 0..5 {
+    for _ in 0..4 {
         model
             .step_with(dispatch, integrator, T::of_f64(2e-4))
             .unwrap();
@@ -122,7 +132,7 @@ fn check_steps<T: Real>(mesh: &TetMesh, precision: Precision, detected: HostDisp
 }
 
 /// The bit pattern of a scalar, as f64 bits (f32 widened exactly).
-fn bits<T: Real>(x: T) -> u64 {
+pub fn bits<T: Real>(x: T) -> u64 {
     x.as_f64().to_bits()
 }
 

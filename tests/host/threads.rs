@@ -14,28 +14,17 @@
 //! a removed one or summed in another order would differ in the last bits
 //! at least.
 
-use nalgebra::Vector3;
 use palpate::dispatch::HostDispatch;
-use palpate::fem::material::Material;
-use palpate::mesh::generate::{box_mesh, cylinder_mesh};
 use palpate::mesh::{MeshReport, TetMesh};
-use palpate::table::build::{BuildOptions, build};
+use palpate::table::build::build;
 use palpate::table::file::Precision;
 use palpate::table::load::TableFile;
-use palpate::tensor_mass::OwnedState;
-use palpate::tensor_mass::run::host_params;
-use palpate::threads::{OwnedSplit, Threaded, split_model};
+use palpate::threads::Threaded;
 use palpate_kernel::Real;
 use palpate_kernel::math::{Dispatch, MAX_PARTS, Portable};
-use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{ElasticLaw, Integrator, TensorMassModel};
+use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
 
-/// The meshes: the cylinder of 6 × 6 × 4 cells (245 vertices, 864 tets,
-/// 108 full blocks of 8) and a 3³-cell box (64 vertices, 162 tets: the last
-/// block has 2 tets, and 3 parts do not divide the blocks evenly).
-fn meshes() -> [TetMesh; 2] {
-    [cylinder_mesh(0.04, 3, 4), box_mesh([3; 3], [0.03; 3])]
-}
+use super::dispatch::{bits, meshes, options, stepped};
 
 /// A serial dispatch that cuts the split passes into `0` parts and runs
 /// them last first: the result must not depend on the order of the parts.
@@ -58,63 +47,11 @@ impl Dispatch for Reversed {
     }
 }
 
-/// The displacements and velocities after 4 steps of `integrator` from a
-/// 20 % shear with a load on the top and tets 5 and 17 removed, the model
-/// split when `dispatch` has more than one part.
-fn stepped<T: Real>(
-    mesh: &TetMesh,
-    file: &TableFile,
-    law: ElasticLaw,
-    penalty: Option<f64>,
-    integrator: Integrator,
-    dispatch: impl Dispatch,
-) -> Vec<[T; 3]> {
-    let table = TensorMassTable::<T>::load(file.bytes()).unwrap();
-    let mut state = OwnedState::for_table(&table);
-    let mut split: Option<OwnedSplit<T>> = None;
-    let params = host_params(&mesh.positions, 3.0)
-        .with_law(law)
-        .with_incompressibility(penalty.map(T::of_f64));
-    let model = TensorMassModel::new(table, state.buffers(), params).unwrap();
-    let mut model = split_model(model, &mut split, dispatch.parts()).unwrap();
-    for tet in [5, 17] {
-        model.remove_tet(tet).unwrap();
-    }
-    let top = mesh.positions.len() as u32 - 1;
-    for (v, p) in mesh.positions.iter().enumerate() {
-        let d = Vector3::new(T::of_f64(0.2 * p[2]), T::zero(), T::of_f64(-0.05 * p[2]));
-        if model.impose(v as u32, d).is_ok() {
-            model.release(v as u32).unwrap();
-        }
-    }
-    model
-        .set_external_force(top, Vector3::new(T::zero(), T::of_f64(0.01), T::zero()))
-        .unwrap();
-    for _ in 0..4 {
-        model
-            .step_with(dispatch, integrator, T::of_f64(2e-4))
-            .unwrap();
-    }
-    let mut out = model.displacements_m().unwrap().to_vec();
-    out.extend_from_slice(model.velocities_m_s().unwrap());
-    out
-}
-
-/// The bit pattern of a scalar, as f64 bits (f32 widened exactly).
-fn bits<T: Real>(x: T) -> u64 {
-    x.as_f64().to_bits()
-}
-
 /// The cases of `precision` on `meshes`: every law and form, with and
 /// without the penalty, semi-implicit Euler and RK4 (four force passes a
 /// step), each on 1–4 threads and in 3 reversed parts.
 fn check<T: Real>(precision: Precision, meshes: &[TetMesh]) -> usize {
-    let options = BuildOptions::tensor_mass(
-        Material::new(5000.0, 0.4).unwrap(),
-        1000.0,
-        vec!["z<1e-9".parse().unwrap()],
-        precision,
-    );
+    let options = options(precision);
     let detected = HostDispatch::detect();
     let mut compared = 0;
     for mesh in meshes {

@@ -1,6 +1,6 @@
 //! Argument groups several commands share, each flattened into a command
-//! with `#[command(flatten)]`: the material (`--young`, `--poisson`), the
-//! fixed-vertex predicates (`--fix`) and the JSON-only output switch
+//! with `#[command(flatten)]`: the material (`--young`, `--poisson`; with `--density` where a
+//! scene may stand in for them), the fixed-vertex predicates (`--fix`) and the JSON-only output switch
 //! (`--json`); and the values of `--form`, which two commands take.
 
 use anyhow::bail;
@@ -25,6 +25,38 @@ impl MaterialArgs {
     /// The validated material.
     pub fn material(&self) -> anyhow::Result<Material> {
         Ok(Material::new(self.young, self.poisson)?)
+    }
+}
+
+/// `--young`, `--poisson` and `--density` of a command that takes a mesh or, in its place, a
+/// scene (`--scene`, which must be an argument of the same command): required unless `--scene`
+/// is given. Negative numbers parse, as for [`MaterialArgs`].
+#[derive(clap::Args)]
+pub struct MassMaterialArgs {
+    /// Young's modulus, Pa.
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
+    pub young: Option<f64>,
+    /// Poisson ratio, in [0, 0.4999].
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
+    pub poisson: Option<f64>,
+    /// Mass density, kg/m3.
+    #[arg(long, required_unless_present = "scene")]
+    pub density: Option<f64>,
+}
+
+impl MassMaterialArgs {
+    /// The validated material and the density (kg/m³) when all three are given, `None` when
+    /// none is (`--scene` in their place).
+    pub fn given(&self) -> Option<anyhow::Result<(Material, f64)>> {
+        let (Some(young), Some(poisson), Some(density)) = (self.young, self.poisson, self.density)
+        else {
+            return None;
+        };
+        Some(
+            MaterialArgs { young, poisson }
+                .material()
+                .map(|m| (m, density)),
+        )
     }
 }
 

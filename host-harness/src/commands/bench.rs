@@ -8,14 +8,13 @@ use palpate::bench::measure::Sampling;
 use palpate::bench::run::{BenchModel, BenchOptions, Record, check, run};
 use palpate::bench::scene::{SceneBenchOptions, bench_scene, check_scene_bench};
 use palpate::dispatch::HostDispatch;
-use palpate::fem::material::Material;
 use palpate::mesh::read_mesh;
 use palpate::output::stderr;
 use palpate::scene::Scene;
 use palpate::table::estimate::SizeLimits;
 use palpate::table::file::Precision;
 
-use super::args::{FixArgs, ThreadsArgs};
+use super::args::{FixArgs, MassMaterialArgs, ThreadsArgs};
 use super::dynamic::IntegratorArg;
 use super::stdout;
 
@@ -37,15 +36,8 @@ pub struct BenchArgs {
         "dispatch",
     ])]
     scene: Option<String>,
-    /// Young's modulus, Pa.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
-    young: Option<f64>,
-    /// Poisson ratio, in [0, 0.4999].
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
-    poisson: Option<f64>,
-    /// Mass density, kg/m3.
-    #[arg(long, required_unless_present = "scene")]
-    density: Option<f64>,
+    #[command(flatten)]
+    material: MassMaterialArgs,
     #[command(flatten)]
     fix: FixArgs,
     #[command(flatten)]
@@ -104,12 +96,11 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
         samples: args.samples,
         sample_s: args.sample_ms / 1e3,
     };
-    let (Some(path), Some(young), Some(poisson), Some(density)) =
-        (&args.mesh, args.young, args.poisson, args.density)
-    else {
+    let (Some(path), Some(material)) = (&args.mesh, args.material.given()) else {
         let scene = Scene::named(args.scene.as_deref().unwrap_or_default())?;
         return run_scene_bench(&scene, sampling, args.threads.count(), args.json);
     };
+    let (material, density) = material?;
     let (mesh, report) = read_mesh(path)?;
     for w in &report.warnings {
         stderr::line(&format!("warning: {w}"));
@@ -123,7 +114,7 @@ pub fn run_bench(args: &BenchArgs) -> anyhow::Result<()> {
         DispatchChoice::All => HostDispatch::available(),
     };
     let options = BenchOptions {
-        material: Material::new(young, poisson)?,
+        material,
         density_kg_m3: density,
         fix: args.fix.fix.clone(),
         models: args.models.clone(),

@@ -21,7 +21,7 @@ use palpate::threads::Threaded;
 use palpate_kernel::tensor_mass::{ElasticLaw, Integrator};
 
 use super::args::{
-    FixArgs, FormArg, JsonArgs, MaterialArgs, ThreadsArgs, finite_vector, non_negative,
+    FixArgs, FormArg, JsonArgs, MassMaterialArgs, ThreadsArgs, finite_vector, non_negative,
     optional_fix, positive,
 };
 use super::stdout;
@@ -88,15 +88,8 @@ pub struct DynamicModelArgs {
     /// run the hybrid model (displacements of every mesh vertex).
     #[arg(long, conflicts_with_all = ["mesh", "young", "poisson", "density", "fix"])]
     scene: Option<String>,
-    /// Young's modulus, Pa.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
-    young: Option<f64>,
-    /// Poisson ratio, in [0, 0.4999].
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "scene")]
-    poisson: Option<f64>,
-    /// Mass density, kg/m3.
-    #[arg(long, required_unless_present = "scene")]
-    density: Option<f64>,
+    #[command(flatten)]
+    material: MassMaterialArgs,
     /// Mass-proportional damping c (1/s): damping force −c·m_i·v_i.
     #[arg(long, value_parser = non_negative, allow_negative_numbers = true)]
     damping: f64,
@@ -151,13 +144,11 @@ impl DynamicModelArgs {
                 name: scene.source,
             });
         }
-        let (Some(path), Some(young), Some(poisson), Some(density)) =
-            (&self.mesh, self.young, self.poisson, self.density)
-        else {
+        let (Some(path), Some(material)) = (&self.mesh, self.material.given()) else {
             bail!("give a mesh with --young, --poisson and --density, or --scene");
         };
+        let (material, density) = material?;
         let (mesh, report) = read_mesh(path)?;
-        let material = MaterialArgs { young, poisson }.material()?;
         let table =
             BuildOptions::tensor_mass(material, density, self.fix.fix.clone(), Precision::F64);
         Ok(Setup {
