@@ -272,6 +272,9 @@ fn a_fold_between_the_quadrature_points_is_refused() {
         )
     };
     let refused = solve(0.7).expect_err("the folded equilibrium was returned");
-    assert!(format!("{refused:#}").contains("folds tet 0"), "{refused:#}");
+    assert!(
+        format!("{refused:#}").contains("folds tet 0"),
+        "{refused:#}"
+    );
     solve(0.4).expect("the unfolded equilibrium");
 }
