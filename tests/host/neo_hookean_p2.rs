@@ -220,11 +220,10 @@ fn p2_mesh_shares_mid_edge_nodes() {
 /// but −0.4 at the apex: the element is folded over inside, and only the
 /// nodes see it. At `c = 0.4` (`J ≥ 0.2` at the apex) it keeps its
 /// orientation: the check rejects the fold, not a strong compression.
-/// Newton on this one tet with its apex's neighbours held at the fold
-/// (all nodes prescribed but the mid-edge node of the base edge 0–1, which
-/// `φ` leaves in place) converges, and `solve_neo_hookean_p2` refuses the
-/// folded equilibrium (it returned it before the check), not the
-/// unfolded one.
+/// Newton on this one tet, every node prescribed at `φ` but the mid-edge
+/// node of the base edge 0–1 (free), converges, and `solve_neo_hookean_p2`
+/// refuses the folded equilibrium (without the check it returned it), not
+/// the unfolded one.
 #[test]
 fn a_fold_between_the_quadrature_points_is_refused() {
     let corners = [
