@@ -32,6 +32,7 @@ mod host {
     mod mesh;
     mod mesh_regions;
     mod neo_hookean;
+    mod neo_hookean_kernel;
     mod neo_hookean_p2;
     mod neo_hookean_reference;
     mod newton;

@@ -1,13 +1,15 @@
 //! The host's 10-node (P2) compressible neo-Hookean tetrahedron
 //! (`palpate::fem::neo_hookean_p2`): forces against central differences of
 //! the energy, the tangent against central differences of the forces, rigid
-//! motions, and the P1 mesh raised to P2 (shared mid-edge nodes). Its Newton
-//! solves on the scikit-fem problems are in `neo_hookean_reference`.
+//! motions, a fold between the quadrature points (refused), and the
+//! P1 mesh raised to P2 (shared mid-edge nodes). Its Newton solves on the
+//! scikit-fem problems are in `neo_hookean_reference`.
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use palpate::fem::hyperelastic::HyperelasticTet;
-use palpate::fem::material::Material;
+use palpate::fem::material::{Material, TetMaterials};
 use palpate::fem::neo_hookean_p2::{EDGES, NeoHookeanP2Tet, P2Mesh};
+use palpate::fem::newton::{NewtonOptions, StaticProblem, solve_neo_hookean_p2};
 
 /// An irregular tet about 5 cm across (positively oriented), m.
 const CORNERS: [[f64; 3]; 4] = [
@@ -209,4 +211,69 @@ fn p2_mesh_shares_mid_edge_nodes() {
     assert_eq!(loads.len(), 14);
     assert_eq!(loads[3], [1.0, 2.0, 3.0]);
     assert!(loads[5..].iter().all(|l| *l == [0.0; 3]));
+}
+
+/// A fold between the quadrature points: the unit corner tet mapped by
+/// `φ(X) = (x, y, z − c z²)`, exactly interpolated by the P2 nodes, has
+/// `F = diag(1, 1, 1 − 2cz)`. At `c = 0.7`, `J = 1 − 2cz` is 0.18 and 0.81
+/// at the quadrature points (`z = α, β`: the element's energy is finite)
+/// but −0.4 at the apex: the element is folded over inside, and only the
+/// nodes see it. At `c = 0.4` (`J ≥ 0.2` at the apex) it keeps its
+/// orientation: the check rejects the fold, not a strong compression.
+/// Newton on this one tet, every node prescribed at `φ` but the mid-edge
+/// node of the base edge 0–1 (free), converges, and `solve_neo_hookean_p2`
+/// refuses the folded equilibrium (without the check it returned it), not
+/// the unfolded one.
+#[test]
+fn a_fold_between_the_quadrature_points_is_refused() {
+    let corners = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let nodes: [[f64; 3]; 10] = core::array::from_fn(|n| {
+        if n < 4 {
+            corners[n]
+        } else {
+            let [i, j] = EDGES[n - 4];
+            ((Vector3::from(corners[i]) + Vector3::from(corners[j])) * 0.5).into()
+        }
+    });
+    let e = NeoHookeanP2Tet::at_rest(&nodes, &material());
+    let fold = |c: f64| nodes.map(|[x, y, z]| [x, y, z - c * z * z]);
+    assert!(e.admissible(&fold(0.7)) && e.energy_j(&fold(0.7)).is_finite());
+    assert!(!e.keeps_orientation(&fold(0.7)), "a folded element kept");
+    assert!(e.keeps_orientation(&fold(0.4)));
+    let solve = |c: f64| {
+        let prescribed: Vec<(u32, [f64; 3])> = (0..10u32)
+            .filter(|&n| n != 4)
+            .map(|n| {
+                let (x, p) = (fold(c)[n as usize], nodes[n as usize]);
+                (n, [x[0] - p[0], x[1] - p[1], x[2] - p[2]])
+            })
+            .collect();
+        let materials = TetMaterials::uniform(material(), 1);
+        let problem = StaticProblem::<10> {
+            positions: &nodes,
+            tets: &[core::array::from_fn(|n| n as u32)],
+            materials: &materials,
+            fixed: &[false; 10],
+            prescribed: &prescribed,
+            loads_n: &[],
+        };
+        solve_neo_hookean_p2(
+            &problem,
+            &NewtonOptions {
+                load_steps: 4,
+                ..NewtonOptions::default()
+            },
+        )
+    };
+    let refused = solve(0.7).expect_err("the folded equilibrium was returned");
+    assert!(
+        format!("{refused:#}").contains("folds tet 0"),
+        "{refused:#}"
+    );
+    solve(0.4).expect("the unfolded equilibrium");
 }

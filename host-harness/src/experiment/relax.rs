@@ -3,6 +3,14 @@
 //! each peak of the kinetic energy (Cundall's method), until the residual
 //! force is small. The same code path for every elastic law, so the laws are
 //! compared at equilibria found the same way.
+//!
+//! The step: the load is applied at once, so the first swing overshoots the
+//! equilibrium, and a law that stiffens in compression (neo-Hookean: `g''(J)`
+//! grows as `J` falls) can leave the step's stability region on the way. At
+//! `0.5/ω_max` (of the tangent at rest) the neo-Hookean relaxation of the
+//! chart's cylinders under a 20 % press diverged (the kernel's displacement
+//! bound faulted) where `0.3/ω_max` settled (on 1×5 on Newton's own
+//! equilibrium: `tests/host/neo_hookean_kernel.rs`).
 
 use nalgebra::Vector3;
 use palpate_kernel::tensor_mass::{Integrator, StepError, TensorMassModel, VertexMode};

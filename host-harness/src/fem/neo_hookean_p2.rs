@@ -17,8 +17,18 @@
 //! no zero-energy modes (4 points × 6 strains = 24 = 30 DOFs − 6 rigid). The energy,
 //! forces and tangent are the sums over the points ([`RestTet`]), so the
 //! forces are exactly `−∂W/∂x` of the integrated energy.
+//!
+//! Folds: the quadrature points do not see an element folded over between
+//! them. Under a strong press of the chart's 2×10 cylinder the Newton solve
+//! settled, with `J > 0` at every point, in a state whose upper column had
+//! passed through its own base by folding one layer of elements (`J =
+//! −0.04` at a node): an equilibrium of the quadrature, not of the body.
+//! [`NeoHookeanP2Tet::keeps_orientation`] also checks `J` at the ten nodes,
+//! and [`super::newton::solve_neo_hookean_p2`] refuses an equilibrium that
+//! fails it. `J` is a cubic in `Λ`, so these 14 samples reject such folds
+//! without proving `J > 0` everywhere.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 use super::element::shape_gradients;
 use super::hyperelastic::{HyperelasticTet, RestTet, TetTangent};
@@ -44,8 +54,28 @@ pub struct NeoHookeanP2Tet {
 
 impl NeoHookeanP2Tet {
     /// `F` at each quadrature point for nodes `x`.
-    fn deformation_gradients(&self, x: &[[f64; 3]; 10]) -> [nalgebra::Matrix3<f64>; 4] {
+    fn deformation_gradients(&self, x: &[[f64; 3]; 10]) -> [Matrix3<f64>; 4] {
         self.points.map(|p| p.deformation_gradient(x))
+    }
+
+    /// Whether `J > 0` at the four quadrature points and at the ten nodes of
+    /// the element at `x` (module documentation: a fold between the points
+    /// fails it). The map is quadratic, so `F` is affine in `Λ`:
+    /// `F(Λ) = Σ Λ_i F_i` (`F_i` at corner `i`); the points' `F` sum to
+    /// `Σ F_i` (`α + 3β = 1`), so `F_i = (F(point i) − β Σ F(points))/(α − β)`,
+    /// and a mid-edge node's is the mean of its corners'.
+    pub fn keeps_orientation(&self, x: &[[f64; 3]; 10]) -> bool {
+        let at_points = self.deformation_gradients(x);
+        let positive = |f: &Matrix3<f64>| NeoHookeanLaw::invert(f).is_some();
+        if !at_points.iter().all(positive) {
+            return false;
+        }
+        let sum: Matrix3<f64> = at_points.iter().sum();
+        let corners = at_points.map(|f| (f - sum * BETA) / (ALPHA - BETA));
+        corners.iter().all(positive)
+            && EDGES
+                .iter()
+                .all(|&[i, j]| positive(&((corners[i] + corners[j]) * 0.5)))
     }
 }
 

@@ -150,7 +150,10 @@ pub fn solve_neo_hookean(
     solve::<4, NeoHookeanTet>(problem, &options)
 }
 
-/// [`solve_neo_hookean`] on 10-node tets ([`super::neo_hookean_p2`]).
+/// [`solve_neo_hookean`] on 10-node tets ([`super::neo_hookean_p2`]); an
+/// equilibrium that folds a tet between its quadrature points
+/// ([`NeoHookeanP2Tet::keeps_orientation`]: `J ≤ 0` at a node) is an error,
+/// a state of the quadrature, not of the body.
 pub fn solve_neo_hookean_p2(
     problem: &StaticProblem<'_, 10>,
     options: &NewtonOptions,
@@ -159,7 +162,26 @@ pub fn solve_neo_hookean_p2(
         descent: true,
         ..*options
     };
-    solve::<10, NeoHookeanP2Tet>(problem, &options)
+    let equilibrium = solve::<10, NeoHookeanP2Tet>(problem, &options)?;
+    let (positions, u) = (problem.positions, &equilibrium.u);
+    for (t, (tet, material)) in problem
+        .tets
+        .iter()
+        .zip(problem.materials.per_tet())
+        .enumerate()
+    {
+        let element = NeoHookeanP2Tet::at_rest(&tet.map(|v| positions[v as usize]), material);
+        let x = tet.map(|v| {
+            let (p, d) = (positions[v as usize], u[v as usize]);
+            [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+        });
+        ensure!(
+            element.keeps_orientation(&x),
+            "the equilibrium found folds tet {t} between its quadrature points (J ≤ 0 at a \
+             node, > 0 at the points): a state of the quadrature, not of the body"
+        );
+    }
+    Ok(equilibrium)
 }
 
 /// Solves `problem` (module documentation) with the element `E`: the load
