@@ -442,13 +442,29 @@ fn entries<T: Real, E: Stored<T>>(
     let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
     let left = factor_rows(values, b.left, i, r)?;
     let right = factor_rows(values, b.right, j, r)?;
+    // One pass over the rank: each of the `6r` factor numbers read (and a
+    // q16 code decoded) once, not three times, the nine sums kept apart,
+    // each summed in the order of `l` from zero (`C_ab = Σ_l L_al R_bl`).
     let mut c = [T::zero(); 9];
-    for (a, row) in c.chunks_exact_mut(3).enumerate() {
-        for (bb, x) in row.iter_mut().enumerate() {
-            *x = dot(factor_row(left, a, r), factor_row(right, bb, r));
+    for (lv, rv) in columns(left, r).zip(columns(right, r)) {
+        for (row, &la) in c.chunks_exact_mut(3).zip(&lv) {
+            for (x, &rb) in row.iter_mut().zip(&rv) {
+                *x += la * rb;
+            }
         }
     }
     Some(c)
+}
+
+/// The `r` columns of a vertex's three factor rows (`3r` numbers, row
+/// after row): column `l` as `[row₀[l], row₁[l], row₂[l]]`, decoded.
+#[inline(always)]
+fn columns<T: Real, E: Stored<T>>(rows: &[E], r: usize) -> impl Iterator<Item = [T; 3]> + '_ {
+    factor_row(rows, 0, r)
+        .iter()
+        .zip(factor_row(rows, 1, r))
+        .zip(factor_row(rows, 2, r))
+        .map(|((&a, &b), &c)| [a.value(), b.value(), c.value()])
 }
 
 /// Entry `C_ij` of near block `b` (block-relative `i`, `j`), from its
@@ -582,14 +598,6 @@ fn block_rows<T: Real, E: Stored<T>>(
 #[inline(always)]
 fn factor_row<E>(rows: &[E], a: usize, r: usize) -> &[E] {
     rows.get(a * r..a * r + r).unwrap_or(&[])
-}
-
-/// `Σ a_l b_l` of two stored rows.
-#[inline(always)]
-fn dot<T: Real, E: Stored<T>>(a: &[E], b: &[E]) -> T {
-    a.iter()
-        .zip(b)
-        .fold(T::zero(), |s, (&x, &y)| s + x.value() * y.value())
 }
 
 /// `Σ a_l t_l` of a stored row and scalars.
