@@ -34,7 +34,10 @@ fn four_probes_make_four_contacts_on_the_organ() {
     let sites = ProbeSites::of(&scene).expect("sites");
     for p in sites.points {
         let [x, y, z] = p.surface_m;
-        assert!(x.abs() < 0.085 && y.abs() < 0.06 && (-0.02..0.041).contains(&z), "{p:?}");
+        assert!(
+            x.abs() < 0.085 && y.abs() < 0.06 && (-0.02..0.041).contains(&z),
+            "{p:?}"
+        );
     }
     let (mesh, report) = scene.load_mesh().expect("mesh");
     let (tables, _) = budget_table(&scene, &mesh, &report, &M4F_CYCLES, None).expect("tables");

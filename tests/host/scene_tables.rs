@@ -149,8 +149,7 @@ fn a_hybrid_scene_builds_a_hierarchical_interface() {
     assert_eq!(blocks.touchable_count(), interface.connection_count());
 
     for code in ["q16", "hmatrix-q16"] {
-        let coded =
-            scene(&format!("{hybrid}[tables]\ncompress = \"{code}\"\n")).expect("valid");
+        let coded = scene(&format!("{hybrid}[tables]\ncompress = \"{code}\"\n")).expect("valid");
         let error = SceneModel::of(&coded, &mesh, &report)
             .expect("model")
             .tables(&coded, &mesh, &report, None)
@@ -158,8 +157,9 @@ fn a_hybrid_scene_builds_a_hierarchical_interface() {
             .expect("refused")
             .to_string();
         assert!(
-            error.contains(&format!("compress = \"{code}\" applies to a pre-computed scene"))
-                && error.contains("a hybrid takes compress = \"hmatrix\""),
+            error.contains(&format!(
+                "compress = \"{code}\" applies to a pre-computed scene"
+            )) && error.contains("a hybrid takes compress = \"hmatrix\""),
             "{error}"
         );
     }

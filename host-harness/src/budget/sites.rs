@@ -54,7 +54,10 @@ impl ProbeSites {
             let points = core::array::from_fn(|k| {
                 let mut surface_m = anchor.surface_m;
                 surface_m[1] += step(k);
-                Press { surface_m, ..anchor }
+                Press {
+                    surface_m,
+                    ..anchor
+                }
             });
             return Ok(Self { anchor, points });
         }
