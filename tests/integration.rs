@@ -21,6 +21,7 @@ mod ffi {
 
 mod host {
     mod bench;
+    mod budget_sites;
     mod chart;
     mod compliance;
     mod demo;

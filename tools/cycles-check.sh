@@ -16,10 +16,19 @@
 #   tools/cycles-check.sh --all   every trajectory of the three (about 8 minutes)
 #   tools/cycles-check.sh --profile N   also each run's worst tick by class and
 #                                 its N costliest functions
-#   tools/cycles-check.sh --model M   only model M (precomputed, dynamic or
-#                                 hybrid; repeatable)
+#   tools/cycles-check.sh --model M   only model M (precomputed, dynamic,
+#                                 hybrid, organ or organ-dense; repeatable)
 #   tools/cycles-check.sh --compress CODE   the pre-computed table compressed
 #                                 (f16 or q16, as `tables build --compress`)
+#   tools/cycles-check.sh --organ  the built-in organ pre-computed
+#                                 (tools/cycles-m4f/organ.toml: its table
+#                                 hmatrix-q16, model `organ`) and the same
+#                                 scene with the dense f32 table (model
+#                                 `organ-dense`), every trajectory, and the
+#                                 worst cycles per contact count of the two
+#                                 side by side, over every tick and over the ticks
+#                                 with every probe in contact (not run by CI;
+#                                 about 6 minutes warm, 15 cold)
 #   tools/cycles-check.sh --target-report-only   report a pre-computed 4-contact
 #                                 tick above TARGET_CYCLES without failing
 #                                 (.ci/run, until the kernel meets it)
@@ -50,8 +59,13 @@ while [ $# -gt 0 ]; do
             shift
             ;;
         --compress) compress=(--compress "$2"); shift ;;
+        --organ)
+            for m in organ organ-dense; do
+                [[ " ${only_models[*]} " == *" $m "* ]] || only_models+=("$m")
+            done
+            ;;
         --target-report-only) target_flag=--warn-limit ;;
-        *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--model M]... [--compress CODE] [--target-report-only]" >&2; exit 2 ;;
+        *) echo "usage: tools/cycles-check.sh [--all] [--profile N] [--model M]... [--compress CODE] [--organ] [--target-report-only]" >&2; exit 2 ;;
     esac
     shift
 done
@@ -60,22 +74,33 @@ palpate="$(tools/palpate.sh --path)"
 (cd tools/cycles && cargo build -q --release)
 counter="$root/tools/cycles/target/release/palpate-cycles"
 
-# model scene features trajectories...
+# The organ with the dense f32 table: organ.toml without its [tables]
+# (written beside the recordings, its mesh path made absolute).
+mkdir -p "$out"
+sed -e '/^\[tables\]/,$d' -e "s|^mesh = \"../../|mesh = \"$root/|" \
+    tools/cycles-m4f/organ.toml >"$out/organ-dense.toml"
+
+# model scene features: the default models, then the ones only --model or
+# --organ runs.
 models=(
     "precomputed built-in -"
     "dynamic tools/cycles-m4f/dynamic.toml dynamic"
     "hybrid tools/cycles-m4f/hybrid.toml hybrid"
 )
+optional=(
+    "organ tools/cycles-m4f/organ.toml -"
+    "organ-dense $out/organ-dense.toml -"
+)
 if [ ${#only_models[@]} -gt 0 ]; then
     chosen=()
-    for spec in "${models[@]}"; do
+    for spec in "${models[@]}" "${optional[@]}"; do
         read -r model _ <<<"$spec"
         for m in "${only_models[@]}"; do
             [ "$m" = "$model" ] && chosen+=("$spec")
         done
     done
     if [ ${#chosen[@]} != ${#only_models[@]} ]; then
-        echo "--model: one of precomputed, dynamic, hybrid" >&2
+        echo "--model: one of precomputed, dynamic, hybrid, organ, organ-dense" >&2
         exit 2
     fi
     models=("${chosen[@]}")
@@ -86,7 +111,7 @@ pids=()
 for spec in "${models[@]}"; do
     read -r model scene features <<<"$spec"
     only=()
-    if [ "$model" != precomputed ] && [ "$all" = 0 ]; then
+    if [ "$features" != - ] && [ "$all" = 0 ]; then
         only=(--trajectory poke --trajectory strike)
     fi
     table=()
@@ -148,6 +173,32 @@ for i in "${!models[@]}"; do
     done
     echo
 done
+# The organ's compressed tick against the dense one (and the block's, when
+# run): worst cycles per probe count, zero and WAIT_STATES wait states.
+if [ -f "$out/organ/ticks.csv" ] && [ -f "$out/organ-dense/ticks.csv" ]; then
+    csvs=("$out/organ/ticks.csv" "$out/organ-dense/ticks.csv")
+    [ -f "$out/precomputed/ticks.csv" ] && [[ " ${only_models[*]} " == *" precomputed "* ]] &&
+        csvs+=("$out/precomputed/ticks.csv")
+    # Every tick, then the ticks with all m probes in contact (where the
+    # table is read: the worst tick of a run is its first, the deep inside
+    # check's walk, the same on either table).
+    for filter in all contact; do
+        echo "worst cycles per tick, $filter ticks (W = 0 / W = $WAIT_STATES); ratios of the organ hmatrix-q16's W = 0 to the dense organ's and the block's"
+        awk -F, -v filter="$filter" 'FNR == 1 { next }
+            filter == "contact" && $11 != $3 { next }
+            { k = $1 SUBSEP $3; if ($6 > w0[k]) w0[k] = $6; if ($7 > w5[k]) w5[k] = $7; seen[$1] = 1 }
+            END {
+                printf "%-3s %-20s %-20s %-20s %-8s %s\n", "m", "organ (hmatrix-q16)", "organ-dense (f32)", "block (f32)", "/dense", "/block"
+                for (m = 1; m <= 4; m++) {
+                    o = "organ" SUBSEP m; d = "organ-dense" SUBSEP m; b = "precomputed" SUBSEP m
+                    block = ("precomputed" in seen) ? w0[b] " / " w5[b] : "-"
+                    rb = ("precomputed" in seen) ? sprintf("%.2f", w0[o] / w0[b]) : "-"
+                    printf "%-3d %-20s %-20s %-20s %-8.2f %s\n", m, w0[o] " / " w5[o], w0[d] " / " w5[d], block, w0[o] / w0[d], rb
+                }
+            }' "${csvs[@]}"
+        echo
+    done
+fi
 if [ "$status" = 0 ]; then
     echo "cycles: every tick within its static bound; the target's tick lines equal the host's (every run)"
 else

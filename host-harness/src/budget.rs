@@ -58,11 +58,6 @@ use palpate_script::ticks::{Header, Settings, tool_words, write_tick};
 
 use crate::mesh::{MeshReport, TetMesh};
 use crate::output::atomic::{AtomicFile, work_folder};
-use crate::scene::generate::{
-    GenerateError, Generator, Keyframe, Pinch, Poke, Press, PressHold, Slide, Strike, hepatectomy,
-    sample_keyframes, surgery,
-};
-use crate::scene::{DEFAULT_HAPTIC_HZ, MAX_TOOL_POINTS, MeshSource, ToolKind};
 use crate::scene::{Scene, Trajectory};
 use crate::session::hybrid::HybridSetup;
 use crate::session::model::{SceneModel, SceneTables};
@@ -72,6 +67,9 @@ use crate::session::setup::{DynamicSetup, loop_config};
 use crate::session::stability::check_stable_step;
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
 use crate::table::compress::Compression;
+
+mod sites;
+pub use sites::{PROBE_SITE_SPACING_M, ProbeSites, trajectories};
 
 /// The unit costs of the static tick bound, in one unit: x86-64
 /// instructions for the host ([`HOST_IR`], measured with callgrind) or
@@ -613,97 +611,4 @@ pub fn chosen_trajectories(
         chosen.retain(|(name, _)| only.iter().any(|o| o == name));
     }
     Ok(chosen)
-}
-
-/// Spacing of the probe sites of a scene with several probes, m: tool
-/// point `k` presses at the default press's point (the built-in block's
-/// top-face centre) moved along y by `PROBE_SITE_SPACING_M` times
-/// `[0, 1, −1, 2][k]` (y = 6, 8, 4 and 10 cm on the built-in block: every
-/// site 2 cm or more from the others and from the edges).
-pub const PROBE_SITE_SPACING_M: f64 = 0.02;
-
-/// The press of tool point `k` (see [`PROBE_SITE_SPACING_M`]): `press`
-/// moved to the point's site.
-fn probe_site(k: usize, press: Press) -> Press {
-    const STEPS: [f64; MAX_TOOL_POINTS] = [0.0, 1.0, -1.0, 2.0];
-    let step = STEPS.get(k).copied().unwrap_or(0.0);
-    let mut surface_m = press.surface_m;
-    surface_m[1] += step * PROBE_SITE_SPACING_M;
-    Press { surface_m, ..press }
-}
-
-/// The generated trajectories a budget runs for `scene`'s tool: for probes
-/// the poke, press-hold, slide and strike, each tool point on its own site
-/// ([`PROBE_SITE_SPACING_M`]) moving together, so that `P` probes make up to
-/// `P` simultaneous contacts, and with two or more points the pinch (tool
-/// points 0 and 1; the others press and hold on their sites); for a scene
-/// with a grasper or a cutter, [`surgery`] (on the built-in block's top),
-/// or [`hepatectomy`] on the built-in organ.
-pub fn trajectories(scene: &Scene) -> anyhow::Result<Vec<(&'static str, Trajectory)>> {
-    let err = |e: crate::scene::GenerateError| anyhow::anyhow!("{e}");
-    let tool = &scene.tool;
-    if tool.kinds.iter().any(|k| *k != ToolKind::Probe) {
-        return Ok(match scene.mesh {
-            MeshSource::BuiltInOrgan => {
-                vec![("hepatectomy", hepatectomy(tool).map_err(err)?)]
-            }
-            _ => vec![("surgery", surgery(tool).map_err(err)?)],
-        });
-    }
-    let points = tool.points.clamp(1, MAX_TOOL_POINTS);
-    // Every tool point's keyframes of one generator, sampled together.
-    let every_point = |keys: &dyn Fn(usize) -> Result<Vec<Keyframe>, GenerateError>| {
-        let mut all = Vec::new();
-        for k in 0..points {
-            all.extend(keys(k)?);
-        }
-        sample_keyframes(&all, DEFAULT_HAPTIC_HZ).map_err(err)
-    };
-    let poke = |k| {
-        Poke {
-            tool: k,
-            press: probe_site(k, Poke::default().press),
-            ..Poke::default()
-        }
-        .keyframes()
-    };
-    let press_hold = |k| {
-        PressHold {
-            tool: k,
-            press: probe_site(k, PressHold::default().press),
-            ..PressHold::default()
-        }
-        .keyframes()
-    };
-    let slide = |k| {
-        Slide {
-            tool: k,
-            press: probe_site(k, Slide::default().press),
-            ..Slide::default()
-        }
-        .keyframes()
-    };
-    let strike = |k| {
-        Strike {
-            tool: k,
-            press: probe_site(k, Strike::default().press),
-            ..Strike::default()
-        }
-        .keyframes()
-    };
-    let mut out = vec![
-        ("poke", every_point(&poke)?),
-        ("press-hold", every_point(&press_hold)?),
-        ("slide", every_point(&slide)?),
-        ("strike", every_point(&strike)?),
-    ];
-    if points >= 2 {
-        let pinch = |k| match k {
-            0 => Pinch::default().keyframes(),
-            1 => Ok(Vec::new()),
-            _ => press_hold(k),
-        };
-        out.push(("pinch", every_point(&pinch)?));
-    }
-    Ok(out)
 }

@@ -1,8 +1,8 @@
 //! A scene's `[tables]` (`host-harness/src/scene/tables.rs`, `session::model::scene_compression`):
 //! each option only with its code and in its range, the defaults of `tables build`, and a
-//! pre-computed scene built with the table the scene names (a hierarchical one read back by the
-//! kernel as such), a hybrid scene's interface hierarchical for `"hmatrix"`, the other codes
-//! refused on the other models.
+//! pre-computed scene built with the table the scene names (a hierarchical one, f32 or q16, read
+//! back by the kernel as such), a hybrid scene's interface hierarchical for `"hmatrix"`, the other
+//! codes refused on the other models.
 
 use std::path::Path;
 
@@ -38,6 +38,13 @@ fn tables_options_take_their_code_and_range() {
     let c = scene_compression(&scene("[tables]\ncompress = \"hmatrix\"\n").unwrap().tables)
         .expect("compressed");
     assert_eq!(c.tolerance, DEFAULT_TOLERANCE);
+    let c = scene_compression(
+        &scene("[tables]\ncompress = \"hmatrix-q16\"\ntolerance = 3e-3\n")
+            .unwrap()
+            .tables,
+    )
+    .expect("compressed");
+    assert_eq!((c.code, c.tolerance), (BlockCode::HmatrixQ16, 3e-3));
     assert!(scene_compression(&scene("").unwrap().tables).is_none());
     for (extra, expected) in [
         (
@@ -53,6 +60,10 @@ fn tables_options_take_their_code_and_range() {
             "[tables] drop_below",
         ),
         ("[tables]\ncompress = \"f16\"\ndrop_below = 1\n", "[0, 1)"),
+        (
+            "[tables]\ncompress = \"hmatrix-q16\"\ndrop_below = 0.1\n",
+            "[tables] drop_below",
+        ),
         ("[tables]\ntolerance = 1e-3\n", "[tables] tolerance"),
         ("[tables]\ncompress = \"zip\"\n", "unknown variant"),
         ("[tables]\ncompres = \"q16\"\n", "unknown field"),
@@ -77,6 +88,20 @@ fn a_precomputed_scene_builds_the_table_its_tables_name() {
     assert_eq!(
         table.surface_blocks().encoding(),
         BlockEncoding::Hierarchical
+    );
+    // The same in 16-bit fixed point (`tables build --compress hmatrix-q16`).
+    let s = scene("[tables]\ncompress = \"hmatrix-q16\"\ntolerance = 3e-3\n").expect("valid");
+    let SceneTables::Precomputed(file) = SceneModel::of(&s, &mesh, &report)
+        .expect("model")
+        .tables(&s, &mesh, &report, None)
+        .expect("tables")
+    else {
+        panic!("a pre-computed scene");
+    };
+    let table = PrecomputedTable::<f32>::load(file.bytes()).expect("load");
+    assert_eq!(
+        table.surface_blocks().encoding(),
+        BlockEncoding::HierarchicalQ16
     );
 
     let dynamic =
@@ -123,16 +148,19 @@ fn a_hybrid_scene_builds_a_hierarchical_interface() {
     assert_eq!(blocks.record().tolerance, 1e-3);
     assert_eq!(blocks.touchable_count(), interface.connection_count());
 
-    let coded = scene(&format!("{hybrid}[tables]\ncompress = \"q16\"\n")).expect("valid");
-    let error = SceneModel::of(&coded, &mesh, &report)
-        .expect("model")
-        .tables(&coded, &mesh, &report, None)
-        .err()
-        .expect("refused");
-    assert!(
-        error
-            .to_string()
-            .contains("a hybrid takes compress = \"hmatrix\""),
-        "{error:#}"
-    );
+    for code in ["q16", "hmatrix-q16"] {
+        let coded = scene(&format!("{hybrid}[tables]\ncompress = \"{code}\"\n")).expect("valid");
+        let error = SceneModel::of(&coded, &mesh, &report)
+            .expect("model")
+            .tables(&coded, &mesh, &report, None)
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(
+            error.contains(&format!(
+                "compress = \"{code}\" applies to a pre-computed scene"
+            )) && error.contains("a hybrid takes compress = \"hmatrix\""),
+            "{error}"
+        );
+    }
 }

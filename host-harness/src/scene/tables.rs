@@ -3,15 +3,17 @@
 //!
 //! ```toml
 //! [tables]
-//! compress = "hmatrix"   # "f16", "q16" or "hmatrix"; absent: the f32 table
-//! tolerance = 1e-4       # hmatrix only: the far blocks' relative truncation
-//!                        # tolerance, in (0, 1); default the build's
+//! compress = "hmatrix"   # "f16", "q16", "hmatrix" or "hmatrix-q16"; absent: the
+//!                        # f32 table
+//! tolerance = 1e-4       # hmatrix and hmatrix-q16 only: the far blocks' relative
+//!                        # truncation tolerance, in (0, 1); default the build's
 //! drop_below = 0.01      # f16 and q16 only: the interior blocks dropped below this
 //!                        # fraction of their column's largest, in [0, 1); default 0
 //! ```
 //!
 //! A pre-computed scene's compliance table takes every code; a hybrid
-//! scene's `"hmatrix"` only, which stores its interface's condensed
+//! scene's `"hmatrix"` only (`"hmatrix-q16"` is refused there as `"f16"` and
+//! `"q16"` are), which stores its interface's condensed
 //! stiffness hierarchically (`crate::hybrid::hmatrix`, `tolerance` its far
 //! blocks'); a tensor-mass scene none (`crate::session::model` refuses
 //! them).
@@ -31,6 +33,21 @@ pub enum TableCode {
     Q16,
     /// A hierarchical matrix: near blocks and low-rank far blocks.
     Hmatrix,
+    /// The hierarchical matrix with its numbers as 16-bit fixed point
+    /// (`tables build --compress hmatrix-q16`); a pre-computed scene's only.
+    HmatrixQ16,
+}
+
+impl TableCode {
+    /// The code as a scene file writes it (`compress = "…"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TableCode::F16 => "f16",
+            TableCode::Q16 => "q16",
+            TableCode::Hmatrix => "hmatrix",
+            TableCode::HmatrixQ16 => "hmatrix-q16",
+        }
+    }
 }
 
 /// The `[tables]` table, validated (`TablesSpec::new`): `compress`
@@ -39,7 +56,7 @@ pub enum TableCode {
 pub struct TablesSpec {
     /// The code, `None` for the f32 table.
     pub compress: Option<TableCode>,
-    /// `hmatrix` only: the far blocks' relative tolerance, in `(0, 1)`;
+    /// `hmatrix` and `hmatrix-q16` only: the far blocks' relative tolerance, in `(0, 1)`;
     /// `None`: the build's default.
     pub tolerance: Option<f64>,
     /// `f16`/`q16` only: the drop threshold, in `[0, 1)`; `None`: 0.
@@ -64,12 +81,18 @@ impl TablesSpec {
             tolerance: raw.tolerance,
             drop_below: raw.drop_below,
         };
-        let hmatrix = spec.compress == Some(TableCode::Hmatrix);
+        let hmatrix = matches!(
+            spec.compress,
+            Some(TableCode::Hmatrix | TableCode::HmatrixQ16)
+        );
         let coded = matches!(spec.compress, Some(TableCode::F16 | TableCode::Q16));
         let fail = |key: &str, msg: &str| Err((format!("[tables] {key}"), msg.to_owned()));
         if let Some(tolerance) = spec.tolerance {
             if !hmatrix {
-                return fail("tolerance", "applies to compress = \"hmatrix\" only");
+                return fail(
+                    "tolerance",
+                    "applies to compress = \"hmatrix\" or \"hmatrix-q16\" only",
+                );
             }
             if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
                 return fail("tolerance", "must be a relative tolerance in (0, 1)");

@@ -188,6 +188,7 @@ pub fn scene_compression(tables: &TablesSpec) -> Option<Compression> {
         TableCode::F16 => BlockCode::F16,
         TableCode::Q16 => BlockCode::Q16,
         TableCode::Hmatrix => BlockCode::Hmatrix,
+        TableCode::HmatrixQ16 => BlockCode::HmatrixQ16,
     };
     Some(Compression {
         code,
@@ -211,10 +212,11 @@ pub fn hybrid_tables(
 ) -> anyhow::Result<HybridTables> {
     let interface_compression = match scene.tables.compress {
         None | Some(TableCode::Hmatrix) => scene.tables.interface_compression(),
-        Some(_) => bail!(
-            "{}: [tables] compress = \"f16\" or \"q16\" applies to a pre-computed scene; a \
-             hybrid takes compress = \"hmatrix\" (its interface's condensed stiffness)",
-            scene.source
+        Some(code) => bail!(
+            "{}: [tables] compress = \"{}\" applies to a pre-computed scene; a hybrid takes \
+             compress = \"hmatrix\" (its interface's condensed stiffness)",
+            scene.source,
+            code.name()
         ),
     };
     let materials = scene.tet_materials(mesh, report)?;

@@ -382,12 +382,21 @@ impl<'a, T: Real> HierarchicalBlocks<'a, T> {
                 continue;
             };
             let i0 = lo - b.row_start as usize;
+            let rows_of = i0..i0 + rows.len();
+            // Each row's part added to its slot of `out`.
+            let add = |i: usize, v: [T; 3]| {
+                if let Some(u) = rows.get_mut(i - i0) {
+                    *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
+                }
+            };
             match self.values {
-                Values::Scalar(data) => add_block(data, b, i0, j, &w, rows),
+                Values::Scalar(data) => {
+                    block_rows(data, b, rows_of, j..j + 1, |_| Some(w), T::one(), add);
+                }
                 Values::Q16 { codes, scales } => {
                     if let Some(&pair) = scales.get(index as usize) {
-                        let s = block_scale(b, pair);
-                        add_block(codes, b, i0, j, &w.map(|x| x * s), rows);
+                        let ws = w.map(|x| x * block_scale(b, pair));
+                        block_rows(codes, b, rows_of, j..j + 1, |_| Some(ws), T::one(), add);
                     }
                 }
             }
@@ -433,13 +442,29 @@ fn entries<T: Real, E: Stored<T>>(
     let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
     let left = factor_rows(values, b.left, i, r)?;
     let right = factor_rows(values, b.right, j, r)?;
+    // One pass over the rank: each of the `6r` factor numbers read (and a
+    // q16 code decoded) once, not three times, the nine sums kept apart,
+    // each summed in the order of `l` from zero (`C_ab = Σ_l L_al R_bl`).
     let mut c = [T::zero(); 9];
-    for (a, row) in c.chunks_exact_mut(3).enumerate() {
-        for (bb, x) in row.iter_mut().enumerate() {
-            *x = dot(factor_row(left, a, r), factor_row(right, bb, r));
+    for (lv, rv) in columns(left, r).zip(columns(right, r)) {
+        for (row, &la) in c.chunks_exact_mut(3).zip(&lv) {
+            for (x, &rb) in row.iter_mut().zip(&rv) {
+                *x += la * rb;
+            }
         }
     }
     Some(c)
+}
+
+/// The `r` columns of a vertex's three factor rows (`3r` numbers, row
+/// after row): column `l` as `[row₀[l], row₁[l], row₂[l]]`, decoded.
+#[inline(always)]
+fn columns<T: Real, E: Stored<T>>(rows: &[E], r: usize) -> impl Iterator<Item = [T; 3]> + '_ {
+    factor_row(rows, 0, r)
+        .iter()
+        .zip(factor_row(rows, 1, r))
+        .zip(factor_row(rows, 2, r))
+        .map(|((&a, &b), &c)| [a.value(), b.value(), c.value()])
 }
 
 /// Entry `C_ij` of near block `b` (block-relative `i`, `j`), from its
@@ -470,62 +495,6 @@ fn factor_rows<E>(values: &[E], offset: u32, i: usize, r: usize) -> Option<&[E]>
     values.get(start..start + 3 * r)
 }
 
-/// [`HierarchicalBlocks::add_column`]'s work on one block: rows `i0..` of
-/// its column `j` times `w` (already times the block's scale).
-#[inline(always)]
-fn add_block<T: Real, E: Stored<T>>(
-    values: &[E],
-    b: &HierarchyBlock,
-    i0: usize,
-    j: usize,
-    w: &[T; 3],
-    rows: &mut [[T; 3]],
-) {
-    if b.rank == 0 {
-        for (i, u) in (i0..).zip(rows) {
-            if let Some(c) = near_entry(values, b, i, j) {
-                let v = block::mul(&c, w);
-                *u = [u[0] + v[0], u[1] + v[1], u[2] + v[2]];
-            }
-        }
-    } else {
-        add_far(values, b, i0, j, w, rows);
-    }
-}
-
-/// A far block's rows: `t = R_jᵀ w`, then `u_i += L_i t`.
-#[inline(always)]
-fn add_far<T: Real, E: Stored<T>>(
-    values: &[E],
-    b: &HierarchyBlock,
-    i0: usize,
-    j: usize,
-    w: &[T; 3],
-    rows: &mut [[T; 3]],
-) {
-    let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
-    let Some(right) = factor_rows(values, b.right, j, r) else {
-        return;
-    };
-    let mut t = [T::zero(); HIERARCHY_MAX_RANK];
-    let Some(t) = t.get_mut(..r) else {
-        return;
-    };
-    for (bb, &wb) in w.iter().enumerate() {
-        for (tl, &x) in t.iter_mut().zip(factor_row(right, bb, r)) {
-            *tl += x.value() * wb;
-        }
-    }
-    for (i, u) in (i0..).zip(rows) {
-        let Some(left) = factor_rows(values, b.left, i, r) else {
-            continue;
-        };
-        for (a, x) in u.iter_mut().enumerate() {
-            *x += dot_scalar(factor_row(left, a, r), t);
-        }
-    }
-}
-
 impl<T: Real> HierarchicalBlocks<'_, T> {
     /// The product `y = C x` of the whole matrix, delivered in parts: for
     /// every block `b` and each of its rows `i`, `sink(at(i), v)` with
@@ -546,11 +515,20 @@ impl<T: Real> HierarchicalBlocks<'_, T> {
         mut sink: impl FnMut(usize, [T; 3]),
     ) {
         for (index, b) in self.blocks.iter().enumerate() {
+            let (r0, c0) = (b.row_start as usize, b.col_start as usize);
+            let input = |j: usize| at(c0 + j).and_then(|slot| x.get(slot)).copied();
+            let deliver = |i: usize, v: [T; 3]| {
+                if let Some(slot) = at(r0 + i) {
+                    sink(slot, v);
+                }
+            };
+            let (rows, cols) = (0..b.rows(), 0..b.cols());
             match self.values {
-                Values::Scalar(data) => block_product(data, b, T::one(), &at, x, &mut sink),
+                Values::Scalar(data) => block_rows(data, b, rows, cols, input, T::one(), deliver),
                 Values::Q16 { codes, scales } => {
                     if let Some(&pair) = scales.get(index) {
-                        block_product(codes, b, block_scale(b, pair), &at, x, &mut sink);
+                        let scale = block_scale(b, pair);
+                        block_rows(codes, b, rows, cols, input, scale, deliver);
                     }
                 }
             }
@@ -558,31 +536,35 @@ impl<T: Real> HierarchicalBlocks<'_, T> {
     }
 }
 
-/// [`HierarchicalBlocks::products`]' work on one block, each part times
-/// `scale` (one for table scalars: the same bits).
+/// The one per-block kernel of [`HierarchicalBlocks::add_column`] (one
+/// column, its input already times the block's scale, `scale` one) and
+/// [`HierarchicalBlocks::products`] (every column, `scale` the block's):
+/// for each block-relative row `i` of `rows`, `out(i, v)` with
+/// `v = scale · Σ_{j ∈ cols} C_ij x(j)` (block-relative `j`; a `None` input
+/// adds nothing). Near: `v` summed from zero, 9 multiply-adds per entry,
+/// then times `scale`; far: `t = scale · Σ_j R_jᵀ x(j)` (`3r` per column,
+/// one `r`-vector on the stack), then `v = L_i t` (`3r` per row), so a far
+/// block costs `3r(rows + cols)` whatever the column range.
 #[inline(always)]
-fn block_product<T: Real, E: Stored<T>>(
+fn block_rows<T: Real, E: Stored<T>>(
     values: &[E],
     b: &HierarchyBlock,
+    rows: core::ops::Range<usize>,
+    cols: core::ops::Range<usize>,
+    x: impl Fn(usize) -> Option<[T; 3]>,
     scale: T,
-    at: &impl Fn(usize) -> Option<usize>,
-    x: &[[T; 3]],
-    sink: &mut impl FnMut(usize, [T; 3]),
+    mut out: impl FnMut(usize, [T; 3]),
 ) {
-    let input = |j: usize| at(j).and_then(|slot| x.get(slot));
-    let (r0, c0) = (b.row_start as usize, b.col_start as usize);
     if b.rank == 0 {
-        for i in 0..b.rows() {
+        for i in rows {
             let mut v = [T::zero(); 3];
-            for j in 0..b.cols() {
-                if let (Some(c), Some(xj)) = (near_entry(values, b, i, j), input(c0 + j)) {
-                    let p = block::mul(&c, xj);
+            for j in cols.clone() {
+                if let (Some(c), Some(xj)) = (near_entry(values, b, i, j), x(j)) {
+                    let p = block::mul(&c, &xj);
                     v = [v[0] + p[0], v[1] + p[1], v[2] + p[2]];
                 }
             }
-            if let Some(slot) = at(r0 + i) {
-                sink(slot, v.map(|e| e * scale));
-            }
+            out(i, v.map(|e| e * scale));
         }
         return;
     }
@@ -591,8 +573,8 @@ fn block_product<T: Real, E: Stored<T>>(
     let Some(t) = t.get_mut(..r) else {
         return;
     };
-    for j in 0..b.cols() {
-        let (Some(right), Some(xj)) = (factor_rows(values, b.right, j, r), input(c0 + j)) else {
+    for j in cols {
+        let (Some(right), Some(xj)) = (factor_rows(values, b.right, j, r), x(j)) else {
             continue;
         };
         for (bb, &xb) in xj.iter().enumerate() {
@@ -602,14 +584,13 @@ fn block_product<T: Real, E: Stored<T>>(
         }
     }
     t.iter_mut().for_each(|tl| *tl *= scale);
-    for i in 0..b.rows() {
-        let (Some(left), Some(slot)) = (factor_rows(values, b.left, i, r), at(r0 + i)) else {
-            continue;
-        };
-        sink(
-            slot,
-            core::array::from_fn(|a| dot_scalar(factor_row(left, a, r), t)),
-        );
+    for i in rows {
+        if let Some(left) = factor_rows(values, b.left, i, r) {
+            out(
+                i,
+                core::array::from_fn(|a| dot_scalar(factor_row(left, a, r), t)),
+            );
+        }
     }
 }
 
@@ -617,14 +598,6 @@ fn block_product<T: Real, E: Stored<T>>(
 #[inline(always)]
 fn factor_row<E>(rows: &[E], a: usize, r: usize) -> &[E] {
     rows.get(a * r..a * r + r).unwrap_or(&[])
-}
-
-/// `Σ a_l b_l` of two stored rows.
-#[inline(always)]
-fn dot<T: Real, E: Stored<T>>(a: &[E], b: &[E]) -> T {
-    a.iter()
-        .zip(b)
-        .fold(T::zero(), |s, (&x, &y)| s + x.value() * y.value())
 }
 
 /// `Σ a_l t_l` of a stored row and scalars.
