@@ -57,7 +57,6 @@ pub struct InterfaceTable<'a, T: Real> {
     connections: &'a [[u32; 2]],
     condensed: CondensedStiffness<'a, T>,
     response: &'a [[T; 3]],
-    response_rows: usize,
     load_displacement: &'a [[T; 3]],
     load_force: &'a [[T; 3]],
     dynamic_vertex: &'a [u32],
@@ -71,13 +70,14 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
     pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
         let c = Container::parse::<T>(bytes, TableKind::Interface)?;
         let (response, response_rows) = connection_response(&c)?;
+        // The handle a C caller holds a table in has a fixed size: the row
+        // count is the response's length over `3c`, not a field of its own.
         let table = Self {
             header: c.header,
             checksum: c.checksum,
             connections: c.section(SectionKind::ConnectionVertex)?,
             condensed: condensed_stiffness(&c)?,
             response,
-            response_rows,
             load_displacement: c.section(SectionKind::LoadDisplacement)?,
             load_force: c.section(SectionKind::LoadForce)?,
             dynamic_vertex: c.section(SectionKind::DynamicVertex)?,
@@ -243,7 +243,7 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
     /// interface whose region is hierarchical
     /// ([`SectionKind::TouchableResponse`]).
     pub fn response_rows(&self) -> usize {
-        self.response_rows
+        self.response.len() / (3 * self.connection_count()).max(1)
     }
 
     /// Row `r = 3n + a` (free index `n` of the pre-computed table, component
