@@ -22,10 +22,10 @@ use palpate::table::build::BuildOptions;
 use palpate::table::file::Precision;
 use palpate_kernel::hybrid::HybridModel;
 use palpate_kernel::precomputed::Constraint;
-use palpate_kernel::{LoadError, PrecomputedTable};
 use palpate_kernel::table::format::SectionKind;
 use palpate_kernel::table::{CondensedStiffness, InterfaceTable};
 use palpate_kernel::tensor_mass::{DynamicParams, Integrator};
+use palpate_kernel::{LoadError, PrecomputedTable};
 use palpate_tests::{Lcg, patch_section};
 
 /// The far blocks' relative tolerance of the compressed interface.
@@ -389,7 +389,10 @@ fn interior(tables: &HybridTables) -> Vec<bool> {
         .expect("interface")
         .response_rows();
     assert_eq!(rows, region.touchable_count(), "touchable rows only");
-    assert!(region.free_count() > rows, "the region has interior vertices");
+    assert!(
+        region.free_count() > rows,
+        "the region has interior vertices"
+    );
     // More than one leaf of the region's cluster tree (32 vertices).
     assert!(rows > 32, "{rows} touchable vertices");
     let mut flags = vec![false; region.vertex_count()];
@@ -452,8 +455,15 @@ fn compressed_region_steady_state_is_the_global_solve() {
         .expect("hybrid");
         errors.push(max_error(&field, &global, &skip, scale));
         if std::ptr::eq(tables, &w.compressed) {
-            let moved = field.iter().zip(&skip).filter(|(u, s)| **s && **u != [0.0; 3]);
-            assert_eq!(moved.count(), 0, "an interior vertex reported a displacement");
+            let moved = field
+                .iter()
+                .zip(&skip)
+                .filter(|(u, s)| **s && **u != [0.0; 3]);
+            assert_eq!(
+                moved.count(),
+                0,
+                "an interior vertex reported a displacement"
+            );
         }
     }
     println!(

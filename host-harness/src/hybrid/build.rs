@@ -19,11 +19,11 @@ use crate::fem::material::{Material, TetMaterials};
 use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, BuiltTable, Stages, TableKindOptions, precomputed};
-use crate::table::compress::{BlockCode, Compression, ContactBlocks};
-use crate::table::hmatrix::clustered;
 use crate::table::compliance::Solver;
+use crate::table::compress::{BlockCode, Compression, ContactBlocks};
 use crate::table::estimate::SizeLimits;
 use crate::table::file::{Precision, Section, write_container};
+use crate::table::hmatrix::clustered;
 use crate::table::load::TableFile;
 use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 
@@ -433,13 +433,9 @@ fn prepare(
         build.precision,
     );
     let estimate = match &options.interface_compression {
-        Some(compression) => estimate.compressed(
-            mesh,
-            &split,
-            &region,
-            compression,
-            options.compress_region,
-        ),
+        Some(compression) => {
+            estimate.compressed(mesh, &split, &region, compression, options.compress_region)
+        }
         None => estimate,
     };
     estimate.check(&options.limits, source)?;
