@@ -454,7 +454,7 @@ fn compressed_region_steady_state_is_the_global_solve() {
         })
         .expect("hybrid");
         errors.push(max_error(&field, &global, &skip, scale));
-        if std::ptr::eq(tables, &w.compressed) {
+        if core::ptr::eq(tables, &w.compressed) {
             let moved = field
                 .iter()
                 .zip(&skip)
