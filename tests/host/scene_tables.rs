@@ -122,11 +122,12 @@ fn a_precomputed_scene_builds_the_table_its_tables_name() {
 }
 
 /// A hybrid scene (a cut sphere in the block) with `compress = "hmatrix"`: its interface's
-/// condensed stiffness hierarchical, read back by the kernel as such (the far-block tolerance
-/// the scene's, in the hierarchy record); `"q16"` refused on a hybrid.
+/// condensed stiffness and its pre-computed region's table hierarchical, read back by the
+/// kernel as such (the far-block tolerance the scene's, in the hierarchy records), the
+/// interface's response over the region's touchable rows only; `"q16"` refused on a hybrid.
 #[test]
 fn a_hybrid_scene_builds_a_hierarchical_interface() {
-    use palpate_kernel::table::{CondensedStiffness, InterfaceTable};
+    use palpate_kernel::table::{ComplianceBlocks, CondensedStiffness, InterfaceTable};
     let hybrid = "[model]\nkind = \"dynamic\"\ndamping_per_s = 2\n[[zone]]\nkind = \"cut\"\n\
                   shape = \"sphere\"\ncenter_m = [0.03, 0.03, 0.03]\nradius_m = 0.005\n";
     let s = scene(&format!(
@@ -147,6 +148,12 @@ fn a_hybrid_scene_builds_a_hierarchical_interface() {
     };
     assert_eq!(blocks.record().tolerance, 1e-3);
     assert_eq!(blocks.touchable_count(), interface.connection_count());
+    let region = PrecomputedTable::<f32>::load(files.precomputed.bytes()).expect("region");
+    let ComplianceBlocks::Hierarchical(region_blocks) = region.surface_blocks() else {
+        panic!("a dense pre-computed region");
+    };
+    assert_eq!(region_blocks.record().tolerance, 1e-3);
+    assert_eq!(interface.response_rows(), region.touchable_count());
 
     for code in ["q16", "hmatrix-q16"] {
         let coded = scene(&format!("{hybrid}[tables]\ncompress = \"{code}\"\n")).expect("valid");

@@ -20,8 +20,10 @@ use crate::fix::{FixPredicate, fixed_vertices};
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, BuiltTable, Stages, TableKindOptions, precomputed};
 use crate::table::compliance::Solver;
+use crate::table::compress::{BlockCode, Compression, ContactBlocks};
 use crate::table::estimate::SizeLimits;
 use crate::table::file::{Precision, Section, write_container};
+use crate::table::hmatrix::clustered;
 use crate::table::load::TableFile;
 use crate::table::tensor_mass::{TensorMassArrays, write_tensor_mass_table};
 
@@ -46,6 +48,13 @@ pub struct HybridOptions {
     /// The interface's condensed stiffness stored hierarchically
     /// (`[tables] compress = "hmatrix"`), `None`: dense.
     pub interface_compression: Option<InterfaceCompression>,
+    /// The pre-computed region's table hierarchical too (`[tables] compress = "hmatrix"` on a
+    /// scene: a hierarchical pre-computed table at the tolerance of
+    /// [`Self::interface_compression`], which it needs), and the interface's response stored
+    /// over the region's touchable vertices only (section `touchable-response`): the region
+    /// then moves its touchable vertices only, as a hierarchical pre-computed table does. f32
+    /// tables only (a hierarchical table's precision).
+    pub compress_region: bool,
     /// What the tables and the build may take ([`SizeLimits::system`] by default), checked
     /// against their estimate ([`HybridEstimate`]) before anything is built.
     pub limits: SizeLimits,
@@ -81,6 +90,7 @@ impl HybridOptions {
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
             interface_compression: None,
+            compress_region: false,
             limits: SizeLimits::system(),
         }
     }
@@ -100,6 +110,7 @@ impl HybridOptions {
             point_loads: Vec::new(),
             connection_mass: ConnectionMass::AllTets,
             interface_compression: None,
+            compress_region: false,
             limits: SizeLimits::system(),
         })
     }
@@ -155,8 +166,9 @@ pub fn build_hybrid(
         ..
     } = prepare(mesh, report, dynamic_tet, options)?;
     let pmaterials = materials.subset(region_tets(&split, false));
+    let pbuild = region_build_options(options)?;
     let (precomputed_summary, ordering) =
-        precomputed_table(mesh, report, &fixed, &region, &pmaterials, build)?;
+        precomputed_table(mesh, report, &fixed, &region, &pmaterials, &pbuild)?;
 
     // Lumped masses of the pre-computed region's tets, and its load.
     let precomputed_mass = lumped_mass(mesh, &split, options.density_kg_m3, false);
@@ -212,9 +224,32 @@ fn region_tets(split: &RegionSplit, dynamic: bool) -> impl Iterator<Item = usize
     (0..flags.len()).filter(move |&t| flags[t] == dynamic)
 }
 
+/// The pre-computed region's build options: the hybrid's, with the
+/// hierarchical compression of [`HybridOptions::compress_region`] (which
+/// needs the interface's compression, for its tolerance, and f32 tables).
+fn region_build_options(options: &HybridOptions) -> anyhow::Result<BuildOptions> {
+    if !options.compress_region {
+        return Ok(options.build.clone());
+    }
+    let Some(compression) = options.interface_compression else {
+        bail!("a hierarchical pre-computed region needs the interface compressed (its tolerance)");
+    };
+    if options.build.precision != Precision::F32 {
+        bail!("a hierarchical pre-computed region is stored in f32: build the hybrid in f32");
+    }
+    Ok(options.build.clone().with_compression(Some(Compression {
+        code: BlockCode::Hmatrix,
+        drop_below: 0.0,
+        contact: ContactBlocks::Coded,
+        tolerance: compression.tolerance,
+    })))
+}
+
 /// The pre-computed region's table (its tets with `pmaterials`, the
-/// connection nodes fixed; Cholesky), with its build summary counting the
-/// whole mesh's `fixed` vertices, and the region's free ordering.
+/// connection nodes fixed; Cholesky; hierarchical if `build` asks), with its
+/// build summary counting the whole mesh's `fixed` vertices, and the
+/// region's free ordering (a hierarchical table's: its touchable vertices in
+/// its cluster tree's order, checked against the table built).
 fn precomputed_table(
     mesh: &TetMesh,
     report: &MeshReport,
@@ -253,6 +288,22 @@ fn precomputed_table(
         mesh.positions.len(),
         &region.fixed,
         &region.surface.vertices,
+    );
+    let hierarchical = matches!(
+        build.kind,
+        TableKindOptions::Precomputed { compression: Some(c), .. } if c.code.is_hierarchical()
+    );
+    if !hierarchical {
+        return Ok((built, ordering));
+    }
+    let (_, ordering) = clustered(&mesh.positions, ordering);
+    let table = TableFile::from_bytes(&built.bytes);
+    let table = PrecomputedTable::<f32>::load(table.bytes())
+        .context("the hierarchical pre-computed region fails Palpate's own load check")?;
+    anyhow::ensure!(
+        table.free_vertices() == ordering.free_vertex.as_slice(),
+        "the hierarchical pre-computed region's free ordering is not the interface's (a bug: \
+         please report it)"
     );
     Ok((built, ordering))
 }
@@ -381,6 +432,12 @@ fn prepare(
         build.list_tool_radius_m(),
         build.precision,
     );
+    let estimate = match &options.interface_compression {
+        Some(compression) => {
+            estimate.compressed(mesh, &split, &region, compression, options.compress_region)
+        }
+        None => estimate,
+    };
     estimate.check(&options.limits, source)?;
     Ok(Prepared {
         fixed,
@@ -457,10 +514,22 @@ fn write_interface_table(
             sections
         }
     };
+    // The response of every free vertex, or of the touchable ones (the first `S` free
+    // indices: their `3S·c` rows lead the row-major `H`) beside a hierarchical region.
+    let response = if options.compress_region {
+        let rows = 3 * ordering.touchable_count * split.connection.len();
+        Section::floats(
+            SectionKind::TouchableResponse,
+            &condensed.response[..rows],
+            p,
+        )
+    } else {
+        Section::floats(SectionKind::ConnectionResponse, &condensed.response, p)
+    };
     let mut sections = vec![Section::ints(SectionKind::ConnectionVertex, &connections)];
     sections.extend(stiffness);
     sections.extend([
-        Section::floats(SectionKind::ConnectionResponse, &condensed.response, p),
+        response,
         Section::floats(
             SectionKind::LoadDisplacement,
             &condensed.load_displacement,

@@ -11,11 +11,17 @@
 //! - The interface: the `3c × 3c` condensed stiffness `S` and the `3F_P × 3c` response `H`
 //!   (`c` connection nodes, `F_P` free pre-computed vertices), and the dense right-hand sides of
 //!   the condensation (`24·F_P·(3c + 1)` bytes, twice: the solve's and `H`'s copy).
+//! - Compressed (`[tables] compress = "hmatrix"`, [`HybridEstimate::compressed`]): the
+//!   hierarchical `S` (`super::hmatrix::estimate`, every far block at the pre-computed
+//!   tables' estimate rank) in place of the dense one, and with a hierarchical region its
+//!   table's own estimate (`TableEstimate`'s for `--compress hmatrix`) and the response over
+//!   the `S_P` touchable rows only (`3S_P × 3c`).
 //! - The peak: the pre-computed build's, or after it the pre-computed table held while the
 //!   interface is condensed and the tensor-mass table is written, whichever is larger.
 
 use palpate_kernel::table::format::TableKind;
 
+use super::hmatrix::InterfaceCompression;
 use super::split::RegionSplit;
 use crate::limits::human_bytes;
 use crate::mesh::{MeshReport, Surface, TetMesh, boundary_surface};
@@ -33,6 +39,9 @@ pub struct HybridEstimate {
     pub interface: TableEstimate,
     /// The whole build's peak working memory, bytes (module doc), saturating.
     pub peak_bytes: u64,
+    /// Multiply-adds of one product `S u` over the connection nodes (the interface update):
+    /// `9c²` dense, one per stored scalar hierarchical (estimated).
+    pub condensed_scalars: u64,
 }
 
 /// The pre-computed region's build inputs, as [`build_hybrid`](super::build_hybrid) takes them:
@@ -109,16 +118,78 @@ impl HybridEstimate {
                 ..TableCounts::default()
             },
         );
-        let after = precomputed
-            .table_bytes
-            .saturating_add(interface.peak_bytes)
-            .saturating_add(dynamic.peak_bytes);
+        let c = split.connection.len() as u64;
         Self {
             precomputed,
             dynamic,
             interface,
-            peak_bytes: precomputed.peak_bytes.max(after),
+            peak_bytes: 0,
+            condensed_scalars: c.saturating_mul(c).saturating_mul(9),
         }
+        .with_peak()
+    }
+
+    /// The same with the peak (module doc) of its tables.
+    fn with_peak(self) -> Self {
+        let after = self
+            .precomputed
+            .table_bytes
+            .saturating_add(self.interface.peak_bytes)
+            .saturating_add(self.dynamic.peak_bytes);
+        Self {
+            peak_bytes: self.precomputed.peak_bytes.max(after),
+            ..self
+        }
+    }
+
+    /// The estimate of the same hybrid compressed (module doc): the interface's `S`
+    /// hierarchical as `compression` asks, and with `region` (the pre-computed region,
+    /// [`HybridOptions::compress_region`](super::HybridOptions::compress_region)) its table
+    /// hierarchical and the interface's response over its touchable rows only.
+    pub fn compressed(
+        self,
+        mesh: &TetMesh,
+        split: &RegionSplit,
+        precomputed: &PrecomputedRegion,
+        compression: &InterfaceCompression,
+        region: bool,
+    ) -> Self {
+        let scalar = u64::from(self.interface.precision.scalar_bytes());
+        let points: Vec<[f64; 3]> = split
+            .connection
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .collect();
+        let c = points.len() as u64;
+        let dense = 9 * c * c;
+        let (scalars, bytes) = super::hmatrix::estimate(&points, compression, scalar);
+        let mut interface = self.interface;
+        (interface.compressed, interface.hierarchical) = (true, true);
+        interface.table_bytes = interface
+            .table_bytes
+            .saturating_add(bytes)
+            .saturating_sub(dense * scalar);
+        let mut table = self.precomputed;
+        if region {
+            let counts = &self.interface.counts;
+            let interior = counts.free.saturating_sub(counts.touchable);
+            interface.table_bytes = interface
+                .table_bytes
+                .saturating_sub(interior.saturating_mul(9 * c * scalar));
+            table = table.hierarchical(
+                &precomputed.mesh,
+                &precomputed.fixed,
+                &precomputed.surface,
+                false,
+            );
+        }
+        Self {
+            precomputed: table,
+            interface,
+            condensed_scalars: scalars,
+            ..self
+        }
+        .with_peak()
     }
 
     /// The three tables, in the order they are built.

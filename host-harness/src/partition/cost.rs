@@ -44,7 +44,7 @@ use crate::fem::material::{Material, TetMaterials};
 use crate::fix::FixPredicate;
 use crate::hybrid::RegionSplit;
 use crate::hybrid::estimate::{HybridEstimate, PrecomputedRegion};
-use crate::hybrid::hmatrix::{self, InterfaceCompression};
+use crate::hybrid::hmatrix::InterfaceCompression;
 use crate::mesh::generate::box_mesh;
 use crate::mesh::{MeshReport, TetMesh, boundary_surface};
 use crate::table::build::{BuildOptions, build};
@@ -88,8 +88,9 @@ pub struct CostOptions {
     /// Their incompressibility penalty `γ`, N, where they take it (`None`: the
     /// experiments' default, `crate::fem::penalty::penalty_n` of the region).
     pub incompressibility_n: Option<f64>,
-    /// A hybrid's interface's condensed stiffness hierarchical (the scene's `[tables]
-    /// compress = "hmatrix"`), `None`: dense.
+    /// A hybrid's tables compressed (the scene's `[tables] compress = "hmatrix"`): the
+    /// interface's condensed stiffness and the pre-computed region's table hierarchical, the
+    /// response over the region's touchable rows (`HybridEstimate::compressed`); `None`: dense.
     pub interface_compression: Option<InterfaceCompression>,
 }
 
@@ -155,35 +156,32 @@ pub fn costs(
         connection[v as usize] = true;
     }
     let hybrid = partition.dynamic.iter().any(|&d| d) && partition.dynamic.iter().any(|&d| !d);
-    let mut estimate = if hybrid {
+    let estimate = if hybrid {
         let split = RegionSplit::new(mesh, fixed, &partition.dynamic)?;
         let region = PrecomputedRegion::of(mesh, &split, fixed);
-        Some(HybridEstimate::of(
+        let estimate = HybridEstimate::of(
             mesh,
             &split,
             fixed,
             &region,
             options.tool_radius_m,
             PRECISION,
-        ))
+        );
+        // The scene's `compress = "hmatrix"`: the hierarchical S, region and touchable
+        // response (`crate::session::model::hybrid_tables`).
+        Some(match &options.interface_compression {
+            Some(compression) => estimate.compressed(mesh, &split, &region, compression, true),
+            None => estimate,
+        })
     } else {
         None
     };
     let c = partition.connection_nodes.len();
     let mut update_s = if c > 0 { interface_update_s(c) } else { 0.0 };
-    if let (Some(e), Some(compression)) = (&mut estimate, &options.interface_compression) {
-        // The hierarchical S instead of the dense one: its bytes, and a product's
-        // multiply-adds (one per scalar) instead of 9c².
-        let points: Vec<[f64; 3]> = partition
-            .connection_nodes
-            .iter()
-            .map(|&v| mesh.positions[v as usize])
-            .collect();
-        let scalar = u64::from(PRECISION.scalar_bytes());
+    if let Some(e) = &estimate {
+        // A hierarchical S: a product's multiply-adds (one per scalar) instead of 9c².
         let dense = 9 * (c as u64).pow(2);
-        let (scalars, bytes) = hmatrix::estimate(&points, compression, scalar);
-        e.interface.table_bytes = (e.interface.table_bytes + bytes).saturating_sub(dense * scalar);
-        update_s *= scalars as f64 / dense.max(1) as f64;
+        update_s *= e.condensed_scalars as f64 / dense.max(1) as f64;
     }
     let default = options.materials.default_material();
     let mut out = Vec::with_capacity(partition.regions.len());

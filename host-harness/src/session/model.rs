@@ -200,9 +200,10 @@ pub fn scene_compression(tables: &TablesSpec) -> Option<Compression> {
 
 /// The hybrid's three tables for `partition` of `scene` (its materials per
 /// tet, density and supports) in `precision`, built in memory
-/// ([`build_hybrid`]); the interface's condensed stiffness hierarchical
-/// when `[tables] compress = "hmatrix"` (its `tolerance`), and `"f16"` or
-/// `"q16"` refused.
+/// ([`build_hybrid`]); with `[tables] compress = "hmatrix"` (its
+/// `tolerance`) the interface's condensed stiffness and the pre-computed
+/// region's table hierarchical, the response over the region's touchable
+/// rows ([`HybridOptions::compress_region`]); `"f16"` or `"q16"` refused.
 pub fn hybrid_tables(
     scene: &Scene,
     mesh: &TetMesh,
@@ -235,6 +236,7 @@ pub fn hybrid_tables(
             print_estimate: true,
             ..options.limits
         },
+        compress_region: interface_compression.is_some(),
         interface_compression,
         ..options
     };

@@ -179,7 +179,13 @@ impl TableEstimate {
     /// the Cholesky factor (about [`FACTOR_SCALARS_PER_DOF`] scalars per free DOF), one batch
     /// of columns (`3F × 3b` f64, `b` ≤ 2 × 64 vertices), the hierarchy as built (f64), the
     /// table and its draft, and [`BUILD_BYTES_PER_VERTEX`] per vertex, plus half of that.
-    fn hierarchical(self, mesh: &TetMesh, fixed: &[bool], surface: &Surface, q16: bool) -> Self {
+    pub(crate) fn hierarchical(
+        self,
+        mesh: &TetMesh,
+        fixed: &[bool],
+        surface: &Surface,
+        q16: bool,
+    ) -> Self {
         let c = &self.counts;
         let points: Vec<[f64; 3]> = surface
             .vertices

@@ -120,7 +120,8 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     /// counts, free counts and touchable counts agree), every vertex of the
     /// tensor-mass table mapped from exactly one mesh vertex at the same
     /// rest position and fixed in the pre-computed table, every connection
-    /// node free in the tensor-mass model, and the buffers' lengths. The
+    /// node free in the tensor-mass model, a response over the touchable
+    /// rows only with a hierarchical region table, and the buffers' lengths. The
     /// background starts at the load's displacement with the connection
     /// nodes at rest.
     ///
@@ -147,6 +148,17 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
         {
             return Err(mismatch(
                 "free or touchable count of the pre-computed region",
+                None,
+            ));
+        }
+        // A response over the touchable rows only leaves the interior
+        // vertices without a background: only a region that does not move
+        // them either (a hierarchical table, its interior part dropped)
+        // goes with it, so that the field never mixes the two.
+        let touchable_rows = interface.response_rows() < interface.free_count();
+        if touchable_rows && !precomputed.surface_blocks().encoding().is_hierarchical() {
+            return Err(mismatch(
+                "a response over the touchable rows only needs a hierarchical pre-computed region",
                 None,
             ));
         }
@@ -226,8 +238,11 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     /// Recomputes the background of the pre-computed free rows `0..rows`
     /// (all of them for `rows ≥ F`; the touchable ones, which contacts
     /// read, for `rows = S`): `b_n = K_ii⁻¹ f_n + Σ_j H_nj u_j`, m, from the
-    /// connection displacements of `dynamic`. `9c` multiply-adds per row. A
-    /// faulted model leaves the background as it was.
+    /// connection displacements of `dynamic`. `9c` multiply-adds per row.
+    /// Only the rows the interface stores are recomputed
+    /// ([`InterfaceTable::response_rows`]: the touchable ones of a
+    /// hierarchical region, whose interior rows keep the load's
+    /// displacement). A faulted model leaves the background as it was.
     pub fn update_background(
         &mut self,
         dynamic: &TensorMassModel<'_, '_, T>,
@@ -240,7 +255,7 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
             .iter_mut()
             .zip(interface.load_displacement_m())
             .enumerate()
-            .take(rows);
+            .take(rows.min(interface.response_rows()));
         for (n, (b, load)) in backgrounds {
             *b = (Vector3::from(*load) + response(interface, n, u)).into();
         }
@@ -317,8 +332,13 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
     /// The displacement of every mesh vertex (m, mesh vertex order): the
     /// tensor-mass region's own (from `dynamic`), and in this region the
     /// background plus the response to the contacts of `solution` (`None`:
-    /// no contact). `9c` multiply-adds per pre-computed free vertex, plus
-    /// [`PrecomputedModel::displacements`]. Not needed by the haptic path.
+    /// no contact). A hierarchical region's interior vertices (free
+    /// indices at or beyond [`InterfaceTable::response_rows`]) report zero,
+    /// as a hierarchical pre-computed table's do: neither their compliance
+    /// nor their response to the connection nodes is stored. `9c`
+    /// multiply-adds per pre-computed free vertex with a stored response
+    /// row, plus [`PrecomputedModel::displacements`]. Not needed by the
+    /// haptic path.
     pub fn displacements<const M: usize>(
         &self,
         dynamic: &TensorMassModel<'_, '_, T>,
@@ -348,6 +368,7 @@ impl<'a, 's, T: Real> CondensedRegion<'a, 's, T> {
             .iter()
             .zip(self.interface.load_displacement_m())
             .enumerate()
+            .take(self.interface.response_rows())
         {
             if let Some(o) = out.get_mut(v as usize) {
                 let b = Vector3::from(*load) + response(&self.interface, n, u);

@@ -42,9 +42,11 @@ pub enum CondensedStiffness<'a, T: Real> {
 ///   hierarchical (the hierarchy sections over `c` connection nodes, their
 ///   invariants [`HierarchicalBlocks`]'s, and a hierarchy order that is a
 ///   permutation of `0..c` stored with its inverse), never both;
-/// - section lengths match the header's counts: the `3F × 3c` response,
-///   `F` load displacements and `c` load forces, `N` dynamic-vertex
-///   entries.
+/// - section lengths match the header's counts: the response over every
+///   free vertex (`3F × 3c`, [`SectionKind::ConnectionResponse`]) or over
+///   the touchable ones only (`3S × 3c`, [`SectionKind::TouchableResponse`],
+///   one of the two, never both), `F` load displacements and `c` load
+///   forces, `N` dynamic-vertex entries.
 ///
 /// That the table belongs with a given pre-computed and tensor-mass table
 /// is checked where the three meet ([`crate::hybrid::HybridModel::new`]).
@@ -67,12 +69,15 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
     /// path.
     pub fn load(bytes: &'a [u8]) -> Result<Self, LoadError> {
         let c = Container::parse::<T>(bytes, TableKind::Interface)?;
+        let (response, response_rows) = connection_response(&c)?;
+        // The handle a C caller holds a table in has a fixed size: the row
+        // count is the response's length over `3c`, not a field of its own.
         let table = Self {
             header: c.header,
             checksum: c.checksum,
             connections: c.section(SectionKind::ConnectionVertex)?,
             condensed: condensed_stiffness(&c)?,
-            response: c.section(SectionKind::ConnectionResponse)?,
+            response,
             load_displacement: c.section(SectionKind::LoadDisplacement)?,
             load_force: c.section(SectionKind::LoadForce)?,
             dynamic_vertex: c.section(SectionKind::DynamicVertex)?,
@@ -87,7 +92,12 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         if let CondensedStiffness::Dense(dense) = table.condensed {
             check_finite(SectionKind::CondensedStiffness, dense)?;
         }
-        check_finite(SectionKind::ConnectionResponse, table.response)?;
+        let response_kind = if response_rows == table.free_count() {
+            SectionKind::ConnectionResponse
+        } else {
+            SectionKind::TouchableResponse
+        };
+        check_finite(response_kind, table.response)?;
         check_finite(SectionKind::LoadDisplacement, table.load_displacement)?;
         check_finite(SectionKind::LoadForce, table.load_force)?;
         let mut previous: Option<u32> = None;
@@ -228,9 +238,17 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
         sum
     }
 
+    /// Free vertices of the pre-computed region whose response rows are
+    /// stored (free indices `0..rows`): `F`, or the touchable `S` of an
+    /// interface whose region is hierarchical
+    /// ([`SectionKind::TouchableResponse`]).
+    pub fn response_rows(&self) -> usize {
+        self.response.len() / (3 * self.connection_count()).max(1)
+    }
+
     /// Row `r = 3n + a` (free index `n` of the pre-computed table, component
-    /// `a`) of the `3F × 3c` response (m/m), as `c` triples; empty out of
-    /// range.
+    /// `a`) of the response (m/m), as `c` triples; empty out of range (`n`
+    /// at or beyond [`Self::response_rows`]).
     pub fn response_row(&self, r: usize) -> &'a [[T; 3]] {
         let c = self.connection_count();
         self.response.get(r * c..(r + 1) * c).unwrap_or(&[])
@@ -266,6 +284,27 @@ impl<'a, T: Real> InterfaceTable<'a, T> {
     /// of the pre-computed region only).
     pub fn dynamic_vertices(&self) -> &'a [u32] {
         self.dynamic_vertex
+    }
+}
+
+/// The response of the interface in `c` and the free vertices it has rows
+/// for: the `3F × 3c` section or the touchable `3S × 3c` one (their lengths
+/// checked against the header's counts by the container), exactly one.
+fn connection_response<'a, T: Real>(c: &Container<'a>) -> Result<(&'a [[T; 3]], usize), LoadError> {
+    let all = c.optional_section(SectionKind::ConnectionResponse)?;
+    let touchable = c.optional_section(SectionKind::TouchableResponse)?;
+    match (all, touchable) {
+        (Some(all), None) => Ok((all, c.header.free_count as usize)),
+        (None, Some(touchable)) => Ok((touchable, c.header.touchable_count as usize)),
+        (None, None) => Err(LoadError::MissingSection {
+            kind: SectionKind::ConnectionResponse,
+        }),
+        (Some(_), Some(_)) => Err(LoadError::BadHierarchy {
+            kind: SectionKind::TouchableResponse,
+            index: 0,
+            what: "an interface stores the response of every free vertex or of the touchable \
+                   ones, not both",
+        }),
     }
 }
 

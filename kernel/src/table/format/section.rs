@@ -308,6 +308,15 @@ pub enum SectionKind {
     /// per connection node `j`, its hierarchy index (the inverse
     /// permutation, so that a load checks the pair in one pass).
     HierarchyOrder = 65,
+    /// `[scalar; 3]` × 3S·c: the response `H` of the touchable free vertices
+    /// only (free indices `0..S`), in place of
+    /// [`Self::ConnectionResponse`] in an interface whose pre-computed
+    /// region is hierarchical (`[tables] compress = "hmatrix"`): the
+    /// `3S × 3c` matrix in the same row-major layout. The step path reads
+    /// only these rows (the background under a contact, the force a contact
+    /// passes); such a region moves its touchable vertices only, as a
+    /// hierarchical pre-computed table does.
+    TouchableResponse = 66,
 }
 
 /// Marks a boundary face in [`SectionKind::TetNeighbour`].
@@ -348,7 +357,7 @@ pub mod tet_lane_row {
 
 impl SectionKind {
     /// Every section kind this version knows.
-    pub const ALL: [SectionKind; 54] = [
+    pub const ALL: [SectionKind; 55] = [
         SectionKind::VertexSlot,
         SectionKind::FreeVertex,
         SectionKind::RestPositions,
@@ -403,6 +412,7 @@ impl SectionKind {
         SectionKind::HierarchyCodes,
         SectionKind::HierarchyScales,
         SectionKind::HierarchyOrder,
+        SectionKind::TouchableResponse,
     ];
 
     /// `true` for the sections whose element count the directory declares
@@ -427,8 +437,9 @@ impl SectionKind {
 
     /// `true` for the matrix sections an encoding may replace: the
     /// compliance sections a [`super::CompressionRecord`] may replace by
-    /// coded or hierarchical ones, and an interface's condensed stiffness,
-    /// which the hierarchy sections may replace. Required by
+    /// coded or hierarchical ones, an interface's condensed stiffness,
+    /// which the hierarchy sections may replace, and its response, which
+    /// [`Self::TouchableResponse`] may replace. Required by
     /// [`TableKind::sections`], but checked by the table's view, not by the
     /// container.
     pub const fn encodable(self) -> bool {
@@ -437,6 +448,7 @@ impl SectionKind {
             SectionKind::ComplianceSurface
                 | SectionKind::ComplianceInterior
                 | SectionKind::CondensedStiffness
+                | SectionKind::ConnectionResponse
         )
     }
 
@@ -451,6 +463,7 @@ impl SectionKind {
             SectionKind::ConnectionVertex | SectionKind::RegionChecksums => 8,
             SectionKind::CondensedStiffness
             | SectionKind::ConnectionResponse
+            | SectionKind::TouchableResponse
             | SectionKind::LoadDisplacement
             | SectionKind::LoadForce => 3 * scalar_bytes,
             SectionKind::RestPositions => 3 * scalar_bytes,
@@ -512,6 +525,7 @@ impl SectionKind {
             SectionKind::ConnectionVertex | SectionKind::LoadForce => Some(c),
             SectionKind::CondensedStiffness => c.checked_mul(c)?.checked_mul(3),
             SectionKind::ConnectionResponse => f.checked_mul(c)?.checked_mul(3),
+            SectionKind::TouchableResponse => s.checked_mul(c)?.checked_mul(3),
             SectionKind::LoadDisplacement => Some(f),
             SectionKind::DynamicVertex => Some(n),
             SectionKind::RegionChecksums => Some(1),
@@ -635,6 +649,7 @@ impl SectionKind {
             SectionKind::HierarchyCodes => "hierarchy-codes",
             SectionKind::HierarchyScales => "hierarchy-scales",
             SectionKind::HierarchyOrder => "hierarchy-order",
+            SectionKind::TouchableResponse => "touchable-response",
         }
     }
 }
