@@ -286,6 +286,58 @@ pub struct MemoryPoint {
     pub displacement_error: f64,
 }
 
+impl MemoryPoint {
+    /// Its `error`.
+    pub fn error(&self, error: MemoryError) -> f64 {
+        match error {
+            MemoryError::Force => self.force_error,
+            MemoryError::TouchableDisplacement => self.touchable_displacement_error,
+        }
+    }
+}
+
+/// The error a memory chart draws against the table's bytes (`plot`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MemoryError {
+    /// [`MemoryPoint::force_error`] (`memory`).
+    Force,
+    /// [`MemoryPoint::touchable_displacement_error`] (`memory-displacement`).
+    TouchableDisplacement,
+}
+
+impl MemoryError {
+    /// Both, in the order drawn.
+    pub const ALL: [MemoryError; 2] = [MemoryError::Force, MemoryError::TouchableDisplacement];
+
+    /// The chart's file name, without extension.
+    pub fn chart(self) -> &'static str {
+        match self {
+            MemoryError::Force => "memory",
+            MemoryError::TouchableDisplacement => "memory-displacement",
+        }
+    }
+
+    /// The chart's caption.
+    pub fn caption(self) -> &'static str {
+        match self {
+            MemoryError::Force => "table bytes against contact-force error",
+            MemoryError::TouchableDisplacement => {
+                "table bytes against touchable displacement error"
+            }
+        }
+    }
+
+    /// The y axis's description.
+    pub fn axis(self) -> &'static str {
+        match self {
+            MemoryError::Force => "contact-force error (dense f32 table: drawn at 1e-8)",
+            MemoryError::TouchableDisplacement => {
+                "touchable displacement error (dense f32 table: drawn at 1e-8)"
+            }
+        }
+    }
+}
+
 /// Builds every encoding's table of every mesh with `material` and reads
 /// its size and measured errors; `tick` after each table.
 pub fn points(

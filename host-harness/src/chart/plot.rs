@@ -14,7 +14,7 @@ use plotters::prelude::*;
 use palpate_kernel::tensor_mass::Integrator;
 
 use super::body::Load;
-use super::memory::MemoryPoint;
+use super::memory::{MemoryError, MemoryPoint};
 use super::model::Model;
 use super::results::Study;
 use super::select::pareto_front;
@@ -636,46 +636,6 @@ fn volume_chart<DB: DrawingBackend>(
     Ok(())
 }
 
-/// The error a memory chart draws against the table's bytes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MemoryError {
-    /// [`MemoryPoint::force_error`] (`memory`).
-    Force,
-    /// [`MemoryPoint::touchable_displacement_error`] (`memory-displacement`).
-    TouchableDisplacement,
-}
-
-impl MemoryError {
-    /// Both, in the order drawn.
-    pub const ALL: [MemoryError; 2] = [MemoryError::Force, MemoryError::TouchableDisplacement];
-
-    /// The chart's file name, without extension.
-    pub fn chart(self) -> &'static str {
-        match self {
-            MemoryError::Force => "memory",
-            MemoryError::TouchableDisplacement => "memory-displacement",
-        }
-    }
-
-    /// The error of `point`.
-    fn of(self, point: &MemoryPoint) -> f64 {
-        match self {
-            MemoryError::Force => point.force_error,
-            MemoryError::TouchableDisplacement => point.touchable_displacement_error,
-        }
-    }
-
-    /// The y axis's description.
-    fn axis(self) -> &'static str {
-        match self {
-            MemoryError::Force => "contact-force error (dense f32 table: drawn at 1e-8)",
-            MemoryError::TouchableDisplacement => {
-                "touchable displacement error (dense f32 table: drawn at 1e-8)"
-            }
-        }
-    }
-}
-
 /// Where a memory chart draws an error of 0 (the dense table's, its own
 /// reference) on its log axis: below every measured error (the smallest,
 /// q16's rounding and the tightest hierarchical tolerance, are above 1e-7).
@@ -690,11 +650,11 @@ fn memory_chart<DB: DrawingBackend>(
     error: MemoryError,
 ) -> Drawn {
     root.fill(&WHITE).map_err(err)?;
-    let xy = |p: &MemoryPoint| (p.bytes as f64, error.of(p).max(MEMORY_ERROR_FLOOR));
+    let xy = |p: &MemoryPoint| (p.bytes as f64, p.error(error).max(MEMORY_ERROR_FLOOR));
     let x = log_range(points.iter().map(|p| xy(p).0));
     let y = log_range(points.iter().map(|p| xy(p).1));
     let mut chart = ChartBuilder::on(root)
-        .caption("table bytes against accuracy", ("sans-serif", 20))
+        .caption(error.caption(), ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
@@ -708,12 +668,10 @@ fn memory_chart<DB: DrawingBackend>(
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(err)?;
-    let mut families: Vec<&str> = points.iter().map(|p| p.family).collect();
-    families.dedup();
-    let mut meshes: Vec<&str> = points.iter().map(|p| p.mesh.as_str()).collect();
-    meshes.dedup();
+    let families = first_seen(points.iter().map(|p| p.family));
+    let meshes = first_seen(points.iter().map(|p| p.mesh.as_str()));
     for (i, &family) in families.iter().enumerate() {
-        let colour = Palette99::pick(i).to_rgba();
+        let colour = FAMILY_COLOURS[i % FAMILY_COLOURS.len()];
         for (m, &mesh) in meshes.iter().enumerate() {
             let mut series: Vec<(f64, f64)> = points
                 .iter()
@@ -722,7 +680,7 @@ fn memory_chart<DB: DrawingBackend>(
                 .collect();
             series.sort_by(|a, b| a.0.total_cmp(&b.0));
             chart
-                .draw_series(LineSeries::new(series.clone(), colour.stroke_width(1)))
+                .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
                 .map_err(err)?;
             chart
                 .draw_series(
@@ -751,11 +709,35 @@ fn memory_chart<DB: DrawingBackend>(
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        // Cheap and accurate, the corner no table reaches.
+        .position(SeriesLabelPosition::LowerLeft)
         .label_font(("sans-serif", 13))
         .draw()
         .map_err(err)?;
     Ok(())
+}
+
+/// A colour per encoding family of a memory chart, in order of first
+/// appearance (the model colours' palette).
+const FAMILY_COLOURS: [RGBColor; 7] = [
+    RGBColor(0, 0, 0),
+    RGBColor(31, 119, 180),
+    RGBColor(23, 190, 207),
+    RGBColor(44, 160, 44),
+    RGBColor(188, 189, 34),
+    RGBColor(214, 39, 40),
+    RGBColor(255, 127, 14),
+];
+
+/// The distinct `items`, in order of first appearance.
+fn first_seen<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
+        }
+    }
+    out
 }
 
 /// The marker of the `m`-th mesh of a memory chart, at the origin: a

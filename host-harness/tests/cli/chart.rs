@@ -9,7 +9,9 @@
 //! 1e-3 lateral imperfection moves the tip errors by at most 5e-5: quasi's
 //! was 4.9e-5 without it); the SVGs carry their text as
 //! glyph outlines; the hybrid's run, maps and trajectories; the press
-//! past buckling; and `--mesh`.
+//! past buckling; the memory/accuracy chart's tables (their ordering, the
+//! default hierarchical tolerance's bound, and that they are what `tables
+//! build` writes); and `--mesh`.
 
 use crate::common::{fresh_dir, palpate, stderr};
 
