@@ -328,15 +328,20 @@ impl MemoryError {
     }
 
     /// The y axis's description.
-    pub fn axis(self) -> &'static str {
-        match self {
-            MemoryError::Force => "contact-force error (dense f32 table: drawn at 1e-8)",
-            MemoryError::TouchableDisplacement => {
-                "touchable displacement error (dense f32 table: drawn at 1e-8)"
-            }
-        }
+    pub fn axis(self) -> String {
+        let error = match self {
+            MemoryError::Force => "contact-force error",
+            MemoryError::TouchableDisplacement => "touchable displacement error",
+        };
+        format!("{error} (dense f32 table: drawn at {ERROR_FLOOR:e})")
     }
 }
+
+/// Where a memory chart draws an error of 0 (the dense table's, its own
+/// reference) on its log axis: below every measured error (the smallest,
+/// q16's rounding and the tightest hierarchical tolerance's, are above
+/// 1e-7).
+pub const ERROR_FLOOR: f64 = 1e-8;
 
 /// Builds every encoding's table of every mesh with `material` and reads
 /// its size and measured errors; `tick` after each table.

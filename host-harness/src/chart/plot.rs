@@ -14,7 +14,7 @@ use plotters::prelude::*;
 use palpate_kernel::tensor_mass::Integrator;
 
 use super::body::Load;
-use super::memory::{MemoryError, MemoryPoint};
+use super::memory::{ERROR_FLOOR, MemoryError, MemoryPoint};
 use super::model::Model;
 use super::results::Study;
 use super::select::pareto_front;
@@ -636,11 +636,6 @@ fn volume_chart<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Where a memory chart draws an error of 0 (the dense table's, its own
-/// reference) on its log axis: below every measured error (the smallest,
-/// q16's rounding and the tightest hierarchical tolerance, are above 1e-7).
-const MEMORY_ERROR_FLOOR: f64 = 1e-8;
-
 /// Table bytes against `error`: a colour per encoding family, a marker per
 /// mesh (circles, triangles, squares), each family's tables of one mesh
 /// joined in order of bytes.
@@ -650,7 +645,7 @@ fn memory_chart<DB: DrawingBackend>(
     error: MemoryError,
 ) -> Drawn {
     root.fill(&WHITE).map_err(err)?;
-    let xy = |p: &MemoryPoint| (p.bytes as f64, p.error(error).max(MEMORY_ERROR_FLOOR));
+    let xy = |p: &MemoryPoint| (p.bytes as f64, p.error(error).max(ERROR_FLOOR));
     let x = log_range(points.iter().map(|p| xy(p).0));
     let y = log_range(points.iter().map(|p| xy(p).1));
     let mut chart = ChartBuilder::on(root)
