@@ -139,3 +139,70 @@ fn escaped_text_and_spaces() {
         "{lo} {hi}"
     );
 }
+
+/// Every table of the memory chart (full and `--quick`) is one `palpate
+/// tables build` can make, and its stated flags are its options: each
+/// encoding's compression passes the build's own check, its flags read
+/// back (`--compress CODE`, `--drop-below REL`, `--contact-blocks dropped`,
+/// `--tolerance REL`) to the same code, threshold, touchable blocks and
+/// tolerance, and no two tables of a chart share flags. Each chart mesh
+/// has fixed and free vertices (the full chart's finer organ: the
+/// documented 1386 vertices).
+#[test]
+fn memory_chart_tables_are_the_stated_builds() {
+    use palpate::chart::memory::{
+        Encoding, FULL_ENCODINGS, FULL_MESHES, QUICK_ENCODINGS, QUICK_MESHES,
+    };
+    use palpate::table::compress::{BlockCode, ContactBlocks};
+    let read_back = |flags: &str| {
+        let words: Vec<&str> = flags.split(' ').collect();
+        let value = |name: &str| words.iter().position(|w| *w == name).map(|i| words[i + 1]);
+        let number = |name: &str| value(name).map_or(0.0, |v| v.parse::<f64>().unwrap());
+        let code = value("--compress").map(|c| match c {
+            "f16" => BlockCode::F16,
+            "q16" => BlockCode::Q16,
+            "hmatrix" => BlockCode::Hmatrix,
+            "hmatrix-q16" => BlockCode::HmatrixQ16,
+            other => panic!("{other}"),
+        });
+        let contact = match value("--contact-blocks") {
+            Some("dropped") => ContactBlocks::Dropped,
+            None => ContactBlocks::Coded,
+            Some(other) => panic!("{other}"),
+        };
+        (code, number("--drop-below"), contact, number("--tolerance"))
+    };
+    for encodings in [&FULL_ENCODINGS[..], &QUICK_ENCODINGS[..]] {
+        let mut seen: Vec<String> = Vec::new();
+        for &encoding in encodings {
+            let flags = encoding.flags();
+            assert!(!seen.contains(&flags), "{flags}");
+            let (code, drop_below, contact, tolerance) = read_back(&flags);
+            match encoding.compression() {
+                None => {
+                    assert_eq!(encoding, Encoding::Dense);
+                    assert_eq!(flags, "(none)");
+                }
+                Some(c) => {
+                    c.check().unwrap();
+                    assert_eq!(Some(c.code), code, "{flags}");
+                    assert_eq!(c.drop_below, drop_below, "{flags}");
+                    assert_eq!(c.contact, contact, "{flags}");
+                    if c.code.is_hierarchical() {
+                        assert_eq!(c.tolerance, tolerance, "{flags}");
+                        assert_eq!(encoding.parameter(), Some(tolerance), "{flags}");
+                    }
+                }
+            }
+            seen.push(flags);
+        }
+    }
+    for mesh in FULL_MESHES.iter().chain(&QUICK_MESHES) {
+        let loaded = mesh.load().unwrap();
+        let fixed = palpate::fix::fixed_vertices(&loaded.mesh.positions, &loaded.fix, &[]).0;
+        let free = fixed.iter().filter(|&&f| !f).count();
+        assert!(free > 0 && free < fixed.len(), "{}", loaded.label);
+    }
+    let finer = FULL_MESHES[1].load().unwrap();
+    assert_eq!(finer.mesh.positions.len(), 1386);
+}

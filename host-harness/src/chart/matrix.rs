@@ -8,7 +8,7 @@ use palpate_kernel::tensor_mass::{DynamicParams, Integrator};
 use super::body::{Body, GivenMesh, Load};
 use super::measure::median_s;
 use super::model::{Model, relaxed_models};
-use super::{stability, trajectory};
+use super::{memory, stability, trajectory};
 use crate::dispatch::HostDispatch;
 use crate::fix::FixPredicate;
 use crate::tensor_mass::run::diagonal;
@@ -50,6 +50,10 @@ pub struct Matrix {
     /// Whether to count the haptic tick's instructions under callgrind
     /// (`ticks`).
     pub tick_counts: bool,
+    /// The memory/accuracy chart's meshes (none on a given mesh).
+    pub memory_meshes: Vec<memory::MemoryMesh>,
+    /// The memory/accuracy chart's encodings.
+    pub memory_encodings: Vec<memory::Encoding>,
 }
 
 impl Matrix {
@@ -64,6 +68,8 @@ impl Matrix {
             max_relax_steps: MAX_RELAX_STEPS,
             trajectory: trajectory::TrajectoryExtent::full(),
             tick_counts: true,
+            memory_meshes: memory::FULL_MESHES.to_vec(),
+            memory_encodings: memory::FULL_ENCODINGS.to_vec(),
         }
     }
 
@@ -78,6 +84,8 @@ impl Matrix {
             max_relax_steps: QUICK_RELAX_STEPS,
             trajectory: trajectory::TrajectoryExtent::quick(),
             tick_counts: false,
+            memory_meshes: memory::QUICK_MESHES.to_vec(),
+            memory_encodings: memory::QUICK_ENCODINGS.to_vec(),
         }
     }
 
@@ -88,10 +96,18 @@ impl Matrix {
         cases * (self.mesh_count() * Model::ALL.len() + 1)
     }
 
-    /// The same study on `given` instead of the cylinders.
+    /// Tables of the memory/accuracy chart.
+    pub fn memory_tables(&self) -> usize {
+        self.memory_meshes.len() * self.memory_encodings.len()
+    }
+
+    /// The same study on `given` instead of the cylinders, without the
+    /// memory/accuracy chart (its meshes are its own: `palpate tables build
+    /// --compress` measures a given mesh's tables).
     pub fn on(self, given: GivenMesh) -> Self {
         Self {
             given: Some(given),
+            memory_meshes: Vec::new(),
             ..self
         }
     }

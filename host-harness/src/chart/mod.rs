@@ -1,8 +1,9 @@
 //! `palpate chart`: the speed/accuracy study. Every model of the harness is
 //! run on the same loaded body at several refinements and loads, measured
 //! against the Newton St Venant-Kirchhoff equilibrium on the finest mesh
-//! ([`crate::fem::newton`]) and timed; [`plot`] draws the charts, [`report`]
-//! writes the report.
+//! ([`crate::fem::newton`]) and timed; [`memory`] builds the pre-computed
+//! tables of every compliance encoding for the memory/accuracy chart;
+//! [`plot`] draws the charts, [`report`] writes the report.
 //!
 //! The body: the generated cylinder ([`cylinder_mesh`](crate::mesh::generate::cylinder_mesh), height
 //! [`HEIGHT_M`], radius `H/5`, E = 5 kPa, ν = 0.4), base fixed, loaded on its
@@ -31,6 +32,7 @@
 //! (135) static runs of at most [`MAX_RELAX_STEPS`] steps each, and the
 //! stability map's [`stability`] trials.
 
+pub mod memory;
 pub mod plot;
 pub mod report;
 pub mod select;

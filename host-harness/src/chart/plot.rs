@@ -14,6 +14,7 @@ use plotters::prelude::*;
 use palpate_kernel::tensor_mass::Integrator;
 
 use super::body::Load;
+use super::memory::{ERROR_FLOOR, MemoryError, MemoryPoint};
 use super::model::Model;
 use super::results::Study;
 use super::select::pareto_front;
@@ -150,6 +151,14 @@ pub fn draw_all(
             root, volume
         ))?;
         names.push("volume".into());
+    }
+    if !study.memory.is_empty() {
+        for error in MemoryError::ALL {
+            render!(dir, error.chart(), |root: &DrawingArea<_, Shift>| {
+                memory_chart(root, &study.memory, error)
+            })?;
+            names.push(error.chart().into());
+        }
     }
     Ok(names)
 }
@@ -625,4 +634,116 @@ fn volume_chart<DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
     Ok(())
+}
+
+/// Table bytes against `error`: a colour per encoding family, a marker per
+/// mesh (circles, triangles, squares), each family's tables of one mesh
+/// joined in order of bytes.
+fn memory_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    points: &[MemoryPoint],
+    error: MemoryError,
+) -> Drawn {
+    root.fill(&WHITE).map_err(err)?;
+    let xy = |p: &MemoryPoint| (p.bytes as f64, p.error(error).max(ERROR_FLOOR));
+    let x = log_range(points.iter().map(|p| xy(p).0));
+    let y = log_range(points.iter().map(|p| xy(p).1));
+    let mut chart = ChartBuilder::on(root)
+        .caption(error.caption(), ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("table bytes")
+        .y_desc(error.axis())
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(err)?;
+    let families = first_seen(points.iter().map(|p| p.family));
+    let meshes = first_seen(points.iter().map(|p| p.mesh.as_str()));
+    for (i, &family) in families.iter().enumerate() {
+        let colour = FAMILY_COLOURS[i % FAMILY_COLOURS.len()];
+        for (m, &mesh) in meshes.iter().enumerate() {
+            let mut series: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.family == family && p.mesh == mesh)
+                .map(xy)
+                .collect();
+            series.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(series.clone(), colour.stroke_width(2)))
+                .map_err(err)?;
+            chart
+                .draw_series(
+                    series
+                        .into_iter()
+                        .map(|p| EmptyElement::at(p) + mesh_marker::<DB>(m, colour.filled())),
+                )
+                .map_err(err)?;
+        }
+        chart
+            .draw_series(core::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(err)?
+            .label(family)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], colour.filled()));
+    }
+    for (m, &mesh) in meshes.iter().enumerate() {
+        chart
+            .draw_series(core::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(err)?
+            .label(mesh)
+            .legend(move |(x, y)| {
+                EmptyElement::at((x + 8, y)) + mesh_marker::<DB>(m, BLACK.filled())
+            });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        // Cheap and accurate, the corner no table reaches.
+        .position(SeriesLabelPosition::LowerLeft)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// A colour per encoding family of a memory chart, in order of first
+/// appearance (the model colours' palette).
+const FAMILY_COLOURS: [RGBColor; 7] = [
+    RGBColor(0, 0, 0),
+    RGBColor(31, 119, 180),
+    RGBColor(23, 190, 207),
+    RGBColor(44, 160, 44),
+    RGBColor(188, 189, 34),
+    RGBColor(214, 39, 40),
+    RGBColor(255, 127, 14),
+];
+
+/// The distinct `items`, in order of first appearance.
+fn first_seen<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
+        }
+    }
+    out
+}
+
+/// The marker of the `m`-th mesh of a memory chart, at the origin: a
+/// circle, a triangle, then squares.
+fn mesh_marker<DB: DrawingBackend>(
+    m: usize,
+    style: ShapeStyle,
+) -> DynElement<'static, DB, (i32, i32)> {
+    match m {
+        0 => Circle::new((0, 0), 5, style).into_dyn(),
+        1 => TriangleMarker::new((0, 0), 7, style).into_dyn(),
+        _ => Rectangle::new([(-4, -4), (4, 4)], style).into_dyn(),
+    }
 }

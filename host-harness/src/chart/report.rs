@@ -211,6 +211,7 @@ pub fn markdown(
             );
         }
     }
+    memory_section(&mut out, study);
     if !volume_table.is_empty() {
         let _ = writeln!(out, "\n## Picinbono 2001 table 2\n\n```\n{volume_table}```");
     }
@@ -219,6 +220,63 @@ pub fn markdown(
         let _ = writeln!(out, "![{name}]({name}.png)\n");
     }
     out
+}
+
+/// The memory/accuracy section: what the tables are, then each one's bytes
+/// and errors.
+fn memory_section(out: &mut String, study: &Study) {
+    if study.memory.is_empty() {
+        return;
+    }
+    let mut meshes: Vec<String> = Vec::new();
+    for p in &study.memory {
+        let mesh = format!(
+            "{} ({} vertices, {} tets, {} touchable, `--fix '{}'`)",
+            p.mesh, p.vertices, p.tets, p.touchable, p.fix
+        );
+        if !meshes.contains(&mesh) {
+            meshes.push(mesh);
+        }
+    }
+    let _ = writeln!(
+        out,
+        "\n## Table memory against accuracy\n\n\
+         Pre-computed f32 tables (E = {} Pa, ν = {}) of {}, each built as `palpate tables build \
+         MESH --young E --poisson NU --fix PRED` with the flags below; bytes and errors as \
+         `palpate tables info --json` gives them (`measured`: the largest over the build's probe \
+         set of contacts, relative; the 16-bit and dropped tables against the dense f32 table, \
+         the hierarchical ones against the exact compliance; the dense table is its own \
+         reference, 0). Dropping interior blocks costs no contact force, dropping touchable ones \
+         does; a hierarchical table stores no interior displacements (its displacement error is \
+         the touchable one). Charts: memory (contact-force error), memory-displacement \
+         (touchable displacement error); data: memory.json.\n",
+        study.material.0,
+        study.material.1,
+        meshes.join(" and ")
+    );
+    let _ = writeln!(
+        out,
+        "| mesh | flags | bytes | bytes / dense | force error | touchable displacement error | \
+         displacement error |\n|---|---|---|---|---|---|---|"
+    );
+    for p in &study.memory {
+        let dense = study
+            .memory
+            .iter()
+            .find(|d| d.mesh == p.mesh && d.family == "dense")
+            .map_or(f64::NAN, |d| d.bytes as f64);
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.3} | {:.2e} | {:.2e} | {:.2e} |",
+            p.mesh,
+            p.flags,
+            p.bytes,
+            p.bytes as f64 / dense,
+            p.force_error,
+            p.touchable_displacement_error,
+            p.displacement_error
+        );
+    }
 }
 
 /// The trajectories' section: the cheapest within each bound per load,

@@ -1,13 +1,13 @@
 //! The study's results, as `study.json` holds them: one [`Run`] per model,
 //! mesh, load and level, one [`Reference`] per load and level, and the
-//! [`Study`] that gathers them with the stability maps, the trajectories and
-//! the tick counts.
+//! [`Study`] that gathers them with the stability maps, the trajectories,
+//! the memory chart's tables and the tick counts.
 
 use serde::Serialize;
 
 use super::body::Load;
 use super::model::Model;
-use super::{stability, ticks, trajectory};
+use super::{memory, stability, ticks, trajectory};
 use crate::remap::fit::FittedModel;
 
 /// One model's run on one mesh at one load.
@@ -96,6 +96,8 @@ pub struct Study {
     pub stability: Vec<stability::Map>,
     /// The dynamic runs' trajectory errors.
     pub trajectories: Vec<trajectory::Trajectory>,
+    /// The memory/accuracy chart's tables (also `memory.json`).
+    pub memory: Vec<memory::MemoryPoint>,
     /// Per-tick instructions of the pre-computed models' haptic tick
     /// ([`ticks`]; measured by the command, after [`run`](super::run)).
     pub ticks: ticks::TickCounts,

@@ -1,6 +1,6 @@
 //! The study's run ([`run`]): the quasi-non-linear fit, every model on
 //! every mesh at every load and level against the reference, then the
-//! stability maps and the trajectories.
+//! stability maps, the trajectories and the memory chart's tables.
 
 use anyhow::Context;
 use palpate_kernel::precomputed::QuasiNonLinear;
@@ -13,13 +13,14 @@ use super::precomputed::precomputed;
 use super::progress::Progress;
 use super::reference::{reference, score};
 use super::results::{Run, Study};
-use super::{stability, ticks, trajectory};
+use super::{memory, stability, ticks, trajectory};
 use crate::experiment::volume_bend::inverted_tets;
 use crate::remap::fit::fit_curves;
 use crate::remap::sample::{Sample, linear_response, stvk_curves};
 use crate::tensor_mass::run::volume_change;
 
-/// Runs the static part and the stability maps of `matrix`.
+/// Runs the static part, the stability maps, the trajectories and the
+/// memory chart's tables of `matrix`.
 pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study> {
     anyhow::ensure!(matrix.mesh_count() > 0, "no mesh in the matrix");
     let bodies = matrix.bodies()?;
@@ -86,6 +87,12 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
     let stability = stability::maps(&bodies[0], &matrix.stability, progress)?;
     let trajectories =
         trajectory::trajectories(&bodies, &trajectory_loads, &matrix.trajectory, progress)?;
+    let memory = memory::points(
+        &matrix.memory_meshes,
+        &matrix.memory_encodings,
+        material,
+        &mut |m| progress.tick(m),
+    )?;
     let hybrid_region = bodies
         .iter()
         .map(|b| {
@@ -105,6 +112,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
         remap,
         stability,
         trajectories,
+        memory,
         ticks: ticks::TickCounts::Skipped {
             reason: "not measured".into(),
         },

@@ -1,6 +1,6 @@
 //! `palpate chart`: the speed/accuracy study ([`palpate::chart`]): runs the
 //! matrix with a progress bar, writes the charts, `report.md`,
-//! `index.html` and `study.json` into `--out` (built in a hidden sibling
+//! `index.html`, `study.json` and `memory.json` into `--out` (built in a hidden sibling
 //! folder and renamed into place whole: `palpate::output::atomic`'s
 //! `SeriesDir`, which refuses a folder palpate did not write), prints the
 //! summary (or the JSON).
@@ -27,7 +27,8 @@ use super::stdout;
 #[derive(Args)]
 pub struct ChartArgs {
     /// The reduced matrix (two meshes, press and bend at 1 % and 5 %, a
-    /// small stability grid, the small volume cylinder): under a minute.
+    /// small stability grid, the small volume cylinder, the memory chart on
+    /// two small boxes): under a minute.
     #[arg(long)]
     quick: bool,
     /// Output folder: created, or replaced as a whole if a previous run
@@ -204,12 +205,17 @@ fn announce(matrix: &Matrix, volume_experiments: usize) -> usize {
     } else {
         0
     };
-    let total =
-        matrix.static_runs() + trials + matrix.trajectories() + volume_experiments + tick_runs;
+    let total = matrix.static_runs()
+        + trials
+        + matrix.trajectories()
+        + matrix.memory_tables()
+        + volume_experiments
+        + tick_runs;
     stderr::line(&format!(
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
-         references), {} stability trials, {} trajectories (each against its Δt/{}), {} volume \
-         experiments, {tick_runs} callgrind runs: {total} steps of progress",
+         references), {} stability trials, {} trajectories (each against its Δt/{}), {} \
+         memory-chart tables, {} volume experiments, {tick_runs} callgrind runs: {total} steps \
+         of progress",
         matrix.mesh_count(),
         matrix.loads.len(),
         matrix.levels.len(),
@@ -219,6 +225,7 @@ fn announce(matrix: &Matrix, volume_experiments: usize) -> usize {
         trials,
         matrix.trajectories(),
         chart::trajectory::REFINEMENT,
+        matrix.memory_tables(),
         volume_experiments,
     ));
     total
@@ -329,9 +336,11 @@ fn tick_counts(
     ticks::measure_ticks(&exe, child, &dir.join("ticks"), &quasi, progress)
 }
 
-/// Writes the charts, `report.md`, `index.html` and `study.json` (the
+/// Writes the charts, `report.md`, `index.html`, `study.json` (the
 /// [`summary`], the study, the volume experiments and the charts' names)
-/// into `dir`; returns the JSON and the report.
+/// and `memory.json` (the memory chart's tables, `study.memory`: an array
+/// of `chart::memory::MemoryPoint`) into `dir`; returns the JSON and the
+/// report.
 fn write_outputs(
     matrix: &Matrix,
     study: &chart::Study,
@@ -357,6 +366,10 @@ fn write_outputs(
         "charts": charts,
     });
     write_file(&dir.join("study.json"), json.to_string().as_bytes())?;
+    write_file(
+        &dir.join("memory.json"),
+        serde_json::to_string(&study.memory)?.as_bytes(),
+    )?;
     Ok((json, markdown))
 }
 

@@ -9,7 +9,9 @@
 //! 1e-3 lateral imperfection moves the tip errors by at most 5e-5: quasi's
 //! was 4.9e-5 without it); the SVGs carry their text as
 //! glyph outlines; the hybrid's run, maps and trajectories; the press
-//! past buckling; and `--mesh`.
+//! past buckling; the memory/accuracy chart's tables (their ordering, the
+//! default hierarchical tolerance's bound, and that they are what `tables
+//! build` writes); and `--mesh`.
 
 use crate::common::{fresh_dir, palpate, stderr};
 
@@ -28,6 +30,10 @@ fn quick_chart_writes_report_charts_and_json() {
         "cost-mesh.png",
         "stability-symplectic.svg",
         "volume.png",
+        "memory.png",
+        "memory.svg",
+        "memory-displacement.svg",
+        "memory.json",
     ] {
         let meta = std::fs::metadata(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(meta.len() > 1000, "{file}: {} bytes", meta.len());
@@ -149,6 +155,137 @@ fn quick_chart_writes_report_charts_and_json() {
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(report.contains("## Cheapest model within an error bound"));
     assert!(report.contains("## Where the methods fail"));
+    assert!(report.contains("## Table memory against accuracy"));
+    let memory: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("memory.json")).unwrap()).unwrap();
+    assert_eq!(memory, json["study"]["memory"]);
+    memory_chart_orders_the_encodings(memory.as_array().unwrap());
+    memory_chart_is_what_tables_build_writes(memory.as_array().unwrap());
+}
+
+/// The memory chart of `--quick` (nine encodings on two boxes), per box:
+/// - the dense table is its own reference (errors 0) and the largest;
+/// - f16 and q16 store the same 16-bit codes and scales (equal bytes);
+/// - dropping interior blocks (`--drop-below 1e-2`) keeps the touchable
+///   blocks' codes: the contact-force and touchable-displacement errors
+///   are q16's exactly, in fewer bytes; dropping the touchable blocks too
+///   costs force accuracy;
+/// - each hierarchical code at its tighter tolerance is no less accurate
+///   and takes more bytes than at 1e-2, and the q16 hierarchy takes fewer
+///   bytes than the f32 one at 1e-2;
+/// - the f32 hierarchy at the default tolerance (1e-5) is within the bound
+///   `table::hmatrix::DEFAULT_TOLERANCE` states, 1e-3 on both errors
+///   (measured: force 2.4e-6 and 3.8e-6, touchable displacement 1.3e-5
+///   and 9.7e-6).
+fn memory_chart_orders_the_encodings(points: &[serde_json::Value]) {
+    assert_eq!(points.len(), 18);
+    for mesh in ["box 6x6x2", "box 8x8x2"] {
+        let point = |flags: &str| {
+            points
+                .iter()
+                .find(|p| p["mesh"] == mesh && p["flags"] == flags)
+                .unwrap_or_else(|| panic!("{mesh}: {flags}"))
+        };
+        let bytes = |flags: &str| point(flags)["bytes"].as_u64().unwrap();
+        let force = |flags: &str| point(flags)["force_error"].as_f64().unwrap();
+        let touchable = |flags: &str| {
+            point(flags)["touchable_displacement_error"]
+                .as_f64()
+                .unwrap()
+        };
+        let (dense, f16, q16) = ("(none)", "--compress f16", "--compress q16");
+        let drop = "--compress q16 --drop-below 1e-2";
+        let drop_contact = "--compress q16 --drop-below 1e-2 --contact-blocks dropped";
+        assert_eq!((force(dense), touchable(dense)), (0.0, 0.0));
+        assert!(
+            points
+                .iter()
+                .filter(|p| p["mesh"] == mesh && p["flags"] != dense)
+                .all(|p| p["bytes"].as_u64() < Some(bytes(dense))),
+            "{mesh}"
+        );
+        assert_eq!(bytes(f16), bytes(q16));
+        assert!(force(q16) > 0.0 && force(f16) > 0.0);
+        assert!(bytes(drop) < bytes(q16), "{mesh}");
+        assert_eq!(force(drop), force(q16), "{mesh}");
+        assert_eq!(touchable(drop), touchable(q16), "{mesh}");
+        assert!(force(drop_contact) > force(q16), "{mesh}");
+        for (code, tight) in [("hmatrix", "1e-5"), ("hmatrix-q16", "1e-4")] {
+            let at = |tolerance: &str| format!("--compress {code} --tolerance {tolerance}");
+            let (loose, tight) = (at("1e-2"), at(tight));
+            assert!(bytes(&loose) < bytes(&tight), "{mesh} {code}");
+            assert!(force(&loose) >= force(&tight), "{mesh} {code}");
+            assert!(touchable(&loose) >= touchable(&tight), "{mesh} {code}");
+        }
+        let at = |code: &str| format!("--compress {code} --tolerance 1e-2");
+        assert!(bytes(&at("hmatrix-q16")) < bytes(&at("hmatrix")), "{mesh}");
+        let default = "--compress hmatrix --tolerance 1e-5";
+        assert!(
+            force(default) <= 1e-3 && touchable(default) <= 1e-3,
+            "{mesh}"
+        );
+    }
+    let dense = |mesh: &str| {
+        points
+            .iter()
+            .find(|p| p["mesh"] == mesh && p["family"] == "dense")
+            .unwrap()["bytes"]
+            .as_u64()
+            .unwrap()
+    };
+    assert!(dense("box 6x6x2") < dense("box 8x8x2"));
+}
+
+/// The chart's bytes and errors are those of the table `palpate tables
+/// build` writes from the same mesh with the flags the chart states, as
+/// `tables info --json` reads them (two of the smaller box's: a dropped
+/// q16 table and a q16 hierarchy; the box written as VTK, whose decimal
+/// coordinates read back exactly).
+fn memory_chart_is_what_tables_build_writes(points: &[serde_json::Value]) {
+    let dir = fresh_dir("chart-memory-tables");
+    let mesh = palpate::mesh::generate::box_mesh([6, 6, 2], [0.1, 0.1, 0.03]);
+    let path = dir.join("box-6x6x2.vtk");
+    write_vtk(&path, &mesh.positions, &mesh.tets);
+    for flags in [
+        "--compress q16 --drop-below 1e-2 --contact-blocks dropped",
+        "--compress hmatrix-q16 --tolerance 1e-2",
+    ] {
+        let point = points
+            .iter()
+            .find(|p| p["mesh"] == "box 6x6x2" && p["flags"] == flags)
+            .unwrap();
+        let table = dir.join("box.tbl");
+        let (mesh_arg, table_arg) = (path.to_str().unwrap(), table.to_str().unwrap());
+        let fix = point["fix"].as_str().unwrap();
+        let mut args = vec![
+            "tables",
+            "build",
+            mesh_arg,
+            "--young",
+            "5000",
+            "--poisson",
+            "0.4",
+            "--fix",
+            fix,
+            "--quiet",
+            "-o",
+            table_arg,
+        ];
+        args.extend(flags.split(' '));
+        let out = palpate(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let out = palpate(&["tables", "info", "--json", table_arg]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(info["bytes"], point["bytes"], "{flags}");
+        assert_eq!(
+            std::fs::metadata(&table).unwrap().len(),
+            point["bytes"].as_u64().unwrap()
+        );
+        for key in ["force_error", "touchable_displacement_error"] {
+            assert_eq!(info["measured"][key], point[key], "{flags}: {key}");
+        }
+    }
 }
 
 /// `--mesh`: the matrix on a user's mesh at its own resolution (a 2×2×6
@@ -203,23 +340,18 @@ fn chart_runs_on_a_given_mesh() {
 
 /// A 2×2×6-cell box, 2 × 2 × 6 cm, six tets per cell, as legacy VTK.
 fn write_box(path: &std::path::Path) {
-    use core::fmt::Write as _;
     let (n, size) = ([2usize, 2, 6], [0.02, 0.02, 0.06]);
     let index = |i: usize, j: usize, k: usize| i + (n[0] + 1) * (j + (n[1] + 1) * k);
-    let mut s = String::from("# vtk DataFile Version 3.0\nbox\nASCII\nDATASET UNSTRUCTURED_GRID\n");
-    let count = (n[0] + 1) * (n[1] + 1) * (n[2] + 1);
-    let _ = writeln!(s, "POINTS {count} double");
+    let mut positions = Vec::new();
     for k in 0..=n[2] {
         for j in 0..=n[1] {
             for i in 0..=n[0] {
                 let p = [i, j, k].map(|c| c as f64);
-                let _ = writeln!(
-                    s,
-                    "{} {} {}",
+                positions.push([
                     size[0] * p[0] / n[0] as f64,
                     size[1] * p[1] / n[1] as f64,
-                    size[2] * p[2] / n[2] as f64
-                );
+                    size[2] * p[2] / n[2] as f64,
+                ]);
             }
         }
     }
@@ -238,17 +370,29 @@ fn write_box(path: &std::path::Path) {
                     [0, 4, 5, 7],
                     [0, 5, 1, 7],
                 ] {
-                    tets.push(t.map(|x| c[x]));
+                    tets.push(t.map(|x| c[x] as u32));
                 }
             }
         }
     }
+    write_vtk(path, &positions, &tets);
+}
+
+/// `positions` (m) and `tets` as legacy ASCII VTK (coordinates in Rust's
+/// shortest round-trip decimal form: they read back exactly).
+fn write_vtk(path: &std::path::Path, positions: &[[f64; 3]], tets: &[[u32; 4]]) {
+    use core::fmt::Write as _;
+    let mut s = String::from("# vtk DataFile Version 3.0\nbox\nASCII\nDATASET UNSTRUCTURED_GRID\n");
+    let _ = writeln!(s, "POINTS {} double", positions.len());
+    for p in positions {
+        let _ = writeln!(s, "{} {} {}", p[0], p[1], p[2]);
+    }
     let _ = writeln!(s, "CELLS {} {}", tets.len(), 5 * tets.len());
-    for t in &tets {
+    for t in tets {
         let _ = writeln!(s, "4 {} {} {} {}", t[0], t[1], t[2], t[3]);
     }
     let _ = writeln!(s, "CELL_TYPES {}", tets.len());
-    for _ in &tets {
+    for _ in tets {
         s.push_str("10\n");
     }
     std::fs::write(path, s).unwrap();
