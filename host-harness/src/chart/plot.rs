@@ -166,18 +166,16 @@ pub fn draw_all(
 /// A chart with both axes logarithmic.
 type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
 
-/// The frame of an error-against-cost chart: log axes over `points`
-/// (`axes`: the x and y descriptions) and the Pareto front (`front`, one
-/// flag per point) joined by a line in the legend.
-fn pareto_frame<'a, DB: DrawingBackend>(
+/// A log-log chart over `points` (both axes' ranges from them): `caption`, the axes'
+/// descriptions `axes` (x, y), tick labels as powers of ten.
+fn log_frame<'a, DB: DrawingBackend>(
     root: &'a DrawingArea<DB, Shift>,
     caption: &str,
     axes: [&str; 2],
-    points: &[(f64, f64)],
-    front: &[bool],
+    points: impl Iterator<Item = (f64, f64)> + Clone,
 ) -> anyhow::Result<LogChart<'a, DB>> {
-    let x = log_range(points.iter().map(|p| p.0));
-    let y = log_range(points.iter().map(|p| p.1));
+    let x = log_range(points.clone().map(|p| p.0));
+    let y = log_range(points.map(|p| p.1));
     let mut chart = ChartBuilder::on(root)
         .caption(caption, ("sans-serif", 20))
         .margin(12)
@@ -194,6 +192,36 @@ fn pareto_frame<'a, DB: DrawingBackend>(
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(err)?;
+    Ok(chart)
+}
+
+/// Every chart's legend: its series' labels on a translucent white box at `position`.
+fn legend<'a, DB: DrawingBackend + 'a, X: Ranged, Y: Ranged>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    position: SeriesLabelPosition,
+) -> Drawn {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(position)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// The frame of an error-against-cost chart: log axes over `points`
+/// (`axes`: the x and y descriptions) and the Pareto front (`front`, one
+/// flag per point) joined by a line in the legend.
+fn pareto_frame<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    axes: [&str; 2],
+    points: &[(f64, f64)],
+    front: &[bool],
+) -> anyhow::Result<LogChart<'a, DB>> {
+    let mut chart = log_frame(root, caption, axes, points.iter().copied())?;
     let mut on_front: Vec<(f64, f64)> = points
         .iter()
         .zip(front)
@@ -262,14 +290,7 @@ fn pareto<DB: DrawingBackend>(
             .label(model.name())
             .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerLeft)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())
 }
 
@@ -364,14 +385,7 @@ fn trajectory_chart<DB: DrawingBackend>(
         .map_err(err)?
         .label(Model::Hybrid.name())
         .legend(move |(x, y)| Cross::new((x + 8, y), 5, grey.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerLeft)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())
 }
 
@@ -419,14 +433,7 @@ fn cost_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, study: &Study) -
             )
             .map_err(err)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }
 
@@ -517,14 +524,7 @@ fn stability<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, map: &Map) -> Dr
             .label(format!("{outcome:?}").to_lowercase())
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled()));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -625,14 +625,7 @@ fn volume_chart<DB: DrawingBackend>(
                 .map_err(err)?;
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }
 
@@ -646,23 +639,9 @@ fn memory_chart<DB: DrawingBackend>(
 ) -> Drawn {
     root.fill(&WHITE).map_err(err)?;
     let xy = |p: &MemoryPoint| (p.bytes as f64, p.error(error).max(ERROR_FLOOR));
-    let x = log_range(points.iter().map(|p| xy(p).0));
-    let y = log_range(points.iter().map(|p| xy(p).1));
-    let mut chart = ChartBuilder::on(root)
-        .caption(error.caption(), ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("table bytes")
-        .y_desc(error.axis())
-        .x_label_formatter(&|v| format!("{v:.0e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(err)?;
+    let y_desc = error.axis();
+    let axes = ["table bytes", y_desc.as_str()];
+    let mut chart = log_frame(root, error.caption(), axes, points.iter().map(xy))?;
     let families = first_seen(points.iter().map(|p| p.family));
     let meshes = first_seen(points.iter().map(|p| p.mesh.as_str()));
     for (i, &family) in families.iter().enumerate() {
@@ -700,15 +679,8 @@ fn memory_chart<DB: DrawingBackend>(
                 EmptyElement::at((x + 8, y)) + mesh_marker::<DB>(m, BLACK.filled())
             });
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        // Cheap and accurate, the corner no table reaches.
-        .position(SeriesLabelPosition::LowerLeft)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(err)?;
+    // Cheap and accurate, the corner no table reaches.
+    legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())
 }
 
