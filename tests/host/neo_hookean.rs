@@ -206,8 +206,8 @@ fn bend(force_n: f64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     (newton.u, linear)
 }
 
-/// `‖a − b‖₂ / ‖b‖₂` over all vertices.
-fn relative(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+/// `‖a − b‖₂ / ‖b‖₂` over all vertices (also `host::neo_hookean_kernel`'s).
+pub fn relative(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     let diff: f64 = a
         .iter()
         .zip(b)

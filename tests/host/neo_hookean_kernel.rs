@@ -25,6 +25,8 @@ use palpate_kernel::tensor_mass::{
     DynamicParams, ElasticLaw, NEO_HOOKEAN_J_FLOOR, TensorMassModel,
 };
 
+use super::neo_hookean::relative;
+
 /// The press's lateral imperfection along x, of the axial force (the
 /// chart's, `palpate::chart::PRESS_IMPERFECTION`): it picks the buckling
 /// direction for both solvers.
@@ -111,17 +113,6 @@ fn min_volume_ratio(scene: &Scene, u: &[[f64; 3]]) -> f64 {
         .iter()
         .map(|t| edges(&deformed, t) / edges(&rest, t))
         .fold(f64::INFINITY, f64::min)
-}
-
-/// `‖a − b‖₂ / ‖b‖₂` over all vertices.
-fn relative(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    let diff: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (Vector3::from(*x) - Vector3::from(*y)).norm_squared())
-        .sum();
-    let norm: f64 = b.iter().map(|y| Vector3::from(*y).norm_squared()).sum();
-    (diff / norm).sqrt()
 }
 
 /// The chart's 1×5 cylinder (54 vertices, 120 tets) under 1.183 N, its

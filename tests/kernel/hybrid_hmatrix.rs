@@ -173,6 +173,23 @@ fn loads(mesh: &TetMesh, vertex: u32, force: [f64; 3]) -> Vec<[f64; 3]> {
     loads
 }
 
+/// The global linear FEM solution of `mesh` (base `z = 0` fixed) under `force` (N) at vertex
+/// `top`, m, and its largest displacement component (the error scale).
+fn global_solution(mesh: &TetMesh, top: u32, force: [f64; 3]) -> (Vec<[f64; 3]>, f64) {
+    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 1e-9).collect();
+    let (global, _) = solve_loaded(
+        &mesh.positions,
+        &mesh.tets,
+        &TetMaterials::uniform(material(), mesh.tets.len()),
+        &fixed,
+        &[],
+        &loads(mesh, top, force),
+    )
+    .expect("global solve");
+    let scale = global.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    (global, scale)
+}
+
 /// A point load on the dynamic region's top: the settled hybrid with the
 /// hierarchical interface equals the global solve. The condensation is
 /// exact, so the error is the compression's: the connection displacements
@@ -189,17 +206,7 @@ fn compressed_interface_steady_state_is_the_global_solve() {
     // (4, 2, 3) cm: the middle of the top, in the dynamic region.
     let top = 3 * 45 + 2 * 9 + 4;
     let force = [0.0, 0.0, -0.05];
-    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 1e-9).collect();
-    let (global, _) = solve_loaded(
-        &mesh.positions,
-        &mesh.tets,
-        &TetMaterials::uniform(material(), mesh.tets.len()),
-        &fixed,
-        &[],
-        &loads(mesh, top, force),
-    )
-    .expect("global solve");
-    let scale = global.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (global, scale) = global_solution(mesh, top, force);
     let mut errors = Vec::new();
     for tables in [&b.dense, &b.compressed] {
         let d = tables.split.dynamic_index[top as usize].expect("dynamic vertex");
@@ -431,17 +438,7 @@ fn compressed_region_steady_state_is_the_global_solve() {
     // (4, 2, 3) cm: the middle of the window's top.
     let top = 3 * 45 + 2 * 9 + 4;
     let force = [0.0, 0.0, -0.05];
-    let fixed: Vec<bool> = mesh.positions.iter().map(|p| p[2] < 1e-9).collect();
-    let (global, _) = solve_loaded(
-        &mesh.positions,
-        &mesh.tets,
-        &TetMaterials::uniform(material(), mesh.tets.len()),
-        &fixed,
-        &[],
-        &loads(mesh, top, force),
-    )
-    .expect("global solve");
-    let scale = global.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (global, scale) = global_solution(mesh, top, force);
     let skip = interior(&w.compressed);
     let mut errors = Vec::new();
     for tables in [&w.dense, &w.compressed] {
