@@ -556,16 +556,7 @@ fn block_rows<T: Real, E: Stored<T>>(
     mut out: impl FnMut(usize, [T; 3]),
 ) {
     if b.rank == 0 {
-        for i in rows {
-            let mut v = [T::zero(); 3];
-            for j in cols.clone() {
-                if let (Some(c), Some(xj)) = (near_entry(values, b, i, j), x(j)) {
-                    let p = block::mul(&c, &xj);
-                    v = [v[0] + p[0], v[1] + p[1], v[2] + p[2]];
-                }
-            }
-            out(i, v.map(|e| e * scale));
-        }
+        near_rows(values, b, rows, cols, x, scale, out);
         return;
     }
     let r = (b.rank as usize).clamp(1, HIERARCHY_MAX_RANK);
@@ -590,6 +581,64 @@ fn block_rows<T: Real, E: Stored<T>>(
                 i,
                 core::array::from_fn(|a| dot_scalar(factor_row(left, a, r), t)),
             );
+        }
+    }
+}
+
+/// Columns of a near block whose inputs [`near_rows`] gathers at once (the default leaf size).
+const GATHER: usize = 32;
+
+/// [`block_rows`] of a near block: its columns taken [`GATHER`] at a time, their inputs gathered
+/// once (a `None` input as zero), then for each row `i` of `rows`, `out(i, v)` with
+/// `v = scale · Σ_j C_ij x(j)` over those columns, summed from zero in column order. A row's
+/// entries of a stored block are contiguous (`9` numbers per column); a mirrored block's row `i`
+/// is its mirror's column `i`, each entry applied transposed. A block of more than [`GATHER`]
+/// columns delivers a row's sum in parts, one per `GATHER` columns.
+#[inline(always)]
+fn near_rows<T: Real, E: Stored<T>>(
+    values: &[E],
+    b: &HierarchyBlock,
+    rows: core::ops::Range<usize>,
+    cols: core::ops::Range<usize>,
+    x: impl Fn(usize) -> Option<[T; 3]>,
+    scale: T,
+    mut out: impl FnMut(usize, [T; 3]),
+) {
+    let mirrored = b.flags & HIERARCHY_MIRRORED != 0;
+    let (n_rows, n_cols) = (b.rows(), b.cols());
+    for start in cols.clone().step_by(GATHER) {
+        let end = (start + GATHER).min(cols.end);
+        let mut gathered = [[T::zero(); 3]; GATHER];
+        for (g, j) in gathered.iter_mut().zip(start..end) {
+            if let Some(xj) = x(j) {
+                *g = xj;
+            }
+        }
+        let xs = gathered.get(..end - start).unwrap_or(&[]);
+        for i in rows.clone() {
+            let mut v = [T::zero(); 3];
+            let mut add = |p: [T; 3]| v = [v[0] + p[0], v[1] + p[1], v[2] + p[2]];
+            if mirrored {
+                for (j, xj) in (start..end).zip(xs) {
+                    let at = b.left as usize + 9 * (j * n_rows + i);
+                    if let Some(c) = values
+                        .get(at..at + 9)
+                        .and_then(|c| <&[E; 9]>::try_from(c).ok())
+                    {
+                        add(block::mul_transposed(&(*c).map(E::value), xj));
+                    }
+                }
+            } else {
+                let at = b.left as usize + 9 * (i * n_cols + start);
+                if let Some(row) = values.get(at..at + 9 * xs.len()) {
+                    for (c, xj) in row.chunks_exact(9).zip(xs) {
+                        if let Ok(c) = <&[E; 9]>::try_from(c) {
+                            add(block::mul(&(*c).map(E::value), xj));
+                        }
+                    }
+                }
+            }
+            out(i, v.map(|e| e * scale));
         }
     }
 }
