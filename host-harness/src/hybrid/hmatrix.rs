@@ -20,8 +20,11 @@ use crate::table::hmatrix::{DEFAULT_TOLERANCE, estimate_with_leaves};
 /// How the interface's condensed stiffness is compressed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InterfaceCompression {
-    /// The far blocks' relative tolerance, in `(0, 1)`: `‖S_b − L Rᵀ‖_F ≤
-    /// tolerance · ‖S_b‖_F` per block, so `‖S − S̃‖_F ≤ tolerance · ‖S‖_F`.
+    /// The relative tolerance, in `(0, 1)`: `‖S − S̃‖_F ≤ tolerance ·
+    /// ‖S‖_F`, each block truncated relative to the whole `S`
+    /// (`crate::table::hmatrix::assemble`, error budget), so that blocks
+    /// negligible against `‖S‖_F` (a stiffness's far blocks) drop to a
+    /// low rank or to zero.
     pub tolerance: f64,
     /// Connection nodes of a leaf cluster, at most (`≥ 1`).
     pub leaf_size: usize,
@@ -67,7 +70,9 @@ pub fn compress_condensed(
     let tree = ClusterTree::new(points, compression.leaf_size);
     let partition = Partition::new(&tree, ETA);
     let batches = batches(&tree);
-    let mut assembler = Assembler::new(&tree, &partition, &batches, compression.tolerance);
+    let norm2: f64 = condensed.iter().flatten().map(|x| x * x).sum();
+    let mut assembler =
+        Assembler::new(&tree, &partition, &batches, compression.tolerance).relative_to_whole(norm2);
     for batch in &batches {
         // Rows and columns in hierarchy order: S[(order i, a), (order k, b)].
         let x = Mat::from_fn(3 * c, 3 * batch.len(), |r, col| {

@@ -13,9 +13,20 @@
 //! one at `tol/4 · ‖B‖_F`: `‖B − L Rᵀ‖_F ≤ tol · ‖B‖_F`. A block within one
 //! batch is truncated once at `tol · ‖B‖_F`.
 //!
+//! **Relative to the whole matrix** ([`Assembler::relative_to_whole`], the
+//! hybrid's condensed stiffness): `‖B‖_F` above is replaced everywhere by
+//! `((‖B‖_F² + ‖A‖_F² · mn / N²) / 2)^{1/2}` for a block of `m × n` of the
+//! matrix `A`'s `N × N` vertices (squares add over disjoint columns, as
+//! `‖B‖_F²` does). Summed over every block (mirrors included, `Σ mn = N²`)
+//! the squared thresholds are at most `tol² ‖A‖_F²`, so
+//! `‖A − Ã‖_F ≤ tol · ‖A‖_F` still holds, while a block negligible against
+//! `‖A‖_F` (a stiffness's far blocks) truncates to a low rank or to zero.
+//!
 //! A far block is stored as entries (`L Rᵀ`, within the same bound) when
 //! its rank would exceed [`HIERARCHY_MAX_RANK`] or its factors would not be
-//! smaller (`3(m + n) r ≥ 9 m n`, `m × n` vertices). An inadmissible
+//! smaller (`3(m + n) r ≥ 9 m n`, `m × n` vertices); truncated to rank zero,
+//! as rank-1 zero factors (the format's far blocks have a rank of at least
+//! one) when they are smaller than its entries. An inadmissible
 //! (near) block off the diagonal, two neighbouring leaves, is truncated at
 //! the same `tol · ‖B‖_F` and stored as factors when they are smaller
 //! (on the built-in organ at `tol = 1e-2`, all 84 such blocks: 36 % of their entries'
@@ -72,6 +83,8 @@ struct Pending {
     seen: usize,
     /// `‖B‖_F²` over the columns seen.
     norm2: f64,
+    /// Vertex pairs (`rows × columns`) seen.
+    pairs: usize,
     /// `(L, R)` with `B ≈ L Rᵀ` over the columns seen (`R` zero beyond).
     factors: Option<(Mat<f64>, Mat<f64>)>,
 }
@@ -84,11 +97,32 @@ enum Work {
     Done,
 }
 
+/// The truncation threshold of a set of a block's entries (module docs,
+/// error budget): `tolerance · ‖B‖_F`, or relative to the whole matrix
+/// with `floor2_per_pair = ‖A‖_F² / N²` (zero: relative to the block).
+#[derive(Clone, Copy, Debug)]
+struct Budget {
+    tolerance: f64,
+    floor2_per_pair: f64,
+}
+
+impl Budget {
+    /// The threshold of entries of squared norm `norm2` over `pairs`
+    /// vertex pairs (m/N, Frobenius norm of what may be discarded).
+    fn threshold(self, norm2: f64, pairs: usize) -> f64 {
+        if self.floor2_per_pair > 0.0 {
+            self.tolerance * (0.5 * (norm2 + self.floor2_per_pair * pairs as f64)).sqrt()
+        } else {
+            self.tolerance * norm2.sqrt()
+        }
+    }
+}
+
 /// The builder's state over the batches.
 pub struct Assembler<'a> {
     tree: &'a ClusterTree,
     partition: &'a Partition,
-    tolerance: f64,
+    budget: Budget,
     work: Vec<Work>,
     stored: Vec<Option<Stored>>,
 }
@@ -117,6 +151,7 @@ impl<'a> Assembler<'a> {
                             .count(),
                         seen: 0,
                         norm2: 0.0,
+                        pairs: 0,
                         factors: None,
                     }),
                 }
@@ -125,10 +160,22 @@ impl<'a> Assembler<'a> {
         Self {
             tree,
             partition,
-            tolerance,
+            budget: Budget {
+                tolerance,
+                floor2_per_pair: 0.0,
+            },
             work,
             stored: (0..partition.blocks.len()).map(|_| None).collect(),
         }
+    }
+
+    /// The same with every threshold relative to the whole matrix (module
+    /// docs): `norm2` is `‖A‖_F²` of the `N × N`-vertex matrix compressed
+    /// (`N` the tree's vertices).
+    pub fn relative_to_whole(mut self, norm2: f64) -> Self {
+        let n = self.tree.order.len().max(1) as f64;
+        self.budget.floor2_per_pair = norm2 / (n * n);
+        self
     }
 
     /// Takes the columns of touchable vertices `batch`: `x` holds (at least)
@@ -136,7 +183,7 @@ impl<'a> Assembler<'a> {
     /// of `(k, b)`. Each block the batch touches is processed, over the
     /// machine's cores.
     pub fn add_batch(&mut self, batch: &Range<usize>, x: MatRef<'_, f64>) -> anyhow::Result<()> {
-        let (tree, partition, tolerance) = (self.tree, self.partition, self.tolerance);
+        let (tree, partition, budget) = (self.tree, self.partition, self.budget);
         let mut items: Vec<(usize, &mut Work, &mut Option<Stored>)> = self
             .work
             .iter_mut()
@@ -165,7 +212,7 @@ impl<'a> Assembler<'a> {
                                 batch: batch.clone(),
                                 x,
                             };
-                            match part.process(work, tolerance) {
+                            match part.process(work, budget) {
                                 Some(Some(s)) => {
                                     **stored = Some(s);
                                     **work = Work::Done;
@@ -256,7 +303,7 @@ impl<'a> Assembler<'a> {
             max_column_blocks: partition.max_column_blocks() as u32,
             leaf_size: leaf_size as u32,
             depth: tree.depth as u32,
-            tolerance: self.tolerance,
+            tolerance: self.budget.tolerance,
             eta,
         };
         Ok(Hierarchy {
@@ -292,7 +339,7 @@ impl Part<'_> {
 
     /// Processes the part: `Some(Some(data))` when the block is complete,
     /// `Some(None)` when it waits for more batches, `None` if an SVD failed.
-    fn process(&self, work: &mut Work, tolerance: f64) -> Option<Option<Stored>> {
+    fn process(&self, work: &mut Work, budget: Budget) -> Option<Option<Stored>> {
         match work {
             Work::Done => Some(None),
             // A near block is leaf × leaf: its columns are in one batch.
@@ -300,18 +347,19 @@ impl Part<'_> {
                 self.view(&self.cols),
                 true,
             )))),
-            Work::Near => self.near_off_diagonal(tolerance).map(Some),
-            Work::Far(pending) => self.add_far(pending, tolerance),
+            Work::Near => self.near_off_diagonal(budget).map(Some),
+            Work::Far(pending) => self.add_far(pending, budget),
         }
     }
 
     /// An inadmissible block off the diagonal (two neighbouring leaves):
-    /// its factors truncated at `tolerance · ‖B‖_F` when they are smaller
-    /// than its entries (`3(m + n) r < 9 m n`, rank within the kernel's
-    /// bound), else its exact entries. `None` if the SVD failed.
-    fn near_off_diagonal(&self, tolerance: f64) -> Option<Stored> {
+    /// its factors truncated at the budget's threshold when they are
+    /// smaller than its entries (`3(m + n) r < 9 m n`, rank within the
+    /// kernel's bound), else its exact entries. `None` if the SVD failed.
+    fn near_off_diagonal(&self, budget: Budget) -> Option<Stored> {
         let b = self.view(&self.cols);
-        let svd = TruncatedSvd::of(b, tolerance * b.squared_norm_l2().sqrt())?;
+        let pairs = self.rows.len() * self.cols.len();
+        let svd = TruncatedSvd::of(b, budget.threshold(b.squared_norm_l2(), pairs))?;
         let (m, n, r) = (self.rows.len(), self.cols.len(), svd.rank());
         Some(
             if (1..=HIERARCHY_MAX_RANK).contains(&r) && 3 * (m + n) * r < 9 * m * n {
@@ -323,14 +371,16 @@ impl Part<'_> {
     }
 
     /// Adds this batch's part to a far block (module docs, error budget).
-    fn add_far(&self, p: &mut Pending, tolerance: f64) -> Option<Option<Stored>> {
+    fn add_far(&self, p: &mut Pending, budget: Budget) -> Option<Option<Stored>> {
         let within = self.cols.start.max(self.batch.start)..self.cols.end.min(self.batch.end);
         let part = self.view(&within);
         let part_norm2 = part.squared_norm_l2();
+        let part_pairs = self.rows.len() * within.len();
         p.norm2 += part_norm2;
+        p.pairs += part_pairs;
         p.seen += 1;
         let share = if p.parts == 1 { 1.0 } else { 0.5 };
-        let svd = TruncatedSvd::of(part, share * tolerance * part_norm2.sqrt())?;
+        let svd = TruncatedSvd::of(part, share * budget.threshold(part_norm2, part_pairs))?;
         if p.parts == 1 {
             return Some(Some(stored(&svd, self.rows.len(), self.cols.len())));
         }
@@ -350,14 +400,14 @@ impl Part<'_> {
                 concat(r0.as_ref(), r.as_ref()),
             ),
         };
-        let norm = p.norm2.sqrt();
+        let threshold = budget.threshold(p.norm2, p.pairs);
         if p.seen == p.parts {
-            let svd = TruncatedSvd::of_product(l.as_ref(), r.as_ref(), tolerance / 4.0 * norm)?;
+            let svd = TruncatedSvd::of_product(l.as_ref(), r.as_ref(), threshold / 4.0)?;
             return Some(Some(stored(&svd, self.rows.len(), self.cols.len())));
         }
         p.factors = Some(if p.seen >= 2 {
             let steps = (p.parts - 2).max(1) as f64;
-            TruncatedSvd::of_product(l.as_ref(), r.as_ref(), tolerance / (4.0 * steps) * norm)?
+            TruncatedSvd::of_product(l.as_ref(), r.as_ref(), threshold / (4.0 * steps))?
                 .weighted_left()
         } else {
             (l, r)
@@ -377,9 +427,17 @@ fn concat(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
 
 /// A complete far block of `rows × cols` vertices, truncated as `svd`: its
 /// balanced factors, or its entries when they are smaller or the rank is
-/// above the kernel's bound (or zero).
+/// above the kernel's bound; truncated to zero, rank-1 zero factors when
+/// they are smaller than its entries (module docs).
 fn stored(svd: &TruncatedSvd, rows: usize, cols: usize) -> Stored {
     let r = svd.rank();
+    if r == 0 && 3 * (rows + cols) < 9 * rows * cols {
+        return Stored::Far {
+            left: vec![0.0; 3 * rows],
+            right: vec![0.0; 3 * cols],
+            rank: 1,
+        };
+    }
     if r == 0 || r > HIERARCHY_MAX_RANK || 3 * (rows + cols) * r >= 9 * rows * cols {
         let (l, v) = svd.weighted_left();
         let product = &l * v.transpose();
