@@ -4,7 +4,7 @@
 
 use super::body::Load;
 use super::model::Model;
-use super::results::Study;
+use super::results::{Run, Study};
 use super::trajectory::Trajectory;
 
 /// The trajectories of one load with an error, as (cost, error) points:
@@ -54,4 +54,19 @@ pub fn cost_series(study: &Study, model: Model) -> Vec<(f64, f64)> {
             (v as f64, t[t.len() / 2])
         })
         .collect()
+}
+
+/// The runs of one load and level with an error against the neo-Hookean
+/// truth, as (cost, error) points: time per step (s) and tip error.
+pub fn points(study: &Study, load: Load, level: f64) -> (Vec<&Run>, Vec<(f64, f64)>) {
+    let runs: Vec<&Run> = study
+        .runs
+        .iter()
+        .filter(|r| r.load == load && r.level == level && r.truth_tip_error.is_some())
+        .collect();
+    let points = runs
+        .iter()
+        .map(|r| (r.step_s, r.truth_tip_error.unwrap_or(f64::NAN)))
+        .collect();
+    (runs, points)
 }

@@ -11,8 +11,9 @@ use super::matrix::Matrix;
 use super::model::Model;
 use super::precomputed::precomputed;
 use super::progress::Progress;
-use super::reference::{reference, score};
+use super::reference::{reference, score, score_truth};
 use super::results::{Run, Study};
+use super::truth::{CONVERGED, truth};
 use super::{memory, stability, ticks, trajectory};
 use crate::experiment::volume_bend::inverted_tets;
 use crate::remap::fit::fit_curves;
@@ -37,6 +38,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
     let quasi = (remap.kernel::<f64>()?, remap.kernel::<f32>()?);
 
     let mut references = Vec::new();
+    let mut truths = Vec::new();
     let mut runs = Vec::new();
     let mut trajectory_loads = Vec::new();
     for &load in &matrix.loads {
@@ -56,6 +58,16 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
                     .clone()
                     .unwrap_or_else(|| format!("{} Newton iterations", reference.0.iterations))
             ));
+            let truth = truth(finest, &matrix.truth, load, level, magnitude);
+            progress.tick(&format!(
+                "truth {} {:.0} %: {}",
+                load.name(),
+                100.0 * level,
+                truth.change.map_or_else(
+                    || "not converged".to_string(),
+                    |c| format!("change {c:.1e}")
+                )
+            ));
             for body in &bodies {
                 let same_mesh = core::ptr::eq(body, finest);
                 for model in Model::ALL {
@@ -71,6 +83,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
                         format!("{} on {} {}", model.name(), body.label, load.name())
                     })?;
                     score(&mut run, &u, &reference, same_mesh);
+                    score_truth(&mut run, &truth);
                     progress.tick(&format!(
                         "{} {} {:.0} % {}",
                         body.label,
@@ -82,6 +95,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
                 }
             }
             references.push(reference.0);
+            truths.push(truth);
         }
     }
     let stability = stability::maps(&bodies[0], &matrix.stability, progress)?;
@@ -108,6 +122,19 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
         material: (material.young_pa, material.poisson),
         reference_mesh: finest.label.clone(),
         references,
+        truths,
+        truth_levels: format!(
+            "{} on the finest chart mesh's geometry (refined by halving every edge), the last \
+             the truth; converged when the quantity changes by at most {CONVERGED:e} between the \
+             last two.{}",
+            matrix
+                .truth
+                .iter()
+                .map(|d| d.label(&finest.label))
+                .collect::<Vec<_>>()
+                .join(", "),
+            matrix.truth_note
+        ),
         runs,
         remap,
         stability,
@@ -147,6 +174,8 @@ fn run_model(
         tip_m: tip_m(&loads, &outcome.u),
         tip_error: None,
         force_error: None,
+        truth_tip_error: None,
+        truth_force_error: None,
         l2_error: None,
         max_error_m: None,
         volume_change: volume_change(&body.mesh, &outcome.u, &alive),

@@ -46,11 +46,14 @@ pub struct ChartArgs {
     /// its own resolution, instead of the cylinder's refinements.
     #[arg(long, requires_all = ["young", "poisson", "fix"])]
     mesh: Option<PathBuf>,
-    /// Young's modulus of `--mesh`, Pa.
-    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    /// Young's modulus, Pa: of `--mesh` (required with it), or of the
+    /// cylinders (default 5000).
+    #[arg(long, allow_negative_numbers = true)]
     young: Option<f64>,
-    /// Poisson ratio of `--mesh`, in [0, 0.4999].
-    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    /// Poisson ratio, in [0, 0.4999]: of `--mesh` (required with it), or of
+    /// the cylinders (default 0.4; the neo-Hookean truth's study is run at
+    /// 0.45 and 0.49).
+    #[arg(long, allow_negative_numbers = true)]
     poisson: Option<f64>,
     /// Fixed vertices of `--mesh`: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
     #[arg(long = "fix", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
@@ -113,7 +116,14 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     let dir = folder.dir();
     let mut matrix = match args.given()? {
         Some(given) => matrix.on(given),
-        None => matrix,
+        None => Matrix {
+            material: MaterialArgs {
+                young: args.young.unwrap_or(matrix.material.young_pa),
+                poisson: args.poisson.unwrap_or(matrix.material.poisson),
+            }
+            .material()?,
+            ..matrix
+        },
     };
     matrix.tick_counts |= args.tick_counts;
     let volume_runs = VolumeRuns::of(&matrix, args.quick);
@@ -213,15 +223,16 @@ fn announce(matrix: &Matrix, volume_experiments: usize) -> usize {
         + tick_runs;
     stderr::line(&format!(
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
-         references), {} stability trials, {} trajectories (each against its Δt/{}), {} \
-         memory-chart tables, {} volume experiments, {tick_runs} callgrind runs: {total} steps \
-         of progress",
+         references and as many neo-Hookean truths of {} levels), {} stability trials, {} \
+         trajectories (each against its Δt/{}), {} memory-chart tables, {} volume experiments, \
+         {tick_runs} callgrind runs: {total} steps of progress",
         matrix.mesh_count(),
         matrix.loads.len(),
         matrix.levels.len(),
         chart::Model::ALL.len(),
-        matrix.static_runs() - matrix.loads.len() * matrix.levels.len(),
+        matrix.static_runs() - 2 * matrix.loads.len() * matrix.levels.len(),
         matrix.loads.len() * matrix.levels.len(),
+        matrix.truth.len(),
         trials,
         matrix.trajectories(),
         chart::trajectory::REFINEMENT,

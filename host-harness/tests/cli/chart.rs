@@ -45,11 +45,23 @@ fn quick_chart_writes_report_charts_and_json() {
     let png = std::fs::read(dir.join("cost-mesh.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let press = &json["summary"]["press-1"];
-    // The hybrid on 2x10 is also within 1 % (0.99 %) at a step time within
-    // the timing noise of the quasi model's (11.6 against 12.0 µs).
+    // The summary measures against the neo-Hookean truth (here the quick
+    // one: P2 on 2x10). Within 1 % of it under the small press on 2x10
+    // (measured): stvk-penalty 0.40 %, hybrid 0.46 %, stvk 0.57 %,
+    // precomputed-quasi 0.62 %, corotational 0.999 %; the linear models are
+    // 1.02 % off, the kernel's neo-Hookean 1.9 % (P1 on 2x10: the truth's
+    // own P1 level is 1.9 % off its P2 level). Which of those is cheapest
+    // is the timing's call.
     let cheapest = press["cheapest_within_percent"]["1"].as_str().unwrap();
     assert!(
-        ["precomputed-quasi on 2x10", "hybrid on 2x10"].contains(&cheapest),
+        [
+            "precomputed-quasi on 2x10",
+            "hybrid on 2x10",
+            "stvk on 2x10",
+            "stvk-penalty on 2x10",
+            "corotational on 2x10"
+        ]
+        .contains(&cheapest),
         "{cheapest}"
     );
     let front: Vec<&str> = press["pareto"]
@@ -59,11 +71,18 @@ fn quick_chart_writes_report_charts_and_json() {
         .map(|v| v.as_str().unwrap())
         .collect();
     // The cheapest within 1 % is on the front by definition (a run that
-    // dominated it would be cheaper and within 1 %), whichever of the quasi
-    // and the hybrid timing made it; the most accurate run, St
-    // Venant-Kirchhoff on the reference mesh, is on it whatever the timing.
+    // dominated it would be cheaper and within 1 %); the most accurate run
+    // against the truth, St Venant-Kirchhoff with the penalty on 2x10, is
+    // on it whatever the timing.
     assert!(front.contains(&cheapest), "{front:?}");
-    assert!(front.contains(&"stvk on 2x10"), "{front:?}");
+    assert!(front.contains(&"stvk-penalty on 2x10"), "{front:?}");
+    // The quick truth's convergence figure (P1 against P2 on 2x10) under
+    // the small press: measured 1.90e-2, the bound the report states for
+    // `--quick` (the full run refines further).
+    let truths = json["study"]["truths"].as_array().unwrap();
+    assert_eq!(truths.len(), 4);
+    let change = truths[0]["change"].as_f64().unwrap();
+    assert!((0.015..0.025).contains(&change), "{change}");
     // One map per integrator for St Venant-Kirchhoff and for the hybrid,
     // whose critical step is its tensor-mass region's: measured on 1x5
     // (symplectic) 3.84e-3 s, within 1 % of 2/ω_max (3.86e-3 s).
@@ -77,7 +96,7 @@ fn quick_chart_writes_report_charts_and_json() {
         / hybrid_map["two_over_omega_s"].as_f64().unwrap();
     assert!((ratio - 1.0).abs() < 0.02, "{ratio}");
     // The hybrid's trajectories: RK4 at 0.5 × 2/ω_max under the bend,
-    // measured 4.06e-5 against its Δt/16 run.
+    // measured 5.67e-5 against its Δt/16 run.
     let rk4 = json["study"]["trajectories"]
         .as_array()
         .unwrap()
@@ -95,8 +114,9 @@ fn quick_chart_writes_report_charts_and_json() {
     // The hybrid (St Venant-Kirchhoff on the tets whose centroid is in the
     // top third: 320 of 960 tets on 2x10, the top three layers and the
     // upper tets of the seventh) lies between the linear and the St Venant-
-    // Kirchhoff model under the small press: measured tip errors 1.59 %
-    // (linear), 0.99 % (hybrid), 1.1e-6 (St Venant-Kirchhoff).
+    // Kirchhoff model under the small press, against the St Venant-Kirchhoff
+    // reference (the `tip_error` column): measured tip errors 1.58 %
+    // (linear), 1.03 % (hybrid), 8.2e-6 (St Venant-Kirchhoff).
     let run = |model: &str, level: f64| {
         json["study"]["runs"]
             .as_array()
@@ -142,8 +162,8 @@ fn quick_chart_writes_report_charts_and_json() {
         .unwrap();
     assert!(straight > 0.9, "{straight}");
     let (linear, hybrid, stvk) = (tip("precomputed-linear"), tip("hybrid"), tip("stvk"));
-    assert!((linear - 0.0159).abs() < 5e-4, "{linear}");
-    assert!((hybrid - 0.0099).abs() < 5e-4, "{hybrid}");
+    assert!((linear - 0.0158).abs() < 5e-4, "{linear}");
+    assert!((hybrid - 0.0103).abs() < 5e-4, "{hybrid}");
     assert!(stvk < 1e-5, "{stvk}");
     assert_eq!(json["study"]["hybrid_region"][1][1], 320);
     assert_eq!(
@@ -155,6 +175,7 @@ fn quick_chart_writes_report_charts_and_json() {
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(report.contains("## Cheapest model within an error bound"));
     assert!(report.contains("## Where the methods fail"));
+    assert!(report.contains("## The neo-Hookean truth"));
     assert!(report.contains("## Table memory against accuracy"));
     let memory: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("memory.json")).unwrap()).unwrap();
