@@ -248,7 +248,11 @@ fn refinement_keeps_the_volume() {
             })
             .collect()
     };
-    let (p, t, flags) = refine(&body.mesh.positions, &body.mesh.tets, &[body.fixed.clone()]);
+    let (p, t, flags) = refine(
+        &body.mesh.positions,
+        &body.mesh.tets,
+        core::slice::from_ref(&body.fixed),
+    );
     assert_eq!(t.len(), 8 * body.mesh.tets.len());
     let fine = volume(&p, &t);
     assert!(fine.iter().all(|&v| v > 0.0));
@@ -285,8 +289,8 @@ fn truth_bends_as_a_timoshenko_beam() {
         HEIGHT_M / 5.0,
     );
     let (area, inertia) = (
-        std::f64::consts::PI * r * r,
-        std::f64::consts::PI * r.powi(4) / 4.0,
+        core::f64::consts::PI * r * r,
+        core::f64::consts::PI * r.powi(4) / 4.0,
     );
     let shear = e / (2.0 * (1.0 + nu));
     let beam = force * (l.powi(3) / (3.0 * e * inertia) + l / (0.9 * shear * area));

@@ -149,8 +149,8 @@ pub fn markdown(
                     "no truth: {}",
                     t.levels
                         .iter()
-                        .filter_map(|l| l.fault.as_deref())
-                        .last()
+                        .rev()
+                        .find_map(|l| l.fault.as_deref())
                         .unwrap_or("not solved")
                 ),
                 None => pareto_members(study, load, level).join(", "),
