@@ -127,46 +127,7 @@ pub fn markdown(
         100.0 * HYBRID_DYNAMIC_FRACTION,
         regions.join(", ")
     );
-    let _ = writeln!(out, "## Cheapest model within an error bound\n");
-    let _ = writeln!(
-        out,
-        "Tip error against the neo-Hookean truth; the Pareto front of time per step against it.\n"
-    );
-    let _ = writeln!(
-        out,
-        "| load | level | within 1 % | within 5 % | within 20 % | Pareto front |"
-    );
-    let _ = writeln!(out, "|---|---|---|---|---|---|");
-    for &load in loads {
-        for &level in levels {
-            let cell = |b: f64| cheapest(study, load, level, b).unwrap_or_else(|| "none".into());
-            let truth = study
-                .truths
-                .iter()
-                .find(|t| t.load == load && t.level == level);
-            let front = match truth.filter(|t| !t.tip_m.is_finite()) {
-                Some(t) => format!(
-                    "no truth: {}",
-                    t.levels
-                        .iter()
-                        .rev()
-                        .find_map(|l| l.fault.as_deref())
-                        .unwrap_or("not solved")
-                ),
-                None => pareto_members(study, load, level).join(", "),
-            };
-            let _ = writeln!(
-                out,
-                "| {} | {:.0} % | {} | {} | {} | {} |",
-                load.name(),
-                100.0 * level,
-                cell(BOUNDS[0]),
-                cell(BOUNDS[1]),
-                cell(BOUNDS[2]),
-                front
-            );
-        }
-    }
+    cheapest_table(&mut out, study, loads, levels);
     let _ = writeln!(out, "\n## Every run\n");
     let _ = writeln!(
         out,
@@ -227,6 +188,50 @@ pub fn markdown(
         let _ = writeln!(out, "![{name}]({name}.png)\n");
     }
     out
+}
+
+/// The "cheapest within" table with the Pareto members, against the truth.
+fn cheapest_table(out: &mut String, study: &Study, loads: &[Load], levels: &[f64]) {
+    let _ = writeln!(out, "## Cheapest model within an error bound\n");
+    let _ = writeln!(
+        out,
+        "Tip error against the neo-Hookean truth; the Pareto front of time per step against it.\n"
+    );
+    let _ = writeln!(
+        out,
+        "| load | level | within 1 % | within 5 % | within 20 % | Pareto front |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    for &load in loads {
+        for &level in levels {
+            let cell = |b: f64| cheapest(study, load, level, b).unwrap_or_else(|| "none".into());
+            let truth = study
+                .truths
+                .iter()
+                .find(|t| t.load == load && t.level == level);
+            let front = match truth.filter(|t| !t.tip_m.is_finite()) {
+                Some(t) => format!(
+                    "no truth: {}",
+                    t.levels
+                        .iter()
+                        .rev()
+                        .find_map(|l| l.fault.as_deref())
+                        .unwrap_or("not solved")
+                ),
+                None => pareto_members(study, load, level).join(", "),
+            };
+            let _ = writeln!(
+                out,
+                "| {} | {:.0} % | {} | {} | {} | {} |",
+                load.name(),
+                100.0 * level,
+                cell(BOUNDS[0]),
+                cell(BOUNDS[1]),
+                cell(BOUNDS[2]),
+                front
+            );
+        }
+    }
 }
 
 /// The memory/accuracy section: what the tables are, then each one's bytes

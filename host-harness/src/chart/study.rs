@@ -123,18 +123,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
         reference_mesh: finest.label.clone(),
         references,
         truths,
-        truth_levels: format!(
-            "{} on the finest chart mesh's geometry (refined by halving every edge), the last \
-             the truth; converged when the quantity changes by at most {CONVERGED:e} between the \
-             last two.{}",
-            matrix
-                .truth
-                .iter()
-                .map(|d| d.label(&finest.label))
-                .collect::<Vec<_>>()
-                .join(", "),
-            matrix.truth_note
-        ),
+        truth_levels: truth_levels(matrix, &finest.label),
         runs,
         remap,
         stability,
@@ -186,4 +175,20 @@ fn run_model(
         settle_s: outcome.steps as f64 * outcome.step_s,
     };
     Ok((run, outcome.u))
+}
+
+/// The report's description of the truth's levels on `finest`.
+fn truth_levels(matrix: &Matrix, finest: &str) -> String {
+    format!(
+        "{} on the finest chart mesh's geometry (refined by halving every edge), the last the \
+         truth; converged when the quantity changes by at most {CONVERGED:e} between the last \
+         two.{}",
+        matrix
+            .truth
+            .iter()
+            .map(|d| d.label(finest))
+            .collect::<Vec<_>>()
+            .join(", "),
+        matrix.truth_note
+    )
 }
