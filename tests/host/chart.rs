@@ -299,3 +299,50 @@ fn truth_bends_as_a_timoshenko_beam() {
     assert_eq!(t.tip_m, p2);
     assert!((t.change.unwrap() - (p2 - p1).abs() / p2).abs() < 1e-15);
 }
+
+/// A truth is scored against only where it converged: its verdict is
+/// `converged` at a change of at most `CONVERGED` (1e-3) between its two
+/// finest levels, and `no converged truth` with the change above it, or with
+/// the finest failed level's fault (the P2 solve's refusal of a fold) when
+/// a level has no quantity.
+#[test]
+fn truth_verdict_needs_convergence() {
+    use palpate::chart::Load;
+    use palpate::chart::truth::{CONVERGED, Discretization, Truth, TruthLevel};
+    let level = |tip_m: f64, fault: Option<&str>| TruthLevel {
+        label: "P2 on 2x10 ×1".into(),
+        discretization: Discretization::p2(0),
+        nodes: 1701,
+        tets: 960,
+        iterations: 4,
+        seconds: 1.0,
+        tip_m,
+        fault: fault.map(Into::into),
+    };
+    let truth = |tips: [f64; 2], fault: Option<&str>| Truth {
+        load: Load::Bend,
+        level: 0.01,
+        magnitude: 1.0,
+        levels: vec![level(tips[0], None), level(tips[1], fault)],
+        tip_m: tips[1],
+        change: (tips[0].is_finite() && tips[1].is_finite())
+            .then(|| (tips[1] - tips[0]).abs() / tips[1].abs()),
+    };
+    let close = truth([1.0, 1.0 + 0.9 * CONVERGED], None);
+    assert!(close.converged());
+    assert_eq!(close.verdict(), "converged");
+    let far = truth([1.0, 1.0 + 2.0 * CONVERGED], None);
+    assert!(!far.converged());
+    assert!(
+        far.verdict()
+            .starts_with("no converged truth: change 2.00e-3"),
+        "{}",
+        far.verdict()
+    );
+    let folded = truth([1.0, f64::NAN], Some("the equilibrium found folds tet 7"));
+    assert!(!folded.converged());
+    assert_eq!(
+        folded.verdict(),
+        "no converged truth: the equilibrium found folds tet 7"
+    );
+}

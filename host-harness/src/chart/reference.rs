@@ -113,9 +113,11 @@ pub(super) fn score(
 }
 
 /// Fills the errors of `run` against the neo-Hookean `truth` (its tip);
-/// none when either has no tip.
+/// none when the run has no tip or the truth did not converge
+/// ([`Truth::converged`]): a run is never scored against an unconverged
+/// truth.
 pub(super) fn score_truth(run: &mut Run, truth: &Truth) {
-    if run.fault.is_some() || !run.tip_m.is_finite() || !truth.tip_m.is_finite() {
+    if run.fault.is_some() || !run.tip_m.is_finite() || !truth.converged() {
         return;
     }
     run.truth_tip_error = Some((run.tip_m - truth.tip_m).abs() / truth.tip_m.abs());

@@ -76,6 +76,8 @@ pub struct TruthLevel {
     pub tets: usize,
     /// Newton iterations over all increments.
     pub iterations: usize,
+    /// Wall time of the level's solve (refinement, loads, Newton), s.
+    pub seconds: f64,
     /// The charted quantity, m (`NaN` on a fault).
     pub tip_m: f64,
     /// `null`, or why Newton failed.
@@ -101,9 +103,26 @@ pub struct Truth {
 }
 
 impl Truth {
-    /// Whether the change is at most [`CONVERGED`].
+    /// Whether the change is at most [`CONVERGED`]: only then are the runs
+    /// scored against it ([`super::reference::score_truth`]).
     pub fn converged(&self) -> bool {
         self.change.is_some_and(|c| c <= CONVERGED)
+    }
+
+    /// What the report says of this truth: `converged`, or `no converged
+    /// truth: ` and why (the change above [`CONVERGED`], or the fault of
+    /// the finest level that failed: Newton's, or the P2 solve's refusal of
+    /// a folded element).
+    pub fn verdict(&self) -> String {
+        match (
+            self.change,
+            self.levels.iter().rev().find_map(|l| l.fault.as_deref()),
+        ) {
+            (Some(c), _) if c <= CONVERGED => "converged".into(),
+            (Some(c), _) => format!("no converged truth: change {c:.2e} > {CONVERGED:e}"),
+            (None, Some(fault)) => format!("no converged truth: {fault}"),
+            (None, None) => "no converged truth: fewer than two levels".into(),
+        }
     }
 }
 
@@ -118,7 +137,12 @@ pub fn truth(
 ) -> Truth {
     let solved: Vec<TruthLevel> = levels
         .iter()
-        .map(|&d| solve_level(body, d, load, level, magnitude))
+        .map(|&d| {
+            let start = std::time::Instant::now();
+            let mut solved = solve_level(body, d, load, level, magnitude);
+            solved.seconds = start.elapsed().as_secs_f64();
+            solved
+        })
         .collect();
     let tips: Vec<f64> = solved.iter().map(|l| l.tip_m).collect();
     let tip_m = tips.last().copied().unwrap_or(f64::NAN);
@@ -246,6 +270,7 @@ fn solve_level(
             nodes,
             tets: tets.len(),
             iterations,
+            seconds: 0.0,
             tip_m,
             fault: None,
         },
@@ -255,6 +280,7 @@ fn solve_level(
             nodes: positions.len(),
             tets: tets.len(),
             iterations: 0,
+            seconds: 0.0,
             tip_m: f64::NAN,
             fault: Some(format!("{e:#}")),
         },

@@ -11,6 +11,7 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use indicatif::ProgressBar;
+use palpate::chart::series::Against;
 use palpate::chart::{self, GivenMesh, Matrix, Progress as _, plot, report, ticks};
 use palpate::experiment::scenes;
 use palpate::experiment::volume_bend::{self, Protocol, SceneResult};
@@ -386,28 +387,39 @@ fn write_outputs(
 
 /// `study.json`'s summary: per load and level (`press-5`), the Pareto
 /// front's members and the cheapest model within each of
-/// [`report::BOUNDS`] (keyed by the bound in percent).
+/// [`report::BOUNDS`] (keyed by the bound in percent) against the
+/// neo-Hookean truth (empty and `null` where it did not converge), the
+/// truth's verdict (`truth`: `converged` or `no converged truth: …`), and
+/// the same selections against the St Venant-Kirchhoff reference (`stvk`).
 fn summary(matrix: &Matrix, study: &chart::Study) -> serde_json::Map<String, serde_json::Value> {
+    let selections = |load, level, against| {
+        let within: serde_json::Map<String, serde_json::Value> = report::BOUNDS
+            .iter()
+            .map(|&b| {
+                (
+                    format!("{:.0}", 100.0 * b),
+                    report::cheapest(study, load, level, b, against).into(),
+                )
+            })
+            .collect();
+        serde_json::json!({
+            "pareto": report::pareto_members(study, load, level, against),
+            "cheapest_within_percent": within,
+        })
+    };
     let mut summary = serde_json::Map::new();
     for &load in &matrix.loads {
         for &level in &matrix.levels {
             let key = format!("{}-{:.0}", load.name(), 100.0 * level);
-            let within: serde_json::Map<String, serde_json::Value> = report::BOUNDS
+            let mut entry = selections(load, level, Against::Truth);
+            let verdict = study
+                .truths
                 .iter()
-                .map(|&b| {
-                    (
-                        format!("{:.0}", 100.0 * b),
-                        report::cheapest(study, load, level, b).into(),
-                    )
-                })
-                .collect();
-            summary.insert(
-                key,
-                serde_json::json!({
-                    "pareto": report::pareto_members(study, load, level),
-                    "cheapest_within_percent": within,
-                }),
-            );
+                .find(|t| t.load == load && t.level == level)
+                .map(chart::truth::Truth::verdict);
+            entry["truth"] = verdict.into();
+            entry["stvk"] = selections(load, level, Against::Stvk);
+            summary.insert(key, entry);
         }
     }
     summary
