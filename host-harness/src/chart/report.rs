@@ -351,6 +351,7 @@ fn truth_section(out: &mut String, study: &Study) {
             stvk
         );
     }
+    let _ = writeln!(out);
 }
 
 /// The trajectories' section: the cheapest within each bound per load,
