@@ -37,10 +37,10 @@ pub const FULL_TRUTH: [Discretization; 3] = [
     Discretization::p1(1),
     Discretization::p2(0),
 ];
-/// The truth's levels of `--quick`: P1 and P2 on its finest mesh (1.3 s
-/// for P2 on 2×10; P2 on its refinement took 503 s under the 1 % bend, on
-/// a loaded machine, and still changed the charted quantity by 8.8e-3):
-/// a check of the truth's machinery, not a converged truth.
+/// The truth's levels of `--quick`: P1 and P2 on its finest mesh (0.6 s
+/// for P2 on 2×10 under the 1 % bend; P2 on its refinement took 16.3 s
+/// there on a loaded machine, and still changed the charted quantity by
+/// 8.8e-3): a check of the truth's machinery, not a converged truth.
 pub const QUICK_TRUTH: [Discretization; 2] = [Discretization::p1(0), Discretization::p2(0)];
 /// Steps of one relaxation at most in `--quick`.
 pub const QUICK_RELAX_STEPS: usize = 20_000;

@@ -67,7 +67,8 @@ impl TrajectoryExtent {
         }
     }
 
-    /// The coarsest mesh, two steps.
+    /// The coarsest mesh, one step (half the limit: the co-rotational and
+    /// neo-Hookean static runs and the truth took the other's time).
     pub fn quick() -> Self {
         Self {
             meshes: 1,
