@@ -151,7 +151,7 @@ pub struct Body {
     /// The loaded vertices (the cylinder's top face).
     pub top: Vec<u32>,
     /// The loaded face: the boundary triangles whose vertices are all
-    /// loaded ([`loaded_faces`]); empty when the loaded vertices form no
+    /// loaded (`chart::face::loaded_faces`); empty when the loaded vertices form no
     /// face (then each gets an equal share of the load).
     pub faces: Vec<[u32; 3]>,
     /// Material.
@@ -281,7 +281,7 @@ impl Body {
         f
     }
 
-    /// The consistent nodal loads (N, [`super::face::nodal_loads`]) of
+    /// The consistent nodal loads (N, `chart::face::nodal_loads`) of
     /// `load` over `faces` of the nodes `positions` (this body's loaded
     /// face, or a refinement of it, with the shape functions `shape`): the
     /// press a uniform traction `F (ε lateral − axis)/A` (`ε` the

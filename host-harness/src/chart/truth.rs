@@ -3,10 +3,11 @@
 //! [`crate::fem::neo_hookean_p2`]) of each load and level on the finest
 //! chart mesh, solved on a sequence of discretizations of that mesh's
 //! geometry ([`Discretization`]: P1 or P2 on the mesh or its red
-//! refinements, each tet split into 8) until the charted quantity
-//! ([`super::tip_m`] of the consistent face loads,
-//! [`super::face`]) changes by at most [`CONVERGED`] between the last two;
-//! the last is the truth ([`Truth`]).
+//! refinements, each tet split into 8); the last is the truth ([`Truth`]),
+//! and the relative change of the charted quantity ([`super::tip_m`] of
+//! the consistent face loads, `chart::face`) between the last two its
+//! convergence figure: the runs are scored against it only where that is
+//! at most [`CONVERGED`] ([`Truth::converged`]).
 //!
 //! The refinements keep the geometry (the polygonal cylinder of the finest
 //! chart mesh), so the levels differ in their discretization only: the
@@ -111,7 +112,7 @@ pub struct Truth {
 
 impl Truth {
     /// Whether the change is at most [`CONVERGED`]: only then are the runs
-    /// scored against it ([`super::reference::score_truth`]).
+    /// scored against it (`chart::reference::score_truth`).
     pub fn converged(&self) -> bool {
         self.change.is_some_and(|c| c <= CONVERGED)
     }
