@@ -271,7 +271,7 @@ fn newton_equals_the_dynamic_model_settled_at_rest() {
 #[test]
 fn descent_follows_the_stable_equilibrium_past_buckling() {
     use palpate::chart::{Body, HEIGHT_M, Load};
-    let body = Body::cylinder((1, 5));
+    let body = Body::cylinder((1, 5), palpate::experiment::scenes::tissue());
     let materials = body.materials();
     let per_newton = body.tip_per_newton_m(Load::Press).expect("linear solve");
     let solve = |level: f64, descent: bool| {

@@ -6,7 +6,7 @@ use anyhow::Context;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use crate::experiment::scenes::tissue;
+use super::face::{integrate, loaded_faces, nodal_loads, p1_shape};
 use crate::fem::material::{Material, TetMaterials};
 use crate::fem::newton::StaticProblem;
 use crate::fem::static_solve::solve_loaded;
@@ -150,6 +150,10 @@ pub struct Body {
     pub fixed: Vec<bool>,
     /// The loaded vertices (the cylinder's top face).
     pub top: Vec<u32>,
+    /// The loaded face: the boundary triangles whose vertices are all
+    /// loaded (`chart::face::loaded_faces`); empty when the loaded vertices form no
+    /// face (then each gets an equal share of the load).
+    pub faces: Vec<[u32; 3]>,
     /// Material.
     pub material: Material,
     /// Unit vector from the supports to the loaded end (the press pushes
@@ -168,8 +172,8 @@ pub struct Body {
 }
 
 impl Body {
-    /// The cylinder of `(radial, height)` cells.
-    pub fn cylinder((radial, height): (usize, usize)) -> Self {
+    /// The cylinder of `(radial, height)` cells, of `material`.
+    pub fn cylinder((radial, height): (usize, usize), material: Material) -> Self {
         let mesh = cylinder_mesh(HEIGHT_M, radial, height);
         let label = format!("{radial}x{height}");
         let fix = vec!["z<=0".parse().expect("a valid predicate")];
@@ -180,7 +184,7 @@ impl Body {
             source: format!("generated cylinder {label}"),
             ..MeshReport::default()
         };
-        let body = Self::with_loaded_vertices(label, mesh, report, fix, top, tissue())
+        let body = Self::with_loaded_vertices(label, mesh, report, fix, top, material)
             .expect("the cylinder is fixed at its base and loaded on its top");
         // The exact axes (the centroids agree with them to rounding).
         Self {
@@ -228,8 +232,14 @@ impl Body {
                 (r - axis * r.dot(&axis)).norm()
             })
             .fold(0.0, f64::max);
+        let mut is_loaded = vec![false; mesh.positions.len()];
+        for &v in &loaded {
+            is_loaded[v as usize] = true;
+        }
+        let faces = loaded_faces(&mesh.tets, &is_loaded);
         Ok(Self {
             radius_m,
+            faces,
             label,
             mesh,
             report,
@@ -245,23 +255,70 @@ impl Body {
     }
 
     /// Nodal loads of `load` with total force (press, bend) or torque
-    /// (twist) `magnitude`, N or N·m.
+    /// (twist) `magnitude`, N or N·m: the consistent loads of its traction
+    /// over [`Body::faces`] ([`Body::face_loads`]), or equal shares per
+    /// loaded vertex when they form no face.
     pub fn loads(&self, load: Load, magnitude: f64) -> Vec<[f64; 3]> {
+        if !self.faces.is_empty() {
+            return self.face_loads(&self.mesh.positions, &self.faces, p1_shape, load, magnitude);
+        }
         let mut f = vec![[0.0; 3]; self.mesh.positions.len()];
         let share = magnitude / self.top.len() as f64;
-        let arm = |v: u32| {
-            let r = Vector3::from(self.mesh.positions[v as usize]) - self.centre;
-            r - self.axis * r.dot(&self.axis)
-        };
-        let polar: f64 = self.top.iter().map(|&v| arm(v).norm_squared()).sum();
+        let polar: f64 = self
+            .top
+            .iter()
+            .map(|&v| self.arm(&self.position(v)).norm_squared())
+            .sum();
         for &v in &self.top {
             f[v as usize] = match load {
                 Load::Press => (share * (PRESS_IMPERFECTION * self.lateral - self.axis)).into(),
                 Load::Bend => (share * self.lateral).into(),
-                Load::Twist => (self.axis.cross(&arm(v)) * (magnitude / polar)).into(),
+                Load::Twist => {
+                    (self.axis.cross(&self.arm(&self.position(v))) * (magnitude / polar)).into()
+                }
             };
         }
         f
+    }
+
+    /// The consistent nodal loads (N, `chart::face::nodal_loads`) of
+    /// `load` over `faces` of the nodes `positions` (this body's loaded
+    /// face, or a refinement of it, with the shape functions `shape`): the
+    /// press a uniform traction `F (ε lateral − axis)/A` (`ε` the
+    /// [`PRESS_IMPERFECTION`]), the bend `F lateral/A`, the twist
+    /// `T (axis × r)/∫|r|² dA` (`r` the distance vector from the axis
+    /// through [`Body::centre`]); `A` and `∫|r|² dA` over `faces` by the
+    /// same quadrature, so the total force or torque is `magnitude`.
+    pub fn face_loads<const K: usize>(
+        &self,
+        positions: &[[f64; 3]],
+        faces: &[[u32; K]],
+        shape: fn([f64; 3]) -> [f64; K],
+        load: Load,
+        magnitude: f64,
+    ) -> Vec<[f64; 3]> {
+        let (mut area, mut polar) = (0.0, 0.0);
+        integrate(positions, faces, |_, x, _, w| {
+            area += w;
+            polar += w * self.arm(x).norm_squared();
+        });
+        let traction = |x: &Vector3<f64>| match load {
+            Load::Press => (PRESS_IMPERFECTION * self.lateral - self.axis) * (magnitude / area),
+            Load::Bend => self.lateral * (magnitude / area),
+            Load::Twist => self.axis.cross(&self.arm(x)) * (magnitude / polar),
+        };
+        nodal_loads(positions, faces, shape, traction)
+    }
+
+    /// Rest position of vertex `v`, m.
+    fn position(&self, v: u32) -> Vector3<f64> {
+        Vector3::from(self.mesh.positions[v as usize])
+    }
+
+    /// The distance vector of `x` from the axis through [`Body::centre`], m.
+    fn arm(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        let r = x - self.centre;
+        r - self.axis * r.dot(&self.axis)
     }
 
     /// The hybrid's tensor-mass region: the tets whose centroid lies in the

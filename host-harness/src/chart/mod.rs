@@ -1,19 +1,22 @@
 //! `palpate chart`: the speed/accuracy study. Every model of the harness is
 //! run on the same loaded body at several refinements and loads, measured
-//! against the Newton St Venant-Kirchhoff equilibrium on the finest mesh
-//! ([`crate::fem::newton`]) and timed; [`memory`] builds the pre-computed
-//! tables of every compliance encoding for the memory/accuracy chart;
-//! [`plot`] draws the charts, [`report`] writes the report.
+//! against the converged compressible neo-Hookean equilibrium ([`truth`]:
+//! the Pareto fronts and the "cheapest within" tables) and against the
+//! Newton St Venant-Kirchhoff equilibrium on the finest mesh (a second
+//! column; [`crate::fem::newton`]) and timed; [`memory`] builds the
+//! pre-computed tables of every compliance encoding for the memory/accuracy
+//! chart; [`plot`] draws the charts, [`report`] writes the report.
 //!
 //! The body: the generated cylinder ([`cylinder_mesh`](crate::mesh::generate::cylinder_mesh), height
 //! [`HEIGHT_M`], radius `H/5`, E = 5 kPa, ν = 0.4), base fixed, loaded on its
-//! top face by dead loads (one force per top vertex):
-//! - **press**: equal shares of an axial force `−F ẑ`, each with the
+//! top face by dead loads, the consistent nodal loads of a traction over
+//! the top face (`face`: the same continuous load on every mesh):
+//! - **press**: a uniform axial traction of total `−F ẑ`, with the
 //!   lateral imperfection [`PRESS_IMPERFECTION`] (so past the buckling
 //!   load every model bends the same way);
-//! - **bend**: equal shares of a lateral force `F x̂`;
-//! - **twist**: tangential forces `T (ẑ × r_v)/Σ|r_v|²` (a torque `T` about
-//!   the axis, `r_v` the vertex's distance vector from it).
+//! - **bend**: a uniform lateral traction of total `F x̂`;
+//! - **twist**: the tangential traction `T (ẑ × r)/∫|r|² dA` (a torque `T`
+//!   about the axis, `r` the distance vector from it).
 //!
 //! Each load has three levels: the force for which the linear FEM solution
 //! on the finest mesh has a top-face displacement ([`tip_m`]) of 1 %, 5 %
@@ -41,9 +44,11 @@ pub mod stability;
 pub mod svg_text;
 pub mod ticks;
 pub mod trajectory;
+pub mod truth;
 
 mod body;
 mod dynamic;
+mod face;
 mod matrix;
 mod measure;
 mod model;
@@ -61,8 +66,8 @@ pub use body::{
 };
 pub use dynamic::RELAX_TOLERANCE;
 pub use matrix::{
-    FULL_MESHES, LEVELS, MAX_RELAX_STEPS, Matrix, QUICK_LEVELS, QUICK_MESHES, QUICK_RELAX_STEPS,
-    seconds_per_tet_step,
+    FULL_MESHES, FULL_TRUTH, LEVELS, MAX_RELAX_STEPS, Matrix, QUICK_LEVELS, QUICK_MESHES,
+    QUICK_RELAX_STEPS, QUICK_TRUTH, seconds_per_tet_step,
 };
 pub use model::{HYBRID_LAW, Model};
 pub use preflight::preflight;

@@ -20,6 +20,10 @@ pub enum Model {
     Stvk,
     /// Tensor-mass, St Venant-Kirchhoff + incompressibility penalty.
     StvkPenalty,
+    /// Tensor-mass, co-rotational linear (stiffness warping).
+    Corotational,
+    /// Tensor-mass, compressible neo-Hookean (the truth's law).
+    NeoHookean,
     /// The hybrid (RR-3510 §6.2): St Venant-Kirchhoff tensor-mass in the
     /// region at the loaded end ([`Body::hybrid_dynamic_tets`]), the rest
     /// pre-computed linear, condensed onto the connection nodes.
@@ -28,12 +32,14 @@ pub enum Model {
 
 impl Model {
     /// Every model, cheapest family first.
-    pub const ALL: [Model; 6] = [
+    pub const ALL: [Model; 8] = [
         Model::PrecomputedLinear,
         Model::PrecomputedQuasi,
         Model::TensorMassLinear,
         Model::Stvk,
         Model::StvkPenalty,
+        Model::Corotational,
+        Model::NeoHookean,
         Model::Hybrid,
     ];
 
@@ -46,6 +52,8 @@ impl Model {
             Model::TensorMassLinear => Some((ElasticLaw::Linear, None)),
             Model::Stvk => Some((stvk, None)),
             Model::StvkPenalty => Some((stvk, Some(penalty_n(&body.mesh, &body.material)))),
+            Model::Corotational => Some((ElasticLaw::Corotational, None)),
+            Model::NeoHookean => Some((ElasticLaw::NeoHookean, None)),
         }
     }
 
@@ -54,7 +62,11 @@ impl Model {
     pub fn is_tensor_mass(self) -> bool {
         matches!(
             self,
-            Model::TensorMassLinear | Model::Stvk | Model::StvkPenalty
+            Model::TensorMassLinear
+                | Model::Stvk
+                | Model::StvkPenalty
+                | Model::Corotational
+                | Model::NeoHookean
         )
     }
 
@@ -81,6 +93,8 @@ impl Model {
             Model::TensorMassLinear => "tensor-mass-linear",
             Model::Stvk => "stvk",
             Model::StvkPenalty => "stvk-penalty",
+            Model::Corotational => "corotational",
+            Model::NeoHookean => "neo-hookean",
             Model::Hybrid => "hybrid",
         }
     }

@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 
 use super::body::{Body, Load, tip_m};
 use super::results::{Reference, Run};
+use super::truth::Truth;
 use crate::experiment::volume_bend::inverted_tets;
 use crate::fem::newton::{NewtonOptions, solve_stvk};
 use crate::tensor_mass::run::volume_change;
@@ -109,4 +110,16 @@ pub(super) fn score(
         run.l2_error = Some((diff / norm).sqrt());
         run.max_error_m = Some(max);
     }
+}
+
+/// Fills the errors of `run` against the neo-Hookean `truth` (its tip);
+/// none when the run has no tip or the truth did not converge
+/// ([`Truth::converged`]): a run is never scored against an unconverged
+/// truth.
+pub(super) fn score_truth(run: &mut Run, truth: &Truth) {
+    if run.fault.is_some() || !run.tip_m.is_finite() || !truth.converged() {
+        return;
+    }
+    run.truth_tip_error = Some((run.tip_m - truth.tip_m).abs() / truth.tip_m.abs());
+    run.truth_force_error = Some((truth.tip_m / run.tip_m - 1.0).abs());
 }

@@ -4,30 +4,15 @@ use core::fmt::Write;
 
 use super::body::{HYBRID_DYNAMIC_FRACTION, Load};
 use super::model::Model;
-use super::results::{Run, Study};
+use super::results::Study;
 use super::select::{cheapest_within, pareto_front};
-use super::series::{cost_series, log_slope, trajectory_points};
+use super::series::{Against, cost_series, log_slope, points, trajectory_points};
 use super::stability::Outcome;
 use super::ticks::TickCounts;
 use super::trajectory::REFINEMENT;
 
 /// Error bounds of the report's "cheapest within" columns.
 pub const BOUNDS: [f64; 3] = [0.01, 0.05, 0.20];
-
-/// The runs of one load and level with an error, as (cost, error) points:
-/// time per step (s) and tip error.
-pub fn points(study: &Study, load: Load, level: f64) -> (Vec<&Run>, Vec<(f64, f64)>) {
-    let runs: Vec<&Run> = study
-        .runs
-        .iter()
-        .filter(|r| r.load == load && r.level == level && r.tip_error.is_some())
-        .collect();
-    let points = runs
-        .iter()
-        .map(|r| (r.step_s, r.tip_error.unwrap_or(f64::NAN)))
-        .collect();
-    (runs, points)
-}
 
 /// The cheapest trajectory of `load` within `bound`, `model, integrator at
 /// Δt on mesh`, or `None`.
@@ -45,15 +30,23 @@ pub fn cheapest_trajectory(study: &Study, load: Load, bound: f64) -> Option<Stri
     })
 }
 
-/// `model on mesh` of the cheapest run within `bound`, or `none`.
-pub fn cheapest(study: &Study, load: Load, level: f64, bound: f64) -> Option<String> {
-    let (runs, points) = points(study, load, level);
+/// `model on mesh` of the cheapest run within `bound` of the tip error
+/// `against` a reference, or `none`.
+pub fn cheapest(
+    study: &Study,
+    load: Load,
+    level: f64,
+    bound: f64,
+    against: Against,
+) -> Option<String> {
+    let (runs, points) = points(study, load, level, against);
     cheapest_within(&points, bound).map(|i| format!("{} on {}", runs[i].model.name(), runs[i].mesh))
 }
 
-/// The Pareto members of one load and level, `model on mesh`.
-pub fn pareto_members(study: &Study, load: Load, level: f64) -> Vec<String> {
-    let (runs, points) = points(study, load, level);
+/// The Pareto members of one load and level (tip error `against` a
+/// reference), `model on mesh`.
+pub fn pareto_members(study: &Study, load: Load, level: f64, against: Against) -> Vec<String> {
+    let (runs, points) = points(study, load, level, against);
     runs.iter()
         .zip(pareto_front(&points))
         .filter(|(_, f)| *f)
@@ -113,11 +106,24 @@ pub fn markdown(
     let _ = writeln!(out, "# Speed against accuracy: palpate chart\n");
     let _ = writeln!(
         out,
-        "{}, length {} m, E = {} Pa, ν = {}. Reference: Newton St Venant-Kirchhoff on mesh {}. \
-         Error: the loaded face's displacement (work-conjugate mean) against the reference; cost: \
-         median time of one step (f64).\n",
-        study.body, study.height_m, study.material.0, study.material.1, study.reference_mesh
+        "{}, length {} m, E = {} Pa, ν = {}. Truth: the compressible neo-Hookean equilibrium \
+         (Newton) on mesh {}'s geometry at the levels below; a load and level is scored against it \
+         only where it converged (the charted quantity changes by at most {:e} between the two \
+         finest levels), and the Pareto fronts, the charts and the first \"cheapest within\" table \
+         measure against it (\"no converged truth\" elsewhere: never against a wrong truth). \
+         Second reference: Newton St Venant-Kirchhoff on mesh {} (the \"StVK\" columns and the \
+         second table; the Pareto charts of a case without a converged truth, as their axis says). \
+         Error: the loaded face's displacement (work-conjugate mean of the consistent face loads); \
+         cost: median time of one step (f64).\n",
+        study.body,
+        study.height_m,
+        study.material.0,
+        study.material.1,
+        study.reference_mesh,
+        super::truth::CONVERGED,
+        study.reference_mesh
     );
+    truth_section(&mut out, study);
     let regions: Vec<String> = study
         .hybrid_region
         .iter()
@@ -133,53 +139,28 @@ pub fn markdown(
         100.0 * HYBRID_DYNAMIC_FRACTION,
         regions.join(", ")
     );
-    let _ = writeln!(out, "## Cheapest model within an error bound\n");
-    let _ = writeln!(
-        out,
-        "| load | level | within 1 % | within 5 % | within 20 % | Pareto front |"
-    );
-    let _ = writeln!(out, "|---|---|---|---|---|---|");
-    for &load in loads {
-        for &level in levels {
-            let cell = |b: f64| cheapest(study, load, level, b).unwrap_or_else(|| "none".into());
-            let reference = study
-                .references
-                .iter()
-                .find(|r| r.load == load && r.level == level);
-            let front = match reference.and_then(|r| r.fault.as_ref()) {
-                Some(f) => format!("no reference: {f}"),
-                None => pareto_members(study, load, level).join(", "),
-            };
-            let _ = writeln!(
-                out,
-                "| {} | {:.0} % | {} | {} | {} | {} |",
-                load.name(),
-                100.0 * level,
-                cell(BOUNDS[0]),
-                cell(BOUNDS[1]),
-                cell(BOUNDS[2]),
-                front
-            );
-        }
-    }
+    cheapest_table(&mut out, study, (loads, levels), Against::Truth);
+    cheapest_table(&mut out, study, (loads, levels), Against::Stvk);
     let _ = writeln!(out, "\n## Every run\n");
     let _ = writeln!(
         out,
-        "| load | level | mesh | model | tip error | force error | L2 error | max error mm | ΔV/V₀ % | inverted | step µs f64 | step µs f32 | steps to settle | settle ms | fault |"
+        "| load | level | mesh | model | tip error (truth) | force error (truth) | tip error (StVK) | force error (StVK) | L2 error (StVK) | max error mm (StVK) | ΔV/V₀ % | inverted | step µs f64 | step µs f32 | steps to settle | settle ms | fault |"
     );
     let _ = writeln!(
         out,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     let opt = |x: Option<f64>, scale: f64| x.map_or("-".into(), |x| format!("{:.3}", scale * x));
     for r in &study.runs {
         let _ = writeln!(
             out,
-            "| {} | {:.0} % | {} | {} | {} | {} | {} | {} | {:+.3} | {} | {:.2} | {} | {} | {:.3} | {} |",
+            "| {} | {:.0} % | {} | {} | {} | {} | {} | {} | {} | {} | {:+.3} | {} | {:.2} | {} | {} | {:.3} | {} |",
             r.load.name(),
             100.0 * r.level,
             r.mesh,
             r.model.name(),
+            opt(r.truth_tip_error, 1.0),
+            opt(r.truth_force_error, 1.0),
             opt(r.tip_error, 1.0),
             opt(r.force_error, 1.0),
             opt(r.l2_error, 1.0),
@@ -220,6 +201,53 @@ pub fn markdown(
         let _ = writeln!(out, "![{name}]({name}.png)\n");
     }
     out
+}
+
+/// The "cheapest within" table with the Pareto members, of the tip error
+/// `against` the truth (a case without a converged truth says so) or the
+/// St Venant-Kirchhoff reference.
+fn cheapest_table(
+    out: &mut String,
+    study: &Study,
+    (loads, levels): (&[Load], &[f64]),
+    against: Against,
+) {
+    let what = match against {
+        Against::Truth => "the neo-Hookean truth",
+        Against::Stvk => "the Newton St Venant-Kirchhoff reference",
+    };
+    let _ = writeln!(
+        out,
+        "## Cheapest model within an error bound of {what}\n\n\
+         Tip error against {what}; the Pareto front of time per step against it.\n\n\
+         | load | level | within 1 % | within 5 % | within 20 % | Pareto front |\n\
+         |---|---|---|---|---|---|"
+    );
+    for &load in loads {
+        for &level in levels {
+            let cell =
+                |b: f64| cheapest(study, load, level, b, against).unwrap_or_else(|| "none".into());
+            let truth = study
+                .truths
+                .iter()
+                .find(|t| t.load == load && t.level == level);
+            let front = match truth.filter(|t| against == Against::Truth && !t.converged()) {
+                Some(t) => t.verdict(),
+                None => pareto_members(study, load, level, against).join(", "),
+            };
+            let _ = writeln!(
+                out,
+                "| {} | {:.0} % | {} | {} | {} | {} |",
+                load.name(),
+                100.0 * level,
+                cell(BOUNDS[0]),
+                cell(BOUNDS[1]),
+                cell(BOUNDS[2]),
+                front
+            );
+        }
+    }
+    let _ = writeln!(out);
 }
 
 /// The memory/accuracy section: what the tables are, then each one's bytes
@@ -277,6 +305,53 @@ fn memory_section(out: &mut String, study: &Study) {
             p.displacement_error
         );
     }
+}
+
+/// The truth's section: per load and level, the quantity on every level
+/// and the change between the last two.
+fn truth_section(out: &mut String, study: &Study) {
+    let _ = writeln!(out, "## The neo-Hookean truth\n");
+    let _ = writeln!(out, "Levels: {}.\n", study.truth_levels);
+    let Some(first) = study.truths.first() else {
+        return;
+    };
+    let names: Vec<&str> = first.levels.iter().map(|l| l.label.as_str()).collect();
+    let _ = writeln!(
+        out,
+        "| load | level | {} | change of the last two | truth | StVK reference mm |",
+        names
+            .iter()
+            .map(|n| format!("{n} mm (nodes, s)"))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
+    let _ = writeln!(out, "|---|---|{}---|---|---|", "---|".repeat(names.len()));
+    for t in &study.truths {
+        let cells: Vec<String> = t
+            .levels
+            .iter()
+            .map(|l| match &l.fault {
+                Some(f) => format!("failed: {f}"),
+                None => format!("{:.5} ({}, {:.1})", 1e3 * l.tip_m, l.nodes, l.seconds),
+            })
+            .collect();
+        let stvk = study
+            .references
+            .iter()
+            .find(|r| r.load == t.load && r.level == t.level)
+            .map_or(f64::NAN, |r| 1e3 * r.tip_m);
+        let _ = writeln!(
+            out,
+            "| {} | {:.0} % | {} | {} | {} | {:.5} |",
+            t.load.name(),
+            100.0 * t.level,
+            cells.join(" | "),
+            t.change.map_or("-".into(), |c| format!("{c:.2e}")),
+            t.verdict(),
+            stvk
+        );
+    }
+    let _ = writeln!(out);
 }
 
 /// The trajectories' section: the cheapest within each bound per load,

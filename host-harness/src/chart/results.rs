@@ -34,6 +34,12 @@ pub struct Run {
     /// Error of the force the model needs for the reference's tip
     /// displacement (its secant stiffness at the tool): `|tip_ref/tip − 1|`.
     pub force_error: Option<f64>,
+    /// `|tip − tip_truth| / |tip_truth|` against the neo-Hookean truth
+    /// (`null` without one): the error the Pareto fronts and the
+    /// "cheapest within" tables use.
+    pub truth_tip_error: Option<f64>,
+    /// `|tip_truth/tip − 1|` against the neo-Hookean truth.
+    pub truth_force_error: Option<f64>,
     /// On the reference's mesh: `‖u − u_ref‖₂ / ‖u_ref‖₂` over all vertices.
     pub l2_error: Option<f64>,
     /// On the reference's mesh: largest `|u_v − u_ref,v|`, m.
@@ -88,6 +94,11 @@ pub struct Study {
     pub reference_mesh: String,
     /// One per load and level.
     pub references: Vec<Reference>,
+    /// The neo-Hookean truth, one per load and level.
+    pub truths: Vec<super::truth::Truth>,
+    /// Which truth levels were solved and why (the full run's, or the
+    /// cheaper one of `--quick`).
+    pub truth_levels: String,
     /// Every run.
     pub runs: Vec<Run>,
     /// The quasi-non-linear fit used.

@@ -4,7 +4,7 @@
 
 use super::body::Load;
 use super::model::Model;
-use super::results::Study;
+use super::results::{Run, Study};
 use super::trajectory::Trajectory;
 
 /// The trajectories of one load with an error, as (cost, error) points:
@@ -54,4 +54,45 @@ pub fn cost_series(study: &Study, model: Model) -> Vec<(f64, f64)> {
             (v as f64, t[t.len() / 2])
         })
         .collect()
+}
+
+/// Which error a selection ([`points`]) measures: against the converged
+/// neo-Hookean truth (the Pareto fronts and "cheapest within" tables) or
+/// against the Newton St Venant-Kirchhoff reference (the second column).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Against {
+    /// [`Run::truth_tip_error`]: none where the truth did not converge.
+    Truth,
+    /// [`Run::tip_error`].
+    Stvk,
+}
+
+impl Against {
+    /// The run's tip error against this reference, if it has one.
+    pub fn tip_error(self, run: &Run) -> Option<f64> {
+        match self {
+            Against::Truth => run.truth_tip_error,
+            Against::Stvk => run.tip_error,
+        }
+    }
+}
+
+/// The runs of one load and level with a tip error `against` a reference,
+/// as (cost, error) points: time per step (s) and tip error.
+pub fn points(
+    study: &Study,
+    load: Load,
+    level: f64,
+    against: Against,
+) -> (Vec<&Run>, Vec<(f64, f64)>) {
+    let runs: Vec<&Run> = study
+        .runs
+        .iter()
+        .filter(|r| r.load == load && r.level == level && against.tip_error(r).is_some())
+        .collect();
+    let points = runs
+        .iter()
+        .map(|r| (r.step_s, against.tip_error(r).unwrap_or(f64::NAN)))
+        .collect();
+    (runs, points)
 }

@@ -11,8 +11,9 @@ use super::matrix::Matrix;
 use super::model::Model;
 use super::precomputed::precomputed;
 use super::progress::Progress;
-use super::reference::{reference, score};
+use super::reference::{reference, score, score_truth};
 use super::results::{Run, Study};
+use super::truth::{CONVERGED, truth};
 use super::{memory, stability, ticks, trajectory};
 use crate::experiment::volume_bend::inverted_tets;
 use crate::remap::fit::fit_curves;
@@ -29,14 +30,16 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
     let height_m = finest.length_m;
 
     // The quasi-non-linear fit: the compression sample of the body's
-    // aspect (radius H/5) and material, 25 % compression in 8 steps, cubic
-    // (the `palpate remap fit` defaults).
+    // aspect (radius H/5) and material, 25 % compression in 8 steps (less
+    // where that finds no equilibrium: [`REMAP_STRAINS`]), cubic (the
+    // `palpate remap fit` defaults).
     let sample = Sample::new(finest.length_m, finest.radius_m, material)?;
-    let curves = stvk_curves(&sample, 0.25, 8).context("remap sample curves")?;
+    let curves = remap_curves(&sample)?;
     let remap = fit_curves(&curves, &linear_response(&sample)?, 3)?;
     let quasi = (remap.kernel::<f64>()?, remap.kernel::<f32>()?);
 
     let mut references = Vec::new();
+    let mut truths = Vec::new();
     let mut runs = Vec::new();
     let mut trajectory_loads = Vec::new();
     for &load in &matrix.loads {
@@ -56,6 +59,16 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
                     .clone()
                     .unwrap_or_else(|| format!("{} Newton iterations", reference.0.iterations))
             ));
+            let truth = truth(finest, &matrix.truth, load, level, magnitude);
+            progress.tick(&format!(
+                "truth {} {:.0} %: {}",
+                load.name(),
+                100.0 * level,
+                truth.change.map_or_else(
+                    || "not converged".to_string(),
+                    |c| format!("change {c:.1e}")
+                )
+            ));
             for body in &bodies {
                 let same_mesh = core::ptr::eq(body, finest);
                 for model in Model::ALL {
@@ -71,6 +84,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
                         format!("{} on {} {}", model.name(), body.label, load.name())
                     })?;
                     score(&mut run, &u, &reference, same_mesh);
+                    score_truth(&mut run, &truth);
                     progress.tick(&format!(
                         "{} {} {:.0} % {}",
                         body.label,
@@ -82,6 +96,7 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
                 }
             }
             references.push(reference.0);
+            truths.push(truth);
         }
     }
     let stability = stability::maps(&bodies[0], &matrix.stability, progress)?;
@@ -108,6 +123,8 @@ pub fn run(matrix: &Matrix, progress: &mut dyn Progress) -> anyhow::Result<Study
         material: (material.young_pa, material.poisson),
         reference_mesh: finest.label.clone(),
         references,
+        truths,
+        truth_levels: truth_levels(matrix, &finest.label),
         runs,
         remap,
         stability,
@@ -147,6 +164,8 @@ fn run_model(
         tip_m: tip_m(&loads, &outcome.u),
         tip_error: None,
         force_error: None,
+        truth_tip_error: None,
+        truth_force_error: None,
         l2_error: None,
         max_error_m: None,
         volume_change: volume_change(&body.mesh, &outcome.u, &alive),
@@ -157,4 +176,42 @@ fn run_model(
         settle_s: outcome.steps as f64 * outcome.step_s,
     };
     Ok((run, outcome.u))
+}
+
+/// The report's description of the truth's levels on `finest`.
+fn truth_levels(matrix: &Matrix, finest: &str) -> String {
+    format!(
+        "{} on the finest chart mesh's geometry (refined by halving every edge), the last the \
+         truth; converged when the quantity changes by at most {CONVERGED:e} between the last \
+         two.{}",
+        matrix
+            .truth
+            .iter()
+            .map(|d| d.label(finest))
+            .collect::<Vec<_>>()
+            .join(", "),
+        matrix.truth_note
+    )
+}
+
+/// The quasi-non-linear fit's sample compressions, tried in order: the
+/// `palpate remap fit` default (25 % of the height), then less where the St
+/// Venant-Kirchhoff sample finds no equilibrium (measured at ν = 0.49: none
+/// past 6.2 %, St Venant-Kirchhoff collapsing under the nearly
+/// incompressible law's large compression); the fit extrapolates beyond.
+const REMAP_STRAINS: [f64; 3] = [0.25, 0.125, 0.0625];
+
+/// The St Venant-Kirchhoff compression curves of `sample` at the first of
+/// [`REMAP_STRAINS`] that converges (8 steps), or the last one's error.
+fn remap_curves(sample: &Sample) -> anyhow::Result<Vec<crate::remap::curves::CurvePoint>> {
+    let mut failure = None;
+    for strain in REMAP_STRAINS {
+        match stvk_curves(sample, strain, 8) {
+            Ok(curves) => return Ok(curves),
+            Err(e) => failure = Some(e),
+        }
+    }
+    Err(failure
+        .unwrap_or_else(|| anyhow::anyhow!("no compression to sample"))
+        .context("remap sample curves"))
 }

@@ -52,12 +52,18 @@ pub fn tick_scene(model: Model, points: usize) -> anyhow::Result<Scene> {
     let name = match model {
         Model::PrecomputedLinear | Model::PrecomputedQuasi => "built-in",
         Model::Hybrid => "built-in-hybrid",
-        Model::TensorMassLinear | Model::Stvk | Model::StvkPenalty => "built-in-dynamic",
+        Model::TensorMassLinear
+        | Model::Stvk
+        | Model::StvkPenalty
+        | Model::Corotational
+        | Model::NeoHookean => "built-in-dynamic",
     };
     let mut scene = Scene::named(name)?;
     scene.tool = ToolSpec::probes(points, scene.tool.radius_m);
     let (law, penalty) = match model {
         Model::TensorMassLinear => (ElasticLaw::Linear, None),
+        Model::Corotational => (ElasticLaw::Corotational, None),
+        Model::NeoHookean => (ElasticLaw::NeoHookean, None),
         Model::StvkPenalty => {
             let (mesh, _) = scene.load_mesh()?;
             (HYBRID_LAW, Some(penalty_n(&mesh, &scene.material.elastic)))

@@ -11,6 +11,7 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use indicatif::ProgressBar;
+use palpate::chart::series::Against;
 use palpate::chart::{self, GivenMesh, Matrix, Progress as _, plot, report, ticks};
 use palpate::experiment::scenes;
 use palpate::experiment::volume_bend::{self, Protocol, SceneResult};
@@ -46,11 +47,14 @@ pub struct ChartArgs {
     /// its own resolution, instead of the cylinder's refinements.
     #[arg(long, requires_all = ["young", "poisson", "fix"])]
     mesh: Option<PathBuf>,
-    /// Young's modulus of `--mesh`, Pa.
-    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    /// Young's modulus, Pa: of `--mesh` (required with it), or of the
+    /// cylinders (default 5000).
+    #[arg(long, allow_negative_numbers = true)]
     young: Option<f64>,
-    /// Poisson ratio of `--mesh`, in [0, 0.4999].
-    #[arg(long, requires = "mesh", allow_negative_numbers = true)]
+    /// Poisson ratio, in [0, 0.4999]: of `--mesh` (required with it), or of
+    /// the cylinders (default 0.4; the neo-Hookean truth's study is run at
+    /// 0.45 and 0.49).
+    #[arg(long, allow_negative_numbers = true)]
     poisson: Option<f64>,
     /// Fixed vertices of `--mesh`: x|y|z then <, <=, > or >= then a number in mesh units (repeatable).
     #[arg(long = "fix", requires = "mesh", value_parser = parse_fix, allow_hyphen_values = true)]
@@ -113,7 +117,14 @@ pub fn run(args: &ChartArgs) -> anyhow::Result<()> {
     let dir = folder.dir();
     let mut matrix = match args.given()? {
         Some(given) => matrix.on(given),
-        None => matrix,
+        None => Matrix {
+            material: MaterialArgs {
+                young: args.young.unwrap_or(matrix.material.young_pa),
+                poisson: args.poisson.unwrap_or(matrix.material.poisson),
+            }
+            .material()?,
+            ..matrix
+        },
     };
     matrix.tick_counts |= args.tick_counts;
     let volume_runs = VolumeRuns::of(&matrix, args.quick);
@@ -213,15 +224,16 @@ fn announce(matrix: &Matrix, volume_experiments: usize) -> usize {
         + tick_runs;
     stderr::line(&format!(
         "chart: {} meshes × {} loads × {} levels × {} models = {} static runs (+ {} Newton \
-         references), {} stability trials, {} trajectories (each against its Δt/{}), {} \
-         memory-chart tables, {} volume experiments, {tick_runs} callgrind runs: {total} steps \
-         of progress",
+         references and as many neo-Hookean truths of {} levels), {} stability trials, {} \
+         trajectories (each against its Δt/{}), {} memory-chart tables, {} volume experiments, \
+         {tick_runs} callgrind runs: {total} steps of progress",
         matrix.mesh_count(),
         matrix.loads.len(),
         matrix.levels.len(),
         chart::Model::ALL.len(),
-        matrix.static_runs() - matrix.loads.len() * matrix.levels.len(),
+        matrix.static_runs() - 2 * matrix.loads.len() * matrix.levels.len(),
         matrix.loads.len() * matrix.levels.len(),
+        matrix.truth.len(),
         trials,
         matrix.trajectories(),
         chart::trajectory::REFINEMENT,
@@ -375,28 +387,39 @@ fn write_outputs(
 
 /// `study.json`'s summary: per load and level (`press-5`), the Pareto
 /// front's members and the cheapest model within each of
-/// [`report::BOUNDS`] (keyed by the bound in percent).
+/// [`report::BOUNDS`] (keyed by the bound in percent) against the
+/// neo-Hookean truth (empty and `null` where it did not converge), the
+/// truth's verdict (`truth`: `converged` or `no converged truth: …`), and
+/// the same selections against the St Venant-Kirchhoff reference (`stvk`).
 fn summary(matrix: &Matrix, study: &chart::Study) -> serde_json::Map<String, serde_json::Value> {
+    let selections = |load, level, against| {
+        let within: serde_json::Map<String, serde_json::Value> = report::BOUNDS
+            .iter()
+            .map(|&b| {
+                (
+                    format!("{:.0}", 100.0 * b),
+                    report::cheapest(study, load, level, b, against).into(),
+                )
+            })
+            .collect();
+        serde_json::json!({
+            "pareto": report::pareto_members(study, load, level, against),
+            "cheapest_within_percent": within,
+        })
+    };
     let mut summary = serde_json::Map::new();
     for &load in &matrix.loads {
         for &level in &matrix.levels {
             let key = format!("{}-{:.0}", load.name(), 100.0 * level);
-            let within: serde_json::Map<String, serde_json::Value> = report::BOUNDS
+            let mut entry = selections(load, level, Against::Truth);
+            let verdict = study
+                .truths
                 .iter()
-                .map(|&b| {
-                    (
-                        format!("{:.0}", 100.0 * b),
-                        report::cheapest(study, load, level, b).into(),
-                    )
-                })
-                .collect();
-            summary.insert(
-                key,
-                serde_json::json!({
-                    "pareto": report::pareto_members(study, load, level),
-                    "cheapest_within_percent": within,
-                }),
-            );
+                .find(|t| t.load == load && t.level == level)
+                .map(chart::truth::Truth::verdict);
+            entry["truth"] = verdict.into();
+            entry["stvk"] = selections(load, level, Against::Stvk);
+            summary.insert(key, entry);
         }
     }
     summary
