@@ -79,7 +79,7 @@
  `palpate_abi_version()` with it at start-up to catch a header and a
  library of different versions.
  */
-#define PALPATE_ABI_VERSION 5
+#define PALPATE_ABI_VERSION 6
 
 /*
  The table format version this library reads (`palpate tables build`
@@ -115,14 +115,14 @@
 /*
  Words of a `palpate_table` on 64-bit targets (the host).
  */
-#define PALPATE_TABLE_WORDS 84
+#define PALPATE_TABLE_WORDS 87
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_table` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_TABLE_WORDS 59
+#define PALPATE_TABLE_WORDS 62
 #endif
 
 /*
@@ -134,42 +134,42 @@
 /*
  Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 396
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 402
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_PRECOMPUTED_LOOP_WORDS 350
+#define PALPATE_PRECOMPUTED_LOOP_WORDS 356
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 64-bit targets (the host).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 473
+#define PALPATE_DYNAMIC_LOOP_WORDS 476
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_DYNAMIC_LOOP_WORDS 377
+#define PALPATE_DYNAMIC_LOOP_WORDS 380
 #endif
 
 #if defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 661
+#define PALPATE_HYBRID_LOOP_WORDS 670
 #endif
 
 #if !defined(PALPATE_POINTER_64)
 /*
  Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
  */
-#define PALPATE_HYBRID_LOOP_WORDS 514
+#define PALPATE_HYBRID_LOOP_WORDS 523
 #endif
 
 /*

@@ -30,10 +30,10 @@ use crate::table::{self, Table};
 
 /// Words of a `palpate_dynamic_loop` on 64-bit targets (the host).
 #[cfg(target_pointer_width = "64")]
-pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 473;
+pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 476;
 /// Words of a `palpate_dynamic_loop` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
-pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 377;
+pub const PALPATE_DYNAMIC_LOOP_WORDS: usize = 380;
 
 /// A haptic loop over a tensor-mass table (opaque). Its memory block must
 /// outlive it, in place and untouched (the table's bytes too). Do not copy

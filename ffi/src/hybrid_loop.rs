@@ -27,10 +27,10 @@ use crate::{M, P};
 
 /// Words of a `palpate_hybrid_loop` on 64-bit targets (the host).
 #[cfg(target_pointer_width = "64")]
-pub const PALPATE_HYBRID_LOOP_WORDS: usize = 661;
+pub const PALPATE_HYBRID_LOOP_WORDS: usize = 670;
 /// Words of a `palpate_hybrid_loop` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
-pub const PALPATE_HYBRID_LOOP_WORDS: usize = 514;
+pub const PALPATE_HYBRID_LOOP_WORDS: usize = 523;
 
 /// A haptic loop over the hybrid model (opaque), as `palpate_dynamic_loop`.
 #[repr(C)]

@@ -70,7 +70,7 @@ use palpate_kernel::table::format::FORMAT_VERSION;
 /// handle's size or a code's meaning changes. Compare
 /// `palpate_abi_version()` with it at start-up to catch a header and a
 /// library of different versions.
-pub const PALPATE_ABI_VERSION: u32 = 5;
+pub const PALPATE_ABI_VERSION: u32 = 6;
 
 /// The table format version this library reads (`palpate tables build`
 /// writes it; any other version is refused with

@@ -16,10 +16,10 @@ use crate::table::{self, Table};
 
 /// Words of a `palpate_precomputed_loop` on 64-bit targets (the host).
 #[cfg(target_pointer_width = "64")]
-pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 396;
+pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 402;
 /// Words of a `palpate_precomputed_loop` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
-pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 350;
+pub const PALPATE_PRECOMPUTED_LOOP_WORDS: usize = 356;
 
 /// A haptic loop over a pre-computed table (opaque). It reads its table
 /// handle, which must outlive it and stay in place. Do not copy it: pass

@@ -19,10 +19,10 @@ use crate::status::Status;
 
 /// Words of a `palpate_table` on 64-bit targets (the host).
 #[cfg(target_pointer_width = "64")]
-pub const PALPATE_TABLE_WORDS: usize = 84;
+pub const PALPATE_TABLE_WORDS: usize = 87;
 /// Words of a `palpate_table` on 32-bit targets (Cortex-M).
 #[cfg(not(target_pointer_width = "64"))]
-pub const PALPATE_TABLE_WORDS: usize = 59;
+pub const PALPATE_TABLE_WORDS: usize = 62;
 
 /// A loaded table (opaque): a validated view of the caller's bytes, which
 /// must stay in place and unchanged while the table and anything created

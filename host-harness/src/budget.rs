@@ -46,7 +46,7 @@ use std::process::Command;
 
 use anyhow::{Context, bail};
 use palpate_kernel::PrecomputedTable;
-use palpate_kernel::contact::{MAX_WALK_STEPS, Tissue};
+use palpate_kernel::contact::Tissue;
 use palpate_kernel::haptic::{
     ForceOutput, HapticLoop, PhysicsTissue, PrecomputedLoop, TickCounters, ToolInput,
 };
@@ -68,132 +68,13 @@ use crate::session::stability::check_stable_step;
 use crate::session::tool_points::{ForToolPoints, with_tool_points};
 use crate::table::compress::Compression;
 
+mod bound;
 mod sites;
+pub use bound::{
+    HOST_IR, M4F_CYCLES, M4F_CYCLES_AT_WAIT_STATES, M4F_WAIT_STATES, UnitCosts, dynamic_tick_bound,
+    hybrid_tick_bound, tick_bound,
+};
 pub use sites::{PROBE_SITE_SPACING_M, ProbeSites, trajectories};
-
-/// The unit costs of the static tick bound, in one unit: x86-64
-/// instructions for the host ([`HOST_IR`], measured with callgrind) or
-/// Cortex-M4F cycles for the target ([`M4F_CYCLES`], counted by
-/// `tools/cycles`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct UnitCosts {
-    /// A tick outside detection, tracking and solves.
-    pub base: u64,
-    /// Per candidate triangle tested in a detection.
-    pub triangle: u64,
-    /// Per triangle edge crossed while sliding.
-    pub walk: u64,
-    /// To track one contact (projection, gap).
-    pub track: u64,
-    /// Per contact solve, per cubed contact capacity (the block LDLᵀ
-    /// is `O(M³)`).
-    pub solve_per_m3: u64,
-    /// To track one contact on the dynamic model's deforming surface.
-    pub dynamic_track: u64,
-    /// Per contact per solve on the dynamic model (the rest-frame normal,
-    /// the stiffness `k` from 9 tensors and 6 edge look-ups, the
-    /// extrapolated force).
-    pub dynamic_solve: u64,
-}
-
-/// The host's unit costs, x86-64 instructions (see the module docs).
-pub const HOST_IR: UnitCosts = UnitCosts {
-    base: 600,
-    triangle: 125,
-    walk: 700,
-    track: 1000,
-    solve_per_m3: 2500,
-    dynamic_track: 1000,
-    dynamic_solve: 1500,
-};
-
-/// The Cortex-M4F's unit costs, cycles at zero wait states: the largest
-/// per-unit costs `palpate-cycles --unit-costs` (`tools/cycles`) derived
-/// from every tick of `tools/cycles-check.sh --all` (the release build of
-/// `tools/cycles-m4f`: the kernel as firmware links it, every generated
-/// trajectory with 1 to 4 probes on the three scenes it records), the
-/// largest over the three models, rounded up (2026-11-25, after the
-/// detection's visited set): an idle tick 4987 (the hybrid's; 2362
-/// pre-computed), a triangle tested 492 (dynamic), an edge crossed 3838
-/// (the dynamic model's, its base not separable: every idle tick there
-/// tests triangles), a tracked contact with its solve 2193 (pre-computed)
-/// and 3333 (dynamic), a solve 915 per `M³` (hybrid; 540 pre-computed) and
-/// 821 per `M` (dynamic).
-pub const M4F_CYCLES: UnitCosts = UnitCosts {
-    base: 5000,
-    triangle: 600,
-    walk: 4000,
-    track: 2200,
-    solve_per_m3: 950,
-    dynamic_track: 3500,
-    dynamic_solve: 900,
-};
-
-/// The static per-tick bound (in the unit of `costs`) for `points` tool
-/// points of radius `radius_m` (m) and capacity `capacity` over `table`.
-pub fn tick_bound(
-    costs: &UnitCosts,
-    table: &PrecomputedTable<'_, f32>,
-    radius_m: f64,
-    points: u64,
-    capacity: u64,
-) -> u64 {
-    let radius_m = radius_m as f32;
-    let detection = u64::from(table.surface_index().max_detection_tests(radius_m));
-    costs.base
-        + points
-            * (costs.triangle * detection + costs.walk * u64::from(MAX_WALK_STEPS) + costs.track)
-        + (points + 1) * costs.solve_per_m3 * capacity * capacity * capacity
-}
-
-/// The static per-tick bound (in the unit of `costs`) of the dynamic
-/// model's tick, between physics updates, for `points` tool points and
-/// capacity `capacity` over `table`. A detection tests at most every
-/// triangle reference of the surface twice, and the deep check that may
-/// follow it once more (`3 × 3F`, `F` the mesh's
-/// faces, every one of which a cut may expose): the re-binned grid's
-/// buckets depend on the deformation, so no tighter bound holds for any
-/// state.
-pub fn dynamic_tick_bound(
-    costs: &UnitCosts,
-    table: &TensorMassTable<'_, f32>,
-    points: u64,
-    capacity: u64,
-) -> u64 {
-    let detection = 3 * 3 * table.mesh_triangles().len() as u64;
-    costs.base
-        + points
-            * (costs.triangle * detection
-                + costs.walk * u64::from(MAX_WALK_STEPS)
-                + costs.dynamic_track)
-        + (points + 1) * costs.dynamic_solve * capacity
-}
-
-/// The static per-tick bound (in the unit of `costs`) of the hybrid
-/// model's tick (RR-3510 §6.2), between physics updates, for `points` tool
-/// points and capacity `capacity`: a detection and its deep check test at
-/// most every triangle reference of the whole surface three times
-/// (`3 × 3 (B + F)`, the pre-computed
-/// region's `B` boundary triangles and the tensor-mass region's `F` faces),
-/// and each solve is the pre-computed one (`O(M³)`) and the tensor-mass one
-/// (linear) together.
-pub fn hybrid_tick_bound(
-    costs: &UnitCosts,
-    precomputed: &PrecomputedTable<'_, f32>,
-    dynamic: &TensorMassTable<'_, f32>,
-    points: u64,
-    capacity: u64,
-) -> u64 {
-    let slots = precomputed.surface_triangles().len() + dynamic.mesh_triangles().len();
-    let detection = 3 * 3 * slots as u64;
-    costs.base
-        + points
-            * (costs.triangle * detection
-                + costs.walk * u64::from(MAX_WALK_STEPS)
-                + costs.track.max(costs.dynamic_track))
-        + (points + 1)
-            * (costs.solve_per_m3 * capacity * capacity * capacity + costs.dynamic_solve * capacity)
-}
 
 /// The f32 tables of `scene` on `mesh` (pre-computed, tensor-mass or
 /// hybrid, by its model: [`SceneModel`]) and the static bound of its tick
@@ -205,10 +86,17 @@ pub fn budget_table(
     costs: &UnitCosts,
     compression: Option<Compression>,
 ) -> anyhow::Result<(SceneTables, u64)> {
-    let points = scene.tool.kernel_points() as u64;
     let tables = SceneModel::of(scene, mesh, report)?.tables(scene, mesh, report, compression)?;
+    let bound = tables_bound(scene, &tables, costs)?;
+    Ok((tables, bound))
+}
+
+/// The static bound of the tick of `scene` over its f32 `tables` with the
+/// unit costs `costs`.
+pub fn tables_bound(scene: &Scene, tables: &SceneTables, costs: &UnitCosts) -> anyhow::Result<u64> {
+    let points = scene.tool.kernel_points() as u64;
     let load = |e| anyhow::anyhow!("table: {e}");
-    let bound = match &tables {
+    Ok(match tables {
         SceneTables::Precomputed(file) => {
             let table = PrecomputedTable::<f32>::load(file.bytes()).map_err(load)?;
             tick_bound(costs, &table, scene.tool.radius_m, points, points)
@@ -223,8 +111,7 @@ pub fn budget_table(
             let dynamic = TensorMassTable::<f32>::load(files.dynamic.bytes()).map_err(load)?;
             hybrid_tick_bound(costs, &precomputed, &dynamic, points, points)
         }
-    };
-    Ok((tables, bound))
+    })
 }
 
 /// One tick, kept out of line so callgrind can collect exactly its cost
@@ -375,6 +262,10 @@ fn probe_ticks<B: Tissue<f32, P>, const P: usize>(
 pub const RECORD_TABLE: &str = "table";
 /// The list of [`record`]'s runs, under its folder.
 pub const RECORD_RUNS: &str = "runs.txt";
+/// The tick's static bounds on the Cortex-M4F, under [`record`]'s folder:
+/// one line `<cycles at zero wait states> <cycles at M4F_WAIT_STATES>`
+/// ([`M4F_CYCLES`], [`M4F_CYCLES_AT_WAIT_STATES`]).
+pub const RECORD_BOUNDS: &str = "bounds.txt";
 
 /// Records what `tools/cycles-check.sh` runs on the Cortex-M4F, for
 /// `scene` on its own mesh, into the folder `dir` (created): the scene's f32
@@ -385,7 +276,7 @@ pub const RECORD_RUNS: &str = "runs.txt";
 /// [`palpate_script::ticks::write_tick`]), which the target must print
 /// byte for byte; and [`RECORD_RUNS`], one line per trajectory,
 /// `<trajectory> <ticks> <bound>`, with the tick's static bound in
-/// Cortex-M4F cycles ([`M4F_CYCLES`]). Only the trajectories named in
+/// Cortex-M4F cycles ([`M4F_CYCLES`]); and [`RECORD_BOUNDS`]. Only the trajectories named in
 /// `only`, if any (each must be one of the scene's). Returns the runs' lines.
 pub fn record(
     scene: &Scene,
@@ -399,7 +290,10 @@ pub fn record(
     check_stable_step(scene, &mesh, &report)?;
     work_folder("--record", dir)?;
     let (tables, bound) = budget_table(scene, &mesh, &report, &M4F_CYCLES, compression)?;
+    let bound_at_wait_states = tables_bound(scene, &tables, &M4F_CYCLES_AT_WAIT_STATES)?;
     tables.write(&dir.join(RECORD_TABLE))?;
+    let bounds = format!("{bound} {bound_at_wait_states}\n");
+    write_whole(&dir.join(RECORD_BOUNDS), bounds.as_bytes())?;
     let load = |e| anyhow::anyhow!("table: {e}");
     let dynamic = match &tables {
         SceneTables::Precomputed(_) => None,

@@ -255,6 +255,50 @@ fn a_far_sample_then_a_return_inside_is_detected() {
     }
 }
 
+/// The deep inside check's box (`SurfaceIndex::surface_box`) is the box of
+/// the surface's corners (the reference cube's faces: the unit cube), which
+/// the grid's cells overreach by up to a cell. A first tick whose centre
+/// lies between the two (9 radii above the top face, beyond the sphere's
+/// reach) is outside with zero force and tests exactly the triangles a
+/// second tick at the same point tests (the detection alone): no 27-cell
+/// walk, which the grid's box paid. A first tick with its centre inside
+/// the body, deeper than the penetration test looks, is still reported
+/// inside (`tool-inside`, zero force), and pays the walk.
+#[test]
+fn a_first_tick_outside_the_surface_box_pays_no_walk() {
+    let file = reference_cube_table(Precision::F64);
+    let table = PrecomputedTable::<f64>::load(file.bytes()).expect("table");
+    let index = table.surface_index();
+    let [lo, hi] = index.surface_box();
+    // The cube's corners are written 0 and 1 exactly in cube.msh.
+    assert_eq!((lo, hi), (Vector3::zeros(), Vector3::repeat(1.0)));
+    let above = Vector3::new(0.41, 0.43, 1.0 + 9.0 * config().radius_m);
+    let [_, grid_hi] = index.bounds();
+    assert!(
+        above.z < grid_hi.z,
+        "the case lies within the grid's cells: {grid_hi:?}"
+    );
+    let mut haptic =
+        PrecomputedLoop::<f64, 1, 1>::new(PrecomputedTissue::new(&table), config()).expect("loop");
+    let first = haptic.tick(&[above]);
+    assert_eq!((first.status, first.contacts), (OutputStatus::Ok, 0));
+    assert_eq!(first.force_n, Vector3::zeros());
+    let first_tests = haptic.counters().contact.triangles_tested;
+    let second = haptic.tick(&[above]);
+    assert_eq!(
+        (second.status, second.force_n),
+        (OutputStatus::Ok, Vector3::zeros())
+    );
+    assert_eq!(first_tests, haptic.counters().contact.triangles_tested);
+
+    let mut haptic =
+        PrecomputedLoop::<f64, 1, 1>::new(PrecomputedTissue::new(&table), config()).expect("loop");
+    let deep = haptic.tick(&[Vector3::new(0.41, 0.43, 0.9)]);
+    assert_eq!((deep.status, deep.contacts), (OutputStatus::ToolInside, 0));
+    assert_eq!(deep.force_n, Vector3::zeros());
+    assert!(haptic.counters().contact.triangles_tested > first_tests);
+}
+
 /// A tool over a thin flap (4 mm thick, radius 10 mm), found where it
 /// stands (no earlier position, so the penetration test alone decides):
 /// 15 mm above the top face it is outside, although its centre lies within

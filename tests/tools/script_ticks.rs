@@ -7,7 +7,7 @@
 //! simultaneous contacts.
 
 use nalgebra::Vector3;
-use palpate::budget::{RECORD_RUNS, RECORD_TABLE, record};
+use palpate::budget::{RECORD_BOUNDS, RECORD_RUNS, RECORD_TABLE, record};
 use palpate::scene::Scene;
 use palpate::scene::{DEFAULT_TOOL_RADIUS_M, ToolSpec};
 use palpate::table::compress::{BlockCode, Compression, ContactBlocks};
@@ -200,6 +200,14 @@ fn replays_to_the_host_lines(dir_name: &str, compression: Option<Compression>) {
         "no physics on the pre-computed model"
     );
     assert!(bound.parse::<u64>().unwrap() > 0);
+    // The bounds: the runs' bound, then the one at 5 wait states (every unit
+    // cost larger there, so the bound too).
+    let bounds = std::fs::read_to_string(dir.join(RECORD_BOUNDS)).unwrap();
+    let [at_zero, at_wait_states] = bounds.split_whitespace().collect::<Vec<_>>()[..] else {
+        panic!("{bounds}");
+    };
+    assert_eq!(at_zero, bound);
+    assert!(at_wait_states.parse::<u64>().unwrap() > bound.parse::<u64>().unwrap());
     let mut haptic = PrecomputedLoop::<f32, 4, 4>::new(
         PrecomputedTissue::new(&table),
         header.settings.loop_config,

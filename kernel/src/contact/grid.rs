@@ -27,8 +27,8 @@ use nalgebra::Vector3;
 use crate::Real;
 use crate::table::format::PLANE_LEN;
 use crate::table::{
-    BuiltLists, DEAD_TRIANGLE, Grid, Plane, SurfaceIndex, for_each_candidate_filing, max_row,
-    plane_record,
+    BuiltLists, DEAD_TRIANGLE, Grid, Plane, SurfaceIndex, box_of, for_each_candidate_filing,
+    max_row, plane_record,
 };
 
 /// Factor by which the cell edge grows until the grid fits its capacity.
@@ -65,6 +65,9 @@ pub struct Binned<T> {
     pub filed: usize,
     /// Most vertices in one cell.
     pub max_bucket: u32,
+    /// The box of the surface vertices, m ([`crate::table::box_of`]; the
+    /// grid's cells reach up to a cell past it).
+    pub surface_box_m: [Vector3<T>; 2],
 }
 
 /// A moving surface's grid: what [`vertex_triangles`] and [`bin`] last left
@@ -74,6 +77,8 @@ pub struct Binned<T> {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Rebinned<T> {
     grid: Grid<T>,
+    /// The surface vertices' box at the last re-bin, m.
+    surface_box_m: [Vector3<T>; 2],
     /// Cells of the current grid.
     cells: usize,
     /// Surface vertices filed (the used prefix of `grid_vertex`).
@@ -105,6 +110,7 @@ impl<T: Real> Rebinned<T> {
                 cell_m: T::one(),
                 dims: [1; 3],
             },
+            surface_box_m: box_of([]),
             cells: 1,
             filed: 0,
             max_bucket: 0,
@@ -128,6 +134,7 @@ impl<T: Real> Rebinned<T> {
             cells,
             filed,
             max_bucket,
+            surface_box_m,
         } = bin(
             lists.positions_m,
             lists.triangles,
@@ -139,6 +146,7 @@ impl<T: Real> Rebinned<T> {
             },
         );
         (self.grid, self.cells, self.filed, self.max_bucket) = (grid, cells, filed, max_bucket);
+        self.surface_box_m = surface_box_m;
     }
 
     /// The index over the buffers the last [`Self::rebin`] filled (the
@@ -161,6 +169,7 @@ impl<T: Real> Rebinned<T> {
                 vertex_triangle_start,
                 vertex_triangle,
                 planes,
+                surface_box_m: self.surface_box_m,
                 max_bucket: self.max_bucket,
                 max_valence: self.max_valence,
             },
@@ -214,7 +223,14 @@ pub fn bin<T: Real>(
 ) -> Binned<T> {
     let longest_m = planes(positions_m, triangles, buffers.planes);
     let capacity = buffers.cell_start.len().saturating_sub(1).max(1);
-    let grid = fitted_grid(positions_m, vertex_triangle_start, longest_m, capacity);
+    let surface_box_m = box_of(
+        positions_m
+            .iter()
+            .enumerate()
+            .filter(|&(v, _)| has_triangles(vertex_triangle_start, v))
+            .map(|(_, p)| Vector3::new(p[0], p[1], p[2])),
+    );
+    let grid = fitted_grid(&surface_box_m, longest_m, capacity);
     let (cells, filed, max_bucket) = file_vertices(
         &grid,
         positions_m,
@@ -227,6 +243,7 @@ pub fn bin<T: Real>(
         cells,
         filed,
         max_bucket,
+        surface_box_m,
     }
 }
 
@@ -316,26 +333,12 @@ fn planes<T: Real>(positions_m: &[[T; 3]], triangles: &[[u32; 3]], planes: &mut 
     longest2.sqrt()
 }
 
-/// The grid over the surface vertices' box with cells of at least
+/// The grid over the surface vertices' box `surface_box_m` (m; the empty
+/// box for no vertex: a grid at the origin) with cells of at least
 /// `longest_m`, within `capacity` cells.
-fn fitted_grid<T: Real>(
-    positions_m: &[[T; 3]],
-    starts: &[u32],
-    longest_m: T,
-    capacity: usize,
-) -> Grid<T> {
-    let mut lo = Vector3::repeat(T::of_f64(f64::MAX));
-    let mut hi = -lo;
-    let mut any = false;
-    for (v, p) in positions_m.iter().enumerate() {
-        if has_triangles(starts, v) {
-            let p = Vector3::new(p[0], p[1], p[2]);
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-            any = true;
-        }
-    }
-    if !any {
+fn fitted_grid<T: Real>(surface_box_m: &[Vector3<T>; 2], longest_m: T, capacity: usize) -> Grid<T> {
+    let [mut lo, mut hi] = *surface_box_m;
+    if lo.x > hi.x {
         lo = Vector3::zeros();
         hi = Vector3::zeros();
     }

@@ -43,6 +43,9 @@ pub struct SurfaceIndex<'a, T> {
     vertex_triangle_start: &'a [u32],
     vertex_triangle: &'a [u32],
     planes: &'a [Plane<T>],
+    /// The box of the surface triangles' corners, m (lowest and highest
+    /// corner; [`Self::surface_box`]).
+    surface_box_m: [Vector3<T>; 2],
     /// The candidate lists' grid: the grid's box in cells `k` times finer
     /// (the grid itself for an index the kernel assembled).
     lists: Grid<T>,
@@ -81,6 +84,9 @@ pub(crate) struct BuiltLists<'a, T> {
     pub(crate) vertex_triangle_start: &'a [u32],
     pub(crate) vertex_triangle: &'a [u32],
     pub(crate) planes: &'a [Plane<T>],
+    /// The box of the surface vertices (those with a triangle), m
+    /// ([`super::grid::box_of`]).
+    pub(crate) surface_box_m: [Vector3<T>; 2],
     /// The largest row of `cell_start` and of `vertex_triangle_start`.
     pub(crate) max_bucket: u32,
     pub(crate) max_valence: u32,
@@ -134,6 +140,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             vertex_triangle_start: lists.vertex_triangle_start,
             vertex_triangle: lists.vertex_triangle,
             planes: lists.planes,
+            surface_box_m: lists.surface_box_m,
             cell_triangle_start: &[],
             cell_triangle: &[],
             candidate_radius_m: None,
@@ -309,6 +316,14 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
     /// filed surface vertex, so a point outside it is outside the body.
     pub fn bounds(&self) -> [Vector3<T>; 2] {
         self.grid.bounds()
+    }
+
+    /// The box of the surface's vertices, m (lowest and highest corner,
+    /// kept at load and by a deforming surface at each re-bin): the body
+    /// lies in it, so a point outside it is outside the body. Tighter than
+    /// [`Self::bounds`], whose cells reach up to a cell past the surface.
+    pub fn surface_box(&self) -> [Vector3<T>; 2] {
+        self.surface_box_m
     }
 
     /// Calls `f` with each surface vertex filed in the 27 cells around the

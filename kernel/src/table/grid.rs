@@ -42,6 +42,17 @@ pub fn within<T: Real>(p: &Vector3<T>, [lo, hi]: &[Vector3<T>; 2]) -> bool {
         .all(|(&x, (&l, &h))| x >= l && x <= h)
 }
 
+/// The box of `points` (m): its lowest and highest corners; for no point,
+/// the empty box (lowest `+MAX`, highest `−MAX`), which [`within`] holds
+/// nothing of. The surface's box ([`super::SurfaceIndex::surface_box`]) is
+/// this over its triangles' corners: the body lies in it.
+pub fn box_of<T: Real>(points: impl IntoIterator<Item = Vector3<T>>) -> [Vector3<T>; 2] {
+    let max = Vector3::repeat(T::of_f64(f64::MAX));
+    points
+        .into_iter()
+        .fold([max, -max], |[lo, hi], p| [lo.inf(&p), hi.sup(&p)])
+}
+
 /// `true` if cells `a` and `b` are at most one apart on every axis (the
 /// same cell, or one of its 26 neighbours).
 #[inline]

@@ -34,7 +34,7 @@ pub(crate) use collision::BuiltLists;
 pub use collision::{CandidateList, DEAD_TRIANGLE, SurfaceIndex};
 pub use compressed::{CodedBlocks, ComplianceBlocks};
 pub use error::LoadError;
-pub use grid::{CellBox, Grid, neighbours, within};
+pub use grid::{CellBox, Grid, box_of, neighbours, within};
 pub use hierarchical::HierarchicalBlocks;
 pub(crate) use index::span;
 pub use index::{EdgeIndex, FreeIndex, TetIndex, TriangleIndex, VertexIndex, VertexSlot, max_row};

@@ -349,9 +349,10 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
     /// centre (its projection inside the triangle) decides:
     /// `Some(true)` when the centre lies behind it (inside the body),
     /// `Some(false)` in front of it, or, without the walk, for a centre
-    /// outside the box of the grid's cells (which holds every surface
-    /// vertex, so the body too: a tool arriving from outside, the usual
-    /// first tick, pays six comparisons, not the 27-cell walk); `None` when no
+    /// outside the box of the surface's vertices
+    /// ([`SurfaceIndex::surface_box`](crate::table::SurfaceIndex::surface_box),
+    /// which holds the body: a tool arriving from outside, the usual first
+    /// tick, pays six comparisons, not the 27-cell walk); `None` when no
     /// plane there lies over the centre (deeper in a body than a grid cell,
     /// or in a cavity wider than one): the surface near the tool does not
     /// say.
@@ -361,7 +362,7 @@ impl<'a, T: Real> SurfaceGeometry<'a, T> {
         radius_m: T,
         work: &mut ContactWork,
     ) -> Option<bool> {
-        if !within(to_m, &self.index.bounds()) {
+        if !within(to_m, &self.index.surface_box()) {
             return Some(false);
         }
         let mut planes = UnreachedPlanes::new();

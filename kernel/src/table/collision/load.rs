@@ -10,7 +10,7 @@ use super::{SurfaceIndex, SurfaceSections};
 use crate::Real;
 use crate::table::LoadError;
 use crate::table::candidates::{candidate_cells, candidate_margin_m, corners_of};
-use crate::table::grid::{Grid, neighbours};
+use crate::table::grid::{Grid, box_of, neighbours};
 use crate::table::index::{TriangleIndex, VertexIndex, csr_ok, max_row, span};
 use crate::table::plane::parts_of;
 
@@ -32,6 +32,7 @@ impl<'a, T: Real> SurfaceIndex<'a, T> {
             vertex_triangle_start: s.vertex_triangle_start,
             vertex_triangle: s.vertex_triangle,
             planes: s.planes,
+            surface_box_m: surface_box(positions, triangles),
             cell_triangle_start: s.cell_triangle_start,
             cell_triangle: s.cell_triangle,
             candidate_radius_m: Some(radius_m),
@@ -245,4 +246,16 @@ fn grid_record<T: Real>(s: &SurfaceSections<'_, T>) -> Result<(Grid<T>, Grid<T>,
         return Err(grid_error);
     }
     Ok((grid, lists, radius_m))
+}
+
+/// The box of the corners of `triangles` over `positions` (m); a corner out
+/// of range (refused by the triangles' own check) is left out.
+fn surface_box<T: Real>(positions: &[[T; 3]], triangles: &[[u32; 3]]) -> [Vector3<T>; 2] {
+    box_of(
+        triangles
+            .iter()
+            .flatten()
+            .filter_map(|&v| positions.get(v as usize))
+            .map(|p| Vector3::new(p[0], p[1], p[2])),
+    )
 }
