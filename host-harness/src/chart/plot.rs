@@ -140,8 +140,8 @@ pub fn draw_all(
     names.push("cost-mesh".into());
     for map in &study.stability {
         let name = match map.model {
-            Model::Hybrid => format!("stability-hybrid-{}", map.integrator),
-            _ => format!("stability-{}", map.integrator),
+            Model::Stvk => format!("stability-{}", map.integrator),
+            model => format!("stability-{}-{}", model.name(), map.integrator),
         };
         render!(dir, name, |root: &DrawingArea<_, Shift>| stability(
             root, map

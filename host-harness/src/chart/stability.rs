@@ -1,8 +1,8 @@
-//! The stability maps: for St Venant-Kirchhoff and for the hybrid
-//! ([`MAP_MODELS`]) and each integrator, a grid of time step × Young's
-//! modulus on the coarsest body, each cell a loaded St Venant-Kirchhoff
-//! run from rest (the hybrid's: on its tensor-mass region) classified by
-//! its outcome, beside the measured critical step ([`critical_dt`],
+//! The stability maps: for St Venant-Kirchhoff, the co-rotational and the
+//! neo-Hookean tensor-mass laws and for the hybrid ([`MAP_MODELS`]) and each
+//! integrator, a grid of time step × Young's modulus on the coarsest body,
+//! each cell a loaded run of the model's law from rest (the hybrid's: St
+//! Venant-Kirchhoff on its tensor-mass region) classified by its outcome, beside the measured critical step ([`critical_dt`],
 //! bisection on the linear law; the hybrid's region's) and `2/ω_max`.
 //!
 //! A trial: the bend load at 5 % of the height (scaled with E, so the same
@@ -16,13 +16,11 @@
 use anyhow::Context;
 use nalgebra::Vector3;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::tensor_mass::{
-    DynamicParams, ElasticLaw, Integrator, StvkForm, TensorMassModel,
-};
+use palpate_kernel::tensor_mass::{DynamicParams, ElasticLaw, Integrator, TensorMassModel};
 use serde::Serialize;
 
 use super::body::{Body, Load, tip_m};
-use super::model::Model;
+use super::model::{HYBRID_LAW, Model};
 use super::progress::Progress;
 use super::tables::{hybrid_field, hybrid_tables, region_loads, set_loads};
 use crate::dispatch::HostDispatch;
@@ -125,9 +123,15 @@ pub struct Map {
     pub cells: Vec<Cell>,
 }
 
-/// The models mapped: St Venant-Kirchhoff on the whole mesh, and the
-/// hybrid (St Venant-Kirchhoff on its region, [`Model::Hybrid`]).
-pub const MAP_MODELS: [Model; 2] = [Model::Stvk, Model::Hybrid];
+/// The models mapped: St Venant-Kirchhoff, co-rotational and neo-Hookean
+/// on the whole mesh, and the hybrid (St Venant-Kirchhoff on its region,
+/// [`Model::Hybrid`]).
+pub const MAP_MODELS: [Model; 4] = [
+    Model::Stvk,
+    Model::Corotational,
+    Model::NeoHookean,
+    Model::Hybrid,
+];
 
 /// Maps of one body: one per model of [`MAP_MODELS`] and integrator.
 pub fn map_count() -> usize {
@@ -308,7 +312,7 @@ pub(crate) fn with_system<R>(
     }
 }
 
-/// One trial of `model` (module documentation). The hybrid's energy is
+/// One trial of `model` (module documentation), with its law. The hybrid's energy is
 /// its tensor-mass region's (kinetic, elastic, the load's work): the
 /// condensed region's linear strain energy, never negative, is left out.
 fn trial(
@@ -335,7 +339,8 @@ fn trial(
         .zip(&u_unit)
         .map(|(f, u)| scale * Vector3::from(*f).dot(&Vector3::from(*u)))
         .sum();
-    let law = ElasticLaw::StVenantKirchhoff(StvkForm::PerTet);
+    // The model's law; the hybrid's region St Venant-Kirchhoff.
+    let law = model.tensor_mass(body).map_or(HYBRID_LAW, |(law, _)| law);
     let params =
         DynamicParams::linear(DAMPING_PER_S, 10.0 * diagonal(&body.mesh.positions)).with_law(law);
     with_system(body, model, material, params, &loads, |system, loads| {

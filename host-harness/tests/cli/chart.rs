@@ -105,11 +105,40 @@ fn quick_chart_writes_report_charts_and_json() {
     // timing.
     assert!(front.contains(&cheapest), "{front:?}");
     assert!(front.contains(&"stvk on 2x10"), "{front:?}");
-    // One map per integrator for St Venant-Kirchhoff and for the hybrid,
-    // whose critical step is its tensor-mass region's: measured on 1x5
+    // One map per integrator for St Venant-Kirchhoff, the co-rotational and
+    // the neo-Hookean laws and the hybrid, whose critical step is its
+    // tensor-mass region's: measured on 1x5
     // (symplectic) 3.84e-3 s, within 1 % of 2/ω_max (3.86e-3 s).
     let maps = json["study"]["stability"].as_array().unwrap();
-    assert_eq!(maps.len(), 8);
+    assert_eq!(maps.len(), 16);
+    // The co-rotational and neo-Hookean rows under symplectic Euler: a
+    // small-strain trial is stable exactly below the linearized limit
+    // 2/ω_max, which scales as 1/√E (2/ω_max is measured at 5 kPa): a cell
+    // at dt = f · 2/ω_max(5 kPa) and E is stable iff f·√(E/5 kPa) < 1
+    // (cells within 5 % of the limit, where rounding decides, skipped).
+    for model in ["corotational", "neo-hookean"] {
+        let map = maps
+            .iter()
+            .find(|m| m["model"] == model && m["integrator"] == "symplectic")
+            .unwrap_or_else(|| panic!("no {model} map"));
+        let limit = map["two_over_omega_s"].as_f64().unwrap();
+        let reference = map["reference_young_pa"].as_f64().unwrap();
+        for cell in map["cells"].as_array().unwrap() {
+            let (e, dt) = (
+                cell["young_pa"].as_f64().unwrap(),
+                cell["dt_s"].as_f64().unwrap(),
+            );
+            let x = dt / limit * (e / reference).sqrt();
+            if (x - 1.0).abs() > 0.05 {
+                assert_eq!(
+                    cell["outcome"] == "stable",
+                    x < 1.0,
+                    "{model} E = {e} Pa, dt = {dt:e} s: {}",
+                    cell["outcome"]
+                );
+            }
+        }
+    }
     let hybrid_map = maps
         .iter()
         .find(|m| m["model"] == "hybrid" && m["integrator"] == "symplectic")
