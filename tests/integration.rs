@@ -67,6 +67,7 @@ mod kernel {
     mod hybrid;
     mod hybrid_hmatrix;
     mod layers;
+    mod link;
     mod neo_hookean;
     mod polar;
     mod precomputed;
