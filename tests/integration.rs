@@ -68,6 +68,7 @@ mod kernel {
     mod hybrid_hmatrix;
     mod layers;
     mod link;
+    mod link_controller;
     mod neo_hookean;
     mod polar;
     mod precomputed;

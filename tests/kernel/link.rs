@@ -54,7 +54,9 @@ fn full_update() -> Up {
         ..Up::default()
     };
     for tool in 0..LINK_REGIONS as u8 {
-        u.regions.push(region(tool, tool % 2 == 1)).expect("capacity");
+        u.regions
+            .push(region(tool, tool % 2 == 1))
+            .expect("capacity");
     }
     u
 }
@@ -134,7 +136,10 @@ fn every_flipped_bit_and_every_truncation_is_refused() {
     let bytes = encode(&full_update(), 5);
     for cut in 0..bytes.len() {
         assert!(
-            matches!(FrameView::parse(&bytes[..cut]), Err(FrameError::Short { .. })),
+            matches!(
+                FrameView::parse(&bytes[..cut]),
+                Err(FrameError::Short { .. })
+            ),
             "prefix of {cut} bytes"
         );
     }
@@ -178,7 +183,12 @@ fn payloads_out_of_range_are_refused() {
         ("tool 0 twice", 8 + 240, 0, PayloadError::OutOfRange),
         ("grip without held", 9, 2, PayloadError::OutOfRange),
         ("7 vertices of 6", 10, 7, PayloadError::OutOfRange),
-        ("a triangle's vertex 6 of 6", tri0, 6, PayloadError::OutOfRange),
+        (
+            "a triangle's vertex 6 of 6",
+            tri0,
+            6,
+            PayloadError::OutOfRange,
+        ),
     ];
     for (what, at, value, error) in cases {
         let mut p = good.clone();
@@ -198,7 +208,11 @@ fn payloads_out_of_range_are_refused() {
     long.push(0);
     assert_eq!(decode_payload(&long), Err(PayloadError::BadLength));
     for cut in 0..good.len() {
-        assert_eq!(decode_payload(&good[..cut]), Err(PayloadError::Short), "{cut}");
+        assert_eq!(
+            decode_payload(&good[..cut]),
+            Err(PayloadError::Short),
+            "{cut}"
+        );
     }
 }
 

@@ -90,16 +90,22 @@ impl<const P: usize, const S: usize> Command<P, S> {
         if !all_finite {
             return Err(EncodeError::OutOfRange);
         }
-        write_frame(out, FrameKind::Command, sequence, self.payload_bytes(), |w| {
-            w.u32(self.first_tick)?;
-            w.u8(u8::try_from(self.samples.len()).ok()?)?;
-            w.u8(u8::try_from(P).ok()?)?;
-            for t in self.samples.iter().flatten() {
-                w.vec3(t.position_m.into())?;
-                w.u8(action_byte(&t.action))?;
-            }
-            blades.iter().try_for_each(|b| w.vec3((*b).into()))
-        })
+        write_frame(
+            out,
+            FrameKind::Command,
+            sequence,
+            self.payload_bytes(),
+            |w| {
+                w.u32(self.first_tick)?;
+                w.u8(u8::try_from(self.samples.len()).ok()?)?;
+                w.u8(u8::try_from(P).ok()?)?;
+                for t in self.samples.iter().flatten() {
+                    w.vec3(t.position_m.into())?;
+                    w.u8(action_byte(&t.action))?;
+                }
+                blades.iter().try_for_each(|b| w.vec3((*b).into()))
+            },
+        )
     }
 
     /// The batch in `payload`, validated.

@@ -119,7 +119,8 @@ impl<'a> FrameView<'a> {
     pub fn parse(bytes: &'a [u8]) -> Result<(Self, usize), FrameError> {
         let short = |needed| FrameError::Short { needed };
         let header = bytes.get(..HEADER_BYTES);
-        if bytes.get(..2).is_some_and(|m| m != MAGIC) || bytes.first().is_some_and(|&b| b != MAGIC[0])
+        if bytes.get(..2).is_some_and(|m| m != MAGIC)
+            || bytes.first().is_some_and(|&b| b != MAGIC[0])
         {
             return Err(FrameError::BadMagic);
         }
@@ -344,7 +345,9 @@ impl<'a> Reader<'a> {
 
     /// A finite `f32`; `None` past the end or for NaN and infinities.
     pub(crate) fn f32(&mut self) -> Option<f32> {
-        self.take().map(f32::from_le_bytes).filter(|x| x.is_finite())
+        self.take()
+            .map(f32::from_le_bytes)
+            .filter(|x| x.is_finite())
     }
 
     pub(crate) fn vec3(&mut self) -> Option<[f32; 3]> {

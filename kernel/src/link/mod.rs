@@ -8,7 +8,9 @@
 //! - [`update`]: host → controller, a physics update: per tool point near
 //!   the surface, the surface triangles near it (positions and velocities)
 //!   and the local contact model (`K_c`, the held contact's force);
-//! - [`command`]: controller → host, the tool points of the last ticks.
+//! - [`command`]: controller → host, the tool points of the last ticks;
+//! - [`controller`]: the controller's haptic loop between updates, its
+//!   link status and counters.
 //!
 //! `no_std`, no allocation, no panic: capacities are const generics, and a
 //! payload is decoded once into a fixed-size value, validated (a small error
@@ -23,10 +25,12 @@
 //! [`command::MAX_COMMAND_FRAME_BYTES`] = 588 bytes per 10 ticks, 58.8 kB/s.
 
 pub mod command;
+pub mod controller;
 pub mod frame;
 pub mod update;
 
 pub use command::{Command, LINK_SAMPLES};
+pub use controller::{Controller, ControllerConfig, LinkCounters, LinkOutput, LinkStatus};
 pub use frame::{EncodeError, FrameError, FrameKind, FrameReader, FrameView};
 pub use update::{
     LINK_REGIONS, LINK_TRIANGLES, LINK_VERTICES, LocalContact, PayloadError, Region, RegionVertex,

@@ -228,13 +228,15 @@ fn write_region<const NV: usize, const NT: usize>(
     w: &mut Writer<'_>,
     r: &Region<NV, NT>,
 ) -> Option<()> {
-    let flags = u8::from(r.held) * FLAG_HELD | u8::from(r.held && r.grip) * FLAG_GRIP;
+    let flags = (u8::from(r.held) * FLAG_HELD) | (u8::from(r.held && r.grip) * FLAG_GRIP);
     w.u8(r.tool)?;
     w.u8(flags)?;
     w.u8(u8::try_from(r.vertices.len()).ok()?)?;
     w.u8(u8::try_from(r.triangles.len()).ok()?)?;
     let c = &r.contact;
-    c.stiffness_tensor_n_per_m.iter().try_for_each(|&x| w.f32(x))?;
+    c.stiffness_tensor_n_per_m
+        .iter()
+        .try_for_each(|&x| w.f32(x))?;
     w.vec3(c.normal)?;
     w.vec3(c.tip_m)?;
     w.vec3(c.force_n)?;
