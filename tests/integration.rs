@@ -47,6 +47,7 @@ mod host {
     mod session_hybrid;
     mod session_run;
     mod session_scene_tools;
+    mod session_serve;
     mod session_stability;
     mod session_tools;
     mod session_trajectory_tools;

@@ -74,7 +74,7 @@ fn frame_sizes_fit_a_1_mbit_serial_link_at_100_hz() {
     // command frame per 10 ms each way.
     assert_eq!(MAX_UPDATE_FRAME_BYTES, 982);
     assert_eq!(MAX_COMMAND_FRAME_BYTES, 588);
-    assert!(MAX_UPDATE_FRAME_BYTES <= 1000 && MAX_COMMAND_FRAME_BYTES <= 1000);
+    const { assert!(MAX_UPDATE_FRAME_BYTES <= 1000 && MAX_COMMAND_FRAME_BYTES <= 1000) };
     let full = encode(&full_update(), 0);
     assert_eq!(full.len(), MAX_UPDATE_FRAME_BYTES);
     assert_eq!(

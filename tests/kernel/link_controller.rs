@@ -31,6 +31,8 @@ fn config(max_slew_n_per_s: f32) -> ControllerConfig {
             max_slew_n_per_s,
         },
         extrapolate_ticks: 30,
+        // No fade: the supervisor's slew limit alone ramps.
+        ramp_ticks: 1,
         update_every_ticks: 10,
     }
 }

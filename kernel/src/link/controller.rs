@@ -26,10 +26,12 @@
 //! sequence numbers in [`LinkCounters::gaps`]. Up to
 //! [`ControllerConfig::extrapolate_ticks`] past the period the update
 //! closes, the force is extrapolated as usual ([`LinkStatus::Extrapolating`]);
-//! after that the requested force is zero and the supervisor's slew limit
-//! ramps it down ([`LinkStatus::StaleRamping`]), then [`LinkStatus::Lost`]
-//! until an update comes; its force ramps back up through the same slew
-//! limit. No allocation; every loop is bounded by the const capacities.
+//! after that the last extrapolated force fades linearly to zero over
+//! [`ControllerConfig::ramp_ticks`], the supervisor's slew limit on top
+//! ([`LinkStatus::StaleRamping`]), then [`LinkStatus::Lost`] until an update
+//! comes; the model's force then fades back in over as many ticks (and at
+//! the first update). No allocation; every loop is bounded by the const
+//! capacities.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -104,6 +106,11 @@ pub struct ControllerConfig {
     /// Ticks past the end of the latest update's period during which it
     /// is still extrapolated, before the force ramps to zero.
     pub extrapolate_ticks: u32,
+    /// Ticks of a full fade: after the timeout the force fades linearly to
+    /// zero over this many ticks (from the last extrapolated force), and
+    /// when updates return (or at the first) it fades back in over as
+    /// many; the slew limit applies on top (≥ 1).
+    pub ramp_ticks: u32,
     /// The agreed physics schedule: a command batch is sent at least every
     /// this many ticks, at the ticks the host's updates close.
     pub update_every_ticks: u32,
@@ -151,13 +158,22 @@ pub struct Controller<const P: usize, const NV: usize, const NT: usize, const S:
     batch: Command<P, S>,
     sent: u32,
     counters: LinkCounters,
+    /// The fade: the model's force is sent times `gain / ramp_ticks`.
+    gain: u32,
+    /// The last force requested while the update was live, N (what a
+    /// stale link fades out).
+    last_live_n: Vector3<f32>,
 }
 
 impl<const P: usize, const NV: usize, const NT: usize, const S: usize> Controller<P, NV, NT, S> {
     /// A controller at tick 0 with no update (zero force, [`LinkStatus::Lost`]).
     pub fn new(config: ControllerConfig) -> Result<Self, BadLimits> {
         let ok = |x: f32| x.is_finite() && x > 0.0;
-        if !(ok(config.radius_m) && ok(config.dt_s) && config.update_every_ticks > 0) {
+        if !(ok(config.radius_m)
+            && ok(config.dt_s)
+            && config.update_every_ticks > 0
+            && config.ramp_ticks > 0)
+        {
             return Err(BadLimits);
         }
         Ok(Self {
@@ -172,6 +188,8 @@ impl<const P: usize, const NV: usize, const NT: usize, const S: usize> Controlle
             batch: Command::new(0),
             sent: 0,
             counters: LinkCounters::default(),
+            gain: 0,
+            last_live_n: Vector3::zeros(),
         })
     }
 
@@ -276,6 +294,14 @@ impl<const P: usize, const NV: usize, const NT: usize, const S: usize> Controlle
             .iter()
             .all(|t| t.position_m.iter().all(|x| x.is_finite()));
         let live = since <= period.saturating_add(self.config.extrapolate_ticks);
+        let ramp = self.config.ramp_ticks;
+        self.gain = if live {
+            self.gain.saturating_add(1).min(ramp)
+        } else {
+            self.gain.saturating_sub(1)
+        };
+        // Exactly 1 at full gain: the model's force unchanged.
+        let gain = self.gain as f32 / ramp as f32;
         let requested = match &self.update {
             _ if !finite => Err(SafetyFault::NonFiniteInput),
             Some(update) if live => {
@@ -285,9 +311,11 @@ impl<const P: usize, const NV: usize, const NT: usize, const S: usize> Controlle
                     period,
                     previous: self.previous.as_ref(),
                 };
-                Ok(at.forces(update, tools, &mut self.touches))
+                let model = at.forces(update, tools, &mut self.touches);
+                self.last_live_n = model;
+                Ok(model * gain)
             }
-            _ => Ok(Vector3::zeros()),
+            _ => Ok(self.last_live_n * gain),
         };
         if !(live && finite) {
             self.touches = [Touch::Free; P];
@@ -298,7 +326,7 @@ impl<const P: usize, const NV: usize, const NT: usize, const S: usize> Controlle
             LinkStatus::Fresh
         } else if live {
             LinkStatus::Extrapolating
-        } else if self.update.is_some() && force_n != Vector3::zeros() {
+        } else if self.update.is_some() && (self.gain > 0 || force_n != Vector3::zeros()) {
             LinkStatus::StaleRamping
         } else {
             LinkStatus::Lost
