@@ -15,7 +15,7 @@ use nalgebra::Vector3;
 use palpate::dispatch::HostDispatch;
 use palpate::scene::{Generator, MeshSource, Poke, Scene};
 use palpate::session::run::ticks;
-use palpate::session::serve::{listen, serve_scene, with_dynamic_setup};
+use palpate::session::serve::{listen, serve_scene, update_every, with_dynamic_setup};
 use palpate::threads::Threaded;
 use palpate_kernel::haptic::{SafetyLimits, ToolInput};
 use palpate_kernel::link::controller::RX_BYTES;
@@ -348,4 +348,24 @@ fn the_force_error_of_a_late_update_at_30_60_and_100_hz() {
         assert!(worst < bound_n, "every {every}: {worst} N");
         assert!(outputs.iter().all(|o| o.link != LinkStatus::StaleRamping));
     }
+}
+
+#[test]
+fn only_loopback_is_served_and_the_update_rate_is_checked() {
+    let err = listen(&"0.0.0.0:0".parse::<SocketAddr>().expect("addr")).expect_err("refused");
+    assert!(err.to_string().contains("only a loopback address"), "{err}");
+    let scene = scene();
+    assert_eq!(update_every(&scene, 30.0).expect("30 Hz"), 33);
+    assert_eq!(update_every(&scene, 100.0).expect("100 Hz"), 10);
+    for bad in [0.0, -1.0, f64::NAN, 2000.0] {
+        assert!(update_every(&scene, bad).is_err(), "{bad}");
+    }
+    let err = serve_scene(
+        &Scene::built_in(),
+        &listen(&"127.0.0.1:0".parse().expect("addr")).expect("listen"),
+        10,
+        1,
+    )
+    .expect_err("pre-computed");
+    assert!(err.to_string().contains("dynamic model only"), "{err}");
 }
