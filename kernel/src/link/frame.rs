@@ -199,7 +199,9 @@ pub(crate) fn write_frame(
     let frame = out
         .get_mut(..total)
         .ok_or(EncodeError::BufferTooSmall { needed: total })?;
-    let (body, crc) = frame.split_at_mut(HEADER_BYTES + payload_bytes);
+    let (body, crc) = frame
+        .split_at_mut_checked(HEADER_BYTES + payload_bytes)
+        .ok_or(EncodeError::OutOfRange)?;
     let mut w = Writer::new(body);
     w.bytes(&MAGIC)
         .and_then(|()| w.u8(LINK_VERSION))
@@ -210,7 +212,7 @@ pub(crate) fn write_frame(
         .filter(|()| w.at == HEADER_BYTES + payload_bytes)
         .ok_or(EncodeError::OutOfRange)?;
     let sum = crc::Crc::<u32>::new(&CRC32).checksum(body);
-    crc.copy_from_slice(&sum.to_le_bytes());
+    copy(crc, &sum.to_le_bytes());
     Ok(total)
 }
 
@@ -258,9 +260,7 @@ impl<const N: usize> FrameReader<N> {
         }
         let free = self.buffer.get_mut(self.len..).unwrap_or(&mut []);
         let taken = free.len().min(bytes.len());
-        if let (Some(to), Some(from)) = (free.get_mut(..taken), bytes.get(..taken)) {
-            to.copy_from_slice(from);
-        }
+        copy(free, bytes);
         self.len += taken;
         taken
     }
@@ -307,8 +307,15 @@ impl<const N: usize> FrameReader<N> {
     /// Moves the unread bytes to the front.
     fn compact(&mut self) {
         if self.consumed > 0 {
-            self.buffer.copy_within(self.consumed..self.len, 0);
-            self.len -= self.consumed;
+            let unread = self.len.saturating_sub(self.consumed);
+            for i in 0..unread {
+                if let Some(&b) = self.buffer.get(i + self.consumed)
+                    && let Some(to) = self.buffer.get_mut(i)
+                {
+                    *to = b;
+                }
+            }
+            self.len = unread;
             self.consumed = 0;
         }
     }
@@ -372,9 +379,8 @@ impl<'a> Writer<'a> {
     }
 
     pub(crate) fn bytes(&mut self, b: &[u8]) -> Option<()> {
-        self.bytes
-            .get_mut(self.at..self.at + b.len())?
-            .copy_from_slice(b);
+        let to = self.bytes.get_mut(self.at..)?.get_mut(..b.len())?;
+        copy(to, b);
         self.at += b.len();
         Some(())
     }
@@ -397,5 +403,13 @@ impl<'a> Writer<'a> {
 
     pub(crate) fn vec3(&mut self, v: [f32; 3]) -> Option<()> {
         v.iter().try_for_each(|&x| self.f32(x))
+    }
+}
+
+/// Copies `from` into the start of `to`, as many bytes as both hold (no
+/// length check that could panic).
+fn copy(to: &mut [u8], from: &[u8]) {
+    for (t, f) in to.iter_mut().zip(from) {
+        *t = *f;
     }
 }
