@@ -217,6 +217,7 @@ fn serve_command(
     threads: usize,
 ) -> anyhow::Result<()> {
     let scene = Scene::named(scene)?;
+    serve::check_servable(&scene)?;
     let every = update_every(&scene, update_hz)?;
     let listener = serve::listen(listen)?;
     stderr::line(&format!(

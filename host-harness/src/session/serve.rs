@@ -421,13 +421,7 @@ pub fn serve_scene(
     every: u32,
     threads: usize,
 ) -> anyhow::Result<(ServeCounters, Option<String>)> {
-    if !matches!(scene.model, ModelSpec::Dynamic(_)) || !scene.zones.is_empty() {
-        bail!(
-            "{}: session serve runs the dynamic model only (the pre-computed model runs whole on \
-             the controller)",
-            scene.source
-        );
-    }
+    check_servable(scene)?;
     with_dynamic_setup(scene, every, |setup| {
         with_tool_points(
             scene.tool.kernel_points(),
@@ -439,6 +433,19 @@ pub fn serve_scene(
             },
         )
     })
+}
+
+/// Refuses a scene that is not on the dynamic model (the pre-computed
+/// model runs whole on the controller; the hybrid is not served yet).
+pub fn check_servable(scene: &Scene) -> anyhow::Result<()> {
+    if !matches!(scene.model, ModelSpec::Dynamic(_)) || !scene.zones.is_empty() {
+        bail!(
+            "{}: session serve runs the dynamic model only (the pre-computed model runs whole on \
+             the controller)",
+            scene.source
+        );
+    }
+    Ok(())
 }
 
 /// Runs `body` on dynamic `scene`'s setup with a physics update every
