@@ -47,6 +47,7 @@ mod host {
     mod session_hybrid;
     mod session_run;
     mod session_scene_tools;
+    mod session_serve;
     mod session_stability;
     mod session_tools;
     mod session_trajectory_tools;
@@ -67,6 +68,8 @@ mod kernel {
     mod hybrid;
     mod hybrid_hmatrix;
     mod layers;
+    mod link;
+    mod link_controller;
     mod neo_hookean;
     mod polar;
     mod precomputed;

@@ -16,7 +16,9 @@
 # - the hybrid (RR-3510 §6.2): the interface table's load, HybridModel::new,
 #   reset, impose, update_background, contact_forces, pass_contact_forces,
 #   step with each integrator, displacements; the haptic loop over
-#   HybridTissue (new, tick_tools, physics_update, reset).
+#   HybridTissue (new, tick_tools, physics_update, reset);
+# - the link's controller (kernel/src/link/): Controller::new, receive on any
+#   bytes, tick, command_frame, reset, counters.
 # The tables are built from the firmware example's box by tools/box-table.sh
 # and (the hybrid's three) tools/hybrid-tables.sh, into target/nopanic (its
 # own folder: the firmware checks build theirs into target/firmware).
@@ -53,7 +55,8 @@ if cargo build --release 2>"$log"; then
         "reset (tensor-mass, deforming surface); InterfaceTable::load, HybridModel::new, reset," \
         "impose, update_background, contact_forces::<MAX_CONTACTS>, pass_contact_forces, step" \
         "(each integrator), displacements; HybridTissue::new, HapticLoop::new, tick_tools" \
-        "(touch, grip, cut), physics_update, removed, reset (hybrid)"
+        "(touch, grip, cut), physics_update, removed, reset (hybrid); Controller::new, receive," \
+        "tick, command_frame, reset, counters (link)"
     exit 0
 fi
 

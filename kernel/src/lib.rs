@@ -12,7 +12,9 @@
 //!   tissue adapter for the haptic loop;
 //! - [`hybrid`]: the two joined at connection nodes (RR-3510 §6.2), the
 //!   pre-computed region condensed onto them, and its tissue adapter;
-//! - [`haptic`]: the fixed-timestep loop and the safety supervisor.
+//! - [`haptic`]: the fixed-timestep loop and the safety supervisor;
+//! - [`link`]: the haptic loop on a controller, the physics on a host: the
+//!   framed wire format between them and the controller's side.
 //!
 //! Data flow: table bytes (built offline by the host harness, linked into
 //! flash or read from a file) → [`table::PrecomputedTable::load`] validates them
@@ -40,6 +42,7 @@
 pub mod contact;
 pub mod haptic;
 pub mod hybrid;
+pub mod link;
 pub mod math;
 pub mod precomputed;
 pub mod table;

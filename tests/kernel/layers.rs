@@ -1,6 +1,6 @@
 //! The kernel's folders form layers with no import cycle (`kernel/src/lib.rs`
 //! lists them): `math` < `table` < `contact` < {`precomputed`,
-//! `tensor_mass`} < `hybrid` < `haptic`. Code in a folder may name items of its own
+//! `tensor_mass`} < `hybrid` < `haptic` < `link`. Code in a folder may name items of its own
 //! folder or of a lower layer only; `precomputed` and `tensor_mass` are
 //! peers and name neither each other. The root's own constants (`pub const`
 //! in `lib.rs`) are allowed everywhere; a root re-export (`crate::Real`)
@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use palpate_tests::source::{code_only, is_ident, rust_files};
 
 /// The folders, lowest first, with their rank; equal ranks are peers.
-const LAYERS: [(&str, u32); 7] = [
+const LAYERS: [(&str, u32); 8] = [
     ("math", 0),
     ("table", 1),
     ("contact", 2),
@@ -25,6 +25,7 @@ const LAYERS: [(&str, u32); 7] = [
     ("tensor_mass", 3),
     ("hybrid", 4),
     ("haptic", 5),
+    ("link", 6),
 ];
 
 /// What a `crate::` path's first segment names.

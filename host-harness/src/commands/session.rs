@@ -1,5 +1,6 @@
 //! `palpate session`: haptic sessions, the kernel's fixed-timestep loop
-//! driven by a trajectory (`run`), and generated trajectories (`generate`).
+//! driven by a trajectory (`run`), the physics for a controller across a
+//! link (`serve`), and generated trajectories (`generate`).
 
 use std::path::{Path, PathBuf};
 
@@ -12,6 +13,7 @@ use palpate::scene::{
     Trajectory,
 };
 use palpate::session::run::{removed_path, removes_tets, run_session_to_files_threads};
+use palpate::session::serve::{self, serve_scene, update_every};
 
 use super::args::ThreadsArgs;
 use super::mesh_files;
@@ -46,6 +48,22 @@ pub enum SessionCommand {
         /// feed them to the kernel, for robustness runs.
         #[arg(long)]
         lenient: bool,
+        #[command(flatten)]
+        threads: ThreadsArgs,
+    },
+    /// Run a dynamic scene's physics for a haptic controller on a loopback socket: reads its
+    /// tool points (command frames), sends a physics update per period (update frames), and
+    /// ends when the controller disconnects.
+    Serve {
+        /// Scene file (TOML) or a built-in scene on the dynamic model (`built-in-dynamic`,
+        /// `built-in-tools`).
+        scene: String,
+        /// Address to listen on: loopback only (`127.0.0.1:PORT`, `[::1]:PORT`).
+        #[arg(long)]
+        listen: core::net::SocketAddr,
+        /// Physics updates per second (the nearest whole number of haptic ticks per update).
+        #[arg(long, default_value_t = 100.0)]
+        update_hz: f64,
         #[command(flatten)]
         threads: ThreadsArgs,
     },
@@ -164,6 +182,12 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        SessionCommand::Serve {
+            scene,
+            listen,
+            update_hz,
+            threads,
+        } => serve_command(&scene, &listen, update_hz, threads.count()),
         SessionCommand::Generate { kind, output } => {
             let trajectory = match kind {
                 TrajectoryKind::Poke => Poke::default().trajectory(),
@@ -183,6 +207,40 @@ pub fn run(command: SessionCommand) -> anyhow::Result<()> {
             Ok(())
         }
     }
+}
+
+/// `session serve`: the scene's physics for one controller on `listen`.
+fn serve_command(
+    scene: &str,
+    listen: &core::net::SocketAddr,
+    update_hz: f64,
+    threads: usize,
+) -> anyhow::Result<()> {
+    let scene = Scene::named(scene)?;
+    serve::check_servable(&scene)?;
+    let every = update_every(&scene, update_hz)?;
+    let listener = serve::listen(listen)?;
+    stderr::line(&format!(
+        "listening on {}: a physics update every {every} ticks ({:.1} Hz)",
+        listener.local_addr()?,
+        scene.rates.haptic_hz / f64::from(every)
+    ));
+    let (counters, physics_error) = serve_scene(&scene, &listener, every, threads)?;
+    stderr::line(&format!(
+        "controller gone: {} commands, {} ticks ({} filled, {} repeated), {} updates sent, {} frames dropped",
+        counters.commands,
+        counters.ticks,
+        counters.filled,
+        counters.repeated,
+        counters.updates,
+        counters.dropped
+    ));
+    if let Some(e) = physics_error {
+        stderr::line(&format!(
+            "physics update failed at {e}; no update was sent after it"
+        ));
+    }
+    Ok(())
 }
 
 /// Refuses `session run` outputs that would overwrite an input: `--out` one

@@ -12,6 +12,7 @@ pub mod hybrid;
 pub mod model;
 pub mod options;
 pub mod run;
+pub mod serve;
 pub mod setup;
 pub mod stability;
 pub mod tool_points;

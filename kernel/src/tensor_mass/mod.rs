@@ -49,7 +49,7 @@ pub use surface::{
     DeformingSurface, NonFinitePosition, SurfaceBufferError, SurfaceBuffers, SurfaceLengths,
 };
 pub use tissue::{
-    Blade, Blades, DynamicTissue, DynamicTissueError, Extrapolation, HeldContact,
+    Blade, Blades, DynamicTissue, DynamicTissueError, Extrapolation, HeldContact, LocalModel,
     MAX_REMOVAL_CAPACITY, MAX_REMOVED_PER_UPDATE, MAX_SUBSTEPS, MIN_MOVABLE_WEIGHT2, PhysicsConfig,
-    PhysicsError, SECANT_MIN_MOTION_M, Tearing,
+    PhysicsError, SECANT_MIN_MOTION_M, Tearing, correction_blend, penalty_on_hand,
 };

@@ -86,6 +86,8 @@
 use core::fmt;
 
 mod extrapolate;
+
+pub use extrapolate::{LocalModel, correction_blend, penalty_on_hand};
 mod held;
 mod removal;
 mod update;

@@ -116,6 +116,7 @@
 #![allow(unsafe_code)]
 
 mod hybrid;
+mod link;
 
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 use palpate_kernel::table::Plane;
@@ -303,6 +304,7 @@ fn main() -> ! {
         dynamic_haptic_step(&tensor, &dynamic, &mut state, &mut surface);
         hybrid::model_step(&tensor, &mut state, &mut hybrid);
         hybrid::haptic_step(&tensor, &dynamic, &mut state, &mut surface, &mut hybrid);
+        link::controller_step();
     }
 }
 

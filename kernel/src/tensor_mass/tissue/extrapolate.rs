@@ -44,6 +44,12 @@ impl<T: Real, const P: usize, D: Dispatch> DynamicTissue<'_, '_, T, P, D> {
         k
     }
 
+    /// `K_c` (N/m) of a contact at `t`'s triangle and weights (the
+    /// stiffness a contact made there before the next update starts with).
+    pub fn local_stiffness(&self, t: &Contact<T>) -> Matrix3<T> {
+        self.contact_stiffness(&t.vertices, &self.shares(t))
+    }
+
     /// The force sent for contact `t` (in the rest frame, with its vertices'
     /// `shares`) at this tick, on the hand, N (module docs). With a held
     /// triangle the motion is the tool's since the update, whatever
@@ -55,26 +61,12 @@ impl<T: Real, const P: usize, D: Dispatch> DynamicTissue<'_, '_, T, P, D> {
             let k = self.contact_stiffness(&t.vertices, shares);
             return match t.grip_offset_m {
                 Some(_) => -(k * (t.displacement_m() - t.normal * t.entry_gap_m)),
-                None => t.normal * (-t.normal.dot(&(k * t.normal)) * (t.gap_m - t.entry_gap_m)),
+                None => penalty_on_hand(&t.normal, &k, t.gap_m - t.entry_gap_m),
             };
         };
-        let motion = t.tip_m - h.contact.tip_m;
-        if t.grip_offset_m.is_some() {
-            return -h.contact.force_n - h.stiffness_tensor_n_per_m * motion;
-        }
-        // 1 − j/period at the j-th tick after the update: zero by the next
-        // one, so corrections never accumulate.
-        let ticks = T::of_f64(f64::from(self.ticks_since_update));
-        let period = T::of_f64(f64::from(self.period_ticks));
-        let remaining = T::one() - ticks / period;
-        let blend = if remaining > T::zero() {
-            remaining
-        } else {
-            T::zero()
-        };
-        let n = h.contact.normal;
-        let gap = motion.dot(&n);
-        n * (-h.contact.force_n.dot(&n) - h.scale * h.stiffness_n_per_m * gap + blend * h.offset_n)
+        let blend = correction_blend(self.ticks_since_update, self.period_ticks);
+        h.local_model()
+            .force_on_hand(&t.tip_m, t.grip_offset_m.is_some(), blend)
     }
 
     /// The extrapolation ratio after an update that changed the force on
@@ -106,6 +98,106 @@ impl<T: Real, const P: usize, D: Dispatch> DynamicTissue<'_, '_, T, P, D> {
         } else {
             ratio
         }
+    }
+}
+
+/// The local contact model of a contact held at a physics update (Cotin
+/// 1999 §4; module docs of the parent): what the force on the hand is
+/// extrapolated from until the next update. The dynamic tissue's ticks and
+/// a controller across a link ([`crate::link`]) both use it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalModel<T> {
+    /// The held triangle's unit normal at rest (the force's direction).
+    pub normal: Vector3<T>,
+    /// The tool point's position at the update, m.
+    pub tip_m: Vector3<T>,
+    /// The force the tool applies to the tissue after the update, N.
+    pub force_n: Vector3<T>,
+    /// `k = n · K_c n`, N/m.
+    pub stiffness_n_per_m: T,
+    /// `K_c = Σ_ij s_i s_j K_ij`, N/m.
+    pub stiffness_tensor_n_per_m: Matrix3<T>,
+    /// Extrapolation stiffness ratio `α`, in `[0, 1]`.
+    pub scale: T,
+    /// Normal force sent just before the update minus the update's, N.
+    pub offset_n: T,
+}
+
+impl<T: Real> LocalModel<T> {
+    /// The model of a contact with unit `normal`, the tool at `tip_m` (m)
+    /// and `force_n` on the tissue (N) at the update, contact stiffness
+    /// `tensor` (N/m), ratio `scale` and `offset_n` (N); `k = n · K_c n`.
+    pub fn new(
+        normal: Vector3<T>,
+        tip_m: Vector3<T>,
+        force_n: Vector3<T>,
+        tensor: Matrix3<T>,
+        scale: T,
+        offset_n: T,
+    ) -> Self {
+        Self {
+            normal,
+            tip_m,
+            force_n,
+            stiffness_n_per_m: normal.dot(&(tensor * normal)),
+            stiffness_tensor_n_per_m: tensor,
+            scale,
+            offset_n,
+        }
+    }
+
+    /// The force on the hand, N, with the tool at `tip_m` (m) and `blend`
+    /// of the update's correction left ([`correction_blend`]): a probe's
+    /// `F = (n · F_update − α k gap + blend · offset) n`, `gap` the tool's
+    /// motion along `n` since the update; a grip's
+    /// `F = F_update − K_c (tip − tip_update)`, the full vector (module docs
+    /// of the parent; `F_update` on the hand, the opposite of
+    /// [`Self::force_n`]).
+    pub fn force_on_hand(&self, tip_m: &Vector3<T>, grip: bool, blend: T) -> Vector3<T> {
+        let motion = tip_m - self.tip_m;
+        if grip {
+            return -self.force_n - self.stiffness_tensor_n_per_m * motion;
+        }
+        let n = self.normal;
+        let gap = motion.dot(&n);
+        n * (-self.force_n.dot(&n) - self.scale * self.stiffness_n_per_m * gap
+            + blend * self.offset_n)
+    }
+}
+
+impl<T: Real> HeldContact<T> {
+    /// Its local contact model.
+    pub fn local_model(&self) -> LocalModel<T> {
+        LocalModel {
+            normal: self.contact.normal,
+            tip_m: self.contact.tip_m,
+            force_n: self.contact.force_n,
+            stiffness_n_per_m: self.stiffness_n_per_m,
+            stiffness_tensor_n_per_m: self.stiffness_tensor_n_per_m,
+            scale: self.scale,
+            offset_n: self.offset_n,
+        }
+    }
+}
+
+/// The force on the hand, N, of a contact made since the last update:
+/// `F = −(n · K_c n) gap n` with `gap` (m, negative pressing) counted from
+/// where the contact started pushing, `K_c` (N/m) of its triangle.
+pub fn penalty_on_hand<T: Real>(normal: &Vector3<T>, tensor: &Matrix3<T>, gap_m: T) -> Vector3<T> {
+    normal * (-normal.dot(&(tensor * normal)) * gap_m)
+}
+
+/// What is left of an update's correction `ticks_since_update` ticks after
+/// it, the last period having had `period_ticks` ticks: `1 − j/k`, zero from
+/// the next update's tick on (corrections never accumulate).
+pub fn correction_blend<T: Real>(ticks_since_update: u32, period_ticks: u32) -> T {
+    let ticks = T::of_f64(f64::from(ticks_since_update));
+    let period = T::of_f64(f64::from(period_ticks));
+    let remaining = T::one() - ticks / period;
+    if remaining > T::zero() {
+        remaining
+    } else {
+        T::zero()
     }
 }
 
