@@ -4,7 +4,7 @@
 //!
 //! - Sessions: [`MAX_HAPTIC_HZ`], [`MAX_TRAJECTORY_SPAN_S`], [`MAX_TRAJECTORY_TIME_S`] and the
 //!   tick count they imply, [`MAX_SESSION_TICKS`] (checked by the scene, the trajectory readers
-//!   and `session::run::tick_count`).
+//!   and `session::run::tick_count`); `session serve`: [`MAX_FILLED_TICKS`], [`PEER_TIMEOUT`].
 //! - Files: [`MAX_MESH_FILE_BYTES`], [`MAX_TABLE_FILE_BYTES`], [`MAX_TRAJECTORY_FILE_BYTES`],
 //!   [`MAX_SCENE_FILE_BYTES`], [`MAX_SEQUENCE_FILE_BYTES`], read through [`read_bounded`] (a
 //!   table through its header first: `table::load::TableFile::read`).
@@ -137,6 +137,14 @@ pub const MAX_TRAJECTORY_TIME_S: f64 = 4_294_967_296.0;
 /// count is computed with checked arithmetic against it all the same (a lenient trajectory, a
 /// scene changed in code).
 pub const MAX_SESSION_TICKS: usize = (MAX_TRAJECTORY_SPAN_S * MAX_HAPTIC_HZ) as usize + 1;
+
+/// Most ticks `session serve` fills with a controller's last tool points when its ticks skip
+/// ahead (a command lost on the line): 1 s at 1 kHz. More is an error naming the peer.
+pub const MAX_FILLED_TICKS: u32 = 1000;
+
+/// A controller of `session serve` silent this long is gone (the connection is closed with an
+/// error naming the peer).
+pub const PEER_TIMEOUT: core::time::Duration = core::time::Duration::from_secs(10);
 
 /// Largest VTK series `session run --vtk` writes, bytes: 8 GiB (estimated before the run from
 /// the frame count and an upper bound on one ASCII frame's size).

@@ -18,11 +18,12 @@
 //! [`MAX_FILLED_TICKS`] at once (more is an error naming the peer).
 
 use core::net::SocketAddr;
-use core::time::Duration;
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
 
 use anyhow::{Context, bail};
+
+use crate::limits::{MAX_FILLED_TICKS, PEER_TIMEOUT};
 use nalgebra::{Matrix3, Vector3};
 use palpate_kernel::contact::Contact;
 use palpate_kernel::haptic::{DynamicLoop, ToolInput};
@@ -50,13 +51,6 @@ pub type LinkUpdate<const P: usize> = Update<P, LINK_VERTICES, LINK_TRIANGLES>;
 
 /// A command batch of `P` tool points at the link's default capacity.
 pub type LinkCommand<const P: usize> = Command<P, LINK_SAMPLES>;
-
-/// Most ticks filled with the last tool points when the controller's
-/// ticks skip ahead (a command lost on the line): 1 s at 1 kHz.
-pub const MAX_FILLED_TICKS: u32 = 1000;
-
-/// A controller silent this long is gone.
-pub const PEER_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// What a served session did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
