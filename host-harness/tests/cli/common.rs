@@ -48,9 +48,12 @@ pub fn reference(rel: &str) -> String {
 /// The path `name` in the calling test module's own temporary folder
 /// (`palpate-cli-<module file>-<process id>`, created if missing: the
 /// modules' tests run in one process and may use the same file names).
-/// The file itself is not created.
+/// The file itself is not created. The first call removes the folders of
+/// earlier runs whose process is gone ([`remove_stale_folders`]).
 #[track_caller]
 pub fn temp(name: &str) -> PathBuf {
+    static STALE_REMOVED: std::sync::Once = std::sync::Once::new();
+    STALE_REMOVED.call_once(remove_stale_folders);
     let module = Path::new(core::panic::Location::caller().file())
         .file_stem()
         .and_then(|stem| stem.to_str())
@@ -62,6 +65,36 @@ pub fn temp(name: &str) -> PathBuf {
     ));
     std::fs::create_dir_all(&dir).expect("temp folder");
     dir.join(name)
+}
+
+/// Removes the temporary folders (`palpate-cli-<module>-<process id>`) of
+/// earlier test runs whose process no longer runs: the test harness has no
+/// hook after the last test, so each run leaves its outputs (hundreds of
+/// MB with the chart's and the sessions') until the next run clears them.
+/// Where `/proc` does not list processes nothing is removed.
+fn remove_stale_folders() {
+    let proc_root = Path::new("/proc");
+    if !proc_root.join("self").exists() {
+        return;
+    }
+    let prefix = format!("palpate-{}-", env!("CARGO_CRATE_NAME"));
+    let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_str()
+            .filter(|n| n.starts_with(&prefix))
+            .and_then(|n| n.rsplit('-').next())
+            .filter(|pid| pid.parse::<u32>().is_ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id().to_string() && !proc_root.join(pid).exists() {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
 }
 
 /// An empty folder of its own for test `name` (under [`temp`]'s folder of
