@@ -273,11 +273,11 @@ impl<const N: usize> FrameReader<N> {
                 return None;
             }
             match FrameView::parse(pending) {
-                Ok((_, total)) => {
-                    let start = self.consumed;
+                // One parse (and one CRC) per frame: the view borrows the
+                // buffer, the count of consumed bytes is another field.
+                Ok((frame, total)) => {
                     self.consumed += total;
-                    let bytes = self.buffer.get(start..start + total)?;
-                    return FrameView::parse(bytes).ok().map(|(frame, _)| frame);
+                    return Some(frame);
                 }
                 Err(FrameError::Short { needed }) if needed <= N => return None,
                 Err(_) => {
