@@ -25,7 +25,6 @@ use anyhow::{Context, bail};
 
 use crate::limits::{MAX_FILLED_TICKS, PEER_TIMEOUT};
 use nalgebra::{Matrix3, Vector3};
-use palpate_kernel::contact::Contact;
 use palpate_kernel::haptic::{DynamicLoop, ToolInput};
 use palpate_kernel::link::controller::RX_BYTES;
 use palpate_kernel::link::frame::MAX_FRAME_BYTES;
@@ -35,7 +34,7 @@ use palpate_kernel::link::{
 };
 use palpate_kernel::math::Dispatch;
 use palpate_kernel::table::TensorMassTable;
-use palpate_kernel::table::{DEAD_TRIANGLE, TriangleIndex, VertexIndex};
+use palpate_kernel::table::{DEAD_TRIANGLE, VertexIndex};
 use palpate_kernel::tensor_mass::{DynamicTissue, HeldContact};
 
 use super::model::{SceneModel, SceneTables};
@@ -224,20 +223,7 @@ fn stiffness_at<const P: usize, D: Dispatch>(
     let tri = surface.triangles().get(t)?;
     let n = surface.positions_m().len();
     let v = |i: usize| VertexIndex::new(*tri.get(i)?, n);
-    let contact = Contact {
-        tool: 0,
-        triangle: TriangleIndex::new(t as u32, surface.triangles().len())?,
-        vertices: [v(0)?, v(1)?, v(2)?],
-        weights,
-        normal: Vector3::z(),
-        point_m: Vector3::zeros(),
-        tip_m: Vector3::zeros(),
-        gap_m: 0.0,
-        force_n: Vector3::zeros(),
-        grip_offset_m: None,
-        entry_gap_m: 0.0,
-    };
-    Some(tissue.local_stiffness(&contact))
+    Some(tissue.local_stiffness(&[v(0)?, v(1)?, v(2)?], weights))
 }
 
 fn row_major(m: &Matrix3<f32>) -> [f32; 9] {

@@ -433,8 +433,14 @@ impl<'a, 's, T: Real, const P: usize, D: Dispatch> DynamicTissue<'a, 's, T, P, D
     /// over the movable vertices, 0 for a fixed one; all 0 when
     /// `Σ_k w_k² < MIN_MOVABLE_WEIGHT2` (the solve refuses such a contact).
     fn shares(&self, t: &Contact<T>) -> [T; 3] {
-        let movable = t.vertices.map(|v| self.movable(v));
-        let w = t.weights;
+        self.shares_at(&t.vertices, t.weights)
+    }
+
+    /// [`Self::shares`] of a point with barycentric `w` on the triangle of
+    /// `vertices`.
+    #[inline(always)]
+    fn shares_at(&self, vertices: &[VertexIndex; 3], w: [T; 3]) -> [T; 3] {
+        let movable = vertices.map(|v| self.movable(v));
         let norm2 = w
             .iter()
             .zip(&movable)

@@ -44,10 +44,11 @@ impl<T: Real, const P: usize, D: Dispatch> DynamicTissue<'_, '_, T, P, D> {
         k
     }
 
-    /// `K_c` (N/m) of a contact at `t`'s triangle and weights (the
-    /// stiffness a contact made there before the next update starts with).
-    pub fn local_stiffness(&self, t: &Contact<T>) -> Matrix3<T> {
-        self.contact_stiffness(&t.vertices, &self.shares(t))
+    /// `K_c` (N/m) of a contact point with barycentric `weights` on the
+    /// triangle of `vertices` (the stiffness a contact made there before
+    /// the next update starts with).
+    pub fn local_stiffness(&self, vertices: &[VertexIndex; 3], weights: [T; 3]) -> Matrix3<T> {
+        self.contact_stiffness(vertices, &self.shares_at(vertices, weights))
     }
 
     /// The force sent for contact `t` (in the rest frame, with its vertices'
